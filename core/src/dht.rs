@@ -1,0 +1,415 @@
+//! In-place radix-2 discrete Hartley transforms.
+//!
+//! # Normalization and order
+//! The forward transform of a length-`N` sequence is
+//! `H(k) = Σ_x f(x) cas(2πkx/N)`, with `cas θ = cos θ + sin θ`, unnormalized.
+//! The DHT is its own inverse up to `1/N`: [`idht`] divides by `N`.
+//! Output is in natural order, `H(0)` (DC) first; index `k ≥ N/2` holds the
+//! signed frequency `k − N`.
+//!
+//! The 2D and 3D transforms are the *true* multidimensional DHT with kernel
+//! `cas(2π(k·x)/N)` (not the separable `cas·cas` product): row-column passes
+//! followed by the Hao–Bracewell correction.
+//!
+//! # Precision
+//! Each radix-2 stage adds at most a few units of roundoff, so the relative
+//! RMS error of a length-`N` transform grows like `ε·log₂N` (ε the unit
+//! roundoff of the arithmetic type); the tests check this bound against a
+//! naive O(N²) transform evaluated in f64.
+
+use crate::error::{mismatch, require_len, require_pow2, Error, Result};
+use crate::real::{Real, Sample};
+
+/// Quarter-wave sine table for transforms of length up to `len`.
+///
+/// Holds `sin(2πk/len)` for `k = 0 ..= len/4` in a caller-provided buffer.
+/// Any power-of-two length `n ≤ len` uses every `(len/n)`-th entry, so one
+/// table built for the largest size serves all smaller ones.
+///
+/// # Provenance and accuracy
+/// Entries are computed once by `libm::sin` in f64 (error below 1 ulp of
+/// f64), then rounded to `T`: each entry is within 0.5 ulp of `T` of the true
+/// value (plus < 1e-16 absolute). Cosines come from the same table by
+/// quarter-wave symmetry, so `sin² + cos²` is 1 to that accuracy.
+#[derive(Debug)]
+pub struct Twiddles<'a, T> {
+    len: usize,
+    quarter: &'a [T],
+}
+
+impl<'a, T: Real> Twiddles<'a, T> {
+    /// Entries a table for transforms of length up to `len` needs.
+    pub const fn buffer_len(len: usize) -> usize {
+        len / 4 + 1
+    }
+
+    /// Fill `buf` with the table for transform lengths up to `len`.
+    ///
+    /// # Errors
+    /// `len` not a power of two, or `buf` shorter than
+    /// [`Twiddles::buffer_len`]`(len)`.
+    pub fn new(buf: &'a mut [T], len: usize) -> Result<Self> {
+        require_pow2("twiddle table length", len)?;
+        let entries = Self::buffer_len(len);
+        require_len("twiddle buffer", entries, buf.len())?;
+        let step = 2.0 * core::f64::consts::PI / len as f64;
+        for (k, slot) in buf[..entries].iter_mut().enumerate() {
+            // Exact symmetric values where the quarter-wave table is tight.
+            *slot = if 4 * k == len {
+                T::ONE
+            } else {
+                T::from_f64(libm::sin(step * k as f64))
+            };
+        }
+        Ok(Self {
+            len,
+            quarter: &buf[..entries],
+        })
+    }
+
+    /// Wrap a table filled earlier by [`Twiddles::new`] (or stored, e.g. in
+    /// flash, from its output) for lengths up to `len`.
+    ///
+    /// # Errors
+    /// `len` not a power of two, or `table` shorter than
+    /// [`Twiddles::buffer_len`]`(len)`.
+    pub fn from_table(table: &'a [T], len: usize) -> Result<Self> {
+        require_pow2("twiddle table length", len)?;
+        let entries = Self::buffer_len(len);
+        require_len("twiddle table", entries, table.len())?;
+        Ok(Self {
+            len,
+            quarter: &table[..entries],
+        })
+    }
+
+    /// Largest transform length this table serves.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// `false`: a table always serves at least length 1.
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// `(cos, sin)` of `2πk/len` for `k < len/2`.
+    #[inline(always)]
+    fn cos_sin(&self, k: usize) -> (T, T) {
+        let q = self.len / 4;
+        if k <= q {
+            (self.quarter[q - k], self.quarter[k])
+        } else {
+            (-self.quarter[k - q], self.quarter[2 * q - k])
+        }
+    }
+
+    fn check(&self, n: usize) -> Result<()> {
+        require_pow2("transform length", n)?;
+        if n > self.len {
+            return Err(Error::TwiddlesTooShort {
+                table_len: self.len,
+                needed: n,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Forward DHT of `data` in place, unnormalized (see the module docs).
+///
+/// # Errors
+/// The length is not a power of two, or exceeds the twiddle table's length.
+pub fn dht<T: Real>(data: &mut [T], tw: &Twiddles<'_, T>) -> Result<()> {
+    tw.check(data.len())?;
+    dht_unchecked(data, tw);
+    Ok(())
+}
+
+/// Inverse DHT in place: the forward transform divided by `N`.
+///
+/// # Errors
+/// As [`dht`].
+pub fn idht<T: Real>(data: &mut [T], tw: &Twiddles<'_, T>) -> Result<()> {
+    dht(data, tw)?;
+    let inv = T::from_f64(1.0 / data.len() as f64);
+    for v in data.iter_mut() {
+        *v *= inv;
+    }
+    Ok(())
+}
+
+fn bit_reverse<T>(data: &mut [T]) {
+    let n = data.len();
+    let mut j = 0usize;
+    for i in 1..n {
+        let mut bit = n >> 1;
+        while j & bit != 0 {
+            j ^= bit;
+            bit >>= 1;
+        }
+        j |= bit;
+        if i < j {
+            data.swap(i, j);
+        }
+    }
+}
+
+/// Radix-2 decimation in time. A block of length `2m` combines the DHTs `X`
+/// (even samples) and `Y` (odd samples) of length `m`:
+/// `H(k) = X(k) + cos(πk/m)·Y(k) + sin(πk/m)·Y(m−k)` and
+/// `H(k+m) = X(k) − (same)`, with `Y(m) ≡ Y(0)`.
+pub(crate) fn dht_unchecked<T: Real>(data: &mut [T], tw: &Twiddles<'_, T>) {
+    let n = data.len();
+    if n <= 1 {
+        return;
+    }
+    bit_reverse(data);
+    let mut m = 1;
+    while m < n {
+        let stride = tw.len / (2 * m);
+        for block in data.chunks_exact_mut(2 * m) {
+            let (x, y) = block.split_at_mut(m);
+            butterfly_pair(&mut x[0], &mut y[0]);
+            if m >= 2 {
+                let h = m / 2;
+                butterfly_pair(&mut x[h], &mut y[h]);
+                for k in 1..h {
+                    let (c, s) = tw.cos_sin(k * stride);
+                    let (yk, ymk) = (y[k], y[m - k]);
+                    let t1 = c * yk + s * ymk;
+                    let t2 = s * yk - c * ymk;
+                    let (xk, xmk) = (x[k], x[m - k]);
+                    x[k] = xk + t1;
+                    y[k] = xk - t1;
+                    x[m - k] = xmk + t2;
+                    y[m - k] = xmk - t2;
+                }
+            }
+        }
+        m *= 2;
+    }
+}
+
+#[inline(always)]
+fn butterfly_pair<T: Real>(a: &mut T, b: &mut T) {
+    let (x, y) = (*a, *b);
+    *a = x + y;
+    *b = x - y;
+}
+
+/// Index of `−k` modulo `n` (a power of two).
+#[inline(always)]
+pub(crate) fn neg_mod(k: usize, n: usize) -> usize {
+    (n - k) & (n - 1)
+}
+
+/// True 2D DHT in place of an `nx × ny` array stored with `x` fastest,
+/// unnormalized: `H(u,v) = Σ f(x,y) cas(2π(ux/nx + vy/ny))`.
+///
+/// Row and column passes give the separable `T = cas⊗cas` transform; the
+/// Hao–Bracewell correction `H(u,v) = ½[T(u,v) + T(−u,v) + T(u,−v) − T(−u,−v)]`
+/// then runs in place over each group of four symmetric points.
+/// `column` is scratch of at least `ny` elements.
+///
+/// # Errors
+/// A side not a power of two or longer than the table, a `data` length other
+/// than `nx·ny`, or short scratch.
+pub fn dht_2d<T: Real>(
+    data: &mut [T],
+    nx: usize,
+    ny: usize,
+    column: &mut [T],
+    tw: &Twiddles<'_, T>,
+) -> Result<()> {
+    tw.check(nx)?;
+    tw.check(ny)?;
+    check_len("2D array", nx * ny, data.len())?;
+    require_len("column scratch", ny, column.len())?;
+    for row in data.chunks_exact_mut(nx) {
+        dht_unchecked(row, tw);
+    }
+    let col = &mut column[..ny];
+    for x in 0..nx {
+        for (y, c) in col.iter_mut().enumerate() {
+            *c = data[x + nx * y];
+        }
+        dht_unchecked(col, tw);
+        for (y, c) in col.iter().enumerate() {
+            data[x + nx * y] = *c;
+        }
+    }
+    for v in 0..=ny / 2 {
+        let vm = neg_mod(v, ny);
+        for u in 0..=nx / 2 {
+            let um = neg_mod(u, nx);
+            let idx = [u + nx * v, um + nx * v, u + nx * vm, um + nx * vm];
+            let [a, b, c, d] = idx.map(|i| data[i]);
+            data[idx[0]] = T::HALF * (a + b + c - d);
+            data[idx[1]] = T::HALF * (b + a + d - c);
+            data[idx[2]] = T::HALF * (c + d + a - b);
+            data[idx[3]] = T::HALF * (d + c + b - a);
+        }
+    }
+    Ok(())
+}
+
+/// Inverse of [`dht_2d`]: the same transform divided by `nx·ny`.
+///
+/// # Errors
+/// As [`dht_2d`].
+pub fn idht_2d<T: Real>(
+    data: &mut [T],
+    nx: usize,
+    ny: usize,
+    column: &mut [T],
+    tw: &Twiddles<'_, T>,
+) -> Result<()> {
+    dht_2d(data, nx, ny, column, tw)?;
+    let inv = T::from_f64(1.0 / (nx * ny) as f64);
+    for v in data.iter_mut() {
+        *v *= inv;
+    }
+    Ok(())
+}
+
+fn check_len(what: &'static str, expected: usize, got: usize) -> Result<()> {
+    if expected == got {
+        Ok(())
+    } else {
+        Err(mismatch(what, expected, got))
+    }
+}
+
+/// Scratch elements [`dht_3d`] needs for dims `[nx, ny, nz]`.
+pub const fn dht_3d_scratch_len(dims: [usize; 3]) -> usize {
+    let a = if dims[0] > dims[1] { dims[0] } else { dims[1] };
+    let b = 4 * dims[2];
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
+
+/// True 3D DHT in place over stored samples, unnormalized:
+/// `H(u,v,w) = Σ f(x,y,z) cas(2π(ux/nx + vy/ny + wz/nz))`, `x` fastest.
+///
+/// Lines are loaded into `scratch` in the arithmetic type `T`, transformed
+/// and rounded back to `S`, to nearest even. There are three roundings:
+/// after the x pass, after the y pass, and after the z pass fused with the
+/// Hao–Bracewell correction
+/// `H(u,v,w) = ½[T(−u,v,w) + T(u,−v,w) + T(u,v,−w) − T(−u,−v,−w)]`, which
+/// loads the four z-lines `(±u, ±v)` together so that the correction works
+/// on unrounded values. `scratch` needs [`dht_3d_scratch_len`] elements,
+/// `4·nz` for a cube: O(n), however large the volume.
+///
+/// # Errors
+/// A side not a power of two or longer than the table, a `data` length other
+/// than `nx·ny·nz`, short scratch, or a value that overflows `S`
+/// ([`Error::Overflow`]; the data is then partly transformed).
+pub fn dht_3d<S: Sample, T: Real>(
+    data: &mut [S],
+    dims: [usize; 3],
+    scratch: &mut [T],
+    tw: &Twiddles<'_, T>,
+) -> Result<()> {
+    let [nx, ny, nz] = dims;
+    for n in dims {
+        tw.check(n)?;
+    }
+    check_len("3D array", nx * ny * nz, data.len())?;
+    require_len(
+        "3D transform scratch",
+        dht_3d_scratch_len(dims),
+        scratch.len(),
+    )?;
+
+    let mut finite = true;
+    // x pass: contiguous lines.
+    let line = &mut scratch[..nx];
+    for chunk in data.chunks_exact_mut(nx) {
+        for (l, s) in line.iter_mut().zip(chunk.iter()) {
+            *l = T::load(*s);
+        }
+        dht_unchecked(line, tw);
+        for (s, l) in chunk.iter_mut().zip(line.iter()) {
+            *s = l.store();
+            finite &= s.is_finite();
+        }
+    }
+    overflow_check(finite, "x pass of the 3D transform")?;
+
+    // y pass: lines of stride nx.
+    let line = &mut scratch[..ny];
+    for z in 0..nz {
+        for x in 0..nx {
+            let base = x + nx * ny * z;
+            for (y, l) in line.iter_mut().enumerate() {
+                *l = T::load(data[base + nx * y]);
+            }
+            dht_unchecked(line, tw);
+            for (y, l) in line.iter().enumerate() {
+                let s: S = l.store();
+                finite &= s.is_finite();
+                data[base + nx * y] = s;
+            }
+        }
+    }
+    overflow_check(finite, "y pass of the 3D transform")?;
+
+    // z pass fused with the correction, over groups of four z-lines.
+    let plane = nx * ny;
+    let lines = &mut scratch[..4 * nz];
+    for v in 0..=ny / 2 {
+        let vm = neg_mod(v, ny);
+        for u in 0..=nx / 2 {
+            let um = neg_mod(u, nx);
+            // Slot s = a + 2b holds the line at (a ? −u : u, b ? −v : v).
+            let bases = [u + nx * v, um + nx * v, u + nx * vm, um + nx * vm];
+            for (slot, base) in bases.iter().enumerate() {
+                let l = &mut lines[slot * nz..(slot + 1) * nz];
+                for (z, e) in l.iter_mut().enumerate() {
+                    *e = T::load(data[base + plane * z]);
+                }
+                dht_unchecked(l, tw);
+            }
+            for w in 0..=nz / 2 {
+                let wm = neg_mod(w, nz);
+                // t[a + 2b + 4c]: sign bits a, b, c for u, v, w.
+                let mut t = [T::ZERO; 8];
+                for (i, e) in t.iter_mut().enumerate() {
+                    let z = if i & 4 == 0 { w } else { wm };
+                    *e = lines[(i & 3) * nz + z];
+                }
+                for (i, _) in t.iter().enumerate() {
+                    let h = T::HALF * (t[i ^ 1] + t[i ^ 2] + t[i ^ 4] - t[i ^ 7]);
+                    let z = if i & 4 == 0 { w } else { wm };
+                    lines[(i & 3) * nz + z] = h;
+                }
+            }
+            for (slot, base) in bases.iter().enumerate() {
+                let l = &lines[slot * nz..(slot + 1) * nz];
+                for (z, e) in l.iter().enumerate() {
+                    let s: S = e.store();
+                    finite &= s.is_finite();
+                    data[base + plane * z] = s;
+                }
+            }
+        }
+    }
+    overflow_check(finite, "z pass of the 3D transform")
+}
+
+fn overflow_check(finite: bool, stage: &'static str) -> Result<()> {
+    if finite {
+        Ok(())
+    } else {
+        Err(overflow(stage))
+    }
+}
+
+#[cold]
+fn overflow(stage: &'static str) -> Error {
+    Error::Overflow { stage }
+}

@@ -1,0 +1,216 @@
+//! The core's error type. Every fallible entry point returns [`Result`]; the
+//! core never panics on data.
+
+use core::fmt;
+
+/// What went wrong. The `Display` text names the offending quantity.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Error {
+    /// A transform or grid length that must be a power of two is not.
+    NotPowerOfTwo {
+        /// Which length.
+        what: &'static str,
+        /// The length given.
+        len: usize,
+    },
+    /// A caller-provided buffer is shorter than required.
+    BufferTooSmall {
+        /// Which buffer.
+        what: &'static str,
+        /// Elements required.
+        needed: usize,
+        /// Elements provided.
+        got: usize,
+    },
+    /// A buffer whose length must match a shape exactly does not.
+    LengthMismatch {
+        /// Which buffer.
+        what: &'static str,
+        /// Elements expected.
+        expected: usize,
+        /// Elements provided.
+        got: usize,
+    },
+    /// The twiddle table was built for a size the transform cannot use.
+    TwiddlesTooShort {
+        /// Size the table was built for.
+        table_len: usize,
+        /// Size the transform needs.
+        needed: usize,
+    },
+    /// The view direction is zero, or the up hint is zero.
+    ZeroViewVector {
+        /// View direction as given.
+        dir: [f64; 3],
+        /// Up hint as given.
+        up: [f64; 3],
+    },
+    /// The up hint is parallel to the view direction.
+    ParallelViewVectors {
+        /// View direction as given.
+        dir: [f64; 3],
+        /// Up hint as given.
+        up: [f64; 3],
+    },
+    /// A view vector has a NaN or infinite component.
+    NonFiniteViewVector {
+        /// View direction as given.
+        dir: [f64; 3],
+        /// Up hint as given.
+        up: [f64; 3],
+    },
+    /// The requested image is larger than the spectrum's grid.
+    ImageTooLarge {
+        /// Requested width.
+        width: usize,
+        /// Requested height.
+        height: usize,
+        /// The largest allowed side (the padded grid size).
+        grid: usize,
+    },
+    /// An image side of zero.
+    EmptyImage,
+    /// The volume does not fit into the padded grid.
+    VolumeTooLarge {
+        /// Volume dimensions.
+        dims: [usize; 3],
+        /// Padded grid side.
+        grid: usize,
+    },
+    /// A volume with a zero dimension.
+    EmptyVolume,
+    /// A voxel is NaN or infinite.
+    NonFiniteVoxel {
+        /// Voxel index `(i, j, k)`.
+        index: [usize; 3],
+        /// Its value.
+        value: f64,
+    },
+    /// A value left the storage format's finite range during a transform.
+    Overflow {
+        /// Which pass overflowed.
+        stage: &'static str,
+    },
+    /// An oversampling factor other than 1 or 2.
+    UnsupportedOversampling {
+        /// The factor given.
+        factor: u32,
+    },
+    /// The spectrum was prepared for another filter than the one asked for.
+    FilterMismatch,
+}
+
+/// Shorthand for results of this crate.
+pub type Result<T> = core::result::Result<T, Error>;
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Error::NotPowerOfTwo { what, len } => {
+                write!(f, "{what} must be a power of two, got {len}")
+            }
+            Error::BufferTooSmall { what, needed, got } => {
+                write!(f, "{what} holds {got} elements, needs at least {needed}")
+            }
+            Error::LengthMismatch { what, expected, got } => {
+                write!(f, "{what} holds {got} elements, expected exactly {expected}")
+            }
+            Error::TwiddlesTooShort { table_len, needed } => write!(
+                f,
+                "twiddle table built for length {table_len} cannot serve a transform of length {needed}"
+            ),
+            Error::ZeroViewVector { dir, up } => write!(
+                f,
+                "zero view vector: direction {} and up {} must both be non-zero",
+                V3(dir),
+                V3(up)
+            ),
+            Error::ParallelViewVectors { dir, up } => write!(
+                f,
+                "view direction {} is parallel to up {}: choose another --up",
+                V3(dir),
+                V3(up)
+            ),
+            Error::NonFiniteViewVector { dir, up } => write!(
+                f,
+                "view vectors must be finite: direction {}, up {}",
+                V3(dir),
+                V3(up)
+            ),
+            Error::ImageTooLarge { width, height, grid } => write!(
+                f,
+                "image size {width}x{height} exceeds the padded grid size {grid}"
+            ),
+            Error::EmptyImage => write!(f, "image width and height must be at least 1"),
+            Error::VolumeTooLarge { dims, grid } => write!(
+                f,
+                "volume {}x{}x{} does not fit a padded grid of side {grid}",
+                dims[0], dims[1], dims[2]
+            ),
+            Error::EmptyVolume => write!(f, "volume has a zero dimension"),
+            Error::NonFiniteVoxel { index, value } => write!(
+                f,
+                "voxel ({}, {}, {}) is {value}: NaN and infinite voxels cannot be rendered",
+                index[0], index[1], index[2]
+            ),
+            Error::Overflow { stage } => write!(
+                f,
+                "value overflowed the storage format during the {stage}"
+            ),
+            Error::UnsupportedOversampling { factor } => {
+                write!(f, "oversampling factor must be 1 or 2, got {factor}")
+            }
+            Error::FilterMismatch => write!(
+                f,
+                "the spectrum was premultiplied for a different filter or oversampling"
+            ),
+        }
+    }
+}
+
+struct V3([f64; 3]);
+
+impl fmt::Display for V3 {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "({}, {}, {})", self.0[0], self.0[1], self.0[2])
+    }
+}
+
+#[cold]
+pub(crate) fn not_power_of_two(what: &'static str, len: usize) -> Error {
+    Error::NotPowerOfTwo { what, len }
+}
+
+#[cold]
+pub(crate) fn too_small(what: &'static str, needed: usize, got: usize) -> Error {
+    Error::BufferTooSmall { what, needed, got }
+}
+
+#[cold]
+pub(crate) fn mismatch(what: &'static str, expected: usize, got: usize) -> Error {
+    Error::LengthMismatch {
+        what,
+        expected,
+        got,
+    }
+}
+
+/// `Ok` if `len` is a power of two (1 counts), else the named error.
+#[inline]
+pub(crate) fn require_pow2(what: &'static str, len: usize) -> Result<()> {
+    if len.is_power_of_two() {
+        Ok(())
+    } else {
+        Err(not_power_of_two(what, len))
+    }
+}
+
+/// `Ok` if `got >= needed`, else the named error.
+#[inline]
+pub(crate) fn require_len(what: &'static str, needed: usize, got: usize) -> Result<()> {
+    if got >= needed {
+        Ok(())
+    } else {
+        Err(too_small(what, needed, got))
+    }
+}

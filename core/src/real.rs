@@ -1,0 +1,222 @@
+//! Arithmetic and storage number types.
+//!
+//! [`Real`] is the arithmetic type of a pipeline (f32 on targets, f64 for
+//! the host reference). [`Sample`] is the storage type of a spectrum
+//! (IEEE binary16 by default). Conversions between them round to nearest,
+//! ties to even.
+
+use core::fmt::Debug;
+use core::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
+use half::f16;
+
+/// Arithmetic type of a pipeline: `f32` or `f64`.
+pub trait Real:
+    Copy
+    + Default
+    + Debug
+    + PartialOrd
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + AddAssign
+    + SubAssign
+    + MulAssign
+{
+    /// 0.
+    const ZERO: Self;
+    /// 1.
+    const ONE: Self;
+    /// 0.5.
+    const HALF: Self;
+    /// Unit roundoff, 2^-24 for f32 and 2^-53 for f64.
+    const EPSILON_HALF: f64;
+    /// Nearest value to `v`.
+    fn from_f64(v: f64) -> Self;
+    /// Widen to f64 (exact).
+    fn to_f64(self) -> f64;
+    /// Load a stored sample (exact for formats no wider than `Self`).
+    fn load<S: Sample>(s: S) -> Self;
+    /// Round to a storage sample, to nearest even.
+    fn store<S: Sample>(self) -> S;
+    /// `true` unless NaN or infinite.
+    fn is_finite(self) -> bool;
+    /// Nearest value to `n`.
+    fn from_usize(n: usize) -> Self;
+    /// Largest integer not above `self`, saturating at the i64 range.
+    fn floor_i64(self) -> i64;
+    /// Integer part of a non-negative value, saturating.
+    fn trunc_usize(self) -> usize;
+}
+
+impl Real for f32 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+    const HALF: Self = 0.5;
+    const EPSILON_HALF: f64 = 5.960_464_477_539_063e-8;
+    #[inline(always)]
+    fn from_f64(v: f64) -> Self {
+        v as f32
+    }
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self as f64
+    }
+    #[inline(always)]
+    fn load<S: Sample>(s: S) -> Self {
+        s.to_f32()
+    }
+    #[inline(always)]
+    fn store<S: Sample>(self) -> S {
+        S::from_f32(self)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        f32::is_finite(self)
+    }
+    #[inline(always)]
+    fn from_usize(n: usize) -> Self {
+        n as f32
+    }
+    #[inline(always)]
+    fn floor_i64(self) -> i64 {
+        libm::floorf(self) as i64
+    }
+    #[inline(always)]
+    fn trunc_usize(self) -> usize {
+        self as usize
+    }
+}
+
+impl Real for f64 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+    const HALF: Self = 0.5;
+    const EPSILON_HALF: f64 = 1.110_223_024_625_156_5e-16;
+    #[inline(always)]
+    fn from_f64(v: f64) -> Self {
+        v
+    }
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self
+    }
+    #[inline(always)]
+    fn load<S: Sample>(s: S) -> Self {
+        s.to_f64()
+    }
+    #[inline(always)]
+    fn store<S: Sample>(self) -> S {
+        S::from_f64(self)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        f64::is_finite(self)
+    }
+    #[inline(always)]
+    fn from_usize(n: usize) -> Self {
+        n as f64
+    }
+    #[inline(always)]
+    fn floor_i64(self) -> i64 {
+        libm::floor(self) as i64
+    }
+    #[inline(always)]
+    fn trunc_usize(self) -> usize {
+        self as usize
+    }
+}
+
+/// Storage format of one spectrum coefficient.
+pub trait Sample: Copy + Default + Debug + PartialEq {
+    /// Short name, e.g. `"f16"`.
+    const NAME: &'static str;
+    /// Largest finite value.
+    const MAX_FINITE: f64;
+    /// Round an f32 to this format, to nearest even.
+    fn from_f32(v: f32) -> Self;
+    /// Round an f64 to this format, to nearest even (one rounding).
+    fn from_f64(v: f64) -> Self;
+    /// Widen to f32 (may round for formats wider than f32).
+    fn to_f32(self) -> f32;
+    /// Widen to f64 (exact).
+    fn to_f64(self) -> f64;
+    /// `true` unless NaN or infinite.
+    fn is_finite(self) -> bool;
+}
+
+impl Sample for f16 {
+    const NAME: &'static str = "f16";
+    const MAX_FINITE: f64 = 65504.0;
+    #[inline(always)]
+    fn from_f32(v: f32) -> Self {
+        f16::from_f32(v)
+    }
+    #[inline(always)]
+    fn from_f64(v: f64) -> Self {
+        f16::from_f64(v)
+    }
+    #[inline(always)]
+    fn to_f32(self) -> f32 {
+        f16::to_f32(self)
+    }
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        f16::to_f64(self)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        f16::is_finite(self)
+    }
+}
+
+impl Sample for f32 {
+    const NAME: &'static str = "f32";
+    const MAX_FINITE: f64 = f32::MAX as f64;
+    #[inline(always)]
+    fn from_f32(v: f32) -> Self {
+        v
+    }
+    #[inline(always)]
+    fn from_f64(v: f64) -> Self {
+        v as f32
+    }
+    #[inline(always)]
+    fn to_f32(self) -> f32 {
+        self
+    }
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self as f64
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        f32::is_finite(self)
+    }
+}
+
+impl Sample for f64 {
+    const NAME: &'static str = "f64";
+    const MAX_FINITE: f64 = f64::MAX;
+    #[inline(always)]
+    fn from_f32(v: f32) -> Self {
+        v as f64
+    }
+    #[inline(always)]
+    fn from_f64(v: f64) -> Self {
+        v
+    }
+    #[inline(always)]
+    fn to_f32(self) -> f32 {
+        self as f32
+    }
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        f64::is_finite(self)
+    }
+}

@@ -1,0 +1,270 @@
+//! Per-view rendering: slice extraction and the 2D inverse transform.
+//!
+//! By the projection-slice theorem (paper §1, fig. 1), the 2D Hartley
+//! transform of the projection along `d` equals the 3D spectrum on the plane
+//! through the origin spanned by `r` and `u`. The slice sample at 2D
+//! frequency index `(kx, ky)` is the spectrum interpolated at the 3D index
+//! `kx·r + ky·u` (paper §2: `F * H`, with the volume premultiplied by
+//! `1/h`). Slice points outside the spectrum's Nyquist cube `|q_a| ≤ n/2` are
+//! zero: the band-limited interpolant has no energy there.
+//!
+//! The image grid is `n × n` with a pitch of one voxel. A `W × H` image is
+//! cut from it around the centre; sub-pixel offsets (odd volume sides, odd
+//! image sides) are applied exactly as a phase ramp on the slice:
+//! in Hartley form, shifting by `t` maps `H(k)` to
+//! `cos φ·H(k) + sin φ·H(−k)` with `φ = −2π k·t/n`.
+
+use crate::dht::{dht_2d, neg_mod, Twiddles};
+use crate::error::{require_len, Error, Result};
+use crate::filter::{KernelTable, MAX_WIDTH};
+use crate::geometry::{dot, Frame, View};
+use crate::real::{Real, Sample};
+use crate::spectrum::Spectrum;
+
+/// Where a `W × H` image sits on the `m × m` projection grid.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placement {
+    /// Grid column (signed, modulo `m`) of image column 0.
+    pub col0: i64,
+    /// Grid row coordinate (signed, up positive) of image row 0.
+    pub row0: i64,
+    /// Sub-pixel shift `(ta, tb)` in `[0, 1)`, along `r` and `u`.
+    pub shift: [f64; 2],
+}
+
+/// The placement of a `width × height` image of a volume of `dims` seen in
+/// `frame`: image pixel `(col, row)` is the projection at grid offset
+/// `(col0 + col + ta, row0 − row + tb)` from the transform origin.
+///
+/// The transform origin is voxel `⌊n_a/2⌋`, the centre is `n_a/2`; their
+/// difference `δ` (0 or ½ per axis) projects to `(δ·r, δ·u)` on the image.
+pub fn placement(dims: [usize; 3], frame: &Frame, width: usize, height: usize) -> Placement {
+    let delta = dims.map(|d| (d % 2) as f64 * 0.5);
+    let a0 = -(width as f64) / 2.0 + dot(delta, frame.right);
+    let b0 = height as f64 / 2.0 + dot(delta, frame.up);
+    let (col0, row0) = (libm::floor(a0), libm::floor(b0));
+    Placement {
+        col0: col0 as i64,
+        row0: row0 as i64,
+        shift: [a0 - col0, b0 - row0],
+    }
+}
+
+/// Scratch elements [`render`] needs: the `m × m` slice grid.
+pub const fn grid_len(m: usize) -> usize {
+    m * m
+}
+
+/// Auxiliary scratch elements [`render`] needs: `4m`.
+pub const fn aux_len(m: usize) -> usize {
+    4 * m
+}
+
+/// Render the X-ray projection of `spec` seen along `view` into `out`, a
+/// `width × height` image, row 0 at the top, in voxel units of the input
+/// volume (`∫ f dt`).
+///
+/// `grid` needs [`grid_len`]`(n)` and `aux` [`aux_len`]`(n)` elements, `out`
+/// `width·height`, and `tw` must serve length `n` (the spectrum's side).
+///
+/// # Errors
+/// Bad view vectors, an image side of 0 or above `n`, short buffers, or a
+/// kernel for another filter than the spectrum was premultiplied for.
+pub fn render<S: Sample, T: Real>(
+    spec: &Spectrum<'_, S>,
+    kernel: &KernelTable<T>,
+    view: &View,
+    width: usize,
+    height: usize,
+    tw: &Twiddles<'_, T>,
+    grid: &mut [T],
+    aux: &mut [T],
+    out: &mut [T],
+) -> Result<()> {
+    let frame = view.frame()?;
+    let n = spec.n();
+    check_image(width, height, n)?;
+    if kernel.filter() != spec.filter() {
+        return Err(Error::FilterMismatch);
+    }
+    require_len("slice grid", grid_len(n), grid.len())?;
+    require_len("auxiliary scratch", aux_len(n), aux.len())?;
+    require_len("output image", width * height, out.len())?;
+    if n > tw.len() {
+        return Err(Error::TwiddlesTooShort {
+            table_len: tw.len(),
+            needed: n,
+        });
+    }
+    extract_slice(spec, kernel, &frame, &mut grid[..n * n]);
+    let place = placement(spec.dims(), &frame, width, height);
+    finish_projection(
+        &mut grid[..n * n],
+        n,
+        &place,
+        1.0 / spec.scale(),
+        width,
+        height,
+        tw,
+        aux,
+        out,
+    )
+}
+
+/// `Ok` if `1 ≤ width, height ≤ n`.
+///
+/// # Errors
+/// [`Error::EmptyImage`] or [`Error::ImageTooLarge`].
+pub fn check_image(width: usize, height: usize, n: usize) -> Result<()> {
+    if width == 0 || height == 0 {
+        return Err(Error::EmptyImage);
+    }
+    if width > n || height > n {
+        return Err(Error::ImageTooLarge {
+            width,
+            height,
+            grid: n,
+        });
+    }
+    Ok(())
+}
+
+/// Signed frequency of index `k` on an axis of length `m`.
+#[inline(always)]
+pub fn signed_index(k: usize, m: usize) -> i64 {
+    if 2 * k < m {
+        k as i64
+    } else {
+        k as i64 - m as i64
+    }
+}
+
+/// Fill the `n × n` slice `grid` (`kx` fastest, natural DHT order) by
+/// interpolating the spectrum with `kernel` on the plane spanned by the
+/// frame's right and up vectors.
+pub fn extract_slice<S: Sample, T: Real>(
+    spec: &Spectrum<'_, S>,
+    kernel: &KernelTable<T>,
+    frame: &Frame,
+    grid: &mut [T],
+) {
+    let n = spec.n();
+    let data = spec.data();
+    let r = frame.right.map(T::from_f64);
+    let u = frame.up.map(T::from_f64);
+    let nyquist = T::from_usize(n) * T::HALF;
+    let w = kernel.filter().width();
+    let mask = n - 1;
+    for (iy, row) in grid.chunks_exact_mut(n).enumerate() {
+        let ky = T::from_f64(signed_index(iy, n) as f64);
+        for (ix, g) in row.iter_mut().enumerate() {
+            let kx = T::from_f64(signed_index(ix, n) as f64);
+            let q: [T; 3] = core::array::from_fn(|a| kx * r[a] + ky * u[a]);
+            if q.iter().any(|&c| c > nyquist || -c > nyquist) {
+                *g = T::ZERO;
+                continue;
+            }
+            let mut wts = [[T::ZERO; MAX_WIDTH]; 3];
+            let mut first = [0i64; 3];
+            for a in 0..3 {
+                first[a] = kernel.taps(q[a], &mut wts[a]);
+            }
+            let mut xs = [0usize; MAX_WIDTH];
+            for (t, x) in xs[..w].iter_mut().enumerate() {
+                *x = (first[0] + t as i64) as usize & mask;
+            }
+            let mut acc = T::ZERO;
+            for (c, wz) in wts[2][..w].iter().enumerate() {
+                let z = ((first[2] + c as i64) as usize & mask) * n * n;
+                let mut acc_y = T::ZERO;
+                for (b, wy) in wts[1][..w].iter().enumerate() {
+                    let line = z + ((first[1] + b as i64) as usize & mask) * n;
+                    let mut acc_x = T::ZERO;
+                    for (x, wx) in xs[..w].iter().zip(&wts[0][..w]) {
+                        acc_x += *wx * T::load(data[line + x]);
+                    }
+                    acc_y += *wy * acc_x;
+                }
+                acc += *wz * acc_y;
+            }
+            *g = acc;
+        }
+    }
+}
+
+/// Turn a filled `m × m` slice into the image: sub-pixel shift, 2D inverse
+/// DHT, then cut the `width × height` image at `place`, multiplied by `gain`
+/// (the reciprocal of the spectrum's scale).
+///
+/// `aux` needs [`aux_len`]`(m)` elements.
+///
+/// # Errors
+/// As [`render`].
+pub fn finish_projection<T: Real>(
+    grid: &mut [T],
+    m: usize,
+    place: &Placement,
+    gain: f64,
+    width: usize,
+    height: usize,
+    tw: &Twiddles<'_, T>,
+    aux: &mut [T],
+    out: &mut [T],
+) -> Result<()> {
+    check_image(width, height, m)?;
+    require_len("auxiliary scratch", aux_len(m), aux.len())?;
+    require_len("output image", width * height, out.len())?;
+    apply_shift(grid, m, place.shift, aux);
+    dht_2d(grid, m, m, &mut aux[..m], tw)?;
+    let g = T::from_f64(gain / (m * m) as f64);
+    let mask = (m - 1) as i64;
+    for (row, line) in out.chunks_exact_mut(width).take(height).enumerate() {
+        let gy = ((place.row0 - row as i64) & mask) as usize;
+        for (col, o) in line.iter_mut().enumerate() {
+            let gx = ((place.col0 + col as i64) & mask) as usize;
+            *o = grid[gy * m + gx] * g;
+        }
+    }
+    Ok(())
+}
+
+/// Shift the projection by `t = (ta, tb)` pixels (`R(x) = Q(x + t)`) on its
+/// Hartley slice: `H'(k) = cos φ·H(k) + sin φ·H(−k)`, `φ = −2π k·t/m`.
+/// Nyquist components get no phase (a real signal cannot hold a shifted
+/// Nyquist cosine), which keeps `φ(−k) = −φ(k)` for every pair.
+fn apply_shift<T: Real>(grid: &mut [T], m: usize, t: [f64; 2], aux: &mut [T]) {
+    if t == [0.0, 0.0] {
+        return;
+    }
+    let (cx, rest) = aux.split_at_mut(m);
+    let (sx, rest) = rest.split_at_mut(m);
+    let (cy, sy) = rest.split_at_mut(m);
+    let tau = -2.0 * core::f64::consts::PI / m as f64;
+    for k in 0..m {
+        let nyq = 2 * k == m;
+        let ks = signed_index(k, m) as f64;
+        let (phx, phy) = if nyq {
+            (0.0, 0.0)
+        } else {
+            (tau * ks * t[0], tau * ks * t[1])
+        };
+        cx[k] = T::from_f64(libm::cos(phx));
+        sx[k] = T::from_f64(libm::sin(phx));
+        cy[k] = T::from_f64(libm::cos(phy));
+        sy[k] = T::from_f64(libm::sin(phy));
+    }
+    for iy in 0..m {
+        let my = neg_mod(iy, m);
+        for ix in 0..m {
+            let (a, b) = (iy * m + ix, my * m + neg_mod(ix, m));
+            if a >= b {
+                continue;
+            }
+            let c = cx[ix] * cy[iy] - sx[ix] * sy[iy];
+            let s = sx[ix] * cy[iy] + cx[ix] * sy[iy];
+            let (h, hm) = (grid[a], grid[b]);
+            grid[a] = c * h + s * hm;
+            grid[b] = c * hm - s * h;
+        }
+    }
+}

@@ -1,0 +1,282 @@
+//! The stored 3D Hartley spectrum and its one-time preparation.
+//!
+//! # Layout
+//! A cube of side `n` (a power of two), `x` fastest. Index `k` on an axis
+//! holds the signed frequency `k` for `k < n/2` and `k − n` above (DC at
+//! index 0). The spatial origin of the transform is the volume's centre: the
+//! volume is stored circularly shifted so that voxel `⌊n_a/2⌋` lands at index
+//! 0 on each axis. The fractional rest of the centre `c = n_a/2` (½ on odd
+//! axes) is applied per view as an exact sub-pixel shift.
+//!
+//! # Scaling rule
+//! Stored values are `s·H` with `s = 2^e` chosen so that `s·Σ|g|` lies in
+//! `(2^13, 2^14]`, where `g` is the premultiplied volume. During the
+//! transform every stored value is bounded by `2·Σ|g|` (x pass: `√2` times a
+//! line sum; y pass: 2 times a plane sum; final: `√2·Σ|g|`, since
+//! `|cas| ≤ √2`), so nothing exceeds `2^15 < 65504`, the f16 maximum, and the
+//! largest coefficients sit within a factor 4 of it, keeping small ones as
+//! far from underflow as the format allows. `s` is a power of two, so scaling
+//! is exact. Renderers divide by `s` at the end.
+
+use crate::dht::{dht_3d, dht_3d_scratch_len, Twiddles};
+use crate::error::{mismatch, require_len, require_pow2, Error, Result};
+use crate::filter::Filter;
+use crate::real::{Real, Sample};
+
+/// A read-only source of voxels for preprocessing.
+pub trait VoxelSource {
+    /// Sizes `[nx, ny, nz]`.
+    fn dims(&self) -> [usize; 3];
+    /// Value of voxel `(i, j, k)`; indices are within `dims`.
+    fn voxel(&self, i: usize, j: usize, k: usize) -> f64;
+}
+
+/// A dense volume borrowed from a slice, `i` fastest.
+#[derive(Clone, Copy, Debug)]
+pub struct DenseVolume<'a, V> {
+    dims: [usize; 3],
+    data: &'a [V],
+}
+
+impl<'a, V: Copy + Into<f64>> DenseVolume<'a, V> {
+    /// Wrap `data` of shape `dims`.
+    ///
+    /// # Errors
+    /// `data.len() != nx·ny·nz`, or a zero dimension.
+    pub fn new(dims: [usize; 3], data: &'a [V]) -> Result<Self> {
+        if dims.contains(&0) {
+            return Err(Error::EmptyVolume);
+        }
+        let count = dims[0]
+            .checked_mul(dims[1])
+            .and_then(|v| v.checked_mul(dims[2]))
+            .ok_or(Error::VolumeTooLarge { dims, grid: 0 })?;
+        if count != data.len() {
+            return Err(mismatch("volume data", count, data.len()));
+        }
+        Ok(Self { dims, data })
+    }
+}
+
+impl<V: Copy + Into<f64>> VoxelSource for DenseVolume<'_, V> {
+    fn dims(&self) -> [usize; 3] {
+        self.dims
+    }
+    #[inline]
+    fn voxel(&self, i: usize, j: usize, k: usize) -> f64 {
+        self.data[i + self.dims[0] * (j + self.dims[1] * k)].into()
+    }
+}
+
+/// Side of the padded cube for a volume: the smallest power of two at least
+/// `oversample × max(nx, ny, nz)`.
+///
+/// # Errors
+/// A zero dimension, or a size beyond `usize`.
+pub fn padded_size(dims: [usize; 3], oversample: u32) -> Result<usize> {
+    if dims.contains(&0) {
+        return Err(Error::EmptyVolume);
+    }
+    let largest = dims.iter().copied().max().unwrap_or(1);
+    largest
+        .checked_mul(oversample as usize)
+        .and_then(usize::checked_next_power_of_two)
+        .ok_or(Error::VolumeTooLarge { dims, grid: 0 })
+}
+
+/// Scratch elements [`Spectrum::prepare`] needs for a padded side `n`:
+/// `n` premultiplication factors plus the transform's `4n`.
+pub const fn prepare_scratch_len(n: usize) -> usize {
+    n + dht_3d_scratch_len([n, n, n])
+}
+
+/// A 3D Hartley spectrum in storage format `S`, ready to render from.
+#[derive(Debug)]
+pub struct Spectrum<'a, S> {
+    data: &'a [S],
+    n: usize,
+    scale: f64,
+    filter: Filter,
+    dims: [usize; 3],
+}
+
+impl<'a, S: Sample> Spectrum<'a, S> {
+    /// Premultiply `volume` for `filter`, zero-pad it into the cube of side
+    /// [`padded_size`]`(dims, filter.oversample())`, scale it (module docs)
+    /// and take its 3D DHT in place in `storage`, with arithmetic in `T`.
+    ///
+    /// `storage` needs `n³` elements, `scratch` [`prepare_scratch_len`]`(n)`,
+    /// and `tw` must serve length `n`.
+    ///
+    /// # Errors
+    /// A NaN or infinite voxel (named), short buffers, a twiddle table too
+    /// short, or an overflow (impossible under the scaling rule unless the
+    /// volume's magnitude exceeds f64's range).
+    pub fn prepare<T: Real, V: VoxelSource>(
+        volume: &V,
+        filter: Filter,
+        storage: &'a mut [S],
+        scratch: &mut [T],
+        tw: &Twiddles<'_, T>,
+    ) -> Result<Self> {
+        let dims = volume.dims();
+        let n = padded_size(dims, filter.oversample())?;
+        let cube = n
+            .checked_mul(n)
+            .and_then(|v| v.checked_mul(n))
+            .ok_or(Error::VolumeTooLarge { dims, grid: n })?;
+        require_len("spectrum storage", cube, storage.len())?;
+        require_len("preparation scratch", prepare_scratch_len(n), scratch.len())?;
+        let storage = &mut storage[..cube];
+        let (premul, rest) = scratch.split_at_mut(n);
+        premultiplier_table(&filter, n, premul);
+
+        // Pass 1: check finiteness and sum |g| exactly (in f64).
+        let mask = n - 1;
+        let offs = dims.map(|d| d / 2);
+        let pm = |idx: usize, axis: usize| premul[(idx + n - offs[axis]) & mask].to_f64();
+        let mut bound = 0.0f64;
+        for k in 0..dims[2] {
+            for j in 0..dims[1] {
+                let pyz = pm(j, 1) * pm(k, 2);
+                for i in 0..dims[0] {
+                    let v = volume.voxel(i, j, k);
+                    if !v.is_finite() {
+                        return Err(Error::NonFiniteVoxel {
+                            index: [i, j, k],
+                            value: v,
+                        });
+                    }
+                    bound += libm::fabs(v * pm(i, 0) * pyz);
+                }
+            }
+        }
+        if !bound.is_finite() {
+            return Err(Error::Overflow {
+                stage: "premultiplication (volume magnitude beyond f64)",
+            });
+        }
+        let scale = scale_for(bound);
+
+        // Pass 2: place the scaled, premultiplied volume, circularly shifted.
+        storage.fill(S::default());
+        let sc = T::from_f64(scale);
+        for k in 0..dims[2] {
+            let pz = (k + n - offs[2]) & mask;
+            for j in 0..dims[1] {
+                let py = (j + n - offs[1]) & mask;
+                let pyz = premul[py] * premul[pz] * sc;
+                let row = n * (py + n * pz);
+                for i in 0..dims[0] {
+                    let px = (i + n - offs[0]) & mask;
+                    let g = T::from_f64(volume.voxel(i, j, k)) * premul[px] * pyz;
+                    storage[row + px] = g.store();
+                }
+            }
+        }
+        dht_3d(storage, [n, n, n], rest, tw)?;
+        Ok(Self {
+            data: storage,
+            n,
+            scale,
+            filter,
+            dims,
+        })
+    }
+
+    /// Rebuild a spectrum from stored parts, e.g. a table in flash made at
+    /// build time by [`Spectrum::prepare`].
+    ///
+    /// # Errors
+    /// `n` not a power of two, `data.len() != n³`, dims that do not fit, or
+    /// a scale that is not a positive finite number.
+    pub fn from_parts(
+        data: &'a [S],
+        n: usize,
+        scale: f64,
+        filter: Filter,
+        dims: [usize; 3],
+    ) -> Result<Self> {
+        require_pow2("spectrum side", n)?;
+        let expected = padded_size(dims, filter.oversample())?;
+        if expected != n {
+            return Err(Error::VolumeTooLarge { dims, grid: n });
+        }
+        if n * n * n != data.len() {
+            return Err(mismatch("spectrum storage", n * n * n, data.len()));
+        }
+        if !(scale.is_finite() && scale > 0.0) {
+            return Err(Error::Overflow {
+                stage: "spectrum scale (not a positive finite number)",
+            });
+        }
+        Ok(Self {
+            data,
+            n,
+            scale,
+            filter,
+            dims,
+        })
+    }
+
+    /// The stored coefficients, `s·H`, `x` fastest.
+    pub fn data(&self) -> &'a [S] {
+        self.data
+    }
+
+    /// Side of the cube.
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
+    /// The scale `s` of the stored values (a power of two).
+    pub fn scale(&self) -> f64 {
+        self.scale
+    }
+
+    /// The filter the volume was premultiplied for.
+    pub fn filter(&self) -> &Filter {
+        &self.filter
+    }
+
+    /// Dimensions of the original volume.
+    pub fn dims(&self) -> [usize; 3] {
+        self.dims
+    }
+
+    /// Bytes of coefficient storage held.
+    pub fn bytes(&self) -> usize {
+        core::mem::size_of_val(self.data)
+    }
+}
+
+/// Premultiplication factors `1/ĥ(x/n)` for signed positions
+/// `x ∈ [−n/2, n/2)`, stored at index `x mod n` (the same on every axis).
+pub fn premultiplier_table<T: Real>(filter: &Filter, n: usize, out: &mut [T]) {
+    let half = (n / 2) as i64;
+    for (idx, v) in out[..n].iter_mut().enumerate() {
+        let x = if (idx as i64) < half || n == 1 {
+            idx as i64
+        } else {
+            idx as i64 - n as i64
+        };
+        *v = T::from_f64(1.0 / filter.response(x as f64 / n as f64));
+    }
+}
+
+/// The power of two `s` with `s·bound ∈ (2^13, 2^14]` (1 when `bound` is 0).
+pub fn scale_for(bound: f64) -> f64 {
+    if bound <= 0.0 {
+        return 1.0;
+    }
+    let e = libm::floor(libm::log2(16384.0 / bound)) as i32;
+    let mut s = libm::scalbn(1.0, e);
+    // Guard against log2 rounding at exact powers of two.
+    while s * bound > 16384.0 {
+        s *= 0.5;
+    }
+    while s * bound * 2.0 <= 16384.0 {
+        s *= 2.0;
+    }
+    s
+}

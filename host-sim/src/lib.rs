@@ -1,0 +1,8 @@
+//! Host simulator for `fvr-core`: volume I/O, analytic phantoms, f64
+//! references, agreement in dB and the `fvr` command-line program.
+
+pub mod nrrd;
+pub mod phantom;
+pub mod pipeline;
+pub mod reference;
+pub mod volume;

@@ -1,0 +1,226 @@
+//! The error type of NRRD and raw volume I/O.
+
+use std::fmt;
+use std::io;
+use std::path::PathBuf;
+
+/// What went wrong reading or writing a volume.
+///
+/// `Display` names the header field or the problem, e.g.
+/// ``NRRD field `sizes`: expected 3 positive integers, got `12 x` ``, and the
+/// file path when the error came from [`read_nrrd`](super::read_nrrd),
+/// [`read_raw`](super::read_raw) or [`write_nrrd_f32`](super::write_nrrd_f32).
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum IoError {
+    /// An operating-system error while opening, reading or writing.
+    Io {
+        /// The underlying error.
+        source: io::Error,
+    },
+    /// The first line is not a NRRD magic `NRRD0001` to `NRRD0005`.
+    BadMagic {
+        /// The start of the first line (control characters escaped).
+        found: String,
+    },
+    /// A header line that is not a comment, field or key/value pair, or a
+    /// header that is too long or not terminated by a blank line.
+    Header {
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// A required header field is absent.
+    MissingField {
+        /// The canonical field name, e.g. `sizes`.
+        field: &'static str,
+    },
+    /// A header field has a malformed or unsupported value.
+    Field {
+        /// The canonical field name, e.g. `sizes`.
+        field: &'static str,
+        /// What is wrong with the value.
+        problem: String,
+    },
+    /// The header refers to a detached data file, which is not supported.
+    DetachedData {
+        /// The value of the `data file` field.
+        file: String,
+    },
+    /// Fewer data bytes than the sizes and sample type call for.
+    Truncated {
+        /// Bytes of sample data needed.
+        expected: u64,
+        /// Bytes of sample data found.
+        found: u64,
+        /// Whether the counts are of gzip-decompressed data.
+        gzip: bool,
+    },
+    /// Decoding would need more memory than allowed.
+    TooLarge {
+        /// Bytes the decoded volume (plus its raw samples) would need.
+        needed: u64,
+        /// The memory limit in bytes.
+        limit: u64,
+    },
+    /// The gzip-encoded data could not be decompressed.
+    Gzip {
+        /// The decompressor's error.
+        source: io::Error,
+    },
+    /// A NaN or infinite sample, or a double too large for `f32`.
+    NonFinite {
+        /// Voxel index `(i, j, k)` of the first offending sample.
+        voxel: [usize; 3],
+        /// Its value as stored in the file.
+        value: f64,
+    },
+    /// Invalid arguments: raw dimensions, sizes for writing, type names.
+    InvalidArgument {
+        /// What is wrong.
+        problem: String,
+    },
+    /// Another error, while reading or writing the file at `path`.
+    File {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        source: Box<IoError>,
+    },
+}
+
+impl IoError {
+    /// Attach a file path to this error.
+    pub(super) fn in_file(self, path: &std::path::Path) -> Self {
+        IoError::File {
+            path: path.to_path_buf(),
+            source: Box::new(self),
+        }
+    }
+
+    /// The innermost error, looking through [`IoError::File`].
+    pub fn root(&self) -> &IoError {
+        match self {
+            IoError::File { source, .. } => source.root(),
+            other => other,
+        }
+    }
+}
+
+impl From<io::Error> for IoError {
+    fn from(source: io::Error) -> Self {
+        IoError::Io { source }
+    }
+}
+
+impl fmt::Display for IoError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            IoError::Io { source } => write!(f, "I/O error: {source}"),
+            IoError::BadMagic { found } if found.is_empty() => {
+                f.write_str("not a NRRD file: empty first line (expected magic `NRRD0001` to `NRRD0005`)")
+            }
+            IoError::BadMagic { found } => write!(
+                f,
+                "not a NRRD file: magic line `{found}` (expected `NRRD0001` to `NRRD0005`)"
+            ),
+            IoError::Header { line, problem } => write!(f, "NRRD header line {line}: {problem}"),
+            IoError::MissingField { field } => {
+                write!(f, "NRRD field `{field}`: required field is missing")
+            }
+            IoError::Field { field, problem } => write!(f, "NRRD field `{field}`: {problem}"),
+            IoError::DetachedData { file } => write!(
+                f,
+                "NRRD field `data file`: detached data files are not supported yet (header refers to `{file}`)"
+            ),
+            IoError::Truncated { expected, found, gzip } => {
+                let after = if *gzip { " after gzip decompression" } else { "" };
+                write!(f, "truncated data: expected {expected} bytes of samples{after}, found {found}")
+            }
+            IoError::TooLarge { needed, limit } => write!(
+                f,
+                "volume too large: decoding would need {needed} bytes ({}) of memory, the limit is {limit} bytes ({})",
+                Gib(*needed),
+                Gib(*limit)
+            ),
+            IoError::Gzip { source } => {
+                write!(f, "NRRD data (`encoding: gzip`): corrupt gzip stream: {source}")
+            }
+            IoError::NonFinite { voxel: [i, j, k], value } if value.is_finite() => write!(
+                f,
+                "sample {value:e} at voxel ({i}, {j}, {k}) does not fit in f32 (it would become infinite)"
+            ),
+            IoError::NonFinite { voxel: [i, j, k], value } => write!(
+                f,
+                "non-finite sample {value} at voxel ({i}, {j}, {k}); NaN/Inf data would corrupt the rendering"
+            ),
+            IoError::InvalidArgument { problem } => f.write_str(problem),
+            IoError::File { path, source } => write!(f, "{}: {source}", path.display()),
+        }
+    }
+}
+
+impl std::error::Error for IoError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            IoError::Io { source } | IoError::Gzip { source } => Some(source),
+            IoError::File { source, .. } => source.source(),
+            _ => None,
+        }
+    }
+}
+
+/// A byte count shown in GiB.
+struct Gib(u64);
+
+impl fmt::Display for Gib {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{:.2} GiB", self.0 as f64 / (1u64 << 30) as f64)
+    }
+}
+
+/// A header value fit for an error message: at most 60 characters, control
+/// characters escaped.
+pub(super) fn excerpt(s: &str) -> String {
+    const MAX_CHARS: usize = 60;
+    let mut out = String::new();
+    for (n, c) in s.chars().enumerate() {
+        if n == MAX_CHARS {
+            out.push('…');
+            break;
+        }
+        if c.is_control() {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// A malformed or unsupported field value.
+#[cold]
+pub(super) fn field_error(field: &'static str, problem: impl Into<String>) -> IoError {
+    IoError::Field {
+        field,
+        problem: problem.into(),
+    }
+}
+
+/// A malformed header line.
+#[cold]
+pub(super) fn header_error(line: usize, problem: impl Into<String>) -> IoError {
+    IoError::Header {
+        line,
+        problem: problem.into(),
+    }
+}
+
+/// Invalid caller-supplied arguments.
+#[cold]
+pub(super) fn invalid_argument(problem: impl Into<String>) -> IoError {
+    IoError::InvalidArgument {
+        problem: problem.into(),
+    }
+}

@@ -1,0 +1,288 @@
+//! Reading and validating an attached NRRD header.
+
+use std::io::{BufRead, Read};
+
+use super::error::{excerpt, field_error, header_error, IoError};
+use super::samples::{Encoding, Endian, SampleType};
+
+/// Longest header line accepted, in bytes (newline included).
+const MAX_LINE_BYTES: usize = 1 << 20;
+/// Longest header accepted, in bytes.
+const MAX_HEADER_BYTES: usize = 16 << 20;
+
+/// Everything needed to decode the data that follows a header.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(super) struct Layout {
+    /// Volume dimensions, padded with 1s.
+    pub dims: [usize; 3],
+    /// Number of samples.
+    pub count: usize,
+    /// Bytes of sample data (`count` times the sample size).
+    pub data_bytes: usize,
+    /// Sample type.
+    pub ty: SampleType,
+    /// Byte order (`Little` for 1-byte types, where it does not matter).
+    pub endian: Endian,
+    /// Data encoding.
+    pub encoding: Encoding,
+    /// Lines to skip before the data (in the file, before decompression).
+    pub line_skip: u64,
+    /// Bytes to skip before the data (after decompression for gzip).
+    pub byte_skip: u64,
+}
+
+/// The raw values of the fields this reader cares about.
+#[derive(Debug, Default)]
+struct Fields {
+    ty: Option<String>,
+    dimension: Option<String>,
+    sizes: Option<String>,
+    encoding: Option<String>,
+    endian: Option<String>,
+    byte_skip: Option<String>,
+    line_skip: Option<String>,
+    data_file: Option<String>,
+}
+
+impl Fields {
+    /// The canonical name and storage slot of a field, `None` for fields
+    /// that are accepted and ignored.
+    fn slot(&mut self, key: &str) -> Option<(&'static str, &mut Option<String>)> {
+        Some(match key {
+            "type" => ("type", &mut self.ty),
+            "dimension" => ("dimension", &mut self.dimension),
+            "sizes" => ("sizes", &mut self.sizes),
+            "encoding" => ("encoding", &mut self.encoding),
+            "endian" => ("endian", &mut self.endian),
+            "byte skip" | "byteskip" => ("byte skip", &mut self.byte_skip),
+            "line skip" | "lineskip" => ("line skip", &mut self.line_skip),
+            "data file" | "datafile" => ("data file", &mut self.data_file),
+            _ => return None,
+        })
+    }
+
+    /// Record `key: value`; duplicates of known fields are an error.
+    fn set(&mut self, key: &str, value: &str) -> Result<(), IoError> {
+        let key = key
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ")
+            .to_ascii_lowercase();
+        match self.slot(&key) {
+            Some((name, slot)) if slot.is_some() => Err(field_error(name, "given more than once")),
+            Some((_, slot)) => {
+                *slot = Some(value.to_owned());
+                Ok(())
+            }
+            None => Ok(()),
+        }
+    }
+
+    /// Check and convert the fields.
+    fn into_layout(self) -> Result<Layout, IoError> {
+        if let Some(file) = self.data_file {
+            return Err(IoError::DetachedData {
+                file: excerpt(&file),
+            });
+        }
+        let ty = SampleType::from_nrrd_field(&required(self.ty, "type")?)?;
+        let dimension = parse_dimension(&required(self.dimension, "dimension")?)?;
+        let sizes = parse_sizes(&required(self.sizes, "sizes")?, dimension)?;
+        let encoding = Encoding::from_nrrd_field(&required(self.encoding, "encoding")?)?;
+        let endian = match ty.size_bytes() {
+            1 => Endian::Little,
+            _ => Endian::from_nrrd_field(&required(self.endian, "endian")?)?,
+        };
+        let byte_skip = parse_skip(self.byte_skip.as_deref(), "byte skip")?;
+        let line_skip = parse_skip(self.line_skip.as_deref(), "line skip")?;
+        let (dims, count, data_bytes) = geometry(&sizes, ty)?;
+        Ok(Layout {
+            dims,
+            count,
+            data_bytes,
+            ty,
+            endian,
+            encoding,
+            line_skip,
+            byte_skip,
+        })
+    }
+}
+
+fn required(value: Option<String>, field: &'static str) -> Result<String, IoError> {
+    value.ok_or(IoError::MissingField { field })
+}
+
+fn parse_dimension(value: &str) -> Result<usize, IoError> {
+    match value.trim().parse::<usize>() {
+        Ok(d @ 1..=3) => Ok(d),
+        Ok(0) => Err(field_error("dimension", "must be at least 1, got `0`")),
+        Ok(d) => Err(field_error(
+            "dimension",
+            format!("dimension {d} is not supported (at most 3)"),
+        )),
+        Err(_) => Err(field_error(
+            "dimension",
+            format!("expected a positive integer, got `{}`", excerpt(value)),
+        )),
+    }
+}
+
+fn parse_sizes(value: &str, dimension: usize) -> Result<Vec<usize>, IoError> {
+    let sizes: Option<Vec<usize>> = value
+        .split_whitespace()
+        .map(|s| s.parse::<usize>().ok().filter(|&n| n > 0))
+        .collect();
+    match sizes {
+        Some(sizes) if sizes.len() == dimension => Ok(sizes),
+        _ => Err(field_error(
+            "sizes",
+            format!(
+                "expected {dimension} positive integer{}, got `{}`",
+                if dimension == 1 { "" } else { "s" },
+                excerpt(value.trim())
+            ),
+        )),
+    }
+}
+
+fn parse_skip(value: Option<&str>, field: &'static str) -> Result<u64, IoError> {
+    let Some(value) = value else { return Ok(0) };
+    match value.trim().parse::<i64>() {
+        Ok(n) if n >= 0 => Ok(n as u64),
+        Ok(-1) => Err(field_error(
+            field,
+            "-1 (data at the end of the file) is not supported; give a nonnegative count",
+        )),
+        _ => Err(field_error(
+            field,
+            format!("expected a nonnegative integer, got `{}`", excerpt(value)),
+        )),
+    }
+}
+
+/// Dimensions padded to 3, sample count and data bytes, with overflow checks.
+pub(super) fn geometry(
+    sizes: &[usize],
+    ty: SampleType,
+) -> Result<([usize; 3], usize, usize), IoError> {
+    let overflow = || field_error("sizes", format!("product of sizes {sizes:?} overflows"));
+    let count = sizes
+        .iter()
+        .try_fold(1usize, |acc, &n| acc.checked_mul(n))
+        .ok_or_else(overflow)?;
+    let data_bytes = count.checked_mul(ty.size_bytes()).ok_or_else(overflow)?;
+    let mut dims = [1usize; 3];
+    for (d, &n) in dims.iter_mut().zip(sizes) {
+        *d = n;
+    }
+    Ok((dims, count, data_bytes))
+}
+
+/// Reads header lines, enforcing the per-line and total length limits.
+struct LineReader<'a, R> {
+    reader: &'a mut R,
+    buf: Vec<u8>,
+    line: usize,
+    total: usize,
+}
+
+impl<R: BufRead> LineReader<'_, R> {
+    /// The next line without its `\n` or `\r\n`, `None` at end of input.
+    fn next_line(&mut self) -> Result<Option<String>, IoError> {
+        self.buf.clear();
+        self.line += 1;
+        let limit = MAX_LINE_BYTES as u64 + 1;
+        let n = self
+            .reader
+            .by_ref()
+            .take(limit)
+            .read_until(b'\n', &mut self.buf)?;
+        if n == 0 {
+            return Ok(None);
+        }
+        self.total = self.total.saturating_add(n);
+        if n > MAX_LINE_BYTES {
+            return Err(header_error(
+                self.line,
+                format!("longer than {MAX_LINE_BYTES} bytes"),
+            ));
+        }
+        if self.total > MAX_HEADER_BYTES {
+            return Err(header_error(
+                self.line,
+                format!("header longer than {MAX_HEADER_BYTES} bytes"),
+            ));
+        }
+        let text = self.buf.strip_suffix(b"\n").unwrap_or(&self.buf);
+        let text = text.strip_suffix(b"\r").unwrap_or(text);
+        Ok(Some(String::from_utf8_lossy(text).into_owned()))
+    }
+}
+
+/// Check the magic line.
+fn check_magic(line: Option<&str>) -> Result<(), IoError> {
+    let line = line.unwrap_or("");
+    let version = line.trim_end().strip_prefix("NRRD000");
+    if matches!(version, Some("1" | "2" | "3" | "4" | "5")) {
+        Ok(())
+    } else {
+        Err(IoError::BadMagic {
+            found: excerpt(line),
+        })
+    }
+}
+
+/// Handle one header line after the magic.
+fn parse_line(fields: &mut Fields, line: &str, number: usize) -> Result<(), IoError> {
+    if line.starts_with('#') {
+        return Ok(());
+    }
+    let field_at = line
+        .find(": ")
+        .or_else(|| line.trim_end().strip_suffix(':').map(str::len));
+    let pair_at = line.find(":=");
+    match (field_at, pair_at) {
+        (_, Some(p)) if field_at.is_none_or(|f| p < f) => Ok(()),
+        (Some(f), _) => {
+            let (key, value) = line.split_at(f);
+            fields.set(key, value.get(1..).unwrap_or("").trim())
+        }
+        _ => Err(header_error(
+            number,
+            format!(
+                "expected `field: value`, `key:=value` or a `#` comment, got `{}`",
+                excerpt(line)
+            ),
+        )),
+    }
+}
+
+/// Read the header from the magic line through the blank line that ends it,
+/// leaving `reader` at the first byte of data.
+pub(super) fn read_header<R: BufRead>(reader: &mut R) -> Result<Layout, IoError> {
+    let mut lines = LineReader {
+        reader,
+        buf: Vec::new(),
+        line: 0,
+        total: 0,
+    };
+    check_magic(lines.next_line()?.as_deref())?;
+    let mut fields = Fields::default();
+    let mut terminated = false;
+    while let Some(line) = lines.next_line()? {
+        if line.is_empty() {
+            terminated = true;
+            break;
+        }
+        parse_line(&mut fields, &line, lines.line)?;
+    }
+    let layout = fields.into_layout()?;
+    if !terminated {
+        return Err(header_error(
+            lines.line,
+            "end of file before the blank line that ends the header (no data follows)",
+        ));
+    }
+    Ok(layout)
+}

@@ -1,0 +1,258 @@
+//! The core pipeline with owned buffers, for the host.
+//!
+//! Three precisions share the one generic core:
+//! - `f16`: spectrum stored as IEEE binary16 (2 bytes a voxel), f32 arithmetic;
+//! - `f32`: spectrum and arithmetic in f32;
+//! - `f64`: spectrum and arithmetic in f64 (the reference pipeline).
+
+use std::fmt;
+use std::str::FromStr;
+
+use fvr_core::dht::Twiddles;
+use fvr_core::filter::{Filter, KernelTable};
+use fvr_core::geometry::View;
+use fvr_core::real::{Real, Sample};
+use fvr_core::render::{aux_len, grid_len, render};
+use fvr_core::spectrum::{padded_size, prepare_scratch_len, DenseVolume, Spectrum};
+use half::f16;
+
+use crate::volume::Volume;
+
+/// Storage and arithmetic of a pipeline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Precision {
+    /// f16 storage, f32 arithmetic (the product).
+    F16,
+    /// f32 storage and arithmetic.
+    F32,
+    /// f64 storage and arithmetic (reference).
+    F64,
+}
+
+impl Precision {
+    /// Every precision.
+    pub const ALL: [Precision; 3] = [Precision::F16, Precision::F32, Precision::F64];
+
+    /// Command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Precision::F16 => "f16",
+            Precision::F32 => "f32",
+            Precision::F64 => "f64",
+        }
+    }
+
+    /// Bytes per stored coefficient.
+    pub fn bytes(self) -> usize {
+        match self {
+            Precision::F16 => 2,
+            Precision::F32 => 4,
+            Precision::F64 => 8,
+        }
+    }
+}
+
+impl fmt::Display for Precision {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Precision {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Precision::ALL
+            .into_iter()
+            .find(|p| p.name() == s)
+            .ok_or_else(|| format!("unknown precision `{s}`: expected f16, f32 or f64"))
+    }
+}
+
+/// An owned, prepared spectrum in storage format `S`.
+#[derive(Clone, Debug)]
+pub struct OwnedSpectrum<S> {
+    data: Vec<S>,
+    n: usize,
+    scale: f64,
+    filter: Filter,
+    dims: [usize; 3],
+}
+
+impl<S: Sample> OwnedSpectrum<S> {
+    /// Premultiply, pad and transform `volume` for `filter`, with arithmetic `T`.
+    ///
+    /// # Errors
+    /// As [`Spectrum::prepare`]; also a volume whose padded cube would not fit
+    /// in memory is refused before allocating.
+    pub fn prepare<T: Real>(volume: &Volume, filter: Filter) -> Result<Self, fvr_core::Error> {
+        let n = padded_size(volume.dims, filter.oversample())?;
+        let source = DenseVolume::new(volume.dims, &volume.data)?;
+        let mut data = vec![S::default(); n * n * n];
+        let mut scratch = vec![T::ZERO; prepare_scratch_len(n)];
+        let mut tw_buf = vec![T::ZERO; Twiddles::<T>::buffer_len(n)];
+        let tw = Twiddles::new(&mut tw_buf, n)?;
+        let spec = Spectrum::prepare(&source, filter, &mut data, &mut scratch, &tw)?;
+        let (scale, dims) = (spec.scale(), spec.dims());
+        Ok(Self {
+            data,
+            n,
+            scale,
+            filter,
+            dims,
+        })
+    }
+
+    /// Borrow as a core spectrum.
+    pub fn view(&self) -> Spectrum<'_, S> {
+        Spectrum::from_parts(&self.data, self.n, self.scale, self.filter, self.dims)
+            .expect("parts come from a prepared spectrum")
+    }
+
+    /// Side of the padded cube.
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
+    /// Bytes of stored coefficients.
+    pub fn bytes(&self) -> usize {
+        std::mem::size_of_val(self.data.as_slice())
+    }
+
+    /// Stored coefficients.
+    pub fn data(&self) -> &[S] {
+        &self.data
+    }
+
+    /// Scale of the stored values.
+    pub fn scale(&self) -> f64 {
+        self.scale
+    }
+}
+
+/// Reusable per-view buffers and tables for arithmetic `T`.
+#[derive(Debug)]
+pub struct ViewRenderer<T> {
+    kernel: KernelTable<T>,
+    tw: Vec<T>,
+    grid: Vec<T>,
+    aux: Vec<T>,
+    n: usize,
+}
+
+impl<T: Real> ViewRenderer<T> {
+    /// Buffers for spectra of side `n` and `filter`.
+    pub fn new(n: usize, filter: Filter) -> Self {
+        let mut tw = vec![T::ZERO; Twiddles::<T>::buffer_len(n)];
+        Twiddles::new(&mut tw, n).expect("n is a power of two");
+        Self {
+            kernel: KernelTable::new(filter),
+            tw,
+            grid: vec![T::ZERO; grid_len(n)],
+            aux: vec![T::ZERO; aux_len(n)],
+            n,
+        }
+    }
+
+    /// Render one view into `out` (`width × height`, row 0 at the top).
+    ///
+    /// # Errors
+    /// As [`fvr_core::render::render`].
+    pub fn render_into<S: Sample>(
+        &mut self,
+        spec: &OwnedSpectrum<S>,
+        view: &View,
+        width: usize,
+        height: usize,
+        out: &mut [T],
+    ) -> Result<(), fvr_core::Error> {
+        let tw = Twiddles::from_table(&self.tw, self.n)?;
+        render(
+            &spec.view(),
+            &self.kernel,
+            view,
+            width,
+            height,
+            &tw,
+            &mut self.grid,
+            &mut self.aux,
+            out,
+        )
+    }
+}
+
+/// A prepared spectrum in any of the three precisions.
+#[derive(Clone, Debug)]
+pub enum AnySpectrum {
+    /// f16 storage.
+    F16(OwnedSpectrum<f16>),
+    /// f32 storage.
+    F32(OwnedSpectrum<f32>),
+    /// f64 storage.
+    F64(OwnedSpectrum<f64>),
+}
+
+impl AnySpectrum {
+    /// Prepare `volume` at `precision` for `filter`.
+    ///
+    /// # Errors
+    /// As [`OwnedSpectrum::prepare`].
+    pub fn prepare(
+        volume: &Volume,
+        filter: Filter,
+        precision: Precision,
+    ) -> Result<Self, fvr_core::Error> {
+        Ok(match precision {
+            Precision::F16 => AnySpectrum::F16(OwnedSpectrum::prepare::<f32>(volume, filter)?),
+            Precision::F32 => AnySpectrum::F32(OwnedSpectrum::prepare::<f32>(volume, filter)?),
+            Precision::F64 => AnySpectrum::F64(OwnedSpectrum::prepare::<f64>(volume, filter)?),
+        })
+    }
+
+    /// Side of the padded cube.
+    pub fn n(&self) -> usize {
+        match self {
+            AnySpectrum::F16(s) => s.n(),
+            AnySpectrum::F32(s) => s.n(),
+            AnySpectrum::F64(s) => s.n(),
+        }
+    }
+
+    /// Bytes of stored coefficients.
+    pub fn bytes(&self) -> usize {
+        match self {
+            AnySpectrum::F16(s) => s.bytes(),
+            AnySpectrum::F32(s) => s.bytes(),
+            AnySpectrum::F64(s) => s.bytes(),
+        }
+    }
+
+    /// Render one view; the image comes back in f64 whatever the precision.
+    ///
+    /// # Errors
+    /// As [`fvr_core::render::render`].
+    pub fn render(
+        &self,
+        filter: Filter,
+        view: &View,
+        width: usize,
+        height: usize,
+    ) -> Result<Vec<f64>, fvr_core::Error> {
+        fn go<S: Sample, T: Real>(
+            s: &OwnedSpectrum<S>,
+            filter: Filter,
+            view: &View,
+            w: usize,
+            h: usize,
+        ) -> Result<Vec<f64>, fvr_core::Error> {
+            let mut r = ViewRenderer::<T>::new(s.n(), filter);
+            let mut out = vec![T::ZERO; w * h];
+            r.render_into(s, view, w, h, &mut out)?;
+            Ok(out.into_iter().map(T::to_f64).collect())
+        }
+        match self {
+            AnySpectrum::F16(s) => go::<_, f32>(s, filter, view, width, height),
+            AnySpectrum::F32(s) => go::<_, f32>(s, filter, view, width, height),
+            AnySpectrum::F64(s) => go::<_, f64>(s, filter, view, width, height),
+        }
+    }
+}

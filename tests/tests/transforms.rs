@@ -1,0 +1,194 @@
+//! The fast Hartley transforms against direct O(N²) summation in f64.
+
+use fvr_core::dht::{dht, dht_2d, dht_3d, dht_3d_scratch_len, idht, idht_2d, Twiddles};
+use fvr_core::Error;
+use fvr_host::reference::{naive_dht, naive_dht_2d, naive_dht_3d};
+use half::f16;
+
+/// Deterministic test signal in [−1, 1) (SplitMix64).
+fn signal(len: usize, seed: u64) -> Vec<f64> {
+    let mut s = seed;
+    (0..len)
+        .map(|_| {
+            s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = s;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            z ^= z >> 31;
+            (z >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        })
+        .collect()
+}
+
+/// Relative RMS error ‖a − b‖ / ‖b‖.
+fn rel_rms(a: &[f64], b: &[f64]) -> f64 {
+    let num: f64 = a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum();
+    let den: f64 = b.iter().map(|y| y * y).sum();
+    (num / den).sqrt()
+}
+
+/// Error budget of a radix-2 transform: each of the log₂N stages adds a few
+/// roundings (a butterfly has one multiply-add chain of depth 3) of unit
+/// roundoff u, plus twiddle error ≤ u. We allow 4·u·(log₂N + 1) relative RMS.
+fn budget(unit_roundoff: f64, n: usize) -> f64 {
+    4.0 * unit_roundoff * ((n as f64).log2() + 1.0)
+}
+
+#[test]
+fn dht_matches_naive_for_all_sizes_1_to_2048() {
+    let mut tw64 = vec![0.0f64; Twiddles::<f64>::buffer_len(4096)];
+    let tw64 = Twiddles::new(&mut tw64, 4096).unwrap();
+    let mut tw32 = vec![0.0f32; Twiddles::<f32>::buffer_len(4096)];
+    let tw32 = Twiddles::new(&mut tw32, 4096).unwrap();
+    let mut n = 1;
+    while n <= 2048 {
+        let x = signal(n, n as u64);
+        let reference = naive_dht(&x);
+        let mut y64 = x.clone();
+        dht(&mut y64, &tw64).unwrap();
+        let e64 = rel_rms(&y64, &reference);
+        assert!(e64 <= budget(f64::EPSILON / 2.0, n), "f64 N={n}: {e64:e}");
+        let mut y32: Vec<f32> = x.iter().map(|&v| v as f32).collect();
+        dht(&mut y32, &tw32).unwrap();
+        let y32: Vec<f64> = y32.into_iter().map(f64::from).collect();
+        let e32 = rel_rms(&y32, &reference);
+        assert!(
+            e32 <= budget(f32::EPSILON as f64 / 2.0, n),
+            "f32 N={n}: {e32:e}"
+        );
+        n *= 2;
+    }
+}
+
+#[test]
+fn forward_then_inverse_is_identity_up_to_4096() {
+    let mut tw = vec![0.0f64; Twiddles::<f64>::buffer_len(4096)];
+    let tw = Twiddles::new(&mut tw, 4096).unwrap();
+    for log in 0..=12 {
+        let n = 1 << log;
+        let x = signal(n, 7 + n as u64);
+        let mut y = x.clone();
+        dht(&mut y, &tw).unwrap();
+        idht(&mut y, &tw).unwrap();
+        let e = rel_rms(&y, &x);
+        assert!(e <= 2.0 * budget(f64::EPSILON / 2.0, n), "N={n}: {e:e}");
+    }
+}
+
+#[test]
+fn non_power_of_two_and_short_tables_are_errors() {
+    let mut tw = vec![0.0f32; Twiddles::<f32>::buffer_len(64)];
+    assert!(matches!(
+        Twiddles::new(&mut tw, 48),
+        Err(Error::NotPowerOfTwo { len: 48, .. })
+    ));
+    let tw = Twiddles::new(&mut tw, 64).unwrap();
+    let mut x = vec![0.0f32; 12];
+    assert!(matches!(
+        dht(&mut x, &tw),
+        Err(Error::NotPowerOfTwo { len: 12, .. })
+    ));
+    let mut x = vec![0.0f32; 128];
+    assert!(matches!(
+        dht(&mut x, &tw),
+        Err(Error::TwiddlesTooShort {
+            table_len: 64,
+            needed: 128
+        })
+    ));
+    let mut short = [0.0f32; 3];
+    assert!(matches!(
+        Twiddles::new(&mut short, 64),
+        Err(Error::BufferTooSmall {
+            needed: 17,
+            got: 3,
+            ..
+        })
+    ));
+    let message = dht(&mut [0.0f32; 12], &tw).unwrap_err().to_string();
+    assert!(
+        message.contains("power of two") && message.contains("12"),
+        "{message}"
+    );
+}
+
+#[test]
+fn true_2d_dht_matches_naive() {
+    let mut tw = vec![0.0f64; Twiddles::<f64>::buffer_len(64)];
+    let tw = Twiddles::new(&mut tw, 64).unwrap();
+    for (nx, ny) in [(1, 1), (2, 4), (8, 8), (16, 4), (32, 16)] {
+        let x = signal(nx * ny, (nx * 100 + ny) as u64);
+        let reference = naive_dht_2d(&x, nx, ny);
+        let mut y = x.clone();
+        let mut col = vec![0.0; ny];
+        dht_2d(&mut y, nx, ny, &mut col, &tw).unwrap();
+        let e = rel_rms(&y, &reference);
+        assert!(
+            e <= 2.0 * budget(f64::EPSILON / 2.0, nx * ny),
+            "{nx}x{ny}: {e:e}"
+        );
+        idht_2d(&mut y, nx, ny, &mut col, &tw).unwrap();
+        assert!(rel_rms(&y, &x) < 1e-13, "{nx}x{ny} round trip");
+    }
+}
+
+#[test]
+fn true_3d_dht_matches_naive_in_f64_f32_and_f16_storage() {
+    let mut tw64 = vec![0.0f64; Twiddles::<f64>::buffer_len(16)];
+    let tw64 = Twiddles::new(&mut tw64, 16).unwrap();
+    let mut tw32 = vec![0.0f32; Twiddles::<f32>::buffer_len(16)];
+    let tw32 = Twiddles::new(&mut tw32, 16).unwrap();
+    for dims in [
+        [1, 1, 1],
+        [2, 2, 2],
+        [4, 8, 2],
+        [8, 8, 8],
+        [16, 4, 8],
+        [2, 16, 16],
+    ] {
+        let len = dims.iter().product();
+        let x = signal(len, len as u64 + dims[0] as u64);
+        let reference = naive_dht_3d(&x, dims);
+        let mut scratch64 = vec![0.0f64; dht_3d_scratch_len(dims)];
+        let mut y = x.clone();
+        dht_3d(&mut y, dims, &mut scratch64, &tw64).unwrap();
+        let e = rel_rms(&y, &reference);
+        assert!(
+            e <= 3.0 * budget(f64::EPSILON / 2.0, len),
+            "f64 {dims:?}: {e:e}"
+        );
+
+        let mut scratch32 = vec![0.0f32; dht_3d_scratch_len(dims)];
+        let mut y32: Vec<f32> = x.iter().map(|&v| v as f32).collect();
+        dht_3d(&mut y32, dims, &mut scratch32, &tw32).unwrap();
+        let y32: Vec<f64> = y32.into_iter().map(f64::from).collect();
+        let e = rel_rms(&y32, &reference);
+        assert!(
+            e <= 3.0 * budget(f32::EPSILON as f64 / 2.0, len),
+            "f32 {dims:?}: {e:e}"
+        );
+
+        // f16 storage: the input rounding plus three roundings (x, y and the
+        // fused z + correction pass), each ≤ 2^-11 relative to its value and
+        // about 2^-11/√3 RMS. Orthogonal passes add errors in energy, so the
+        // relative RMS stays below 2·2^-11 ≈ 1e-3 with margin.
+        let mut y16: Vec<f16> = x.iter().map(|&v| f16::from_f64(v)).collect();
+        let x16: Vec<f64> = y16.iter().map(|v| v.to_f64()).collect();
+        let reference16 = naive_dht_3d(&x16, dims);
+        dht_3d(&mut y16, dims, &mut scratch32, &tw32).unwrap();
+        let y16: Vec<f64> = y16.into_iter().map(f64::from).collect();
+        let e = rel_rms(&y16, &reference16);
+        assert!(e <= 2.0 * 2f64.powi(-11), "f16 {dims:?}: {e:e}");
+    }
+}
+
+#[test]
+fn f16_overflow_in_the_3d_transform_is_an_error() {
+    let mut tw = vec![0.0f32; Twiddles::<f32>::buffer_len(8)];
+    let tw = Twiddles::new(&mut tw, 8).unwrap();
+    let mut data = vec![f16::from_f32(60000.0); 512];
+    let mut scratch = vec![0.0f32; dht_3d_scratch_len([8, 8, 8])];
+    let err = dht_3d(&mut data, [8, 8, 8], &mut scratch, &tw).unwrap_err();
+    assert!(matches!(err, Error::Overflow { .. }), "{err}");
+    assert!(err.to_string().contains("x pass"), "{err}");
+}
