@@ -129,8 +129,12 @@ impl Filter {
         }
         let w = kind.width() as f64;
         let s = design.clamp(oversample as f64, 4.0);
-        let beta =
-            core::f64::consts::PI * libm::sqrt((w / s) * (w / s) * (s - 0.5) * (s - 0.5) - 0.8);
+        // β only shapes the Kaiser–Bessel kernels; 0 elsewhere keeps filters comparable.
+        let beta = if kind.is_kaiser_bessel() {
+            core::f64::consts::PI * libm::sqrt((w / s) * (w / s) * (s - 0.5) * (s - 0.5) - 0.8)
+        } else {
+            0.0
+        };
         Ok(Self {
             kind,
             oversample,

@@ -1,8 +1,11 @@
 //! Host simulator for `fvr-core`: volume I/O, analytic phantoms, f64
 //! references, agreement in dB and the `fvr` command-line program.
 
+pub mod accuracy;
+pub mod image;
 pub mod nrrd;
 pub mod phantom;
 pub mod pipeline;
 pub mod reference;
+pub mod scene;
 pub mod volume;

@@ -9,7 +9,7 @@ use std::fmt;
 use std::str::FromStr;
 
 use fvr_core::dht::Twiddles;
-use fvr_core::filter::{Filter, KernelTable};
+use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::View;
 use fvr_core::real::{Real, Sample};
 use fvr_core::render::{aux_len, grid_len, render};
@@ -84,8 +84,9 @@ impl<S: Sample> OwnedSpectrum<S> {
     /// # Errors
     /// As [`Spectrum::prepare`]; also a volume whose padded cube would not fit
     /// in memory is refused before allocating.
-    pub fn prepare<T: Real>(volume: &Volume, filter: Filter) -> Result<Self, fvr_core::Error> {
+    pub fn prepare<T: Real>(volume: &Volume, filter: Filter) -> Result<Self, PipelineError> {
         let n = padded_size(volume.dims, filter.oversample())?;
+        check_memory(n, std::mem::size_of::<S>())?;
         let source = DenseVolume::new(volume.dims, &volume.data)?;
         let mut data = vec![S::default(); n * n * n];
         let mut scratch = vec![T::ZERO; prepare_scratch_len(n)];
@@ -116,6 +117,38 @@ impl<S: Sample> OwnedSpectrum<S> {
     /// Bytes of stored coefficients.
     pub fn bytes(&self) -> usize {
         std::mem::size_of_val(self.data.as_slice())
+    }
+
+    /// The filter the volume was premultiplied for.
+    pub fn filter(&self) -> Filter {
+        self.filter
+    }
+
+    /// Estimated SNR (dB) of images against the same pipeline in f64, from
+    /// the storage format's rounding alone:
+    /// `(Σf)²/n² ÷ (r·u²/3 · Σg²)`.
+    ///
+    /// `g` is the premultiplied volume; `Σg² = Σ_k H_k²/n³` by Parseval,
+    /// read off the stored spectrum. Each of the `r = 4` roundings (input and
+    /// three passes) adds noise of relative variance `u²/3` (`u` the unit
+    /// roundoff) to every coefficient, and a slice inherits it; the image
+    /// energy is at least `(Σf)²/n²` by Cauchy–Schwarz. Premultiplication
+    /// that amplifies the volume's edges (Kaiser–Bessel at σ = 1 on data that
+    /// fills the grid) inflates `Σg²` and shows up here.
+    pub fn storage_snr_estimate_db(&self, volume_sum: f64, unit_roundoff: f64) -> f64 {
+        let n3 = (self.n * self.n * self.n) as f64;
+        let sum_sq: f64 = self
+            .data
+            .iter()
+            .map(|v| {
+                let x = v.to_f64() / self.scale;
+                x * x
+            })
+            .sum();
+        let g2 = sum_sq / n3;
+        let signal = volume_sum * volume_sum / (self.n * self.n) as f64;
+        let noise = 4.0 * unit_roundoff * unit_roundoff / 3.0 * g2;
+        10.0 * (signal / noise).log10()
     }
 
     /// Stored coefficients.
@@ -180,6 +213,99 @@ impl<T: Real> ViewRenderer<T> {
     }
 }
 
+/// Why a host pipeline could not run.
+#[derive(Debug)]
+pub enum PipelineError {
+    /// The core refused (bad view, bad size, non-finite voxel, ...).
+    Core(fvr_core::Error),
+    /// The padded spectrum would need more memory than is available.
+    OutOfMemory {
+        /// Bytes the spectrum would need.
+        needed: u64,
+        /// Bytes available.
+        limit: u64,
+        /// Side of the padded cube.
+        n: usize,
+    },
+}
+
+impl fmt::Display for PipelineError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            PipelineError::Core(e) => e.fmt(f),
+            PipelineError::OutOfMemory { needed, limit, n } => write!(
+                f,
+                "a {n}^3 spectrum needs {needed} bytes, more than the {limit} bytes available"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for PipelineError {}
+
+impl From<fvr_core::Error> for PipelineError {
+    fn from(e: fvr_core::Error) -> Self {
+        PipelineError::Core(e)
+    }
+}
+
+/// Refuse a spectrum of side `n` whose storage and f32 working buffers would
+/// exceed the memory available, before allocating it.
+fn check_memory(n: usize, bytes_per_sample: usize) -> Result<(), PipelineError> {
+    let needed = (n as u64)
+        .checked_pow(3)
+        .and_then(|c| c.checked_mul(bytes_per_sample as u64))
+        .unwrap_or(u64::MAX);
+    let limit = crate::nrrd::memory_limit_bytes();
+    if needed > limit {
+        return Err(PipelineError::OutOfMemory { needed, limit, n });
+    }
+    Ok(())
+}
+
+/// How the Kaiser–Bessel shape parameter is chosen.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum KbDesign {
+    /// Fitted to the volume's energy distribution ([`Filter::fit`]).
+    Auto,
+    /// Beatty's β for this design oversampling.
+    Sigma(f64),
+}
+
+impl FromStr for KbDesign {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        if s == "auto" {
+            return Ok(KbDesign::Auto);
+        }
+        match s.parse::<f64>() {
+            Ok(v) if v.is_finite() && v >= 1.0 => Ok(KbDesign::Sigma(v)),
+            _ => Err(format!(
+                "kb design `{s}` must be `auto` or an oversampling factor >= 1"
+            )),
+        }
+    }
+}
+
+/// Choose the filter for `volume`.
+///
+/// # Errors
+/// As [`Filter::fit`].
+pub fn choose_filter(
+    volume: &Volume,
+    kind: FilterKind,
+    oversample: u32,
+    design: KbDesign,
+) -> Result<Filter, fvr_core::Error> {
+    match design {
+        KbDesign::Auto => {
+            let src = DenseVolume::new(volume.dims, &volume.data)?;
+            Ok(Filter::fit(kind, oversample, &src)?.0)
+        }
+        KbDesign::Sigma(s) => Filter::with_design_oversampling(kind, oversample, s),
+    }
+}
+
 /// A prepared spectrum in any of the three precisions.
 #[derive(Clone, Debug)]
 pub enum AnySpectrum {
@@ -200,7 +326,7 @@ impl AnySpectrum {
         volume: &Volume,
         filter: Filter,
         precision: Precision,
-    ) -> Result<Self, fvr_core::Error> {
+    ) -> Result<Self, PipelineError> {
         Ok(match precision {
             Precision::F16 => AnySpectrum::F16(OwnedSpectrum::prepare::<f32>(volume, filter)?),
             Precision::F32 => AnySpectrum::F32(OwnedSpectrum::prepare::<f32>(volume, filter)?),
@@ -226,33 +352,50 @@ impl AnySpectrum {
         }
     }
 
+    /// The filter the spectrum was premultiplied for.
+    pub fn filter(&self) -> Filter {
+        match self {
+            AnySpectrum::F16(s) => s.filter(),
+            AnySpectrum::F32(s) => s.filter(),
+            AnySpectrum::F64(s) => s.filter(),
+        }
+    }
+
+    /// [`OwnedSpectrum::storage_snr_estimate_db`] for this precision's unit
+    /// roundoff (`+∞` for f64, the reference).
+    pub fn storage_snr_estimate_db(&self, volume_sum: f64) -> f64 {
+        match self {
+            AnySpectrum::F16(s) => s.storage_snr_estimate_db(volume_sum, 2f64.powi(-11)),
+            AnySpectrum::F32(s) => s.storage_snr_estimate_db(volume_sum, 2f64.powi(-24)),
+            AnySpectrum::F64(_) => f64::INFINITY,
+        }
+    }
+
     /// Render one view; the image comes back in f64 whatever the precision.
     ///
     /// # Errors
     /// As [`fvr_core::render::render`].
     pub fn render(
         &self,
-        filter: Filter,
         view: &View,
         width: usize,
         height: usize,
     ) -> Result<Vec<f64>, fvr_core::Error> {
         fn go<S: Sample, T: Real>(
             s: &OwnedSpectrum<S>,
-            filter: Filter,
             view: &View,
             w: usize,
             h: usize,
         ) -> Result<Vec<f64>, fvr_core::Error> {
-            let mut r = ViewRenderer::<T>::new(s.n(), filter);
+            let mut r = ViewRenderer::<T>::new(s.n(), s.filter());
             let mut out = vec![T::ZERO; w * h];
             r.render_into(s, view, w, h, &mut out)?;
             Ok(out.into_iter().map(T::to_f64).collect())
         }
         match self {
-            AnySpectrum::F16(s) => go::<_, f32>(s, filter, view, width, height),
-            AnySpectrum::F32(s) => go::<_, f32>(s, filter, view, width, height),
-            AnySpectrum::F64(s) => go::<_, f64>(s, filter, view, width, height),
+            AnySpectrum::F16(s) => go::<_, f32>(s, view, width, height),
+            AnySpectrum::F32(s) => go::<_, f32>(s, view, width, height),
+            AnySpectrum::F64(s) => go::<_, f64>(s, view, width, height),
         }
     }
 }

@@ -1,0 +1,234 @@
+//! The `fvr` program end to end: outputs, and clear errors on bad input.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+use fvr_host::nrrd::{encode_nrrd, Encoding, Endian, SampleType};
+
+fn fvr(args: &[&str], dir: &std::path::Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_fvr"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("fvr runs")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("fvr-cli-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Exit status 2 and a message on stderr containing every `needle`.
+fn assert_error(out: &Output, needles: &[&str]) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "stderr: {stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    for n in needles {
+        assert!(stderr.contains(n), "`{n}` not in: {stderr}");
+    }
+}
+
+#[test]
+fn no_arguments_renders_the_default_scene_and_says_where() {
+    let dir = temp_dir("default");
+    let out = fvr(&[], &dir);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("wrote fvr-default.png"), "{stdout}");
+    let png = std::fs::read(dir.join("fvr-default.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+}
+
+#[test]
+fn render_to_nrrd_and_compare_precisions() {
+    let dir = temp_dir("compare");
+    for p in ["f16", "f64"] {
+        let out = fvr(
+            &[
+                "render",
+                "gaussians@32",
+                "--dir",
+                "1,0.3,0.2",
+                "--filter",
+                "kb6",
+                "--precision",
+                p,
+                "--out",
+                &format!("{p}.nrrd"),
+            ],
+            &dir,
+        );
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let out = fvr(&["compare", "f64.nrrd", "f16.nrrd"], &dir);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}");
+    let db: f64 = stdout
+        .split(": ")
+        .nth(1)
+        .and_then(|s| s.split(' ').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("no dB figure in `{stdout}`"));
+    assert!(db > 70.0, "f16 against f64: {db} dB");
+    let header = std::fs::read(dir.join("f16.nrrd")).unwrap();
+    let text = String::from_utf8_lossy(&header[..200]);
+    assert!(
+        text.contains("type: float") && text.contains("sizes: 32 32"),
+        "{text}"
+    );
+}
+
+#[test]
+fn zero_and_parallel_view_vectors_are_named() {
+    let dir = temp_dir("view");
+    let out = fvr(
+        &["render", "sphere@16", "--dir", "0,0,0", "--out", "x.png"],
+        &dir,
+    );
+    assert_error(&out, &["zero view vector", "(0, 0, 0)", "(0, 0, 1)"]);
+    let out = fvr(
+        &["render", "sphere@16", "--dir", "0,0,-2", "--out", "x.png"],
+        &dir,
+    );
+    assert_error(&out, &["parallel", "(0, 0, -2)", "(0, 0, 1)"]);
+    let out = fvr(
+        &["render", "sphere@16", "--dir", "1,nan,0", "--out", "x.png"],
+        &dir,
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("finite"));
+}
+
+#[test]
+fn oversized_image_unknown_filter_and_bad_output_are_errors() {
+    let dir = temp_dir("args");
+    let out = fvr(
+        &[
+            "render",
+            "sphere@16",
+            "--dir",
+            "1,0,0",
+            "--size",
+            "40x8",
+            "--out",
+            "x.png",
+        ],
+        &dir,
+    );
+    assert_error(&out, &["40x8", "padded grid size 16"]);
+    let out = fvr(
+        &[
+            "render",
+            "sphere@16",
+            "--dir",
+            "1,0,0",
+            "--filter",
+            "kb9",
+            "--out",
+            "x.png",
+        ],
+        &dir,
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("unknown filter `kb9`"));
+    let out = fvr(
+        &["render", "sphere@16", "--dir", "1,0,0", "--out", "x.bmp"],
+        &dir,
+    );
+    assert_error(&out, &["x.bmp", ".png or .nrrd"]);
+    let out = fvr(
+        &["render", "nosuchthing", "--dir", "1,0,0", "--out", "x.png"],
+        &dir,
+    );
+    assert_error(
+        &out,
+        &["nosuchthing", "neither a file nor a built-in phantom"],
+    );
+    let out = fvr(
+        &["render", "sphere@99999", "--dir", "1,0,0", "--out", "x.png"],
+        &dir,
+    );
+    assert_error(&out, &["phantom size `99999`"]);
+}
+
+#[test]
+fn nan_voxels_truncated_and_malformed_files_are_named() {
+    let dir = temp_dir("files");
+    let mut values = vec![1.0; 4 * 4 * 4];
+    values[1 + 4 * (2 + 4 * 3)] = f64::NAN;
+    let nan = encode_nrrd(
+        &[4, 4, 4],
+        SampleType::F32,
+        Encoding::Raw,
+        Endian::Little,
+        &values,
+    );
+    std::fs::write(dir.join("nan.nrrd"), &nan).unwrap();
+    let out = fvr(
+        &["render", "nan.nrrd", "--dir", "1,0,0", "--out", "x.png"],
+        &dir,
+    );
+    assert_error(&out, &["NaN", "(1, 2, 3)"]);
+
+    let good = encode_nrrd(
+        &[4, 4, 4],
+        SampleType::U16,
+        Encoding::Gzip,
+        Endian::Big,
+        &[7.0; 64],
+    );
+    std::fs::write(dir.join("short.nrrd"), &good[..good.len() - 20]).unwrap();
+    let out = fvr(
+        &["render", "short.nrrd", "--dir", "1,0,0", "--out", "x.png"],
+        &dir,
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+
+    let bad = b"NRRD0004\ntype: complex\ndimension: 3\nsizes: 4 4 4\nencoding: raw\n\n";
+    std::fs::write(dir.join("bad.nrrd"), bad).unwrap();
+    let out = fvr(
+        &["render", "bad.nrrd", "--dir", "1,0,0", "--out", "x.png"],
+        &dir,
+    );
+    assert_error(&out, &["type", "complex"]);
+
+    let huge = b"NRRD0004\ntype: float\ndimension: 3\nsizes: 100000 100000 100000\nencoding: raw\nendian: little\n\n";
+    std::fs::write(dir.join("huge.nrrd"), huge).unwrap();
+    let out = fvr(
+        &["render", "huge.nrrd", "--dir", "1,0,0", "--out", "x.png"],
+        &dir,
+    );
+    assert_error(&out, &["bytes"]);
+}
+
+#[test]
+fn help_documents_the_geometry_contract_and_every_option() {
+    let dir = temp_dir("help");
+    let out = fvr(&["render", "--help"], &dir);
+    let text = String::from_utf8_lossy(&out.stdout);
+    for needle in [
+        "GEOMETRY CONTRACT",
+        "c = (nx/2, ny/2, nz/2)",
+        "--dir",
+        "--up",
+        "--size",
+        "--filter",
+        "--oversample",
+        "--precision",
+        "--out",
+        "--kb-design",
+        "gaussians",
+    ] {
+        assert!(text.contains(needle), "`{needle}` missing from help");
+    }
+}

@@ -1,0 +1,59 @@
+//! The f16 storage codec over all 65,536 bit patterns.
+
+use fvr_core::real::{Real, Sample};
+use half::f16;
+
+#[test]
+fn every_f16_bit_pattern_round_trips_through_f32_and_f64() {
+    for bits in 0..=u16::MAX {
+        let h = f16::from_bits(bits);
+        let wide32: f32 = Real::load(h);
+        let wide64: f64 = Real::load(h);
+        if h.is_nan() {
+            assert!(wide32.is_nan() && wide64.is_nan(), "{bits:#06x}");
+            assert!(!Sample::is_finite(h));
+            continue;
+        }
+        assert_eq!(wide32 as f64, wide64, "{bits:#06x}: widening is exact");
+        let back32: f16 = wide32.store();
+        let back64: f16 = wide64.store();
+        assert_eq!(back32.to_bits(), bits, "{bits:#06x} via f32");
+        assert_eq!(back64.to_bits(), bits, "{bits:#06x} via f64");
+        assert_eq!(Sample::is_finite(h), wide64.is_finite(), "{bits:#06x}");
+    }
+}
+
+#[test]
+fn f32_to_f16_rounds_to_nearest_even_between_every_pair_of_neighbours() {
+    // Between consecutive positive finite f16 values a < b, the midpoint must
+    // round to whichever has an even significand, and points just inside the
+    // interval to the nearer one.
+    for bits in 0..0x7BFFu16 {
+        let (a, b) = (f16::from_bits(bits), f16::from_bits(bits + 1));
+        let (fa, fb) = (a.to_f64(), b.to_f64());
+        let mid = 0.5 * (fa + fb);
+        let expect_mid = if bits % 2 == 0 { bits } else { bits + 1 };
+        let got: f16 = Real::store(mid);
+        assert_eq!(got.to_bits(), expect_mid, "midpoint above {bits:#06x}");
+        let got32: f16 = Real::store(mid as f32);
+        assert_eq!(
+            got32.to_bits(),
+            expect_mid,
+            "f32 midpoint above {bits:#06x}"
+        );
+        let below: f16 = Real::store(mid - (fb - fa) * 0.25);
+        assert_eq!(below.to_bits(), bits);
+        let above: f16 = Real::store(mid + (fb - fa) * 0.25);
+        assert_eq!(above.to_bits(), bits + 1);
+    }
+}
+
+#[test]
+fn values_beyond_the_f16_range_become_infinite_and_are_reported_non_finite() {
+    // 65520 is the midpoint between 65504 (max) and the next step: rounds up to ∞.
+    let over: f16 = Real::store(65520.0f32);
+    assert!(!Sample::is_finite(over));
+    let max: f16 = Real::store(65519.0f32);
+    assert_eq!(max.to_f64(), 65504.0);
+    assert_eq!(<f16 as Sample>::MAX_FINITE, 65504.0);
+}
