@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Runs every test of the project, installing what the tests need first.
+# Usage: bash scripts/test-all.sh
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+echo "== toolchain: thumbv7em-none-eabihf target (the core must build for Cortex-M4F)"
+rustup target add thumbv7em-none-eabihf
+
+echo "== no_std core for thumbv7em-none-eabihf"
+cargo build --locked -p fvr-core --target thumbv7em-none-eabihf --release
+
+echo "== lints"
+cargo fmt --all -- --check
+cargo clippy --locked --workspace --all-targets -- -D warnings
+
+echo "== tests (workspace)"
+cargo test --locked --workspace
+
+echo "== benchmarks compile"
+cargo bench --locked -p fvr-host --no-run
