@@ -36,7 +36,11 @@ fn benches(c: &mut Criterion) {
             let mut out = vec![0.0f32; n * n];
             let v = View::along([1.0, 0.3, 0.2]);
             view.bench_function(BenchmarkId::new(kind.name(), n), |b| {
-                b.iter(|| renderer.render_into(&spec, black_box(&v), n, n, &mut out).unwrap())
+                b.iter(|| {
+                    renderer
+                        .render_into(&spec, black_box(&v), n, n, &mut out)
+                        .unwrap()
+                })
             });
         }
     }
