@@ -98,6 +98,38 @@ pub enum Error {
     },
     /// The spectrum was prepared for another filter than the one asked for.
     FilterMismatch,
+    /// A scene parameter is NaN, infinite, or outside its documented range.
+    InvalidSceneValue {
+        /// Which parameter (e.g. "light colour", "depth-cue front weight").
+        what: &'static str,
+        /// Index of the light or profile point it belongs to (0 if none).
+        index: usize,
+        /// The value given.
+        value: f64,
+    },
+    /// A light direction is zero.
+    ZeroLightVector {
+        /// Index of the light.
+        index: usize,
+    },
+    /// More items than a fixed-capacity scene can hold.
+    TooMany {
+        /// What (e.g. "lights", "depth-profile points").
+        what: &'static str,
+        /// How many were given.
+        given: usize,
+        /// The capacity.
+        capacity: usize,
+    },
+    /// The filter's kernel has no usable derivative for gradient-based
+    /// depth cueing (nearest neighbour: its derivative is two impulses).
+    NoKernelDerivative,
+    /// The scene has directional lights but no `|∇f|` spectrum was given,
+    /// or the one given does not match the density spectrum.
+    GradientSpectrum {
+        /// What is wrong with it.
+        problem: &'static str,
+    },
 }
 
 /// Shorthand for results of this crate.
@@ -164,6 +196,25 @@ impl fmt::Display for Error {
                 f,
                 "the spectrum was premultiplied for a different filter or oversampling"
             ),
+            Error::InvalidSceneValue { what, index, value } => {
+                write!(f, "{what} #{index} is {value}, which is not allowed")
+            }
+            Error::ZeroLightVector { index } => write!(
+                f,
+                "light #{index} has a zero direction vector: give the direction towards the light"
+            ),
+            Error::TooMany {
+                what,
+                given,
+                capacity,
+            } => write!(f, "{given} {what} given, but a scene holds at most {capacity}"),
+            Error::NoKernelDerivative => write!(
+                f,
+                "the nearest-neighbour kernel has no usable derivative: linear depth cueing needs another filter"
+            ),
+            Error::GradientSpectrum { problem } => {
+                write!(f, "gradient-magnitude spectrum: {problem}")
+            }
         }
     }
 }

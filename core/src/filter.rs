@@ -278,6 +278,43 @@ impl Filter {
         }
     }
 
+    /// Kernel derivative `k'(t)` (index units), exact, in f64: the weights
+    /// of `∇H` for linear depth cueing (paper eq. 5).
+    ///
+    /// Kaiser–Bessel: with `r = 2|t|/W`, `s = √(1 − r²)`,
+    /// `k'(t) = −sign(t)·β²·(2r/W)·[I1(βs)/(βs)] / I0(β)`; Keys cubic and
+    /// linear: the derivatives of their polynomial pieces (0 at the linear
+    /// kernel's kink at `t = 0`). Nearest neighbour has no derivative worth
+    /// the name (two impulses) and returns 0; scenes refuse it.
+    pub fn kernel_derivative(&self, t: f64) -> f64 {
+        let a = libm::fabs(t);
+        let sign = if t < 0.0 { -1.0 } else { 1.0 };
+        let half = self.width() as f64 / 2.0;
+        let magnitude = match self.kind {
+            FilterKind::Nearest => 0.0,
+            FilterKind::Linear => {
+                if a > 0.0 && a < 1.0 {
+                    -1.0
+                } else {
+                    0.0
+                }
+            }
+            FilterKind::Cubic => keys_cubic_derivative(a),
+            _ => {
+                if a > half {
+                    0.0
+                } else {
+                    let w = self.width() as f64;
+                    let r = 2.0 * a / w;
+                    let x = self.beta * libm::sqrt(1.0 - r * r);
+                    -self.beta * self.beta * (2.0 * r / w) * bessel_i1_over_x(x)
+                        / bessel_i0(self.beta)
+                }
+            }
+        };
+        sign * magnitude
+    }
+
     /// Spatial response `ĥ(ν) = ∫ k(t) cos(2πνt) dt` at `ν` cycles per voxel.
     ///
     /// Closed forms: `sinc(ν)` for nearest, `sinc²(ν)` for linear, and for
@@ -361,6 +398,17 @@ fn sinc(x: f64) -> f64 {
     }
 }
 
+fn keys_cubic_derivative(a: f64) -> f64 {
+    const A: f64 = -0.5;
+    if a <= 1.0 {
+        (3.0 * (A + 2.0) * a - 2.0 * (A + 3.0)) * a
+    } else if a < 2.0 {
+        (3.0 * A * a - 10.0 * A) * a + 8.0 * A
+    } else {
+        0.0
+    }
+}
+
 fn keys_cubic(a: f64) -> f64 {
     const A: f64 = -0.5;
     if a <= 1.0 {
@@ -387,6 +435,20 @@ pub fn bessel_i0(x: f64) -> f64 {
     sum
 }
 
+/// `I1(x)/x` by its power series `½·Σ (x²/4)^k / (k!·(k+1)!)`, finite at 0.
+pub fn bessel_i1_over_x(x: f64) -> f64 {
+    let q = x * x / 4.0;
+    let mut term = 0.5;
+    let mut sum = 0.5;
+    let mut k = 1.0;
+    while term > 1e-17 * sum && k < 500.0 {
+        term *= q / (k * (k + 1.0));
+        sum += term;
+        k += 1.0;
+    }
+    sum
+}
+
 /// 16-point Gauss–Legendre nodes and weights on [−1, 1] (positive half;
 /// standard tabulated values, Abramowitz & Stegun table 25.4).
 const GL16: [(f64, f64); 8] = [
@@ -400,7 +462,7 @@ const GL16: [(f64, f64); 8] = [
     (0.989_400_934_991_649_9, 0.027_152_459_411_754_09),
 ];
 
-fn gauss_legendre_16(a: f64, b: f64, f: impl Fn(f64) -> f64) -> f64 {
+pub(crate) fn gauss_legendre_16(a: f64, b: f64, f: impl Fn(f64) -> f64) -> f64 {
     let mid = 0.5 * (a + b);
     let half = 0.5 * (b - a);
     let mut sum = 0.0;
@@ -484,6 +546,84 @@ impl<T: Real> KernelTable<T> {
         // q − j0 in (W/2 − 1, W/2]; exact in T because j0 is small.
         let d0 = q - T::from_f64(j0 as f64);
         let mut d = d0;
+        for wt in weights[..w].iter_mut() {
+            *wt = self.eval(d);
+            d -= T::ONE;
+        }
+        j0
+    }
+}
+
+/// The kernel derivative `k'` tabulated like [`KernelTable`] (odd: the table
+/// holds `k'(|t|)` and [`DerivativeTable::eval`] restores the sign). Built
+/// only for scenes that need `∇H` (linear depth cueing, paper eq. 5).
+///
+/// # Accuracy
+/// As [`KernelTable`], with `k'''` in place of `k''`: `Δ²/8·max|k'''|`,
+/// `Δ = 1/1024`.
+#[derive(Clone, Debug)]
+pub struct DerivativeTable<T> {
+    filter: Filter,
+    values: [T; TABLE_CAP],
+    len: usize,
+}
+
+impl<T: Real> DerivativeTable<T> {
+    /// Tabulate `filter`'s kernel derivative.
+    ///
+    /// # Errors
+    /// [`Error::NoKernelDerivative`] for nearest neighbour.
+    pub fn new(filter: Filter) -> Result<Self> {
+        if filter.kind == FilterKind::Nearest {
+            return Err(Error::NoKernelDerivative);
+        }
+        let len = filter.width() * TABLE_RESOLUTION / 2 + 1;
+        let mut values = [T::ZERO; TABLE_CAP];
+        for (i, v) in values[..len].iter_mut().enumerate() {
+            *v = T::from_f64(filter.kernel_derivative(i as f64 / TABLE_RESOLUTION as f64));
+        }
+        Ok(Self {
+            filter,
+            values,
+            len,
+        })
+    }
+
+    /// The filter whose derivative is tabulated.
+    pub fn filter(&self) -> &Filter {
+        &self.filter
+    }
+
+    /// `k'(t)` for `|t| ≤ W/2` (0 beyond).
+    #[inline(always)]
+    pub fn eval(&self, t: T) -> T {
+        let (a, negative) = if t < T::ZERO { (-t, true) } else { (t, false) };
+        let x = a * T::from_usize(TABLE_RESOLUTION);
+        let i = x.trunc_usize();
+        let v = if i + 1 >= self.len {
+            if i < self.len {
+                self.values[i]
+            } else {
+                T::ZERO
+            }
+        } else {
+            let f = x - T::from_usize(i);
+            self.values[i] + f * (self.values[i + 1] - self.values[i])
+        };
+        if negative {
+            -v
+        } else {
+            v
+        }
+    }
+
+    /// Derivative weights `k'(q − j0 − m)`, `m = 0 … W−1`, at the same taps
+    /// as [`KernelTable::taps`]; returns `j0`.
+    #[inline(always)]
+    pub fn taps(&self, q: T, weights: &mut [T; MAX_WIDTH]) -> i64 {
+        let w = self.filter.width();
+        let j0 = (q - T::from_usize(w) * T::HALF).floor_i64() + 1;
+        let mut d = q - T::from_f64(j0 as f64);
         for wt in weights[..w].iter_mut() {
             *wt = self.eval(d);
             d -= T::ONE;

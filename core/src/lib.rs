@@ -15,8 +15,11 @@ pub mod dht;
 pub mod error;
 pub mod filter;
 pub mod geometry;
+pub mod gradient;
 pub mod real;
 pub mod render;
+pub mod scene;
+pub mod scene_render;
 pub mod spectrum;
 
 pub use error::{Error, Result};

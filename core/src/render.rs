@@ -211,18 +211,52 @@ pub fn finish_projection<T: Real>(
     aux: &mut [T],
     out: &mut [T],
 ) -> Result<()> {
+    finish_channel(grid, m, place, gain, width, height, tw, aux, out, 1, 0)
+}
+
+/// [`finish_projection`] into channel `channel` of an interleaved image of
+/// `channels` channels (channel fastest: `out[(row·width + col)·channels +
+/// channel]`).
+///
+/// # Errors
+/// As [`render`], and `channel ≥ channels`.
+pub fn finish_channel<T: Real>(
+    grid: &mut [T],
+    m: usize,
+    place: &Placement,
+    gain: f64,
+    width: usize,
+    height: usize,
+    tw: &Twiddles<'_, T>,
+    aux: &mut [T],
+    out: &mut [T],
+    channels: usize,
+    channel: usize,
+) -> Result<()> {
     check_image(width, height, m)?;
+    if channel >= channels {
+        return Err(Error::LengthMismatch {
+            what: "channel index",
+            expected: channels,
+            got: channel,
+        });
+    }
+    require_len("slice grid", grid_len(m), grid.len())?;
     require_len("auxiliary scratch", aux_len(m), aux.len())?;
-    require_len("output image", width * height, out.len())?;
+    require_len("output image", width * height * channels, out.len())?;
     apply_shift(grid, m, place.shift, aux);
     dht_2d(grid, m, m, &mut aux[..m], tw)?;
     let g = T::from_f64(gain / (m * m) as f64);
     let mask = (m - 1) as i64;
-    for (row, line) in out.chunks_exact_mut(width).take(height).enumerate() {
+    for (row, line) in out
+        .chunks_exact_mut(width * channels)
+        .take(height)
+        .enumerate()
+    {
         let gy = ((place.row0 - row as i64) & mask) as usize;
-        for (col, o) in line.iter_mut().enumerate() {
+        for (col, o) in line.chunks_exact_mut(channels).enumerate() {
             let gx = ((place.col0 + col as i64) & mask) as usize;
-            *o = grid[gy * m + gx] * g;
+            o[channel] = grid[gy * m + gx] * g;
         }
     }
     Ok(())

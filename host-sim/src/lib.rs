@@ -8,4 +8,6 @@ pub mod phantom;
 pub mod pipeline;
 pub mod reference;
 pub mod scene;
+pub mod scene_reference;
+pub mod shaded;
 pub mod volume;

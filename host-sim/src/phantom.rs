@@ -142,7 +142,7 @@ pub struct Gaussian {
 
 impl Gaussian {
     /// `Rᵀ v / σ`: coordinates of `v` in the whitened principal frame.
-    fn whiten(&self, v: [f64; 3]) -> [f64; 3] {
+    pub fn whiten(&self, v: [f64; 3]) -> [f64; 3] {
         let y = mul_transpose(&self.rotation, v);
         [
             y[0] / self.sigmas[0],

@@ -1,0 +1,525 @@
+//! Rendering a [`Scene`]: depth cues and shading applied on the slice.
+//!
+//! # Hartley forms of the paper's operators
+//! Let `X(k) = Σ_x g(x)·cas(2πk·x/n)` be a stored spectrum (index units,
+//! `x` the signed position from the transform origin) and `X(q)` its
+//! interpolation at a real 3D index `q`. Differentiating under the sum,
+//! `∂X/∂q_a (q) = (2π/n)·Σ x_a·g·cas(−2πq·x/n)`, hence:
+//!
+//! - **Linear ramp (eq. 4–5).** `H{(d·x)·g}(k) = (n/2π)·(d·∇X)(−k)`: the
+//!   gradient filter `d·∇H` applied at the *mirrored* point `−k`. (In
+//!   Fourier terms `F{(d·x)g} = (i/2π)·d·∇F`; the factor `i` becomes the
+//!   mirror.) For a slice point `k` the cued sample is
+//!   `C_avg·X(k) + C_cue·(n/2π)·(d·∇X)(−k)`.
+//! - **Sinusoid (after eq. 5).** For `a` a 3D index offset,
+//!   `H{cos(2πa·x/n)·g}(k) = ½[X(k − a) + X(k + a)]` and
+//!   `H{sin(2πa·x/n)·g}(k) = ½[X(a − k) − X(−a − k)]`. All four values come
+//!   from the one neighbourhood of `k + a`: `U(k) = X(k + a)` read
+//!   directly and `V(k) = X(−(k + a))` read at the mirrored indices `−j`
+//!   with the same weights (the kernel is even). Then `X(k − a) = V(−k)`
+//!   and `X(a − k) = U(−k)`. This is the paper's "shifted H"; the Hartley
+//!   spectrum needs the mirrored read where a complex one holds `F` and
+//!   `F*` in one sample, so a sinusoid costs two reads per tap.
+//! - **First moment (eq. 11).** `H{∂_L f}(k) = −(2π/n)·(k·L)·X(−k)`.
+//! - **Both (eq. 12–14).** `∫w·∂_L f = ∫∂_L(w·f) − (d·L)·∫w'·f`: shading
+//!   the cued spectrum misses `−(d·L)` times the projection cued by `w'`.
+//!   For linear cueing `w' = C_cue` and the correction is eq. 14,
+//!   `½·C_cue·C_dif·L_dif·f·(V·L)`; for sinusoids `w'` is another sinusoid
+//!   read from the same neighbourhood, so it costs no extra reads.
+//!
+//! Terms that need the partner point `−k` are accumulated in a second grid
+//! `Q` and folded in at the end: `DC(k) = P(k) + Q(−k)`.
+//!
+//! Then channel `c`'s slice is
+//! `A_c·DC_f(k) + K_c·DC_|∇f|(k) + (2π/n)·(k·M_c)·DC_f(−k) + (d·M_c)·DC'_f(k)`
+//! with `K_c = Σ_l ½D_{l,c}` and `M_c = Σ_l ½D_{l,c}·L_l` (all lights in one
+//! moment), and is inverse-transformed like a plain projection.
+
+use crate::dht::{neg_mod, Twiddles};
+use crate::error::{require_len, Error, Result};
+use crate::filter::{DerivativeTable, KernelTable, MAX_WIDTH};
+use crate::geometry::View;
+use crate::real::{Real, Sample};
+use crate::render::{aux_len, check_image, extract_slice, finish_channel, placement, signed_index};
+use crate::scene::{Scene, ViewPlan};
+use crate::spectrum::Spectrum;
+
+const PI: f64 = core::f64::consts::PI;
+
+/// Scratch elements [`render_scene`] needs for `scene` on a spectrum of
+/// side `n`: [`Scene::field_count`] slice grids of `n²`.
+pub fn fields_len(scene: &Scene, n: usize) -> usize {
+    scene.field_count() * n * n
+}
+
+/// What one extraction pass computes at each slice point.
+mod mode {
+    /// `X(p)`.
+    pub const VALUE: u8 = 0;
+    /// `X(p)` and `(d·∇X)(p)`.
+    pub const VALUE_GRADIENT: u8 = 1;
+    /// `X(p)` and `X(−p)`.
+    pub const VALUE_MIRROR: u8 = 2;
+}
+
+/// A destination of a pass: `fields[field] += c0·r0 + c1·r1`.
+#[derive(Clone, Copy)]
+struct Target<T> {
+    field: usize,
+    c0: T,
+    c1: T,
+}
+
+/// The tables a pass reads.
+struct Tables<'k, T> {
+    kernel: &'k KernelTable<T>,
+    derivative: Option<&'k DerivativeTable<T>>,
+}
+
+/// Slice geometry in index units: `p = kx·r + ky·u + offset`.
+struct PassGeometry<T> {
+    right: [T; 3],
+    up: [T; 3],
+    dir: [T; 3],
+    offset: [T; 3],
+}
+
+fn run_pass<S: Sample, T: Real, const MODE: u8>(
+    spec: &Spectrum<'_, S>,
+    tables: &Tables<'_, T>,
+    geo: &PassGeometry<T>,
+    fields: &mut [T],
+    targets: &[Target<T>],
+) -> Result<()> {
+    let n = spec.n();
+    let nn = n * n;
+    let data = spec.data();
+    let w = tables.kernel.filter().width();
+    let mask = n - 1;
+    let nyquist = T::from_usize(n) * T::HALF;
+    let derivative = match (MODE, tables.derivative) {
+        (mode::VALUE_GRADIENT, None) => return Err(Error::NoKernelDerivative),
+        (_, d) => d,
+    };
+    for iy in 0..n {
+        let ky = T::from_f64(signed_index(iy, n) as f64);
+        for ix in 0..n {
+            let kx = T::from_f64(signed_index(ix, n) as f64);
+            let q: [T; 3] =
+                core::array::from_fn(|a| kx * geo.right[a] + ky * geo.up[a] + geo.offset[a]);
+            if q.iter().any(|&c| c > nyquist || -c > nyquist) {
+                continue;
+            }
+            let mut wts = [[T::ZERO; MAX_WIDTH]; 3];
+            let mut first = [0i64; 3];
+            for a in 0..3 {
+                first[a] = tables.kernel.taps(q[a], &mut wts[a]);
+            }
+            let index = |a: usize, t: usize| (first[a] + t as i64) as usize & mask;
+            let (r0, r1) = match MODE {
+                mode::VALUE_GRADIENT => {
+                    let mut dwts = [[T::ZERO; MAX_WIDTH]; 3];
+                    if let Some(table) = derivative {
+                        for a in 0..3 {
+                            table.taps(q[a], &mut dwts[a]);
+                        }
+                    }
+                    value_gradient(data, n, w, &index, &wts, &dwts, geo.dir)
+                }
+                mode::VALUE_MIRROR => value_mirror(data, n, w, &index, &wts),
+                _ => (value(data, n, w, &index, &wts), T::ZERO),
+            };
+            let i = iy * n + ix;
+            for t in targets {
+                fields[t.field * nn + i] += t.c0 * r0 + t.c1 * r1;
+            }
+        }
+    }
+    Ok(())
+}
+
+type Weights<T> = [[T; MAX_WIDTH]; 3];
+
+#[inline(always)]
+fn value<S: Sample, T: Real>(
+    data: &[S],
+    n: usize,
+    w: usize,
+    index: &impl Fn(usize, usize) -> usize,
+    wts: &Weights<T>,
+) -> T {
+    let mut acc = T::ZERO;
+    for c in 0..w {
+        let z = index(2, c) * n * n;
+        let mut acc_y = T::ZERO;
+        for b in 0..w {
+            let line = z + index(1, b) * n;
+            let mut acc_x = T::ZERO;
+            for t in 0..w {
+                acc_x += wts[0][t] * T::load(data[line + index(0, t)]);
+            }
+            acc_y += wts[1][b] * acc_x;
+        }
+        acc += wts[2][c] * acc_y;
+    }
+    acc
+}
+
+/// `X(p)` and `(d·∇X)(p)` from one neighbourhood: the separable gradient
+/// `∂_x = k'⊗k⊗k`, `∂_y = k⊗k'⊗k`, `∂_z = k⊗k⊗k'`.
+#[inline(always)]
+fn value_gradient<S: Sample, T: Real>(
+    data: &[S],
+    n: usize,
+    w: usize,
+    index: &impl Fn(usize, usize) -> usize,
+    wts: &Weights<T>,
+    dwts: &Weights<T>,
+    dir: [T; 3],
+) -> (T, T) {
+    let (mut value, mut grad) = (T::ZERO, T::ZERO);
+    for c in 0..w {
+        let z = index(2, c) * n * n;
+        let (mut v_y, mut gx_y, mut gy_y) = (T::ZERO, T::ZERO, T::ZERO);
+        for b in 0..w {
+            let line = z + index(1, b) * n;
+            let (mut v_x, mut gx_x) = (T::ZERO, T::ZERO);
+            for t in 0..w {
+                let s = T::load(data[line + index(0, t)]);
+                v_x += wts[0][t] * s;
+                gx_x += dwts[0][t] * s;
+            }
+            v_y += wts[1][b] * v_x;
+            gx_y += wts[1][b] * gx_x;
+            gy_y += dwts[1][b] * v_x;
+        }
+        value += wts[2][c] * v_y;
+        grad += wts[2][c] * (dir[0] * gx_y + dir[1] * gy_y) + dir[2] * dwts[2][c] * v_y;
+    }
+    (value, grad)
+}
+
+/// `X(p)` and `X(−p)`: the same weights on the taps `j` and `−j`.
+#[inline(always)]
+fn value_mirror<S: Sample, T: Real>(
+    data: &[S],
+    n: usize,
+    w: usize,
+    index: &impl Fn(usize, usize) -> usize,
+    wts: &Weights<T>,
+) -> (T, T) {
+    let mask = n - 1;
+    let (mut direct, mut mirror) = (T::ZERO, T::ZERO);
+    for c in 0..w {
+        let zi = index(2, c);
+        let (z, zm) = (zi * n * n, ((n - zi) & mask) * n * n);
+        let (mut d_y, mut m_y) = (T::ZERO, T::ZERO);
+        for b in 0..w {
+            let yi = index(1, b);
+            let (line, line_m) = (z + yi * n, zm + ((n - yi) & mask) * n);
+            let (mut d_x, mut m_x) = (T::ZERO, T::ZERO);
+            for t in 0..w {
+                let xi = index(0, t);
+                d_x += wts[0][t] * T::load(data[line + xi]);
+                m_x += wts[0][t] * T::load(data[line_m + ((n - xi) & mask)]);
+            }
+            d_y += wts[1][b] * d_x;
+            m_y += wts[1][b] * m_x;
+        }
+        direct += wts[2][c] * d_y;
+        mirror += wts[2][c] * m_y;
+    }
+    (direct, mirror)
+}
+
+/// Where each accumulator lives in the fields buffer.
+#[derive(Clone, Copy)]
+struct Accumulators {
+    /// Own-point part `P`.
+    own: usize,
+    /// Partner part `Q` (folded in as `Q(−k)`), if the cue has one.
+    partner: Option<usize>,
+}
+
+/// Accumulate the cued spectrum `spec` (times `gain`) into `acc`, and the
+/// `w'`-cued one into `acc_derivative` if given.
+fn accumulate_cue<S: Sample, T: Real>(
+    spec: &Spectrum<'_, S>,
+    tables: &Tables<'_, T>,
+    plan: &ViewPlan,
+    frame: &crate::geometry::Frame,
+    gain: f64,
+    acc: Accumulators,
+    acc_derivative: Option<Accumulators>,
+    fields: &mut [T],
+) -> Result<()> {
+    let n = spec.n() as f64;
+    let mut geo = PassGeometry {
+        right: frame.right.map(T::from_f64),
+        up: frame.up.map(T::from_f64),
+        dir: frame.dir.map(T::from_f64),
+        offset: [T::ZERO; 3],
+    };
+    let mut targets: heapless::Vec<Target<T>, 4> = heapless::Vec::new();
+    let push = |targets: &mut heapless::Vec<Target<T>, 4>, field, c0: f64, c1: f64| {
+        if c0 != 0.0 || c1 != 0.0 {
+            // At most 4 targets per pass: P, Q, P', Q'.
+            let _ = targets.push(Target {
+                field,
+                c0: T::from_f64(gain * c0),
+                c1: T::from_f64(gain * c1),
+            });
+        }
+    };
+    if plan.slope != 0.0 {
+        let partner = acc.partner.ok_or(Error::GradientSpectrum {
+            problem: "internal: no partner accumulator for a sloped cue",
+        })?;
+        push(&mut targets, acc.own, plan.base, 0.0);
+        push(&mut targets, partner, 0.0, plan.slope * n / (2.0 * PI));
+        if let Some(d) = acc_derivative {
+            push(&mut targets, d.own, plan.slope, 0.0);
+        }
+        run_pass::<S, T, { mode::VALUE_GRADIENT }>(spec, tables, &geo, fields, &targets)?;
+    } else if plan.base != 0.0 {
+        push(&mut targets, acc.own, plan.base, 0.0);
+        run_pass::<S, T, { mode::VALUE }>(spec, tables, &geo, fields, &targets)?;
+    }
+    for wave in plan.waves.iter() {
+        let Some(partner) = acc.partner else {
+            return Err(Error::GradientSpectrum {
+                problem: "internal: no partner accumulator for a sinusoidal cue",
+            });
+        };
+        targets.clear();
+        let shift = wave.nu * n;
+        geo.offset = frame.dir.map(|c| T::from_f64(c * shift));
+        let (s, c) = (libm::sin(wave.phase), libm::cos(wave.phase));
+        let half = 0.5 * wave.amplitude;
+        push(&mut targets, acc.own, half * s, -half * c);
+        push(&mut targets, partner, half * c, half * s);
+        if let Some(d) = acc_derivative {
+            // w' = 2πν·A·sin(2πντ + φ + π/2): sin → cos, cos → −sin.
+            let half_d = half * 2.0 * PI * wave.nu;
+            push(&mut targets, d.own, half_d * c, half_d * s);
+            if let Some(dp) = d.partner {
+                push(&mut targets, dp, -half_d * s, half_d * c);
+            }
+        }
+        run_pass::<S, T, { mode::VALUE_MIRROR }>(spec, tables, &geo, fields, &targets)?;
+    }
+    Ok(())
+}
+
+/// `P(k) += Q(−k)` over the `n × n` slice.
+fn fold_partner<T: Real>(fields: &mut [T], n: usize, acc: Accumulators) {
+    let Some(q) = acc.partner else { return };
+    let nn = n * n;
+    for iy in 0..n {
+        let my = neg_mod(iy, n);
+        for ix in 0..n {
+            let partner = fields[q * nn + my * n + neg_mod(ix, n)];
+            fields[acc.own * nn + iy * n + ix] += partner;
+        }
+    }
+}
+
+/// Render `scene` seen along `view` into `out`: `width × height` pixels of
+/// [`Scene::channels`] interleaved channels (channel fastest), row 0 at the
+/// top, in the units of the module docs' integral.
+///
+/// - `gradient` is the `|∇f|` spectrum ([`crate::gradient`]), required iff
+///   [`Scene::needs_gradient_spectrum`], with the same side, filter and
+///   volume dims as `density`;
+/// - `derivative` is required iff [`Scene::needs_kernel_derivative`];
+/// - `fields` needs [`fields_len`]`(scene, n)` elements and `aux`
+///   [`aux_len`]`(n)`; `out` needs `channels·width·height`.
+///
+/// Returns the number of channels written.
+///
+/// # Errors
+/// As [`crate::render::render`], plus invalid scene values
+/// ([`Scene::validate`]), a missing or mismatched gradient spectrum, and a
+/// missing derivative table.
+pub fn render_scene<S: Sample, T: Real>(
+    density: &Spectrum<'_, S>,
+    gradient: Option<&Spectrum<'_, S>>,
+    kernel: &KernelTable<T>,
+    derivative: Option<&DerivativeTable<T>>,
+    scene: &Scene,
+    view: &View,
+    width: usize,
+    height: usize,
+    tw: &Twiddles<'_, T>,
+    fields: &mut [T],
+    aux: &mut [T],
+    out: &mut [T],
+) -> Result<usize> {
+    let frame = view.frame()?;
+    let n = density.n();
+    let nn = n * n;
+    check_image(width, height, n)?;
+    if kernel.filter() != density.filter() {
+        return Err(Error::FilterMismatch);
+    }
+    let plan = ViewPlan::new(scene, &frame, density.dims())?;
+    let channels = plan.channels.len();
+    require_len("scene fields", fields_len(scene, n), fields.len())?;
+    require_len("auxiliary scratch", aux_len(n), aux.len())?;
+    require_len("output image", channels * width * height, out.len())?;
+    if n > tw.len() {
+        return Err(Error::TwiddlesTooShort {
+            table_len: tw.len(),
+            needed: n,
+        });
+    }
+    if plan.slope != 0.0 {
+        match derivative {
+            None => return Err(Error::NoKernelDerivative),
+            Some(d) if d.filter() != density.filter() => return Err(Error::FilterMismatch),
+            Some(_) => {}
+        }
+    }
+    let gradient = if scene.needs_gradient_spectrum() {
+        let g = gradient.ok_or(Error::GradientSpectrum {
+            problem: "the scene has lights but none was given",
+        })?;
+        if g.n() != n || g.filter() != density.filter() || g.dims() != density.dims() {
+            return Err(Error::GradientSpectrum {
+                problem: "its side, filter or volume dims differ from the density spectrum's",
+            });
+        }
+        Some(g)
+    } else {
+        None
+    };
+    let place = placement(density.dims(), &frame, width, height);
+    let gain = 1.0 / density.scale();
+    let tables = Tables { kernel, derivative };
+    let fields = &mut fields[..fields_len(scene, n)];
+    fields.fill(T::ZERO);
+
+    // Field layout, matching Scene::field_count.
+    let partner = scene.has_partner_terms();
+    let partner_slots = if partner { 2 } else { 1 };
+    let mut next = 0;
+    let mut take = |slots: usize| {
+        let acc = Accumulators {
+            own: next,
+            partner: if slots == 2 { Some(next + 1) } else { None },
+        };
+        next += slots;
+        acc
+    };
+    let density_acc = take(partner_slots);
+
+    if channels == 1 {
+        let a = plan.channels[0].ambient;
+        if !partner {
+            // The plain path: one extraction, no accumulators.
+            extract_slice(density, kernel, &frame, &mut fields[..nn]);
+        } else {
+            accumulate_cue(
+                density,
+                &tables,
+                &plan,
+                &frame,
+                1.0,
+                density_acc,
+                None,
+                fields,
+            )?;
+            fold_partner(fields, n, density_acc);
+        }
+        finish_channel(
+            &mut fields[..nn],
+            n,
+            &place,
+            gain * a,
+            width,
+            height,
+            tw,
+            aux,
+            out,
+            1,
+            0,
+        )?;
+        return Ok(1);
+    }
+
+    let output = take(1).own;
+    let gradient_acc = gradient.map(|_| take(partner_slots));
+    let derivative_acc = if scene.needs_cue_derivative_fields() {
+        Some(take(partner_slots))
+    } else {
+        None
+    };
+    accumulate_cue(
+        density,
+        &tables,
+        &plan,
+        &frame,
+        1.0,
+        density_acc,
+        derivative_acc,
+        fields,
+    )?;
+    fold_partner(fields, n, density_acc);
+    if let Some(d) = derivative_acc {
+        fold_partner(fields, n, d);
+    }
+    if let (Some(g), Some(acc)) = (gradient, gradient_acc) {
+        // Bring |∇f| to the density's scaled units.
+        accumulate_cue(
+            g,
+            &tables,
+            &plan,
+            &frame,
+            density.scale() / g.scale(),
+            acc,
+            None,
+            fields,
+        )?;
+        fold_partner(fields, n, acc);
+    }
+    let moment_unit = 2.0 * PI / n as f64;
+    for (c, ch) in plan.channels.iter().enumerate() {
+        let (a, k) = (T::from_f64(ch.ambient), T::from_f64(ch.gradient));
+        let mr = T::from_f64(ch.moment[0] * moment_unit);
+        let mu = T::from_f64(ch.moment[1] * moment_unit);
+        let along = T::from_f64(ch.along_view);
+        for iy in 0..n {
+            let ky = T::from_f64(signed_index(iy, n) as f64);
+            let my = neg_mod(iy, n);
+            for ix in 0..n {
+                let kx = T::from_f64(signed_index(ix, n) as f64);
+                let i = iy * n + ix;
+                let mirror = my * n + neg_mod(ix, n);
+                let f = &*fields;
+                let mut s = a * f[density_acc.own * nn + i]
+                    + (kx * mr + ky * mu) * f[density_acc.own * nn + mirror];
+                if let Some(g) = gradient_acc {
+                    s += k * f[g.own * nn + i];
+                }
+                if let Some(d) = derivative_acc {
+                    s += along * f[d.own * nn + i];
+                }
+                fields[output * nn + i] = s;
+            }
+        }
+        finish_channel(
+            &mut fields[output * nn..(output + 1) * nn],
+            n,
+            &place,
+            gain,
+            width,
+            height,
+            tw,
+            aux,
+            out,
+            channels,
+            c,
+        )?;
+    }
+    Ok(channels)
+}
