@@ -129,6 +129,17 @@ impl Scene {
         }
     }
 
+    /// Add a light.
+    ///
+    /// # Errors
+    /// [`Error::TooMany`] beyond [`MAX_LIGHTS`].
+    pub fn add_light(&mut self, light: Light) -> Result<()> {
+        let given = self.lights.len() + 1;
+        self.lights
+            .push(light)
+            .map_err(|_| too_many("lights", given, MAX_LIGHTS))
+    }
+
     /// Check every value against its documented range.
     ///
     /// # Errors

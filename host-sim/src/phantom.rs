@@ -15,6 +15,11 @@ pub trait Phantom {
     /// Exact `∫ density(origin + t·dir) dt` over the whole line, for a
     /// **unit** vector `dir`.
     fn line_integral(&self, origin: [f64; 3], dir: [f64; 3]) -> f64;
+    /// The phantom as a Gaussian mixture, if it is one (shading references
+    /// have closed forms for mixtures only).
+    fn as_gaussian_mixture(&self) -> Option<&GaussianMixture> {
+        None
+    }
 }
 
 /// Sample the density at every voxel centre `(i, j, k)` into a [`Volume`].
@@ -197,10 +202,16 @@ impl GaussianMixture {
     /// Only IEEE-exact operations (`+ - * / sqrt`) touch the random numbers,
     /// so a seed gives the same mixture on every platform.
     pub fn random(seed: u64, n: usize, count: usize) -> Self {
+        Self::random_with(seed, n, count, 0.12)
+    }
+
+    /// As [`GaussianMixture::random`] with sigmas in
+    /// `[1.5, max(1.5, sigma_fraction·n)]`.
+    pub fn random_with(seed: u64, n: usize, count: usize, sigma_fraction: f64) -> Self {
         let mut rng = SplitMix64::new(seed);
         let nf = n as f64;
         let c = nf / 2.0;
-        let sigma_hi = (0.12 * nf).max(1.5);
+        let sigma_hi = (sigma_fraction * nf).max(1.5);
         let components = (0..count)
             .map(|_| {
                 let sigmas = [(); 3].map(|_| rng.uniform(1.5, sigma_hi));
@@ -233,6 +244,10 @@ impl GaussianMixture {
 impl Phantom for GaussianMixture {
     fn density(&self, p: [f64; 3]) -> f64 {
         self.components.iter().map(|g| g.density(p)).sum()
+    }
+
+    fn as_gaussian_mixture(&self) -> Option<&GaussianMixture> {
+        Some(self)
     }
 
     fn line_integral(&self, origin: [f64; 3], dir: [f64; 3]) -> f64 {

@@ -14,10 +14,15 @@ pub const MAX_PHANTOM_SIZE: usize = 1024;
 pub const DEFAULT_SEED: u64 = 1;
 /// Components of the `gaussians` phantom.
 pub const GAUSSIAN_COUNT: usize = 8;
+/// Components of the `blobs` phantom.
+pub const BLOB_COUNT: usize = 24;
+/// Largest σ of the `blobs` phantom, as a fraction of its side.
+pub const BLOB_SIGMA_FRACTION: f64 = 0.05;
 
 /// The built-in phantoms, as `name[@SIZE][:SEED]`.
 pub const PHANTOM_HELP: &str = "built-in phantoms: `gaussians[@N][:SEED]` (8 random anisotropic \
-Gaussians, sigma >= 1.5 voxels, inside the sphere of radius 0.4 N), `shepp-logan[@N]` (modified 3D \
+Gaussians, sigma 1.5 to 0.12 N voxels, inside the sphere of radius 0.4 N), `blobs[@N][:SEED]` (24 \
+smaller ones, sigma 1.5 to 0.05 N), `shepp-logan[@N]` (modified 3D \
 Shepp-Logan), `sphere[@N]` (uniform ball of radius 0.3 N); N defaults to 64";
 
 /// A phantom with its sampled volume.
@@ -42,7 +47,7 @@ pub fn phantom_by_name(spec: &str) -> Option<Result<PhantomVolume, String>> {
         Some((n, s)) => (n, Some(s)),
         None => (head, None),
     };
-    if !["gaussians", "shepp-logan", "sphere"].contains(&name) {
+    if !["gaussians", "blobs", "shepp-logan", "sphere"].contains(&name) {
         return None;
     }
     Some(build_phantom(name, size, seed))
@@ -65,7 +70,7 @@ fn build_phantom(
     };
     let seed = match seed {
         None => DEFAULT_SEED,
-        Some(s) if name == "gaussians" => s
+        Some(s) if name == "gaussians" || name == "blobs" => s
             .parse::<u64>()
             .map_err(|_| format!("phantom seed `{s}` must be a non-negative integer"))?,
         Some(_) => return Err(format!("phantom `{name}` takes no seed")),
@@ -73,6 +78,12 @@ fn build_phantom(
     let dims = [n, n, n];
     let phantom: Box<dyn Phantom> = match name {
         "gaussians" => Box::new(GaussianMixture::random(seed, n, GAUSSIAN_COUNT)),
+        "blobs" => Box::new(GaussianMixture::random_with(
+            seed,
+            n,
+            BLOB_COUNT,
+            BLOB_SIGMA_FRACTION,
+        )),
         "shepp-logan" => Box::new(SheppLogan::new(dims)),
         _ => Box::new(Sphere {
             center: dims.map(|d| d as f64 / 2.0),

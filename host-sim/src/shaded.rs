@@ -9,7 +9,7 @@ use fvr_core::geometry::View;
 use fvr_core::gradient::{gradient_magnitude, gradient_scratch_len};
 use fvr_core::real::{Real, Sample};
 use fvr_core::render::aux_len;
-use fvr_core::scene::Scene;
+use fvr_core::scene::{DepthCue, Light, Scene, MAX_PROFILE_POINTS};
 use fvr_core::scene_render::{fields_len, render_scene};
 use fvr_core::spectrum::DenseVolume;
 
@@ -233,4 +233,298 @@ impl<T: Real> SceneRenderer<T> {
             out,
         )
     }
+}
+
+/// Default harmonics for `profile:` depth cues.
+pub const DEFAULT_PROFILE_HARMONICS: usize = 8;
+
+/// Points a `profile:gauss:CENTER,WIDTH` formula is sampled at.
+const FORMULA_POINTS: usize = 33;
+
+/// Text for `--depth-cue` help.
+pub const DEPTH_CUE_HELP: &str = "\
+Depth cue, with t the depth from the volume's centre along the view and R half its largest \
+dimension; FRONT applies at t = -R, BACK at t = +R:
+  linear:FRONT,BACK   w = C_avg + C_cue t (paper eq. 3-5; the gradient filter)
+  sine:FRONT,BACK     DC-free sine through FRONT and BACK, crest at the brighter end (one shifted \
+filter; departs from linear by up to 0.21 for 1,0)
+  profile:W0,W1,...   weights at equally spaced depths from front to back, joined linearly \
+(2 to 64 points)
+  profile:@FILE       the same weights read from FILE (numbers separated by commas, spaces or \
+newlines; # starts a comment)
+  profile:gauss:C,S   a Gaussian bump exp(-((t/R - C)/S)^2/2), e.g. gauss:0,0.4 highlights the \
+middle
+Profiles are fitted with --cue-harmonics cosine terms (default 8), each costing about two plain \
+extractions. Weights must be finite and >= 0 (negative ones are refused).";
+
+fn parse_numbers(text: &str) -> Result<Vec<f64>, String> {
+    text.lines()
+        .map(|l| l.split('#').next().unwrap_or(""))
+        .flat_map(|l| l.split([',', ' ', '\t', ';']))
+        .filter(|t| !t.trim().is_empty())
+        .map(|t| {
+            t.trim()
+                .parse::<f64>()
+                .map_err(|_| format!("`{t}` is not a number"))
+        })
+        .collect()
+}
+
+/// Parse a `--depth-cue` value (see [`DEPTH_CUE_HELP`]).
+///
+/// # Errors
+/// An unknown form, a malformed number, an unreadable file, or a profile
+/// outside 2–64 points. Range checks (non-negative weights) are the
+/// scene's: [`Scene::validate`].
+pub fn parse_depth_cue(spec: &str, harmonics: usize) -> Result<DepthCue, String> {
+    let pair = |rest: &str, kind: &str| -> Result<(f64, f64), String> {
+        match parse_numbers(rest)?.as_slice() {
+            [f, b] => Ok((*f, *b)),
+            _ => Err(format!(
+                "`{kind}:` needs two weights FRONT,BACK, got `{rest}`"
+            )),
+        }
+    };
+    let weights = |values: Vec<f64>| -> Result<DepthCue, String> {
+        if values.len() < 2 || values.len() > MAX_PROFILE_POINTS {
+            return Err(format!(
+                "a depth profile needs 2 to {MAX_PROFILE_POINTS} weights, got {}",
+                values.len()
+            ));
+        }
+        Ok(DepthCue::Profile {
+            weights: values.into_iter().collect(),
+            harmonics,
+        })
+    };
+    if spec == "none" {
+        Ok(DepthCue::None)
+    } else if let Some(rest) = spec.strip_prefix("linear:") {
+        let (front, back) = pair(rest, "linear")?;
+        Ok(DepthCue::Linear { front, back })
+    } else if let Some(rest) = spec.strip_prefix("sine:") {
+        let (front, back) = pair(rest, "sine")?;
+        Ok(DepthCue::Sine { front, back })
+    } else if let Some(path) = spec.strip_prefix("profile:@") {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| format!("cannot read depth profile `{path}`: {e}"))?;
+        weights(parse_numbers(&text).map_err(|e| format!("depth profile `{path}`: {e}"))?)
+    } else if let Some(rest) = spec.strip_prefix("profile:gauss:") {
+        let (c, s) = pair(rest, "profile:gauss")?;
+        if !(s.is_finite() && s > 0.0 && c.is_finite()) {
+            return Err(format!(
+                "profile:gauss:C,S needs a finite centre and a width > 0, got `{rest}`"
+            ));
+        }
+        weights(
+            (0..FORMULA_POINTS)
+                .map(|i| {
+                    let t = -1.0 + 2.0 * i as f64 / (FORMULA_POINTS - 1) as f64;
+                    (-0.5 * ((t - c) / s).powi(2)).exp()
+                })
+                .collect(),
+        )
+    } else if let Some(rest) = spec.strip_prefix("profile:") {
+        weights(parse_numbers(rest)?)
+    } else {
+        Err(format!(
+            "unknown depth cue `{spec}`: expected none, linear:FRONT,BACK, sine:FRONT,BACK, \
+             profile:W0,W1,..., profile:@FILE or profile:gauss:C,S"
+        ))
+    }
+}
+
+/// Parse a colour `R,G,B` or a single grey value.
+///
+/// # Errors
+/// Not one or three numbers.
+pub fn parse_rgb(s: &str) -> Result<[f64; 3], String> {
+    match parse_numbers(s)?.as_slice() {
+        [g] => Ok([*g; 3]),
+        [r, g, b] => Ok([*r, *g, *b]),
+        _ => Err(format!(
+            "expected a colour R,G,B or one grey value, got `{s}`"
+        )),
+    }
+}
+
+/// Parse a `--light X,Y,Z:R,G,B` (direction towards the light, colour).
+///
+/// # Errors
+/// A malformed direction or colour. Zero directions and negative colours
+/// are the scene's to refuse ([`Scene::validate`]).
+pub fn parse_light(s: &str) -> Result<Light, String> {
+    let (dir, color) = s
+        .split_once(':')
+        .ok_or_else(|| format!("expected a light X,Y,Z:R,G,B, got `{s}`"))?;
+    let towards = match parse_numbers(dir)?.as_slice() {
+        [x, y, z] => [*x, *y, *z],
+        _ => return Err(format!("light direction must be X,Y,Z, got `{dir}`")),
+    };
+    Ok(Light {
+        towards,
+        color: parse_rgb(color)?,
+    })
+}
+
+impl Image {
+    /// Write as a float32 NRRD: `sizes: W H` for grey, `sizes: 3 W H`
+    /// (channel fastest) for RGB.
+    ///
+    /// # Errors
+    /// File errors, with the path.
+    pub fn write_nrrd(&self, path: &std::path::Path) -> Result<(), String> {
+        let data: Vec<f32> = self.data.iter().map(|&v| v as f32).collect();
+        let sizes: Vec<usize> = if self.channels == 1 {
+            vec![self.width, self.height]
+        } else {
+            vec![self.channels, self.width, self.height]
+        };
+        crate::nrrd::write_nrrd_f32(path, &sizes, &data).map_err(|e| e.to_string())
+    }
+
+    /// Write as an 8-bit PNG, grey or RGB, auto-windowed over all channels
+    /// together (one window keeps the lights' colour balance).
+    ///
+    /// # Errors
+    /// File or encoding errors, with the path.
+    pub fn write_png(&self, path: &std::path::Path) -> Result<(), String> {
+        if self.channels == 1 {
+            return crate::image::write_png(path, self.width, self.height, &self.data);
+        }
+        let window = crate::image::auto_window(&self.data);
+        let bytes = crate::image::to_gray8(&self.data, window);
+        let fail =
+            |e: &dyn std::fmt::Display| format!("cannot write PNG `{}`: {e}", path.display());
+        let file = std::fs::File::create(path).map_err(|e| fail(&e))?;
+        let mut enc = png::Encoder::new(
+            std::io::BufWriter::new(file),
+            self.width as u32,
+            self.height as u32,
+        );
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        let mut writer = enc.write_header().map_err(|e| fail(&e))?;
+        writer.write_image_data(&bytes).map_err(|e| fail(&e))?;
+        writer.finish().map_err(|e| fail(&e))
+    }
+}
+
+/// How much of the image a depth cue weights negatively on `view`: the
+/// weights are given between `t = −R` and `+R`, and oblique views reach
+/// beyond into the box's corners, where a linear cue can extrapolate below
+/// zero. Returns `(lowest weight, share)` where `share` is
+/// `Σ_{w<0} |w·f| / Σ |w·f|` over the voxels (0 when no voxel is weighted
+/// negatively).
+///
+/// # Errors
+/// Bad view vectors or scene values.
+pub fn negative_cue_share(
+    volume: &Volume,
+    scene: &Scene,
+    view: &View,
+) -> Result<(f64, f64), fvr_core::Error> {
+    let frame = view.frame()?;
+    let d = frame.dir;
+    let dims = volume.dims;
+    let c = fvr_core::geometry::center(dims);
+    let radius = dims.iter().copied().max().unwrap_or(1) as f64 / 2.0;
+    let terms = fvr_core::scene::CueTerms::new(&scene.cue, radius)?;
+    // The weight on a table over the box's depth range (it is smooth).
+    let reach: f64 = (0..3)
+        .map(|a| d[a].abs() * dims[a] as f64 / 2.0)
+        .sum::<f64>()
+        + 1.0;
+    const STEPS: usize = 4096;
+    let table: Vec<f64> = (0..=STEPS)
+        .map(|s| terms.weight(-reach + 2.0 * reach * s as f64 / STEPS as f64))
+        .collect();
+    let lowest = table.iter().copied().fold(f64::INFINITY, f64::min);
+    if lowest >= 0.0 {
+        return Ok((lowest, 0.0));
+    }
+    let (mut negative, mut total) = (0.0f64, 0.0f64);
+    for k in 0..dims[2] {
+        for j in 0..dims[1] {
+            let row = (j as f64 - c[1]) * d[1] + (k as f64 - c[2]) * d[2];
+            for i in 0..dims[0] {
+                let v = volume.data[i + dims[0] * (j + dims[1] * k)].abs() as f64;
+                let t = row + (i as f64 - c[0]) * d[0];
+                let s = ((t + reach) / (2.0 * reach) * STEPS as f64).round() as usize;
+                let w = table[s.min(STEPS)];
+                total += (w * v).abs();
+                if w < 0.0 {
+                    negative -= w * v;
+                }
+            }
+        }
+    }
+    Ok((lowest, if total > 0.0 { negative / total } else { 0.0 }))
+}
+
+/// `count` lights evenly spaced around the view axis, as in the paper's
+/// figure 8, starting at the top of the image and going counter-clockwise,
+/// each tilted `tilt_degrees` from the image plane towards the eye, with
+/// fully saturated colours evenly spaced in hue (3 lights: red, green,
+/// blue).
+///
+/// # Errors
+/// Bad view vectors.
+pub fn light_ring(
+    view: &View,
+    count: usize,
+    tilt_degrees: f64,
+) -> Result<Vec<Light>, fvr_core::Error> {
+    let frame = view.frame()?;
+    let tilt = tilt_degrees.to_radians();
+    Ok((0..count)
+        .map(|i| {
+            let frac = i as f64 / count as f64;
+            let theta = std::f64::consts::FRAC_PI_2 + 2.0 * std::f64::consts::PI * frac;
+            let towards: [f64; 3] = std::array::from_fn(|a| {
+                tilt.cos() * (frame.right[a] * theta.cos() + frame.up[a] * theta.sin())
+                    - tilt.sin() * frame.dir[a]
+            });
+            Light {
+                towards,
+                color: hue(frac),
+            }
+        })
+        .collect())
+}
+
+/// A saturated colour at `frac` of the hue circle (0 red, ⅓ green, ⅔ blue).
+fn hue(frac: f64) -> [f64; 3] {
+    std::array::from_fn(|c| {
+        let d = (frac * 3.0 - c as f64).rem_euclid(3.0);
+        let d = d.min(3.0 - d);
+        (1.0 - d).max(0.0)
+    })
+}
+
+/// Parse `--light-ring N[:TILT]`.
+///
+/// # Errors
+/// Not a count from 1 to 8 and an optional finite angle.
+pub fn parse_light_ring(s: &str) -> Result<(usize, f64), String> {
+    let (count, tilt) = match s.split_once(':') {
+        Some((c, t)) => (c, Some(t)),
+        None => (s, None),
+    };
+    let count: usize = count
+        .trim()
+        .parse()
+        .ok()
+        .filter(|c| (1..=fvr_core::scene::MAX_LIGHTS).contains(c))
+        .ok_or_else(|| format!("light ring needs a count from 1 to 8, got `{s}`"))?;
+    let tilt = match tilt {
+        Some(t) => t
+            .trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|t| t.is_finite())
+            .ok_or_else(|| format!("light ring tilt must be degrees, got `{s}`"))?,
+        None => 30.0,
+    };
+    Ok((count, tilt))
 }

@@ -7,15 +7,24 @@ use std::time::Instant;
 use clap::{Args, Parser, Subcommand};
 use fvr_core::filter::FilterKind;
 use fvr_core::geometry::{View, DEFAULT_UP};
-use fvr_host::image::write_png;
-use fvr_host::nrrd::{read_nrrd, write_nrrd_f32, Endian, SampleType};
-use fvr_host::pipeline::{choose_filter, AnySpectrum, KbDesign, Precision};
+use fvr_core::scene::{Light, Scene, MAX_LIGHTS};
+use fvr_host::nrrd::{read_nrrd, Endian, SampleType};
+use fvr_host::pipeline::{choose_filter, KbDesign, Precision};
 use fvr_host::reference::{exact_projection, max_abs_error, snr_db};
 use fvr_host::scene::{load_volume, phantom_by_name, RawLayout, PHANTOM_HELP};
+use fvr_host::scene_reference::exact_scene_projection;
+use fvr_host::shaded::{
+    light_ring, negative_cue_share, parse_depth_cue, parse_light, parse_light_ring, parse_rgb,
+    SceneRenderer, SceneSpectra, DEFAULT_PROFILE_HARMONICS, DEPTH_CUE_HELP,
+};
 
 /// Below this estimated storage SNR the renderer warns (see
 /// `OwnedSpectrum::storage_snr_estimate_db`).
 const STORAGE_SNR_WARNING_DB: f64 = 50.0;
+
+/// Above this share of negatively weighted density (−30 dB) a depth cue
+/// warns (see `negative_cue_share`).
+const NEGATIVE_CUE_WARNING_SHARE: f64 = 1e-3;
 
 const GEOMETRY: &str = "\
 GEOMETRY CONTRACT
@@ -42,7 +51,7 @@ struct Cli {
 enum Command {
     /// Render the projection of a volume along a view direction.
     #[command(after_help = GEOMETRY)]
-    Render(RenderArgs),
+    Render(Box<RenderArgs>),
     /// Print the SNR in dB of image B against reference image A (NRRD files).
     Compare {
         /// Reference image.
@@ -87,7 +96,34 @@ struct RenderArgs {
     /// distribution; a number is the design oversampling of Beatty's formula.
     #[arg(long, default_value = "auto")]
     kb_design: KbDesign,
-    /// Output file: .nrrd (float32, sizes W H) or .png (auto-windowed 8-bit).
+    /// Depth cue: none, linear:FRONT,BACK, sine:FRONT,BACK, profile:W0,W1,...,
+    /// profile:@FILE or profile:gauss:C,S (details with --help).
+    #[arg(long, default_value = "none", long_help = DEPTH_CUE_HELP)]
+    depth_cue: String,
+    /// Cosine harmonics fitted to a profile depth cue (1 to 16).
+    #[arg(long, default_value_t = DEFAULT_PROFILE_HARMONICS)]
+    cue_harmonics: usize,
+    /// Ambient colour R,G,B or one grey value (paper eq. 7). Default: 1 without
+    /// lights, 0.2 with.
+    #[arg(long, value_parser = parse_rgb)]
+    ambient: Option<[f64; 3]>,
+    /// A directional light X,Y,Z:R,G,B: the direction towards the light and
+    /// its colour (or one grey value). Repeatable, up to 8. Surfaces of denser
+    /// structures that face a light are lit (hemispherical model, eq. 8-11).
+    #[arg(long = "light", value_parser = parse_light, allow_hyphen_values = true)]
+    lights: Vec<Light>,
+    /// N lights evenly spaced around the view axis (as in the paper's figure
+    /// 8), saturated colours evenly spaced in hue (3: red at the top, green,
+    /// blue), tilted TILT degrees towards the eye (default 30). Added to any
+    /// --light.
+    #[arg(long, value_name = "N[:TILT]", value_parser = parse_light_ring)]
+    light_ring: Option<(usize, f64)>,
+    /// Leave out the eq. 14 correction when depth cueing and shading are
+    /// combined (only to see what it fixes).
+    #[arg(long)]
+    no_cue_correction: bool,
+    /// Output file: .nrrd (float32; sizes W H, or 3 W H for RGB) or .png
+    /// (auto-windowed 8-bit grey or RGB).
     #[arg(long)]
     out: PathBuf,
     /// Print timing, memory and filter details.
@@ -190,6 +226,12 @@ fn default_scene() -> Result<(), String> {
         oversample: 1,
         precision: Precision::F16,
         kb_design: KbDesign::Auto,
+        depth_cue: "none".into(),
+        cue_harmonics: DEFAULT_PROFILE_HARMONICS,
+        ambient: None,
+        lights: Vec::new(),
+        light_ring: None,
+        no_cue_correction: false,
         out: PathBuf::from("fvr-default.png"),
         stats: true,
         exact: true,
@@ -222,13 +264,15 @@ fn render(args: &RenderArgs) -> Result<(), String> {
     let t0 = Instant::now();
     let volume = load_volume(&args.volume, raw)?;
     let t_load = t0.elapsed();
+    let scene = build_scene(args)?;
     let t1 = Instant::now();
     let filter = choose_filter(&volume, args.filter, args.oversample, args.kb_design)
         .map_err(|e| e.to_string())?;
-    let spec = AnySpectrum::prepare(&volume, filter, args.precision).map_err(|e| e.to_string())?;
+    let spectra = SceneSpectra::prepare(&volume, filter, args.precision, &scene)
+        .map_err(|e| e.to_string())?;
     let t_prep = t1.elapsed();
     let volume_sum: f64 = volume.data.iter().map(|&v| v as f64).sum();
-    let storage_snr = spec.storage_snr_estimate_db(volume_sum);
+    let storage_snr = spectra.density.storage_snr_estimate_db(volume_sum);
     if storage_snr < STORAGE_SNR_WARNING_DB {
         eprintln!(
             "fvr: warning: premultiplying for {} at oversample {} amplifies this volume's edges; \
@@ -239,20 +283,31 @@ fn render(args: &RenderArgs) -> Result<(), String> {
             args.precision
         );
     }
-    let n = spec.n();
+    let (lowest, share) = negative_cue_share(&volume, &scene, &view).map_err(|e| e.to_string())?;
+    if share > NEGATIVE_CUE_WARNING_SHARE {
+        eprintln!(
+            "fvr: warning: the depth cue is given between t = -R and +R; extrapolated beyond, \
+             into the volume's corners on this view, it falls to {lowest:.3}, and {:.2}% of the \
+             weighted density counts negatively. Raise the smaller of FRONT and BACK to avoid it.",
+            100.0 * share
+        );
+    }
+    let n = spectra.density.n();
     let (w, h) = args
         .size
         .unwrap_or((n / args.oversample as usize, n / args.oversample as usize));
     let t2 = Instant::now();
-    let image = spec.render(&view, w, h).map_err(|e| e.to_string())?;
+    let image = spectra
+        .render(&scene, &view, w, h)
+        .map_err(|e| e.to_string())?;
     let t_view = t2.elapsed();
     if ext == "png" {
-        write_png(&args.out, w, h, &image)?;
+        image.write_png(&args.out)?;
     } else {
-        let data: Vec<f32> = image.iter().map(|&v| v as f32).collect();
-        write_nrrd_f32(&args.out, &[w, h], &data).map_err(|e| e.to_string())?;
+        image.write_nrrd(&args.out)?;
     }
-    println!("wrote {} ({w}x{h})", args.out.display());
+    let kind = if image.channels == 1 { "grey" } else { "RGB" };
+    println!("wrote {} ({w}x{h} {kind})", args.out.display());
     if args.stats {
         let d = volume.dims;
         println!(
@@ -262,10 +317,27 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         println!(
             "  spectrum      {n}^3 {} = {} bytes ({} bytes/voxel)",
             args.precision,
-            spec.bytes(),
+            spectra.density.bytes(),
             args.precision.bytes()
         );
-        let f = spec.filter();
+        match &spectra.gradient {
+            Some(g) => println!(
+                "  |grad f|      {} bytes (second spectrum, for the lights)",
+                g.bytes()
+            ),
+            None => println!("  |grad f|      not built (no light needs it)"),
+        }
+        let working = match args.precision {
+            Precision::F64 => SceneRenderer::<f64>::new(n, filter, &scene).map(|r| r.bytes()),
+            _ => SceneRenderer::<f32>::new(n, filter, &scene).map(|r| r.bytes()),
+        }
+        .map_err(|e| e.to_string())?;
+        println!(
+            "  per view      {working} bytes ({} slice fields, tables, twiddles)",
+            scene.field_count()
+        );
+        println!("  held          {} bytes in all", spectra.bytes() + working);
+        let f = spectra.density.filter();
         if f.kind().is_kaiser_bessel() {
             println!(
                 "  filter        {} (oversample {}, beta {:.3})",
@@ -286,16 +358,61 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         println!("  view          {:.2} ms", t_view.as_secs_f64() * 1e3);
     }
     if args.exact {
+        let plain = scene.channels() == 1 && !scene.has_partner_terms();
         match phantom_by_name(&args.volume) {
-            Some(Ok(p)) => {
+            Some(Ok(p)) if plain => {
                 let exact = exact_projection(p.phantom.as_ref(), volume.dims, &view, w, h)
                     .map_err(|e| e.to_string())?;
-                println!("  SNR vs exact  {:.2} dB", snr_db(&exact, &image));
+                let ambient = scene.ambient[0];
+                let exact: Vec<f64> = exact.iter().map(|v| v * ambient).collect();
+                println!("  SNR vs exact  {:.2} dB", snr_db(&exact, &image.data));
             }
+            Some(Ok(p)) => match p.phantom.as_gaussian_mixture() {
+                Some(mixture) => {
+                    let exact =
+                        exact_scene_projection(mixture, volume.dims, &scene, &view, w, h, 0.05)
+                            .map_err(|e| e.to_string())?;
+                    println!("  SNR vs exact  {:.2} dB", snr_db(&exact.data, &image.data));
+                }
+                None => println!(
+                    "  SNR vs exact  n/a (cued or shaded references exist for gaussians only)"
+                ),
+            },
             _ => println!("  SNR vs exact  n/a (not a built-in phantom)"),
         }
     }
     Ok(())
+}
+
+/// The scene from the command line: cue, ambient, lights.
+fn build_scene(args: &RenderArgs) -> Result<Scene, String> {
+    let cue = parse_depth_cue(&args.depth_cue, args.cue_harmonics)?;
+    let mut lights = args.lights.clone();
+    if let Some((count, tilt)) = args.light_ring {
+        let view = View {
+            dir: args.dir,
+            up: args.up,
+        };
+        lights.extend(light_ring(&view, count, tilt).map_err(|e| e.to_string())?);
+    }
+    let default_ambient = if lights.is_empty() { 1.0 } else { 0.2 };
+    let mut scene = Scene {
+        cue,
+        ambient: args.ambient.unwrap_or([default_ambient; 3]),
+        correct_cue_shading: !args.no_cue_correction,
+        ..Scene::xray()
+    };
+    if lights.len() > MAX_LIGHTS {
+        return Err(format!(
+            "{} lights given, but a scene holds at most {MAX_LIGHTS}",
+            lights.len()
+        ));
+    }
+    for light in &lights {
+        scene.add_light(*light).map_err(|e| e.to_string())?;
+    }
+    scene.validate().map_err(|e| e.to_string())?;
+    Ok(scene)
 }
 
 fn compare(a: &Path, b: &Path) -> Result<(), String> {
