@@ -6,6 +6,7 @@ pub mod image;
 pub mod nrrd;
 pub mod phantom;
 pub mod pipeline;
+pub mod raycast;
 pub mod reference;
 pub mod scene;
 pub mod scene_reference;

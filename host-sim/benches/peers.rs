@@ -1,0 +1,44 @@
+//! Criterion benchmarks: the frequency-domain view (kb3, f16, one thread)
+//! against the spatial-domain peer ray caster (f32, trilinear, step 1 voxel,
+//! all cores), one view of n² pixels at 128³ and 256³. Compare as ratios
+//! within one run.
+//!
+//! Run: `cargo bench -p fvr-host --bench peers`.
+
+use std::hint::black_box;
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use fvr_core::filter::{Filter, FilterKind};
+use fvr_core::geometry::View;
+use fvr_host::phantom::{sample, GaussianMixture};
+use fvr_host::pipeline::{OwnedSpectrum, ViewRenderer};
+use fvr_host::raycast::RayCaster;
+use half::f16;
+
+fn benches(c: &mut Criterion) {
+    let mut group = c.benchmark_group("view_vs_peer");
+    group.sample_size(10);
+    let view = View::along([1.0, 0.3, 0.2]);
+    for n in [128usize, 256] {
+        let volume = sample(&GaussianMixture::random(1, n, 8), [n, n, n]);
+        let filter = Filter::new(FilterKind::Kb3, 1).unwrap();
+        let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+        let mut renderer = ViewRenderer::<f32>::new(n, filter);
+        let mut out = vec![0.0f32; n * n];
+        group.bench_function(BenchmarkId::new("frequency_kb3_f16", n), |b| {
+            b.iter(|| {
+                renderer
+                    .render_into(&spec, black_box(&view), n, n, &mut out)
+                    .unwrap()
+            })
+        });
+        let caster = RayCaster::new(&volume);
+        group.bench_function(BenchmarkId::new("raycast_trilinear_f32", n), |b| {
+            b.iter(|| caster.project(black_box(&view), n, n, 1.0, 0).unwrap())
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(peers, benches);
+criterion_main!(peers);
