@@ -98,6 +98,14 @@ pub enum Error {
     },
     /// The spectrum was prepared for another filter than the one asked for.
     FilterMismatch,
+    /// A stored table (e.g. a kernel table from flash) holds a NaN or
+    /// infinite entry.
+    NonFiniteTableEntry {
+        /// Which table.
+        what: &'static str,
+        /// Index of the first bad entry.
+        index: usize,
+    },
 }
 
 /// Shorthand for results of this crate.
@@ -164,6 +172,9 @@ impl fmt::Display for Error {
                 f,
                 "the spectrum was premultiplied for a different filter or oversampling"
             ),
+            Error::NonFiniteTableEntry { what, index } => {
+                write!(f, "{what} entry {index} is NaN or infinite")
+            }
         }
     }
 }

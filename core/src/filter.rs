@@ -433,7 +433,7 @@ pub struct KernelTable<T> {
 impl<T: Real> KernelTable<T> {
     /// Tabulate `filter`'s kernel.
     pub fn new(filter: Filter) -> Self {
-        let len = filter.width() * TABLE_RESOLUTION / 2 + 1;
+        let len = Self::len_for(&filter);
         let mut values = [T::ZERO; TABLE_CAP];
         for (i, v) in values[..len].iter_mut().enumerate() {
             let t = i as f64 / TABLE_RESOLUTION as f64;
@@ -449,6 +449,46 @@ impl<T: Real> KernelTable<T> {
             values,
             len,
         }
+    }
+
+    /// Entries a table for `filter` holds: `W·1024/2 + 1`, the samples
+    /// `k(i/1024)` for `i = 0 ..= W·512`.
+    pub const fn len_for(filter: &Filter) -> usize {
+        filter.kind.width() * TABLE_RESOLUTION / 2 + 1
+    }
+
+    /// Rebuild a table from the values [`KernelTable::values`] returned for
+    /// the same filter, e.g. a table in flash generated at build time, so a
+    /// target without fast f64 never evaluates the Bessel series. The result
+    /// equals `KernelTable::new(filter)` bit for bit when `values` came from
+    /// it.
+    ///
+    /// # Errors
+    /// `values.len()` other than [`KernelTable::len_for`]`(&filter)`, or a
+    /// NaN or infinite entry (named by its index).
+    pub fn from_values(filter: Filter, values: &[T]) -> Result<Self> {
+        let len = Self::len_for(&filter);
+        if values.len() != len {
+            return Err(crate::error::mismatch("kernel table", len, values.len()));
+        }
+        if let Some(index) = values.iter().position(|v| !v.is_finite()) {
+            return Err(Error::NonFiniteTableEntry {
+                what: "kernel table",
+                index,
+            });
+        }
+        let mut table = [T::ZERO; TABLE_CAP];
+        table[..len].copy_from_slice(values);
+        Ok(Self {
+            filter,
+            values: table,
+            len,
+        })
+    }
+
+    /// The tabulated samples `k(i/1024)`, `i = 0 ..= W·512`.
+    pub fn values(&self) -> &[T] {
+        &self.values[..self.len]
     }
 
     /// The filter tabulated.
