@@ -1,6 +1,8 @@
 //! Build script of the firmware:
-//! 1. puts `memory.x` (workspace root, or `$FVR_MEMORY_X`) on the link path
-//!    and, for the thumb target, links with `link.x` and `defmt.x`;
+//! 1. copies `memory.x` (workspace root) to `OUT_DIR`, puts that on the link
+//!    path and, for the thumb target, links with `link.x` and `defmt.x`. (When
+//!    cargo builds from the workspace root the linker finds the root's file
+//!    first, in its working directory: the same file.)
 //! 2. runs the core **on the host** to make the flash tables: it samples the
 //!    scene's phantom (`src/scene.rs`), prepares one f16 spectrum per stored
 //!    filter, tabulates the kernels and the twiddles, and writes them to
@@ -33,10 +35,7 @@ fn main() {
 
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=src/scene.rs");
-    println!("cargo:rerun-if-env-changed=FVR_MEMORY_X");
-    let memory = env::var_os("FVR_MEMORY_X")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| manifest.join("../memory.x"));
+    let memory = manifest.join("../memory.x");
     println!("cargo:rerun-if-changed={}", memory.display());
     let layout = fs::read_to_string(&memory)
         .unwrap_or_else(|e| panic!("cannot read the memory layout {}: {e}", memory.display()));
