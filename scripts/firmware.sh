@@ -50,6 +50,7 @@ bin_dir="$target_dir/$TARGET/release"
 run_dir="$target_dir/fvr-firmware-run"
 
 echo "== firmware: build ($TARGET, release)"
+cargo clippy --locked -p fvr-firmware --target "$TARGET" --release -- -D warnings
 cargo build --locked -p fvr-firmware --target "$TARGET" --release
 
 echo "== firmware: run in QEMU (mps2-an386, -icount shift=0, timeout ${QEMU_TIMEOUT_S}s)"
