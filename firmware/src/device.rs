@@ -183,6 +183,8 @@ fn run_inner(
         calibration
     );
 
+    f16_codec_report(&clock)?;
+
     let grid = cortex_m::singleton!(GRID: [f32; GRID_LEN] = [0.0; GRID_LEN])
         .ok_or(RunError::Host("buffers taken"))?;
     let aux = cortex_m::singleton!(AUX: [f32; AUX_LEN] = [0.0; AUX_LEN])
@@ -247,6 +249,44 @@ fn run_inner(
         stack.peak,
         stack.available
     );
+    Ok(())
+}
+
+/// On the target's own arithmetic: the fast f16 → f32 widening of the core
+/// (`fvr_core::real::f16_bits_to_f32`) against `half`'s, for all 65,536
+/// patterns, and the instructions per conversion of each over the 63,488
+/// finite patterns (a spectrum holds only finite values).
+fn f16_codec_report(clock: &SysTickClock) -> Result<(), RunError> {
+    use core::hint::black_box;
+    use fvr_core::f16;
+    use fvr_core::real::f16_bits_to_f32;
+
+    let differing = (0..=u16::MAX)
+        .filter(|&b| f16_bits_to_f32(b).to_bits() != f16::from_bits(b).to_f32().to_bits())
+        .count();
+    let finite = (0..0x7C00u16).chain(0x8000..0xFC00u16);
+    let count = finite.clone().count() as u64;
+    let time = |convert: &dyn Fn(u16) -> u32| {
+        let t0 = clock.now();
+        let mut acc = 0u32;
+        for b in finite.clone() {
+            acc ^= convert(black_box(b));
+        }
+        black_box(acc);
+        clock.now() - t0
+    };
+    let empty = time(&|b| b as u32);
+    let half = time(&|b| f16::from_bits(b).to_f32().to_bits());
+    let fast = time(&|b| f16_bits_to_f32(b).to_bits());
+    defmt::println!(
+        "f16 -> f32: {=usize} of 65536 patterns differ from half; per conversion (x100): half {=u64}, rebias {=u64}",
+        differing,
+        (half - empty) * 100 / count,
+        (fast - empty) * 100 / count
+    );
+    if differing != 0 {
+        return Err(RunError::Host("the fast f16 widening differs from half on this target"));
+    }
     Ok(())
 }
 

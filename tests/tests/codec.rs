@@ -57,3 +57,21 @@ fn values_beyond_the_f16_range_become_infinite_and_are_reported_non_finite() {
     assert_eq!(max.to_f64(), 65504.0);
     assert_eq!(<f16 as Sample>::MAX_FINITE, 65504.0);
 }
+
+#[test]
+fn fast_f16_widening_is_bit_identical_to_half_for_every_pattern() {
+    for bits in 0..=u16::MAX {
+        let fast = fvr_core::real::f16_bits_to_f32(bits);
+        let reference = f16::from_bits(bits).to_f32();
+        assert_eq!(fast.to_bits(), reference.to_bits(), "{bits:#06x}");
+        // And the storage trait uses it.
+        assert_eq!(Sample::to_f32(f16::from_bits(bits)).to_bits(), reference.to_bits());
+    }
+    // The subnormal and boundary cases the rebias relies on, by value.
+    assert_eq!(fvr_core::real::f16_bits_to_f32(0x0001), 2f32.powi(-24));
+    assert_eq!(fvr_core::real::f16_bits_to_f32(0x03FF), 1023.0 * 2f32.powi(-24));
+    assert_eq!(fvr_core::real::f16_bits_to_f32(0x0400), 2f32.powi(-14));
+    assert_eq!(fvr_core::real::f16_bits_to_f32(0x7BFF), 65504.0);
+    assert_eq!(fvr_core::real::f16_bits_to_f32(0x8000).to_bits(), (-0.0f32).to_bits());
+    assert_eq!(fvr_core::real::f16_bits_to_f32(0xFC00), f32::NEG_INFINITY);
+}
