@@ -79,9 +79,19 @@ impl Real for f32 {
     fn from_usize(n: usize) -> Self {
         n as f32
     }
+    /// In the i32 range, by the hardware float → int conversion (a
+    /// truncation) and one correction for negative non-integers; `libm`
+    /// beyond it and for NaN. Targets without 64-bit float conversions
+    /// (Cortex-M4F) would otherwise call `floorf` and a software f32 → i64.
     #[inline(always)]
     fn floor_i64(self) -> i64 {
-        libm::floorf(self) as i64
+        const TWO_POW_31: f32 = 2_147_483_648.0;
+        if self.abs() < TWO_POW_31 {
+            let t = self as i32;
+            (t - ((t as f32) > self) as i32) as i64
+        } else {
+            libm::floorf(self) as i64
+        }
     }
     #[inline(always)]
     fn trunc_usize(self) -> usize {
