@@ -522,7 +522,7 @@ impl<T: Real> KernelTable<T> {
         let lo = (q - T::from_usize(w) * T::HALF).floor_i64();
         let j0 = lo + 1;
         // q − j0 in (W/2 − 1, W/2]; exact in T because j0 is small.
-        let d0 = q - T::from_f64(j0 as f64);
+        let d0 = q - T::from_i32(j0 as i32);
         let mut d = d0;
         for wt in weights[..w].iter_mut() {
             *wt = self.eval(d);

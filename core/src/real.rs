@@ -44,6 +44,10 @@ pub trait Real:
     fn is_finite(self) -> bool;
     /// Nearest value to `n`.
     fn from_usize(n: usize) -> Self;
+    /// Nearest value to `n` (exact for |n| ≤ 2^24 in f32), by the hardware
+    /// int → float conversion where there is one; `from_f64(n as f64)`
+    /// costs two soft-float calls on a target with no 64-bit FPU.
+    fn from_i32(n: i32) -> Self;
     /// Largest integer not above `self`, saturating at the i64 range.
     fn floor_i64(self) -> i64;
     /// Integer part of a non-negative value, saturating.
@@ -77,6 +81,10 @@ impl Real for f32 {
     }
     #[inline(always)]
     fn from_usize(n: usize) -> Self {
+        n as f32
+    }
+    #[inline(always)]
+    fn from_i32(n: i32) -> Self {
         n as f32
     }
     /// In the i32 range, by the hardware float → int conversion (a
@@ -126,6 +134,10 @@ impl Real for f64 {
     }
     #[inline(always)]
     fn from_usize(n: usize) -> Self {
+        n as f64
+    }
+    #[inline(always)]
+    fn from_i32(n: i32) -> Self {
         n as f64
     }
     #[inline(always)]
