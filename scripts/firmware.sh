@@ -77,12 +77,13 @@ echo "== firmware: QEMU images against the host core (bit for bit)"
 FVR_QEMU_OUT="$run_dir" cargo test --locked -p fvr-firmware --test qemu_agreement -- --ignored --nocapture
 
 echo "== firmware: instruction counts (64x64 view, Cortex-M4F, exact to +-40)"
-printf '%-18s %-10s %12s %12s %12s\n' program frame render extraction "2D inverse"
+printf '%-18s %-10s %11s %11s %11s %11s\n' program frame render extraction inverse "(2D DHT)"
 for program in "${PROGRAMS[@]}"; do
-    sed -n 's/^frame \([^ ]*\) \([^:]*\): render \([0-9]*\) instructions = extraction \([0-9]*\) + inverse \([0-9]*\).*/\1 \2 \3 \4 \5/p' \
+    sed -n 's/^frame \([^ ]*\) \([^:]*\): render \([0-9]*\) instructions = extraction \([0-9]*\) + inverse \([0-9]*\).*2D DHT alone \([0-9]*\).*/\1 \2 \3 \4 \5 \6/p' \
         "$run_dir/$program.log" \
-        | while read -r p f r e i; do printf '%-18s %-10s %12s %12s %12s\n' "$p" "$f" "$r" "$e" "$i"; done
+        | while read -r p f r e i d; do printf '%-18s %-10s %11s %11s %11s %11s\n' "$p" "$f" "$r" "$e" "$i" "$d"; done
 done
+grep -h '^f16 -> f32' "$run_dir/fvr-filter-bench.log" || fail "no f16 conversion report"
 grep -h '^frame' "$run_dir"/*.log >/dev/null || fail "no instruction counts in the firmware logs"
 
 echo "== firmware: footprint (bytes)"

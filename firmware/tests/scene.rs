@@ -62,7 +62,10 @@ fn staged_render_equals_render_bit_for_bit() {
             };
             let counts =
                 render_frame(spec, stored_for(spec), &tw, &mut bufs, &Ticks(Cell::new(0))).unwrap();
-            assert_eq!((counts.render, counts.extract, counts.inverse), (1, 1, 1));
+            assert_eq!(
+                (counts.render, counts.extract, counts.inverse, counts.dht_2d),
+                (1, 1, 1, 1)
+            );
             let host = host_image(spec);
             assert!(image
                 .iter()
