@@ -19,3 +19,6 @@ cargo test --locked --workspace
 
 echo "== benchmarks compile"
 cargo bench --locked -p fvr-host --no-run
+
+echo "== firmware on a Cortex-M4F in QEMU: bit-for-bit agreement, instruction counts, footprint, budget"
+bash scripts/firmware.sh

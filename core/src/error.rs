@@ -130,6 +130,14 @@ pub enum Error {
         /// What is wrong with it.
         problem: &'static str,
     },
+    /// A stored table (e.g. a kernel table from flash) holds a NaN or
+    /// infinite entry.
+    NonFiniteTableEntry {
+        /// Which table.
+        what: &'static str,
+        /// Index of the first bad entry.
+        index: usize,
+    },
 }
 
 /// Shorthand for results of this crate.
@@ -214,6 +222,9 @@ impl fmt::Display for Error {
             ),
             Error::GradientSpectrum { problem } => {
                 write!(f, "gradient-magnitude spectrum: {problem}")
+            }
+            Error::NonFiniteTableEntry { what, index } => {
+                write!(f, "{what} entry {index} is NaN or infinite")
             }
         }
     }

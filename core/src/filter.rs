@@ -495,7 +495,7 @@ pub struct KernelTable<T> {
 impl<T: Real> KernelTable<T> {
     /// Tabulate `filter`'s kernel.
     pub fn new(filter: Filter) -> Self {
-        let len = filter.width() * TABLE_RESOLUTION / 2 + 1;
+        let len = Self::len_for(&filter);
         let mut values = [T::ZERO; TABLE_CAP];
         for (i, v) in values[..len].iter_mut().enumerate() {
             let t = i as f64 / TABLE_RESOLUTION as f64;
@@ -511,6 +511,46 @@ impl<T: Real> KernelTable<T> {
             values,
             len,
         }
+    }
+
+    /// Entries a table for `filter` holds: `W·1024/2 + 1`, the samples
+    /// `k(i/1024)` for `i = 0 ..= W·512`.
+    pub const fn len_for(filter: &Filter) -> usize {
+        filter.kind.width() * TABLE_RESOLUTION / 2 + 1
+    }
+
+    /// Rebuild a table from the values [`KernelTable::values`] returned for
+    /// the same filter, e.g. a table in flash generated at build time, so a
+    /// target without fast f64 never evaluates the Bessel series. The result
+    /// equals `KernelTable::new(filter)` bit for bit when `values` came from
+    /// it.
+    ///
+    /// # Errors
+    /// `values.len()` other than [`KernelTable::len_for`]`(&filter)`, or a
+    /// NaN or infinite entry (named by its index).
+    pub fn from_values(filter: Filter, values: &[T]) -> Result<Self> {
+        let len = Self::len_for(&filter);
+        if values.len() != len {
+            return Err(crate::error::mismatch("kernel table", len, values.len()));
+        }
+        if let Some(index) = values.iter().position(|v| !v.is_finite()) {
+            return Err(Error::NonFiniteTableEntry {
+                what: "kernel table",
+                index,
+            });
+        }
+        let mut table = [T::ZERO; TABLE_CAP];
+        table[..len].copy_from_slice(values);
+        Ok(Self {
+            filter,
+            values: table,
+            len,
+        })
+    }
+
+    /// The tabulated samples `k(i/1024)`, `i = 0 ..= W·512`.
+    pub fn values(&self) -> &[T] {
+        &self.values[..self.len]
     }
 
     /// The filter tabulated.
@@ -544,7 +584,7 @@ impl<T: Real> KernelTable<T> {
         let lo = (q - T::from_usize(w) * T::HALF).floor_i64();
         let j0 = lo + 1;
         // q − j0 in (W/2 − 1, W/2]; exact in T because j0 is small.
-        let d0 = q - T::from_f64(j0 as f64);
+        let d0 = q - T::from_i32(j0 as i32);
         let mut d = d0;
         for wt in weights[..w].iter_mut() {
             *wt = self.eval(d);
@@ -623,7 +663,7 @@ impl<T: Real> DerivativeTable<T> {
     pub fn taps(&self, q: T, weights: &mut [T; MAX_WIDTH]) -> i64 {
         let w = self.filter.width();
         let j0 = (q - T::from_usize(w) * T::HALF).floor_i64() + 1;
-        let mut d = q - T::from_f64(j0 as f64);
+        let mut d = q - T::from_i32(j0 as i32);
         for wt in weights[..w].iter_mut() {
             *wt = self.eval(d);
             d -= T::ONE;

@@ -44,6 +44,10 @@ pub trait Real:
     fn is_finite(self) -> bool;
     /// Nearest value to `n`.
     fn from_usize(n: usize) -> Self;
+    /// Nearest value to `n` (exact for |n| ≤ 2^24 in f32), by the hardware
+    /// int → float conversion where there is one; `from_f64(n as f64)`
+    /// costs two soft-float calls on a target with no 64-bit FPU.
+    fn from_i32(n: i32) -> Self;
     /// Largest integer not above `self`, saturating at the i64 range.
     fn floor_i64(self) -> i64;
     /// Integer part of a non-negative value, saturating.
@@ -80,8 +84,22 @@ impl Real for f32 {
         n as f32
     }
     #[inline(always)]
+    fn from_i32(n: i32) -> Self {
+        n as f32
+    }
+    /// In the i32 range, by the hardware float → int conversion (a
+    /// truncation) and one correction for negative non-integers; `libm`
+    /// beyond it and for NaN. Targets without 64-bit float conversions
+    /// (Cortex-M4F) would otherwise call `floorf` and a software f32 → i64.
+    #[inline(always)]
     fn floor_i64(self) -> i64 {
-        libm::floorf(self) as i64
+        const TWO_POW_31: f32 = 2_147_483_648.0;
+        if self.abs() < TWO_POW_31 {
+            let t = self as i32;
+            (t - ((t as f32) > self) as i32) as i64
+        } else {
+            libm::floorf(self) as i64
+        }
     }
     #[inline(always)]
     fn trunc_usize(self) -> usize {
@@ -119,6 +137,10 @@ impl Real for f64 {
         n as f64
     }
     #[inline(always)]
+    fn from_i32(n: i32) -> Self {
+        n as f64
+    }
+    #[inline(always)]
     fn floor_i64(self) -> i64 {
         libm::floor(self) as i64
     }
@@ -146,6 +168,33 @@ pub trait Sample: Copy + Default + Debug + PartialEq {
     fn is_finite(self) -> bool;
 }
 
+/// IEEE binary16 bits to the binary32 of the same value, exactly, by
+/// exponent rebias: the 15 magnitude bits shifted into binary32 position
+/// read as `2^-112` times the value (a binary16 subnormal lands on a
+/// binary32 subnormal), so one multiplication by `2^112` rebiases normals
+/// and normalizes subnormals, exactly because it is a power of two. Infinity
+/// and NaN (exponent all ones) take `half`'s path, which quiets NaNs.
+///
+/// Bit-identical to `half::f16::to_f32` for all 65,536 patterns (tested
+/// exhaustively on the host and, in the firmware, on the Cortex-M4F). It
+/// needs subnormal f32 arithmetic: a flush-to-zero FPU mode (FPSCR.FZ on
+/// Arm, off at reset) would zero binary16 subnormals.
+///
+/// Why: `half` converts in software on targets without F16C or FP16
+/// (Cortex-M4F, x86-64 without `target-feature=+f16c`) through a branchy
+/// path of about 25 instructions; this is about 8, and slice extraction does
+/// one per filter tap.
+#[inline(always)]
+pub fn f16_bits_to_f32(bits: u16) -> f32 {
+    const TWO_POW_112: f32 = f32::from_bits((127 + 112) << 23);
+    let magnitude = (bits & 0x7FFF) as u32;
+    if magnitude >= 0x7C00 {
+        return f16::from_bits(bits).to_f32();
+    }
+    let value = f32::from_bits(magnitude << 13) * TWO_POW_112;
+    f32::from_bits(value.to_bits() | ((bits as u32 & 0x8000) << 16))
+}
+
 impl Sample for f16 {
     const NAME: &'static str = "f16";
     const MAX_FINITE: f64 = 65504.0;
@@ -159,7 +208,7 @@ impl Sample for f16 {
     }
     #[inline(always)]
     fn to_f32(self) -> f32 {
-        f16::to_f32(self)
+        f16_bits_to_f32(self.to_bits())
     }
     #[inline(always)]
     fn to_f64(self) -> f64 {

@@ -156,9 +156,9 @@ pub fn extract_slice<S: Sample, T: Real>(
     let w = kernel.filter().width();
     let mask = n - 1;
     for (iy, row) in grid.chunks_exact_mut(n).enumerate() {
-        let ky = T::from_f64(signed_index(iy, n) as f64);
+        let ky = T::from_i32(signed_index(iy, n) as i32);
         for (ix, g) in row.iter_mut().enumerate() {
-            let kx = T::from_f64(signed_index(ix, n) as f64);
+            let kx = T::from_i32(signed_index(ix, n) as i32);
             let q: [T; 3] = core::array::from_fn(|a| kx * r[a] + ky * u[a]);
             if q.iter().any(|&c| c > nyquist || -c > nyquist) {
                 *g = T::ZERO;

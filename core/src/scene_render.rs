@@ -102,9 +102,9 @@ fn run_pass<S: Sample, T: Real, const MODE: u8>(
         (_, d) => d,
     };
     for iy in 0..n {
-        let ky = T::from_f64(signed_index(iy, n) as f64);
+        let ky = T::from_i32(signed_index(iy, n) as i32);
         for ix in 0..n {
-            let kx = T::from_f64(signed_index(ix, n) as f64);
+            let kx = T::from_i32(signed_index(ix, n) as i32);
             let q: [T; 3] =
                 core::array::from_fn(|a| kx * geo.right[a] + ky * geo.up[a] + geo.offset[a]);
             if q.iter().any(|&c| c > nyquist || -c > nyquist) {
@@ -489,10 +489,10 @@ pub fn render_scene<S: Sample, T: Real>(
         let mu = T::from_f64(ch.moment[1] * moment_unit);
         let along = T::from_f64(ch.along_view);
         for iy in 0..n {
-            let ky = T::from_f64(signed_index(iy, n) as f64);
+            let ky = T::from_i32(signed_index(iy, n) as i32);
             let my = neg_mod(iy, n);
             for ix in 0..n {
-                let kx = T::from_f64(signed_index(ix, n) as f64);
+                let kx = T::from_i32(signed_index(ix, n) as i32);
                 let i = iy * n + ix;
                 let mirror = my * n + neg_mod(ix, n);
                 let f = &*fields;

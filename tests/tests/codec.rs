@@ -57,3 +57,77 @@ fn values_beyond_the_f16_range_become_infinite_and_are_reported_non_finite() {
     assert_eq!(max.to_f64(), 65504.0);
     assert_eq!(<f16 as Sample>::MAX_FINITE, 65504.0);
 }
+
+#[test]
+fn fast_f16_widening_is_bit_identical_to_half_for_every_pattern() {
+    for bits in 0..=u16::MAX {
+        let fast = fvr_core::real::f16_bits_to_f32(bits);
+        let reference = f16::from_bits(bits).to_f32();
+        assert_eq!(fast.to_bits(), reference.to_bits(), "{bits:#06x}");
+        // And the storage trait uses it.
+        assert_eq!(
+            Sample::to_f32(f16::from_bits(bits)).to_bits(),
+            reference.to_bits()
+        );
+    }
+    // The subnormal and boundary cases the rebias relies on, by value.
+    assert_eq!(fvr_core::real::f16_bits_to_f32(0x0001), 2f32.powi(-24));
+    assert_eq!(
+        fvr_core::real::f16_bits_to_f32(0x03FF),
+        1023.0 * 2f32.powi(-24)
+    );
+    assert_eq!(fvr_core::real::f16_bits_to_f32(0x0400), 2f32.powi(-14));
+    assert_eq!(fvr_core::real::f16_bits_to_f32(0x7BFF), 65504.0);
+    assert_eq!(
+        fvr_core::real::f16_bits_to_f32(0x8000).to_bits(),
+        (-0.0f32).to_bits()
+    );
+    assert_eq!(fvr_core::real::f16_bits_to_f32(0xFC00), f32::NEG_INFINITY);
+}
+
+#[test]
+fn f32_floor_i64_equals_libm_floor_on_a_dense_sweep_and_the_edges() {
+    let check = |x: f32| {
+        assert_eq!(
+            Real::floor_i64(x),
+            libm::floorf(x) as i64,
+            "{x:e} ({:#010x})",
+            x.to_bits()
+        );
+    };
+    // Every 251st bit pattern (positive and negative, all exponents).
+    for bits in (0..=u32::MAX).step_by(251) {
+        check(f32::from_bits(bits));
+    }
+    for x in [
+        0.0,
+        -0.0,
+        0.5,
+        -0.5,
+        1.0,
+        -1.0,
+        -1.5,
+        2.5,
+        -2.5,
+        1e-45,
+        -1e-45,
+        16_777_215.0,
+        16_777_216.0,
+        -16_777_217.0,
+        2_147_483_520.0,
+        -2_147_483_520.0,
+        2_147_483_648.0,
+        -2_147_483_648.0,
+        1e30,
+        -1e30,
+        f32::MAX,
+        f32::MIN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::NAN,
+        f32::EPSILON,
+        -f32::EPSILON,
+    ] {
+        check(x);
+    }
+}

@@ -1,0 +1,405 @@
+//! The device runtime (thumbv7em-none-eabihf under QEMU mps2-an386):
+//! instruction counting with SysTick, host files over semihosting, the
+//! stack scan, the panic handler and [`firmware_main!`](crate::firmware_main).
+//!
+//! # Instruction counts
+//! QEMU runs with `-icount shift=0`: one instruction is one nanosecond of
+//! virtual time, and SysTick on the processor clock (25 MHz on mps2) ticks
+//! once every 40 instructions. Counts are therefore exact to ±40 and
+//! repeatable run to run. The 24-bit counter never reloads during a run (it
+//! would after 671 M instructions); [`run`] fails if it did.
+
+use core::ffi::CStr;
+use core::fmt::Write as _;
+
+use cortex_m::peripheral::syst::SystClkSource;
+use cortex_m::peripheral::SYST;
+use semihosting::fs::File;
+use semihosting::io::Write as _;
+
+use crate::capture::{ByteSink, CaptureBus};
+use crate::display::{DcsPanel, Window};
+use crate::frame::{
+    render_frame, spectrum_for, FrameBuffers, FrameError, InstructionClock, AUX_LEN, GRID_LEN,
+    IMAGE_LEN,
+};
+use crate::nrrd::{write_samples_le, Header};
+use crate::scene::{FrameSpec, IMAGE_SIDE};
+use crate::stored::{twiddles, StoredSpectrum};
+
+// The critical-section implementation defmt-semihosting needs.
+use cortex_m as _;
+use defmt_semihosting as _;
+
+/// Instructions per SysTick tick under `-icount shift=0` on mps2 (1 ns per
+/// instruction, a 25 MHz tick).
+pub const INSTRUCTIONS_PER_TICK: u64 = 40;
+const RELOAD: u32 = 0x00FF_FFFF;
+
+/// SysTick as a free-running instruction counter.
+pub struct SysTickClock {
+    syst: SYST,
+}
+
+impl SysTickClock {
+    /// Start counting down from `2^24 − 1` on the processor clock, without
+    /// interrupts.
+    pub fn start(mut syst: SYST) -> Self {
+        syst.disable_interrupt();
+        syst.set_clock_source(SystClkSource::Core);
+        syst.set_reload(RELOAD);
+        syst.clear_current();
+        syst.enable_counter();
+        // Clearing sets the counter to 0; it loads RELOAD on the next tick.
+        while SYST::get_current() == 0 {}
+        // Reading COUNTFLAG clears it; it is read again at the end.
+        let _ = syst.has_wrapped();
+        Self { syst }
+    }
+
+    /// `true` if the counter reloaded since [`SysTickClock::start`] (the
+    /// counts would then be ambiguous).
+    pub fn wrapped(&mut self) -> bool {
+        self.syst.has_wrapped()
+    }
+}
+
+impl InstructionClock for SysTickClock {
+    fn now(&self) -> u64 {
+        (RELOAD - SYST::get_current()) as u64 * INSTRUCTIONS_PER_TICK
+    }
+}
+
+/// A file on the host, written over semihosting.
+pub struct HostFile(File);
+
+impl HostFile {
+    /// Create (or truncate) `name` in QEMU's working directory.
+    ///
+    /// # Errors
+    /// A name of 95 bytes or more, or the host refused.
+    pub fn create(name: &str) -> Result<Self, RunError> {
+        let mut path = [0u8; 96];
+        let slot = path
+            .get_mut(..name.len())
+            .filter(|_| name.len() < 96)
+            .ok_or(RunError::Host("file name too long"))?;
+        slot.copy_from_slice(name.as_bytes());
+        let c = CStr::from_bytes_until_nul(&path).map_err(|_| RunError::Host("bad file name"))?;
+        File::create(c)
+            .map(HostFile)
+            .map_err(|_| RunError::Host("cannot create a file on the host"))
+    }
+}
+
+impl ByteSink for HostFile {
+    type Error = ();
+    fn put(&mut self, bytes: &[u8]) -> Result<(), ()> {
+        self.0.write_all(bytes).map_err(|_| ())
+    }
+}
+
+/// Why a run failed.
+#[derive(Debug)]
+pub enum RunError {
+    /// A frame failed.
+    Frame(FrameError),
+    /// Host I/O failed.
+    Host(&'static str),
+    /// The display path failed.
+    Display,
+    /// The instruction counter reloaded: the run was too long to count.
+    CounterWrapped,
+}
+
+impl From<FrameError> for RunError {
+    fn from(e: FrameError) -> Self {
+        RunError::Frame(e)
+    }
+}
+
+/// A `core::fmt` buffer for file names.
+struct Name {
+    buf: [u8; 80],
+    len: usize,
+}
+
+impl core::fmt::Write for Name {
+    fn write_str(&mut self, s: &str) -> core::fmt::Result {
+        let end = self.len + s.len();
+        self.buf
+            .get_mut(self.len..end)
+            .ok_or(core::fmt::Error)?
+            .copy_from_slice(s.as_bytes());
+        self.len = end;
+        Ok(())
+    }
+}
+
+impl Name {
+    fn new(program: &str, frame: &str, ext: &str) -> Result<Self, RunError> {
+        let mut n = Name {
+            buf: [0; 80],
+            len: 0,
+        };
+        write!(n, "{program}-{frame}.{ext}").map_err(|_| RunError::Host("file name too long"))?;
+        Ok(n)
+    }
+    fn as_str(&self) -> &str {
+        core::str::from_utf8(&self.buf[..self.len]).unwrap_or("?")
+    }
+}
+
+/// Render every frame of `frames` from `spectra`, write each image to
+/// `<program>-<frame>.nrrd` and its display recording to
+/// `<program>-<frame>.spi` on the host, log the counts with defmt, and exit
+/// QEMU with status 0 (1 on any error).
+pub fn run(program: &str, frames: &[FrameSpec], spectra: &[&'static StoredSpectrum]) -> ! {
+    let status = match run_inner(program, frames, spectra) {
+        Ok(()) => 0,
+        Err(e) => {
+            defmt::error!("{=str}: {}", program, defmt::Debug2Format(&e));
+            1
+        }
+    };
+    semihosting::process::exit(status)
+}
+
+fn run_inner(
+    program: &str,
+    frames: &[FrameSpec],
+    spectra: &[&'static StoredSpectrum],
+) -> Result<(), RunError> {
+    let peripherals = cortex_m::Peripherals::take().ok_or(RunError::Host("peripherals taken"))?;
+    let mut clock = SysTickClock::start(peripherals.SYST);
+
+    // Calibration: `asm::delay(c)` runs exactly 2c + 2 instructions
+    // (`subs`/`bne` c + 1 times).
+    let t0 = clock.now();
+    cortex_m::asm::delay(1_000_000);
+    let calibration = clock.now() - t0;
+    defmt::println!(
+        "calibration: delay loop of 2000002 instructions counted as {=u64}",
+        calibration
+    );
+
+    f16_codec_report(&clock)?;
+
+    let grid = cortex_m::singleton!(GRID: [f32; GRID_LEN] = [0.0; GRID_LEN])
+        .ok_or(RunError::Host("buffers taken"))?;
+    let aux = cortex_m::singleton!(AUX: [f32; AUX_LEN] = [0.0; AUX_LEN])
+        .ok_or(RunError::Host("buffers taken"))?;
+    let image = cortex_m::singleton!(IMAGE: [f32; IMAGE_LEN] = [0.0; IMAGE_LEN])
+        .ok_or(RunError::Host("buffers taken"))?;
+    let staged = cortex_m::singleton!(STAGED: [f32; IMAGE_LEN] = [0.0; IMAGE_LEN])
+        .ok_or(RunError::Host("buffers taken"))?;
+    let mut bufs = FrameBuffers {
+        grid,
+        aux,
+        image,
+        staged,
+    };
+    let tw = twiddles().map_err(|e| RunError::Frame(FrameError::Core(e)))?;
+
+    for spec in frames {
+        let stored = spectrum_for(spec, spectra)?;
+        let counts = render_frame(spec, stored, &tw, &mut bufs, &clock)?;
+
+        let t0 = clock.now();
+        let window = Window::fit(bufs.image);
+        let bus = CaptureBus::new(HostFile::create(
+            Name::new(program, spec.name, "spi")?.as_str(),
+        )?);
+        let mut panel = DcsPanel::new(bus.spi(), bus.dc());
+        let mut row = [0u8; 2 * IMAGE_SIDE];
+        panel
+            .draw_gray(0, 0, bufs.image, IMAGE_SIDE, &window, &mut row)
+            .map_err(|_| RunError::Display)?;
+        let display = clock.now() - t0;
+
+        let mut nrrd = HostFile::create(Name::new(program, spec.name, "nrrd")?.as_str())?;
+        let header = Header::image_f32(
+            IMAGE_SIDE,
+            IMAGE_SIDE,
+            format_args!("{program} {}: rendered on a Cortex-M4F", spec.name),
+        )
+        .map_err(|_| RunError::Host("NRRD header too long"))?;
+        nrrd.put(header.as_bytes())
+            .map_err(|_| RunError::Host("NRRD write"))?;
+        write_samples_le(bufs.image, |b| nrrd.put(b)).map_err(|_| RunError::Host("NRRD write"))?;
+
+        defmt::println!(
+            "frame {=str} {=str}: render {=u64} instructions = extraction {=u64} + inverse {=u64} (+ {=u64} in render's checks); 2D DHT alone {=u64}; display sink {=u64}",
+            program,
+            spec.name,
+            counts.render,
+            counts.extract,
+            counts.inverse,
+            counts.render.saturating_sub(counts.extract + counts.inverse),
+            counts.dht_2d,
+            display
+        );
+    }
+
+    if clock.wrapped() {
+        return Err(RunError::CounterWrapped);
+    }
+    let stack = unsafe_parts::stack_usage();
+    defmt::println!(
+        "stack: peak {=usize} bytes of {=usize} free for the stack",
+        stack.peak,
+        stack.available
+    );
+    Ok(())
+}
+
+/// On the target's own arithmetic: the fast f16 → f32 widening of the core
+/// (`fvr_core::real::f16_bits_to_f32`) against `half`'s, for all 65,536
+/// patterns, and the instructions per conversion of each over the 63,488
+/// finite patterns (a spectrum holds only finite values).
+fn f16_codec_report(clock: &SysTickClock) -> Result<(), RunError> {
+    use core::hint::black_box;
+    use fvr_core::f16;
+    use fvr_core::real::f16_bits_to_f32;
+
+    let differing = (0..=u16::MAX)
+        .filter(|&b| f16_bits_to_f32(b).to_bits() != f16::from_bits(b).to_f32().to_bits())
+        .count();
+    let finite = (0..0x7C00u16).chain(0x8000..0xFC00u16);
+    let count = finite.clone().count() as u64;
+    let time = |convert: &dyn Fn(u16) -> u32| {
+        let t0 = clock.now();
+        let mut acc = 0u32;
+        for b in finite.clone() {
+            acc ^= convert(black_box(b));
+        }
+        black_box(acc);
+        clock.now() - t0
+    };
+    let empty = time(&|b| b as u32);
+    let half = time(&|b| f16::from_bits(b).to_f32().to_bits());
+    let fast = time(&|b| f16_bits_to_f32(b).to_bits());
+    let hardware = time(&|b| unsafe_parts::vcvtb_f16_to_f32(b).to_bits());
+    let hardware_differing = (0..=u16::MAX)
+        .filter(|&b| {
+            unsafe_parts::vcvtb_f16_to_f32(b).to_bits() != f16::from_bits(b).to_f32().to_bits()
+        })
+        .count();
+    defmt::println!(
+        "f16 -> f32: {=usize} of 65536 patterns differ from half (VCVTB: {=usize}); per conversion (x100): half {=u64}, rebias {=u64}, VCVTB {=u64}",
+        differing,
+        hardware_differing,
+        (half - empty) * 100 / count,
+        (fast - empty) * 100 / count,
+        (hardware - empty) * 100 / count
+    );
+    if differing != 0 {
+        return Err(RunError::Host(
+            "the fast f16 widening differs from half on this target",
+        ));
+    }
+    Ok(())
+}
+
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    defmt::error!("panic: {}", defmt::Display2Format(info));
+    semihosting::process::exit(101)
+}
+
+/// A HardFault ends QEMU with status 102 instead of looping forever.
+pub fn hard_fault() -> ! {
+    defmt::error!("HardFault");
+    semihosting::process::exit(102)
+}
+
+/// The only unsafe code of the crate.
+#[allow(unsafe_code)]
+pub mod unsafe_parts {
+    /// Stack use measured on the painted stack.
+    #[derive(Clone, Copy, Debug)]
+    pub struct StackUsage {
+        /// Bytes between the stack top and the deepest overwritten word.
+        pub peak: usize,
+        /// Bytes between the stack top and the end of `.bss`/`.uninit`.
+        pub available: usize,
+    }
+
+    /// The FPv4-SP instruction `VCVTB.F32.F16` (IEEE half, FPSCR.AHP = 0):
+    /// the conversion the core cannot use, because it forbids `unsafe` and
+    /// stable Rust has no other way to emit it. Measured here to show what
+    /// it would buy.
+    ///
+    /// Stable Rust cannot hand an FPU register to `asm!` on this target (the
+    /// `sreg` class needs the unstable `vfp2` feature), so the block saves
+    /// and restores `s0` itself: 2 of the instructions counted for it would
+    /// not be there in compiler-emitted code.
+    #[inline(always)]
+    pub fn vcvtb_f16_to_f32(bits: u16) -> f32 {
+        let out: u32;
+        // SAFETY: register-only FPU instructions of the M4F (FPv4-SP with
+        // the half-precision extension), whose FPU cortex-m-rt enables for
+        // the hard-float target before `main`; `s0` is restored, and the
+        // stack use is 4 bytes, balanced. (`readonly`: vpush writes below the
+        // stack pointer only, which no Rust code can observe.)
+        unsafe {
+            core::arch::asm!(
+                "vpush {{s0}}",
+                "vmov s0, {r}",
+                "vcvtb.f32.f16 s0, s0",
+                "vmov {o}, s0",
+                "vpop {{s0}}",
+                r = in(reg) bits as u32,
+                o = lateout(reg) out,
+                // No `nomem`: vpush and vpop touch the stack.
+                options(pure, readonly),
+            );
+        }
+        f32::from_bits(out)
+    }
+
+    extern "C" {
+        static _stack_start: u32;
+        static _stack_end: u32;
+    }
+
+    /// Scan the stack painted by cortex-m-rt (`paint-stack`: every word
+    /// from `_stack_end` up to `_stack_start` set to 0xCCCC_CCCC at reset)
+    /// for the deepest word overwritten since.
+    pub fn stack_usage() -> StackUsage {
+        let lo = &raw const _stack_end as usize;
+        let hi = &raw const _stack_start as usize;
+        let mut p = lo;
+        // SAFETY: [lo, hi) is RAM reserved for the stack by the linker
+        // script, 4-byte aligned (asserted there); reading it is sound, and
+        // volatile keeps the compiler from assuming its contents.
+        while p < hi
+            && unsafe { core::ptr::read_volatile(p as *const u32) }
+                == cortex_m_rt::STACK_PAINT_VALUE
+        {
+            p += 4;
+        }
+        StackUsage {
+            peak: hi - p,
+            available: hi - lo,
+        }
+    }
+}
+
+/// The entry point, SysTick-free exception handlers and the call to
+/// [`run`] for a firmware program: `firmware_main!(name, frames, [spectra])`.
+#[macro_export]
+macro_rules! firmware_main {
+    ($program:expr, $frames:expr, [$($spectrum:expr),+ $(,)?]) => {
+        #[cortex_m_rt::entry]
+        fn main() -> ! {
+            $crate::device::run($program, &$frames, &[$($spectrum),+])
+        }
+
+        #[allow(unsafe_code)]
+        #[cortex_m_rt::exception]
+        unsafe fn HardFault(_frame: &cortex_m_rt::ExceptionFrame) -> ! {
+            $crate::device::hard_fault()
+        }
+    };
+}

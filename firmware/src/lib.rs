@@ -1,0 +1,24 @@
+//! fvr-core on a Cortex-M4F: the firmware's portable parts and, for
+//! `target_os = "none"`, its device runtime.
+//!
+//! The scene ([`scene`]) is an analytic phantom whose f16 spectra `build.rs`
+//! makes on the host, with the core, and keeps in flash ([`stored`]). On the
+//! device each frame is rendered twice, once by `fvr_core::render::render`
+//! and once stage by stage to count instructions ([`frame`]); the image goes
+//! back to the host as a NRRD over semihosting ([`nrrd`]) and to a display
+//! through an `embedded-hal` 1.0 `SpiDevice` ([`display`]), whose bytes a
+//! capture bus ([`capture`]) records for the host to check.
+//!
+//! Everything but `device` builds and is tested on the host; `device` needs
+//! `thumbv7em-none-eabihf` (`bash scripts/firmware.sh`).
+#![cfg_attr(not(test), no_std)]
+
+pub mod capture;
+pub mod display;
+pub mod frame;
+pub mod nrrd;
+pub mod scene;
+pub mod stored;
+
+#[cfg(target_os = "none")]
+pub mod device;

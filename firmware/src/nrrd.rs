@@ -1,0 +1,72 @@
+//! A float NRRD image without allocation: the header in a fixed buffer,
+//! the samples as little-endian bytes in chunks.
+
+use core::fmt::{self, Write};
+
+/// Header bytes this writer can hold.
+pub const HEADER_CAP: usize = 256;
+
+/// A NRRD header in a fixed buffer.
+#[derive(Clone, Debug)]
+pub struct Header {
+    buf: [u8; HEADER_CAP],
+    len: usize,
+}
+
+impl Header {
+    /// The header of a `float` image of `width × height`, raw encoding,
+    /// little endian, with one comment line.
+    ///
+    /// # Errors
+    /// `fmt::Error` if the header would exceed [`HEADER_CAP`] bytes.
+    pub fn image_f32(
+        width: usize,
+        height: usize,
+        comment: fmt::Arguments<'_>,
+    ) -> Result<Self, fmt::Error> {
+        let mut h = Self {
+            buf: [0; HEADER_CAP],
+            len: 0,
+        };
+        write!(
+            h,
+            "NRRD0004\n# {comment}\ntype: float\ndimension: 2\nsizes: {width} {height}\n\
+             endian: little\nencoding: raw\n\n"
+        )?;
+        Ok(h)
+    }
+
+    /// The header's bytes.
+    pub fn as_bytes(&self) -> &[u8] {
+        &self.buf[..self.len]
+    }
+}
+
+impl Write for Header {
+    fn write_str(&mut self, s: &str) -> fmt::Result {
+        let end = self.len + s.len();
+        let slot = self.buf.get_mut(self.len..end).ok_or(fmt::Error)?;
+        slot.copy_from_slice(s.as_bytes());
+        self.len = end;
+        Ok(())
+    }
+}
+
+/// Pass the samples to `put` as little-endian bytes, up to 256 bytes at a
+/// time.
+///
+/// # Errors
+/// The first error of `put`.
+pub fn write_samples_le<E>(
+    samples: &[f32],
+    mut put: impl FnMut(&[u8]) -> Result<(), E>,
+) -> Result<(), E> {
+    let mut chunk = [0u8; 256];
+    for group in samples.chunks(64) {
+        for (v, out) in group.iter().zip(chunk.chunks_exact_mut(4)) {
+            out.copy_from_slice(&v.to_le_bytes());
+        }
+        put(&chunk[..4 * group.len()])?;
+    }
+    Ok(())
+}

@@ -1,0 +1,100 @@
+//! The tables `build.rs` keeps in flash: the scene's f16 spectra, their
+//! kernel tables and the twiddles, each made on the host by the core
+//! (`Spectrum::prepare`, `KernelTable::new`, `Twiddles::new`), so the device
+//! evaluates no transcendental function at all.
+
+use fvr_core::dht::Twiddles;
+use fvr_core::f16;
+use fvr_core::filter::{Filter, FilterKind, KernelTable};
+use fvr_core::spectrum::Spectrum;
+use fvr_core::Result;
+
+use crate::scene::{StoredKind, SIDE};
+
+/// A spectrum in flash with what it takes to rebuild the core's objects.
+#[derive(Debug)]
+pub struct StoredSpectrum {
+    /// What was transformed, and for which filter.
+    pub kind: StoredKind,
+    /// Oversampling factor of the filter design.
+    pub oversample: u32,
+    /// Kaiser–Bessel β the volume was premultiplied for.
+    pub beta: f64,
+    /// The power-of-two scale `s` of the stored values.
+    pub scale: f64,
+    /// Side of the cube.
+    pub n: usize,
+    /// Dimensions of the original volume.
+    pub dims: [usize; 3],
+    /// The coefficients `s·H`, `x` fastest.
+    pub data: &'static [f16],
+    /// The kernel, `k(i/1024)` for `i = 0 ..= W·512`.
+    pub kernel: &'static [f32],
+}
+
+impl StoredSpectrum {
+    /// The interpolation filter.
+    pub fn filter_kind(&self) -> FilterKind {
+        match self.kind {
+            StoredKind::Density(kind) => kind,
+        }
+    }
+
+    /// The filter, as designed on the host.
+    ///
+    /// # Errors
+    /// A bad oversampling or β (not for tables made by `build.rs`).
+    pub fn filter(&self) -> Result<Filter> {
+        Filter::from_parts(self.filter_kind(), self.oversample, self.beta)
+    }
+
+    /// The core's view of the spectrum.
+    ///
+    /// # Errors
+    /// As `Spectrum::from_parts`.
+    pub fn spectrum(&self) -> Result<Spectrum<'static, f16>> {
+        Spectrum::from_parts(self.data, self.n, self.scale, self.filter()?, self.dims)
+    }
+
+    /// The kernel table, copied from flash (12 KiB of f32 at most).
+    ///
+    /// # Errors
+    /// As `KernelTable::from_values`.
+    pub fn kernel_table(&self) -> Result<KernelTable<f32>> {
+        KernelTable::from_values(self.filter()?, self.kernel)
+    }
+
+    /// Bytes of flash the spectrum and its kernel table take.
+    pub fn flash_bytes(&self) -> usize {
+        core::mem::size_of_val(self.data) + core::mem::size_of_val(self.kernel)
+    }
+}
+
+/// The twiddles for transforms up to the scene's side.
+///
+/// # Errors
+/// None for the generated table (its length is checked).
+pub fn twiddles() -> Result<Twiddles<'static, f32>> {
+    Twiddles::from_table(&TWIDDLES, SIDE)
+}
+
+/// Every stored spectrum, for the host-side checks. (Firmware programs name
+/// the ones they use, so that the linker keeps only those.)
+pub fn all() -> [&'static StoredSpectrum; 3] {
+    [&DENSITY_KB3, &DENSITY_KB4, &DENSITY_KB6]
+}
+
+/// Decode little-endian f16 bytes at compile time, so a spectrum lands in
+/// flash as `[f16; N]` with no unsafe cast and no runtime copy.
+const fn decode_f16<const N: usize, const B: usize>(bytes: &[u8; B]) -> [f16; N] {
+    assert!(B == 2 * N, "a spectrum file holds 2 bytes per coefficient");
+    let mut out = [f16::ZERO; N];
+    let mut i = 0;
+    while i < N {
+        out[i] = f16::from_bits(u16::from_le_bytes([bytes[2 * i], bytes[2 * i + 1]]));
+        i += 1;
+    }
+    out
+}
+
+include!(concat!(env!("OUT_DIR"), "/tables.rs"));

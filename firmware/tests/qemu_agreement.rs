@@ -1,0 +1,84 @@
+//! The firmware's images, rendered on a Cortex-M4F under QEMU, against the
+//! host core's images of the same scene: bit for bit, for the NRRD each
+//! frame wrote and for the display bytes it pushed through the SPI sink.
+//!
+//! Needs the QEMU outputs, so it is ignored in `cargo test` and run by
+//! `scripts/firmware.sh` as
+//! `FVR_QEMU_OUT=<dir> cargo test -p fvr-firmware --test qemu_agreement -- --ignored`.
+
+mod common;
+
+use std::path::PathBuf;
+
+use common::{exact_image, host_image, snr_db};
+use fvr_firmware::capture::decode_frame;
+use fvr_firmware::display::{rgb565_gray, Window};
+use fvr_firmware::scene::{IMAGE_SIDE, PROGRAMS};
+use fvr_host::nrrd::parse_nrrd;
+
+#[test]
+#[ignore = "needs the firmware's QEMU outputs: bash scripts/firmware.sh"]
+fn qemu_images_equal_host_images_bit_for_bit() {
+    let dir = PathBuf::from(
+        std::env::var_os("FVR_QEMU_OUT")
+            .expect("FVR_QEMU_OUT must name the directory QEMU wrote the firmware's files to"),
+    );
+    let mut failures = Vec::new();
+    for (program, frames) in PROGRAMS {
+        for spec in frames {
+            let host = host_image(spec);
+            let path = dir.join(format!("{program}-{}.nrrd", spec.name));
+            let bytes = std::fs::read(&path)
+                .unwrap_or_else(|e| panic!("{}: {e} (did the firmware run?)", path.display()));
+            let device = parse_nrrd(&bytes).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            assert_eq!(
+                device.dims,
+                [IMAGE_SIDE, IMAGE_SIDE, 1],
+                "{}",
+                path.display()
+            );
+            let differing = host
+                .iter()
+                .zip(&device.data)
+                .filter(|(a, b)| a.to_bits() != b.to_bits())
+                .count();
+            let exact = exact_image(spec);
+            let host_f64: Vec<f64> = host.iter().map(|&v| v as f64).collect();
+            println!(
+                "{program} {}: {differing} of {} pixels differ from the host core; \
+                 QEMU vs host {}; QEMU vs exact line integrals {:.1} dB",
+                spec.name,
+                host.len(),
+                if differing == 0 {
+                    "bit-identical".to_string()
+                } else {
+                    format!("{:.1} dB", snr_db(&host_f64, &device.data))
+                },
+                snr_db(&exact, &device.data)
+            );
+            if differing != 0 {
+                failures.push(format!(
+                    "{program} {}: {differing} pixels differ",
+                    spec.name
+                ));
+            }
+
+            // The display path: what the SPI sink sent is the host image
+            // through the same window, pixel for pixel.
+            let spi = dir.join(format!("{program}-{}.spi", spec.name));
+            let recording =
+                std::fs::read(&spi).unwrap_or_else(|e| panic!("{}: {e}", spi.display()));
+            let mut pixels = vec![0u16; host.len()];
+            let decoded = decode_frame(&recording, &mut pixels)
+                .unwrap_or_else(|e| panic!("{}: {e:?}", spi.display()));
+            let last = IMAGE_SIDE as u16 - 1;
+            assert_eq!((decoded.columns, decoded.rows), ((0, last), (0, last)));
+            let window = Window::fit(&host);
+            let expected: Vec<u16> = host.iter().map(|&v| rgb565_gray(window.gray(v))).collect();
+            if pixels != expected {
+                failures.push(format!("{program} {}: display bytes differ", spec.name));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}

@@ -1,0 +1,121 @@
+#!/usr/bin/env bash
+# The firmware on a Cortex-M4F under QEMU (mps2-an386), end to end:
+#  1. installs what it needs when missing (thumb target, qemu-system-arm,
+#     defmt-print), and fails loudly if it cannot;
+#  2. builds fvr-scene and fvr-filter-bench for thumbv7em-none-eabihf;
+#  3. runs each in QEMU with -icount shift=0 under a timeout (a HardFault
+#     would otherwise spin forever), decodes its defmt log and requires exit 0;
+#  4. checks every QEMU image against the host core bit for bit, and the
+#     display bytes against the host image (firmware/tests/qemu_agreement.rs);
+#  5. prints the instruction counts and the flash/RAM footprint;
+#  6. checks that a scene over the flash budget fails to build, naming the
+#     excess (build.rs for the tables alone, the linker for tables + code).
+# Usage: bash scripts/firmware.sh
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+TARGET=thumbv7em-none-eabihf
+PROGRAMS=(fvr-scene fvr-filter-bench)
+QEMU_TIMEOUT_S=120
+DEFMT_PRINT_VERSION=1.2.0
+
+fail() {
+    echo "ERROR: $*" >&2
+    exit 1
+}
+
+echo "== firmware: tools"
+rustup target add "$TARGET"
+if ! command -v qemu-system-arm >/dev/null; then
+    echo "qemu-system-arm is missing: installing it with apt-get"
+    if [ "$(id -u)" -eq 0 ]; then
+        apt-get update -qq || fail "apt-get update failed: cannot install qemu-system-arm"
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq qemu-system-arm \
+            || fail "apt-get install qemu-system-arm failed"
+    else
+        fail "qemu-system-arm is missing and this script is not root: install it (apt-get install -y qemu-system-arm)"
+    fi
+fi
+command -v qemu-system-arm >/dev/null || fail "qemu-system-arm is still missing after installation"
+qemu-system-arm --version | head -1
+if ! command -v defmt-print >/dev/null; then
+    echo "defmt-print is missing: cargo install defmt-print@$DEFMT_PRINT_VERSION (about 3 minutes)"
+    cargo install --locked defmt-print --version "$DEFMT_PRINT_VERSION" || fail "cargo install defmt-print failed"
+fi
+command -v defmt-print >/dev/null || fail "defmt-print is not on PATH after cargo install"
+
+target_dir=$(cargo metadata --format-version 1 --no-deps --locked \
+    | python3 -c 'import json, sys; print(json.load(sys.stdin)["target_directory"])')
+bin_dir="$target_dir/$TARGET/release"
+run_dir="$target_dir/fvr-firmware-run"
+
+echo "== firmware: build ($TARGET, release)"
+cargo clippy --locked -p fvr-firmware --target "$TARGET" --release -- -D warnings
+cargo build --locked -p fvr-firmware --target "$TARGET" --release
+
+echo "== firmware: run in QEMU (mps2-an386, -icount shift=0, timeout ${QEMU_TIMEOUT_S}s)"
+rm -rf "$run_dir"
+mkdir -p "$run_dir"
+for program in "${PROGRAMS[@]}"; do
+    elf="$bin_dir/$program"
+    set +e
+    (cd "$run_dir" && timeout --kill-after=5 "$QEMU_TIMEOUT_S" qemu-system-arm \
+        -machine mps2-an386 -cpu cortex-m4 -nographic -monitor none -serial none \
+        -semihosting-config enable=on,target=native -icount shift=0 \
+        -kernel "$elf" >"$program.defmt")
+    status=$?
+    set -e
+    defmt-print -e "$elf" <"$run_dir/$program.defmt" | tee "$run_dir/$program.log"
+    case $status in
+        0) ;;
+        124 | 137) fail "$program: QEMU timed out after ${QEMU_TIMEOUT_S}s (a HardFault loop or a hang)" ;;
+        *) fail "$program: exited with status $status (101 panic, 102 HardFault, 1 error)" ;;
+    esac
+done
+
+echo "== firmware: QEMU images against the host core (bit for bit)"
+FVR_QEMU_OUT="$run_dir" cargo test --locked -p fvr-firmware --test qemu_agreement -- --ignored --nocapture
+
+echo "== firmware: instruction counts (64x64 view, Cortex-M4F, exact to +-40)"
+printf '%-18s %-10s %11s %11s %11s %11s\n' program frame render extraction inverse "(2D DHT)"
+for program in "${PROGRAMS[@]}"; do
+    sed -n 's/^frame \([^ ]*\) \([^:]*\): render \([0-9]*\) instructions = extraction \([0-9]*\) + inverse \([0-9]*\).*2D DHT alone \([0-9]*\).*/\1 \2 \3 \4 \5 \6/p' \
+        "$run_dir/$program.log" \
+        | while read -r p f r e i d; do printf '%-18s %-10s %11s %11s %11s %11s\n' "$p" "$f" "$r" "$e" "$i" "$d"; done
+done
+grep -h '^f16 -> f32' "$run_dir/fvr-filter-bench.log" || fail "no f16 conversion report"
+grep -h '^frame' "$run_dir"/*.log >/dev/null || fail "no instruction counts in the firmware logs"
+
+echo "== firmware: footprint (bytes)"
+printf '%-18s %8s %8s %8s %8s %8s %10s %10s\n' program .text .rodata .data .bss stack flash RAM
+for program in "${PROGRAMS[@]}"; do
+    read -r text rodata data bss vt < <(size -A "$bin_dir/$program" | awk '
+        $1==".text"{t=$2} $1==".rodata"{r=$2} $1==".data"{d=$2} $1==".bss"{b=$2} $1==".vector_table"{v=$2}
+        END{print t+0, r+0, d+0, b+0, v+0}')
+    stack=$(sed -n 's/^stack: peak \([0-9]*\) bytes.*/\1/p' "$run_dir/$program.log")
+    [ -n "$stack" ] || fail "$program: no stack measurement in its log"
+    printf '%-18s %8s %8s %8s %8s %8s %10s %10s\n' "$program" "$text" "$rodata" "$data" "$bss" "$stack" \
+        $((vt + text + rodata + data)) $((data + bss + stack))
+done
+
+echo "== firmware: a scene over the flash budget fails to build, naming the excess"
+# In a copy of the workspace whose memory.x is smaller (the linker reads
+# memory.x from the workspace root), with its own target directory.
+budget_ws=$(mktemp -d)
+trap 'rm -rf "$budget_ws"' EXIT
+git ls-files -z --cached --others --exclude-standard | xargs -0 cp --parents -t "$budget_ws"
+expect_build_failure() { # flash-length pattern what
+    sed -i "s/^\( *FLASH *: *ORIGIN = 0x00000000, LENGTH = \).*/\1$1/" "$budget_ws/memory.x"
+    grep -q "LENGTH = $1\$" "$budget_ws/memory.x" || fail "could not set FLASH to $1 in the copy of memory.x"
+    set +e
+    (cd "$budget_ws" && CARGO_TARGET_DIR="$target_dir/fvr-firmware-budget" \
+        cargo build --locked -p fvr-firmware --target "$TARGET" --release) >"$budget_ws/build.log" 2>&1
+    local status=$?
+    set -e
+    [ $status -ne 0 ] || fail "$3: the build succeeded with FLASH = $1"
+    grep -Eo "$2" "$budget_ws/build.log" | head -1 | sed "s/^/$3: /" | grep . \
+        || { cat "$budget_ws/build.log" >&2; fail "$3: the build failed without saying by how much"; }
+}
+expect_build_failure 1M 'does not fit: .* over by [0-9]+ bytes' "FLASH 1 MiB, tables alone too big (build.rs)"
+expect_build_failure 1600K "section '[^']+' will not fit in region 'FLASH': overflowed by [0-9]+ bytes" "FLASH 1600 KiB, tables + code too big (linker)"
+echo "firmware: all checks passed"
