@@ -11,6 +11,7 @@
 //! fallible call returns [`Result`]. The crate never panics on data.
 #![no_std]
 
+pub mod adaptive;
 pub mod dht;
 pub mod error;
 pub mod filter;
