@@ -20,7 +20,8 @@ use semihosting::io::Write as _;
 use crate::capture::{ByteSink, CaptureBus};
 use crate::display::{DcsPanel, Window};
 use crate::frame::{
-    render_frame, tables_for, FrameBuffers, FrameError, InstructionClock, Split, IMAGE_LEN,
+    check_linked_tables, render_frame, tables_for, FrameBuffers, FrameError, InstructionClock,
+    Split, IMAGE_LEN,
 };
 use crate::nrrd::{write_samples_le, Header};
 use crate::scene::{FrameSpec, IMAGE_SIDE};
@@ -191,6 +192,7 @@ fn run_inner(
     );
 
     f16_codec_report(&clock)?;
+    check_linked_tables(frames, spectra, derivatives)?;
 
     let tw = twiddles().map_err(|e| RunError::Frame(FrameError::Core(e)))?;
 

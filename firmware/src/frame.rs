@@ -124,6 +124,15 @@ pub enum FrameError {
         /// Its filter.
         filter: FilterKind,
     },
+    /// The program links a table none of its frames reads (it would take
+    /// flash for nothing, and the flash budget of `build.rs`, which counts
+    /// what the frames need, would not see it).
+    UnusedTable {
+        /// The spectrum, or `None` for a kernel-derivative table.
+        kind: Option<StoredKind>,
+        /// Its filter.
+        filter: FilterKind,
+    },
     /// The staged render differs from `render` at this pixel.
     StagesDisagree {
         /// The frame.
@@ -152,6 +161,20 @@ impl fmt::Display for FrameError {
             FrameError::MissingDerivative { frame, filter } => write!(
                 f,
                 "frame {frame}: no stored kernel-derivative table for {} (its linear depth cue needs one)",
+                filter.name()
+            ),
+            FrameError::UnusedTable {
+                kind: Some(kind),
+                ..
+            } => write!(
+                f,
+                "the {} spectrum for {} is linked but no frame reads it",
+                kind.prefix(),
+                kind.filter().name()
+            ),
+            FrameError::UnusedTable { kind: None, filter } => write!(
+                f,
+                "the kernel-derivative table for {} is linked but no frame reads it",
                 filter.name()
             ),
             FrameError::StagesDisagree { frame, pixel } => write!(
@@ -213,6 +236,48 @@ pub fn tables_for(
         gradient: gradient.map(find).transpose()?,
         derivative,
     })
+}
+
+/// Check that a program links exactly what its frames read: every frame
+/// finds its tables ([`tables_for`]) and every linked table is read by some
+/// frame.
+///
+/// # Errors
+/// The first missing table ([`FrameError::MissingSpectrum`],
+/// [`FrameError::MissingDerivative`]) or unused one
+/// ([`FrameError::UnusedTable`]).
+pub fn check_linked_tables(
+    frames: &[FrameSpec],
+    spectra: &[&'static StoredSpectrum],
+    derivatives: &[&'static StoredDerivative],
+) -> Result<(), FrameError> {
+    for spec in frames {
+        tables_for(spec, spectra, derivatives)?;
+    }
+    for s in spectra {
+        let read = frames.iter().any(|f| {
+            let (density, gradient) = f.spectra();
+            density == s.kind || gradient == Some(s.kind)
+        });
+        if !read {
+            return Err(FrameError::UnusedTable {
+                kind: Some(s.kind),
+                filter: s.filter_kind(),
+            });
+        }
+    }
+    for d in derivatives {
+        let read = frames
+            .iter()
+            .any(|f| f.filter == d.kind && f.shading.needs_kernel_derivative());
+        if !read {
+            return Err(FrameError::UnusedTable {
+                kind: None,
+                filter: d.kind,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Render `spec` from `tables` into `bufs.image` (an [`IMAGE_SIDE`]²

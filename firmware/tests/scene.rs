@@ -13,14 +13,18 @@ use fvr_core::filter::{DerivativeTable, Filter, FilterKind, KernelTable};
 use fvr_core::scene::ViewPlan;
 use fvr_core::spectrum::{DenseVolume, Spectrum};
 use fvr_firmware::frame::{
-    render_frame, tables_for, FrameBuffers, FrameError, InstructionClock, Split, AUX_LEN, IMAGE_LEN,
+    check_linked_tables, render_frame, tables_for, FrameBuffers, FrameError, InstructionClock,
+    Split, AUX_LEN, IMAGE_LEN,
 };
 use fvr_firmware::nrrd::{write_samples_le, Header};
 use fvr_firmware::scene::{
-    buffer_sizes, density, FrameSpec, Shading, StoredKind, DIMS, IMAGE_SIDE, LIGHTS, OVERSAMPLE,
-    PROGRAMS, SCENE_FRAMES,
+    buffer_sizes, density, FrameSpec, Shading, StoredKind, BENCH_FRAMES, DIMS, IMAGE_SIDE, LIGHTS,
+    OVERSAMPLE, PROGRAMS, SCENE_FRAMES,
 };
-use fvr_firmware::stored::{all, all_derivatives, twiddles, DENSITY_KB3, DERIVATIVE_KB3};
+use fvr_firmware::stored::{
+    all, all_derivatives, twiddles, DENSITY_KB3, DENSITY_KB4, DENSITY_KB6, DERIVATIVE_KB3,
+    GRADIENT_KB3,
+};
 use fvr_host::pipeline::{AnySpectrum, Precision};
 use fvr_host::shaded::{gradient_volume, SceneSpectra};
 use fvr_host::volume::Volume;
@@ -174,7 +178,7 @@ fn constant_buffer_sizes_match_the_cores_scene_counts() {
     assert_eq!(scene_frames, [(1, 1), (2, 1), (3, 3), (7, 3)]);
     let sizes = buffer_sizes(&SCENE_FRAMES);
     assert_eq!((sizes.fields, sizes.image), (7 * n2, 3 * n2));
-    let bench = buffer_sizes(&PROGRAMS[1].1);
+    let bench = buffer_sizes(&BENCH_FRAMES);
     assert_eq!((bench.fields, bench.image), (n2, n2));
 }
 
@@ -251,7 +255,7 @@ fn staged_render_equals_render_bit_for_bit() {
 
 #[test]
 fn a_frame_without_its_tables_is_an_error_naming_it() {
-    let spec = &fvr_firmware::scene::BENCH_FRAMES[2];
+    let spec = &BENCH_FRAMES[2];
     let err = tables_for(spec, &[&DENSITY_KB3], &[]).unwrap_err();
     assert_eq!(
         err,
@@ -284,6 +288,34 @@ fn a_frame_without_its_tables_is_an_error_naming_it() {
     assert_eq!(
         err.to_string(),
         "frame cued-kb3: no stored kernel-derivative table for kb3 (its linear depth cue needs one)"
+    );
+    // A program must link exactly what its frames read: the two programs'
+    // lists (src/bin/*.rs) pass, a missing or an unused table fails.
+    let scene_tables = [&DENSITY_KB3, &GRADIENT_KB3];
+    check_linked_tables(&SCENE_FRAMES, &scene_tables, &[&DERIVATIVE_KB3]).unwrap();
+    check_linked_tables(
+        &BENCH_FRAMES,
+        &[&DENSITY_KB3, &DENSITY_KB4, &DENSITY_KB6],
+        &[],
+    )
+    .unwrap();
+    assert_eq!(
+        check_linked_tables(&SCENE_FRAMES, &scene_tables, &[]).unwrap_err(),
+        FrameError::MissingDerivative {
+            frame: "cued-kb3",
+            filter: FilterKind::Kb3
+        }
+    );
+    let err = check_linked_tables(&BENCH_FRAMES[..2], &all(), &[]).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "the density spectrum for kb6 is linked but no frame reads it"
+    );
+    let err =
+        check_linked_tables(&SCENE_FRAMES[..1], &[&DENSITY_KB3], &[&DERIVATIVE_KB3]).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "the kernel-derivative table for kb3 is linked but no frame reads it"
     );
     // Each frame gets exactly the tables it needs.
     for spec in SCENE_FRAMES.iter() {
