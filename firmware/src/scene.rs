@@ -18,8 +18,11 @@
 //!   [`StoredKind::GradientMagnitude`] in [`STORED`]: 512 KiB for a 64³ f16
 //!   cube.
 //!
-//! A program links only the tables its frames name (`src/bin/*.rs`), and
-//! `build.rs` checks each program's flash budget from its frames.
+//! A program names the tables it links (`src/bin/*.rs`); it must name
+//! exactly those its frames read (`frame::check_linked_tables`, run on the
+//! device before any frame), and `build.rs` checks each program's flash
+//! budget from its frames. The buffers are sized from the frames too
+//! ([`buffer_sizes`]).
 
 use fvr_core::filter::FilterKind;
 use fvr_core::geometry::View;
