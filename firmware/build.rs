@@ -4,8 +4,10 @@
 //!    cargo builds from the workspace root the linker finds the root's file
 //!    first, in its working directory: the same file.)
 //! 2. runs the core **on the host** to make the flash tables: it samples the
-//!    scene's phantom (`src/scene.rs`), prepares one f16 spectrum per stored
-//!    filter, tabulates the kernels and the twiddles, and writes them to
+//!    scene's phantom (`src/scene.rs`), computes its gradient magnitude
+//!    `|∇f|` if a stored spectrum needs it, prepares the f16 spectra listed
+//!    in `STORED`, tabulates the kernels, the kernel derivatives listed in
+//!    `DERIVATIVES` and the twiddles, and writes them to
 //!    `OUT_DIR` (the spectra as little-endian f16 files, the rest as Rust);
 //! 3. refuses a scene whose tables do not fit the flash in `memory.x`, saying
 //!    by how many bytes it is over.
@@ -18,7 +20,8 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use fvr_core::dht::Twiddles;
-use fvr_core::filter::{Filter, KernelTable};
+use fvr_core::filter::{DerivativeTable, Filter, FilterKind, KernelTable};
+use fvr_core::gradient::{gradient_magnitude, gradient_scratch_len};
 use fvr_core::spectrum::{padded_size, prepare_scratch_len, DenseVolume, Spectrum};
 use half::f16;
 
@@ -26,7 +29,7 @@ use half::f16;
 #[path = "src/scene.rs"]
 mod scene;
 
-use scene::{StoredKind, DIMS, OVERSAMPLE, PROGRAMS, STORED};
+use scene::{StoredKind, DERIVATIVES, DIMS, OVERSAMPLE, PROGRAMS, STORED};
 
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
@@ -51,9 +54,20 @@ fn main() {
     check_flash_budget(&layout, &memory, &tables);
 }
 
-/// Bytes of flash one stored spectrum takes with its kernel table.
+/// A table `build.rs` puts in flash.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Table {
+    /// An f16 spectrum.
+    Spectrum(StoredKind),
+    /// A filter's kernel table (shared by the spectra of that filter).
+    Kernel(FilterKind),
+    /// A filter's kernel-derivative table.
+    Derivative(FilterKind),
+}
+
+/// Bytes of flash one table takes.
 struct Made {
-    kind: StoredKind,
+    table: Table,
     bytes: usize,
 }
 
@@ -71,6 +85,22 @@ fn make_tables(out: &Path) -> Vec<Made> {
     }
     let volume = DenseVolume::new(DIMS, &voxels).expect("phantom shape");
     let n = padded_size(DIMS, OVERSAMPLE).expect("phantom size");
+
+    // |∇f| of the samples, in f64 and rounded to f32, as the host's
+    // `fvr_host::shaded::gradient_volume` makes it; only if a stored
+    // spectrum needs it.
+    let gradient_voxels: Option<Vec<f32>> = STORED
+        .iter()
+        .any(|k| matches!(k, StoredKind::GradientMagnitude(_)))
+        .then(|| {
+            let len = gradient_scratch_len(DIMS);
+            let mut tw_buf = vec![0.0f64; Twiddles::<f64>::buffer_len(len)];
+            let tw = Twiddles::new(&mut tw_buf, len).expect("twiddles");
+            let mut line = vec![0.0f64; len];
+            let mut g = vec![0.0f64; voxels.len()];
+            gradient_magnitude(&volume, &mut g, &mut line, &tw).expect("|∇f| of the phantom");
+            g.into_iter().map(|v| v as f32).collect()
+        });
 
     let mut tw_buf = vec![0.0f32; Twiddles::<f32>::buffer_len(n)];
     Twiddles::new(&mut tw_buf, n).expect("twiddles");
@@ -94,43 +124,65 @@ fn make_tables(out: &Path) -> Vec<Made> {
     )
     .unwrap();
 
+    // One filter design per filter, from the density (every spectrum of a
+    // filter, density or |∇f|, is premultiplied for the same β).
+    let mut filters: Vec<(FilterKind, Filter, f64)> = Vec::new();
+    let mut design_for = |kind: FilterKind| -> (Filter, f64) {
+        if let Some(&(_, f, d)) = filters.iter().find(|(k, _, _)| *k == kind) {
+            return (f, d);
+        }
+        let (f, d) = Filter::fit(kind, OVERSAMPLE, &volume).expect("filter design for the phantom");
+        filters.push((kind, f, d));
+        (f, d)
+    };
+
     let mut made = Vec::new();
     for kind in STORED {
-        let StoredKind::Density(filter_kind) = kind;
+        let filter_kind = kind.filter();
         let name = filter_kind.name();
-        let (filter, design) =
-            Filter::fit(filter_kind, OVERSAMPLE, &volume).expect("filter design for the phantom");
+        let (filter, design) = design_for(filter_kind);
+        let gradient_volume;
+        let (source, what) = match kind {
+            StoredKind::Density(_) => (&volume, "density"),
+            StoredKind::GradientMagnitude(_) => {
+                let g = gradient_voxels.as_deref().expect("made above");
+                gradient_volume = DenseVolume::new(DIMS, g).expect("|∇f| shape");
+                (&gradient_volume, "gradient magnitude |∇f|")
+            }
+        };
         let mut data = vec![f16::ZERO; n * n * n];
-        let spec = Spectrum::prepare(&volume, filter, &mut data, &mut scratch, &tw)
+        let spec = Spectrum::prepare(source, filter, &mut data, &mut scratch, &tw)
             .expect("preparing the phantom's spectrum");
         let scale = spec.scale();
         let bytes: Vec<u8> = data
             .iter()
             .flat_map(|h| h.to_bits().to_le_bytes())
             .collect();
-        let file = format!("density-{name}.f16");
+        let prefix = kind.prefix();
+        let file = format!("{prefix}-{name}.f16");
         fs::write(out.join(&file), &bytes).expect("write spectrum");
-        let kernel = KernelTable::<f32>::new(filter);
-        let upper = name.to_uppercase();
+        let upper = format!("{}_{}", prefix.to_uppercase(), name.to_uppercase());
+        let variant_path = match kind {
+            StoredKind::Density(_) => "Density",
+            StoredKind::GradientMagnitude(_) => "GradientMagnitude",
+        };
         writeln!(
             src,
-            "/// The phantom's density spectrum for {name} (β = {beta}, designed for\n\
+            "/// The phantom's {what} spectrum for {name} (β = {beta}, designed for\n\
              /// σ = {design:.3}), {n}³ f16, scale 2^{e}.\n\
-             pub static DENSITY_{upper}: StoredSpectrum = StoredSpectrum {{\n    \
-                 kind: StoredKind::Density(FilterKind::{variant}),\n    \
+             pub static {upper}: StoredSpectrum = StoredSpectrum {{\n    \
+                 kind: StoredKind::{variant_path}(FilterKind::{variant}),\n    \
                  oversample: {OVERSAMPLE},\n    \
                  beta: f64::from_bits({beta_bits:#018x}),\n    \
                  scale: f64::from_bits({scale_bits:#018x}),\n    \
                  n: {n},\n    \
                  dims: [{}, {}, {}],\n    \
-                 data: &DENSITY_{upper}_DATA,\n    \
-                 kernel: &KERNEL_{upper},\n\
+                 data: &{upper}_DATA,\n    \
+                 kernel: &KERNEL_{kupper},\n\
              }};\n\
              #[allow(long_running_const_eval)]\n\
-             static DENSITY_{upper}_DATA: [f16; {cube}] =\n    \
-                 decode_f16(include_bytes!(concat!(env!(\"OUT_DIR\"), \"/{file}\")));\n\
-             /// The {name} kernel tabulated by `KernelTable::new` on the host.\n\
-             static KERNEL_{upper}: [f32; {klen}] = {karr};\n",
+             static {upper}_DATA: [f16; {cube}] =\n    \
+                 decode_f16(include_bytes!(concat!(env!(\"OUT_DIR\"), \"/{file}\")));\n",
             DIMS[0],
             DIMS[1],
             DIMS[2],
@@ -140,13 +192,56 @@ fn make_tables(out: &Path) -> Vec<Made> {
             scale_bits = scale.to_bits(),
             e = libm::log2(scale) as i32,
             cube = n * n * n,
-            klen = kernel.values().len(),
-            karr = f32_array(kernel.values()),
+            kupper = name.to_uppercase(),
         )
         .unwrap();
         made.push(Made {
-            kind,
-            bytes: bytes.len() + 4 * kernel.values().len(),
+            table: Table::Spectrum(kind),
+            bytes: bytes.len(),
+        });
+        if !made.iter().any(|m| m.table == Table::Kernel(filter_kind)) {
+            let kernel = KernelTable::<f32>::new(filter);
+            writeln!(
+                src,
+                "/// The {name} kernel tabulated by `KernelTable::new` on the host.\n\
+                 static KERNEL_{}: [f32; {}] = {};\n",
+                name.to_uppercase(),
+                kernel.values().len(),
+                f32_array(kernel.values()),
+            )
+            .unwrap();
+            made.push(Made {
+                table: Table::Kernel(filter_kind),
+                bytes: 4 * kernel.values().len(),
+            });
+        }
+    }
+    for filter_kind in DERIVATIVES {
+        let name = filter_kind.name();
+        let (filter, _) = design_for(filter_kind);
+        let table = DerivativeTable::<f32>::new(filter).expect("a kernel with a derivative");
+        let upper = name.to_uppercase();
+        writeln!(
+            src,
+            "/// The {name} kernel derivative tabulated by `DerivativeTable::new`\n\
+             /// on the host (β = {beta}).\n\
+             pub static DERIVATIVE_{upper}: StoredDerivative = StoredDerivative {{\n    \
+                 kind: FilterKind::{variant},\n    \
+                 oversample: {OVERSAMPLE},\n    \
+                 beta: f64::from_bits({beta_bits:#018x}),\n    \
+                 values: &DERIVATIVE_{upper}_VALUES,\n\
+             }};\n\
+             static DERIVATIVE_{upper}_VALUES: [f32; {len}] = {arr};\n",
+            beta = filter.beta(),
+            variant = variant(name),
+            beta_bits = filter.beta().to_bits(),
+            len = table.values().len(),
+            arr = f32_array(table.values()),
+        )
+        .unwrap();
+        made.push(Made {
+            table: Table::Derivative(filter_kind),
+            bytes: 4 * table.values().len(),
         });
     }
     fs::write(out.join("tables.rs"), src).expect("write tables.rs");
@@ -184,14 +279,30 @@ fn check_flash_budget(layout: &str, path: &Path, made: &[Made]) {
         )
     });
     for (program, frames) in PROGRAMS {
-        let mut kinds: Vec<StoredKind> = frames
-            .iter()
-            .map(|f| StoredKind::Density(f.filter))
-            .collect();
-        kinds.dedup();
+        let mut tables: Vec<Table> = Vec::new();
+        for f in frames.iter() {
+            let (density, gradient) = f.spectra();
+            let mut needs = vec![Table::Spectrum(density), Table::Kernel(f.filter)];
+            needs.extend(gradient.map(Table::Spectrum));
+            if f.shading.needs_kernel_derivative() {
+                needs.push(Table::Derivative(f.filter));
+            }
+            for table in needs {
+                if !made.iter().any(|m| m.table == table) {
+                    panic!(
+                        "frame {} of {program} needs {table:?}, which src/scene.rs does not \
+                         list in STORED or DERIVATIVES",
+                        f.name
+                    );
+                }
+                if !tables.contains(&table) {
+                    tables.push(table);
+                }
+            }
+        }
         let bytes: usize = made
             .iter()
-            .filter(|m| kinds.contains(&m.kind))
+            .filter(|m| tables.contains(&m.table))
             .map(|m| m.bytes)
             .sum();
         if bytes > flash {

@@ -2,7 +2,8 @@
 # The firmware on a Cortex-M4F under QEMU (mps2-an386), end to end:
 #  1. installs what it needs when missing (thumb target, qemu-system-arm,
 #     defmt-print), and fails loudly if it cannot;
-#  2. builds fvr-scene and fvr-filter-bench for thumbv7em-none-eabihf;
+#  2. builds fvr-scene (plain, depth-cued, shaded and both) and
+#     fvr-filter-bench for thumbv7em-none-eabihf;
 #  3. runs each in QEMU with -icount shift=0 under a timeout (a HardFault
 #     would otherwise spin forever), decodes its defmt log and requires exit 0;
 #  4. checks every QEMU image against the host core bit for bit, and the
@@ -77,14 +78,26 @@ echo "== firmware: QEMU images against the host core (bit for bit)"
 FVR_QEMU_OUT="$run_dir" cargo test --locked -p fvr-firmware --test qemu_agreement -- --ignored --nocapture
 
 echo "== firmware: instruction counts (64x64 view, Cortex-M4F, exact to +-40)"
-printf '%-18s %-10s %11s %11s %11s %11s\n' program frame render extraction inverse "(2D DHT)"
+# Plain frames are split by a staged render; cued and shaded frames by
+# timing their inverse again after render_scene (extraction is the rest),
+# which relies on the inverse's cost not depending on the data: each plain
+# frame's "inverse again on other data" must equal its inverse within two
+# clock readings (80 instructions).
+printf '%-18s %-13s %11s %11s %11s %11s\n' program frame render extraction inverse "(2D DHT)"
 for program in "${PROGRAMS[@]}"; do
     sed -n 's/^frame \([^ ]*\) \([^:]*\): render \([0-9]*\) instructions = extraction \([0-9]*\) + inverse \([0-9]*\).*2D DHT alone \([0-9]*\).*/\1 \2 \3 \4 \5 \6/p' \
         "$run_dir/$program.log" \
-        | while read -r p f r e i d; do printf '%-18s %-10s %11s %11s %11s %11s\n' "$p" "$f" "$r" "$e" "$i" "$d"; done
+        | while read -r p f r e i d; do printf '%-18s %-13s %11s %11s %11s %11s\n' "$p" "$f" "$r" "$e" "$i" "$d"; done
+    sed -n 's/^frame [^ ]* \([^:]*\): .* inverse \([0-9]*\) (+ .*inverse again on other data \([0-9]*\);.*/\1 \2 \3/p' \
+        "$run_dir/$program.log" \
+        | while read -r f i again; do
+            diff=$((i > again ? i - again : again - i))
+            [ "$diff" -le 80 ] || fail "$program $f: the inverse took $i instructions, and $again on other data: its cost depends on the data, so the cued and shaded frames' split is wrong"
+        done
 done
 grep -h '^f16 -> f32' "$run_dir/fvr-filter-bench.log" || fail "no f16 conversion report"
 grep -h '^frame' "$run_dir"/*.log >/dev/null || fail "no instruction counts in the firmware logs"
+grep -q 'inverse again on other data' "$run_dir/fvr-scene.log" || fail "fvr-scene: no re-timed inverse of its plain frame"
 
 echo "== firmware: footprint (bytes)"
 printf '%-18s %8s %8s %8s %8s %8s %10s %10s\n' program .text .rodata .data .bss stack flash RAM

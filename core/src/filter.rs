@@ -617,7 +617,7 @@ impl<T: Real> DerivativeTable<T> {
         if filter.kind == FilterKind::Nearest {
             return Err(Error::NoKernelDerivative);
         }
-        let len = filter.width() * TABLE_RESOLUTION / 2 + 1;
+        let len = Self::len_for(&filter);
         let mut values = [T::ZERO; TABLE_CAP];
         for (i, v) in values[..len].iter_mut().enumerate() {
             *v = T::from_f64(filter.kernel_derivative(i as f64 / TABLE_RESOLUTION as f64));
@@ -627,6 +627,55 @@ impl<T: Real> DerivativeTable<T> {
             values,
             len,
         })
+    }
+
+    /// Entries a table for `filter` holds: `W·1024/2 + 1`, the samples
+    /// `k'(i/1024)` for `i = 0 ..= W·512` (as [`KernelTable::len_for`]).
+    pub const fn len_for(filter: &Filter) -> usize {
+        KernelTable::<T>::len_for(filter)
+    }
+
+    /// Rebuild a table from the values [`DerivativeTable::values`] returned
+    /// for the same filter, e.g. a table in flash generated at build time,
+    /// so a target without fast f64 never evaluates the Bessel series. The
+    /// result equals `DerivativeTable::new(filter)` bit for bit when
+    /// `values` came from it.
+    ///
+    /// # Errors
+    /// [`Error::NoKernelDerivative`] for nearest neighbour (as
+    /// [`DerivativeTable::new`]); `values.len()` other than
+    /// [`DerivativeTable::len_for`]`(&filter)`; a NaN or infinite entry
+    /// (named by its index).
+    pub fn from_values(filter: Filter, values: &[T]) -> Result<Self> {
+        if filter.kind == FilterKind::Nearest {
+            return Err(Error::NoKernelDerivative);
+        }
+        let len = Self::len_for(&filter);
+        if values.len() != len {
+            return Err(crate::error::mismatch(
+                "kernel derivative table",
+                len,
+                values.len(),
+            ));
+        }
+        if let Some(index) = values.iter().position(|v| !v.is_finite()) {
+            return Err(Error::NonFiniteTableEntry {
+                what: "kernel derivative table",
+                index,
+            });
+        }
+        let mut table = [T::ZERO; TABLE_CAP];
+        table[..len].copy_from_slice(values);
+        Ok(Self {
+            filter,
+            values: table,
+            len,
+        })
+    }
+
+    /// The tabulated samples `k'(i/1024)`, `i = 0 ..= W·512`.
+    pub fn values(&self) -> &[T] {
+        &self.values[..self.len]
     }
 
     /// The filter whose derivative is tabulated.

@@ -20,12 +20,12 @@ use semihosting::io::Write as _;
 use crate::capture::{ByteSink, CaptureBus};
 use crate::display::{DcsPanel, Window};
 use crate::frame::{
-    render_frame, spectrum_for, FrameBuffers, FrameError, InstructionClock, AUX_LEN, GRID_LEN,
-    IMAGE_LEN,
+    check_linked_tables, render_frame, tables_for, FrameBuffers, FrameError, InstructionClock,
+    Split, IMAGE_LEN,
 };
 use crate::nrrd::{write_samples_le, Header};
 use crate::scene::{FrameSpec, IMAGE_SIDE};
-use crate::stored::{twiddles, StoredSpectrum};
+use crate::stored::{twiddles, StoredDerivative, StoredSpectrum};
 
 // The critical-section implementation defmt-semihosting needs.
 use cortex_m as _;
@@ -150,12 +150,18 @@ impl Name {
     }
 }
 
-/// Render every frame of `frames` from `spectra`, write each image to
-/// `<program>-<frame>.nrrd` and its display recording to
-/// `<program>-<frame>.spi` on the host, log the counts with defmt, and exit
-/// QEMU with status 0 (1 on any error).
-pub fn run(program: &str, frames: &[FrameSpec], spectra: &[&'static StoredSpectrum]) -> ! {
-    let status = match run_inner(program, frames, spectra) {
+/// Render every frame of `frames` from `spectra` and `derivatives` into
+/// `bufs`, write each image to `<program>-<frame>.nrrd` and its display
+/// recording to `<program>-<frame>.spi` on the host, log the counts with
+/// defmt, and exit QEMU with status 0 (1 on any error).
+pub fn run(
+    program: &str,
+    frames: &[FrameSpec],
+    spectra: &[&'static StoredSpectrum],
+    derivatives: &[&'static StoredDerivative],
+    bufs: FrameBuffers<'_>,
+) -> ! {
+    let status = match run_inner(program, frames, spectra, derivatives, bufs) {
         Ok(()) => 0,
         Err(e) => {
             defmt::error!("{=str}: {}", program, defmt::Debug2Format(&e));
@@ -169,6 +175,8 @@ fn run_inner(
     program: &str,
     frames: &[FrameSpec],
     spectra: &[&'static StoredSpectrum],
+    derivatives: &[&'static StoredDerivative],
+    mut bufs: FrameBuffers<'_>,
 ) -> Result<(), RunError> {
     let peripherals = cortex_m::Peripherals::take().ok_or(RunError::Host("peripherals taken"))?;
     let mut clock = SysTickClock::start(peripherals.SYST);
@@ -184,41 +192,37 @@ fn run_inner(
     );
 
     f16_codec_report(&clock)?;
+    check_linked_tables(frames, spectra, derivatives)?;
 
-    let grid = cortex_m::singleton!(GRID: [f32; GRID_LEN] = [0.0; GRID_LEN])
-        .ok_or(RunError::Host("buffers taken"))?;
-    let aux = cortex_m::singleton!(AUX: [f32; AUX_LEN] = [0.0; AUX_LEN])
-        .ok_or(RunError::Host("buffers taken"))?;
-    let image = cortex_m::singleton!(IMAGE: [f32; IMAGE_LEN] = [0.0; IMAGE_LEN])
-        .ok_or(RunError::Host("buffers taken"))?;
-    let staged = cortex_m::singleton!(STAGED: [f32; IMAGE_LEN] = [0.0; IMAGE_LEN])
-        .ok_or(RunError::Host("buffers taken"))?;
-    let mut bufs = FrameBuffers {
-        grid,
-        aux,
-        image,
-        staged,
-    };
     let tw = twiddles().map_err(|e| RunError::Frame(FrameError::Core(e)))?;
 
     for spec in frames {
-        let stored = spectrum_for(spec, spectra)?;
-        let counts = render_frame(spec, stored, &tw, &mut bufs, &clock)?;
+        let tables = tables_for(spec, spectra, derivatives)?;
+        let rendered = render_frame(spec, &tables, &tw, &mut bufs, &clock)?;
+        let (channels, counts) = (rendered.channels, rendered.counts);
+        let image = bufs
+            .image
+            .get(..channels * IMAGE_LEN)
+            .ok_or(RunError::Host("image buffer shorter than the frame"))?;
 
         let t0 = clock.now();
-        let window = Window::fit(bufs.image);
+        let window = Window::fit(image);
         let bus = CaptureBus::new(HostFile::create(
             Name::new(program, spec.name, "spi")?.as_str(),
         )?);
         let mut panel = DcsPanel::new(bus.spi(), bus.dc());
         let mut row = [0u8; 2 * IMAGE_SIDE];
-        panel
-            .draw_gray(0, 0, bufs.image, IMAGE_SIDE, &window, &mut row)
-            .map_err(|_| RunError::Display)?;
+        let drawn = if channels == 1 {
+            panel.draw_gray(0, 0, image, IMAGE_SIDE, &window, &mut row)
+        } else {
+            panel.draw_rgb(0, 0, image, IMAGE_SIDE, &window, &mut row)
+        };
+        drawn.map_err(|_| RunError::Display)?;
         let display = clock.now() - t0;
 
         let mut nrrd = HostFile::create(Name::new(program, spec.name, "nrrd")?.as_str())?;
         let header = Header::image_f32(
+            channels,
             IMAGE_SIDE,
             IMAGE_SIDE,
             format_args!("{program} {}: rendered on a Cortex-M4F", spec.name),
@@ -226,19 +230,33 @@ fn run_inner(
         .map_err(|_| RunError::Host("NRRD header too long"))?;
         nrrd.put(header.as_bytes())
             .map_err(|_| RunError::Host("NRRD write"))?;
-        write_samples_le(bufs.image, |b| nrrd.put(b)).map_err(|_| RunError::Host("NRRD write"))?;
+        write_samples_le(image, |b| nrrd.put(b)).map_err(|_| RunError::Host("NRRD write"))?;
 
-        defmt::println!(
-            "frame {=str} {=str}: render {=u64} instructions = extraction {=u64} + inverse {=u64} (+ {=u64} in render's checks); 2D DHT alone {=u64}; display sink {=u64}",
-            program,
-            spec.name,
-            counts.render,
-            counts.extract,
-            counts.inverse,
-            counts.render.saturating_sub(counts.extract + counts.inverse),
-            counts.dht_2d,
-            display
-        );
+        match counts.split {
+            Split::Staged { inverse_again } => defmt::println!(
+                "frame {=str} {=str}: render {=u64} instructions = extraction {=u64} + inverse {=u64} (+ {=u64} in render's checks); inverse again on other data {=u64}; 2D DHT alone {=u64}; display sink {=u64}",
+                program,
+                spec.name,
+                counts.render,
+                counts.extract,
+                counts.inverse,
+                counts.render.saturating_sub(counts.extract + counts.inverse),
+                inverse_again,
+                counts.dht_2d,
+                display
+            ),
+            Split::Retimed { channels } => defmt::println!(
+                "frame {=str} {=str}: render {=u64} instructions = extraction {=u64} + inverse {=u64} (the inverse of {=usize} channels timed again after render_scene, extraction and combination the rest); 2D DHT alone {=u64}; display sink {=u64}",
+                program,
+                spec.name,
+                counts.render,
+                counts.extract,
+                counts.inverse,
+                channels,
+                counts.dht_2d,
+                display
+            ),
+        }
     }
 
     if clock.wrapped() {
@@ -305,6 +323,12 @@ fn f16_codec_report(clock: &SysTickClock) -> Result<(), RunError> {
 fn panic(info: &core::panic::PanicInfo) -> ! {
     defmt::error!("panic: {}", defmt::Display2Format(info));
     semihosting::process::exit(101)
+}
+
+/// Log `reason` and end QEMU with status 1.
+pub fn abort(reason: &str) -> ! {
+    defmt::error!("{=str}", reason);
+    semihosting::process::exit(1)
 }
 
 /// A HardFault ends QEMU with status 102 instead of looping forever.
@@ -386,14 +410,38 @@ pub mod unsafe_parts {
     }
 }
 
-/// The entry point, SysTick-free exception handlers and the call to
-/// [`run`] for a firmware program: `firmware_main!(name, frames, [spectra])`.
+/// The entry point, SysTick-free exception handlers, the frame buffers (in
+/// `.bss`, sized for the program's frames by
+/// [`buffer_sizes`](crate::scene::buffer_sizes)) and the call to [`run`]
+/// for a firmware program:
+/// `firmware_main!(name, frames, [spectra], [derivative tables])`.
 #[macro_export]
 macro_rules! firmware_main {
-    ($program:expr, $frames:expr, [$($spectrum:expr),+ $(,)?]) => {
+    ($program:expr, $frames:expr, [$($spectrum:expr),+ $(,)?], [$($derivative:expr),* $(,)?]) => {
+        const BUFFER_SIZES: $crate::scene::BufferSizes = $crate::scene::buffer_sizes(&$frames);
+        const FRAME_FIELDS_LEN: usize = BUFFER_SIZES.fields;
+        const FRAME_IMAGE_LEN: usize = BUFFER_SIZES.image;
+
         #[cortex_m_rt::entry]
         fn main() -> ! {
-            $crate::device::run($program, &$frames, &[$($spectrum),+])
+            let fields = cortex_m::singleton!(FIELDS: [f32; FRAME_FIELDS_LEN] = [0.0; FRAME_FIELDS_LEN]);
+            let aux = cortex_m::singleton!(
+                AUX: [f32; $crate::frame::AUX_LEN] = [0.0; $crate::frame::AUX_LEN]
+            );
+            let image = cortex_m::singleton!(IMAGE: [f32; FRAME_IMAGE_LEN] = [0.0; FRAME_IMAGE_LEN]);
+            let staged = cortex_m::singleton!(STAGED: [f32; FRAME_IMAGE_LEN] = [0.0; FRAME_IMAGE_LEN]);
+            // Each singleton is taken once, here.
+            let (Some(fields), Some(aux), Some(image), Some(staged)) = (fields, aux, image, staged)
+            else {
+                $crate::device::abort("frame buffers taken twice")
+            };
+            let bufs = $crate::frame::FrameBuffers {
+                fields,
+                aux,
+                image,
+                staged,
+            };
+            $crate::device::run($program, &$frames, &[$($spectrum),+], &[$($derivative),*], bufs)
         }
 
         #[allow(unsafe_code)]

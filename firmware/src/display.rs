@@ -61,11 +61,16 @@ impl Window {
     }
 }
 
-/// RGB565 of a gray level (5, 6 and 5 top bits).
+/// RGB565 of 8-bit levels (their 5, 6 and 5 top bits).
+#[inline]
+pub const fn rgb565(r: u8, g: u8, b: u8) -> u16 {
+    (((r as u16) >> 3) << 11) | (((g as u16) >> 2) << 5) | ((b as u16) >> 3)
+}
+
+/// RGB565 of a gray level.
 #[inline]
 pub const fn rgb565_gray(g: u8) -> u16 {
-    let g = g as u16;
-    ((g >> 3) << 11) | ((g >> 2) << 5) | (g >> 3)
+    rgb565(g, g, g)
 }
 
 /// Why a frame could not be sent.
@@ -75,12 +80,15 @@ pub enum PanelError<S, P> {
     Spi(S),
     /// The D/C pin failed.
     Pin(P),
-    /// Width 0, or an image that is not `width × height`.
+    /// Width 0, or an image that is not `width × height` pixels of
+    /// `channels` values.
     BadShape {
-        /// Pixels given.
+        /// Values given.
         len: usize,
         /// Width given.
         width: usize,
+        /// Values per pixel.
+        channels: usize,
     },
     /// The row buffer holds fewer than `2·width` bytes.
     RowBufferTooSmall {
@@ -98,9 +106,14 @@ impl<S: fmt::Debug, P: fmt::Debug> fmt::Display for PanelError<S, P> {
         match self {
             PanelError::Spi(e) => write!(f, "SPI write failed: {e:?}"),
             PanelError::Pin(e) => write!(f, "D/C pin failed: {e:?}"),
-            PanelError::BadShape { len, width } => {
-                write!(f, "{len} pixels do not make rows of width {width}")
-            }
+            PanelError::BadShape {
+                len,
+                width,
+                channels,
+            } => write!(
+                f,
+                "{len} values do not make rows of {width} pixels of {channels} channels"
+            ),
             PanelError::RowBufferTooSmall { needed, got } => {
                 write!(f, "row buffer holds {got} bytes, needs {needed}")
             }
@@ -142,13 +155,51 @@ impl<SPI: SpiDevice, DC: OutputPin> DcsPanel<SPI, DC> {
         window: &Window,
         row: &mut [u8],
     ) -> Result<(), PanelError<SPI::Error, DC::Error>> {
-        if width == 0 || image.is_empty() || image.len() % width != 0 {
+        self.draw(x0, y0, image, 1, width, row, |px| {
+            rgb565_gray(window.gray(px[0]))
+        })
+    }
+
+    /// Send an RGB `image` (`width` pixels a row of 3 values each, red
+    /// first, row 0 at the top) like [`DcsPanel::draw_gray`], every channel
+    /// through the same `window` (one window keeps the colour balance; fit
+    /// it over all values).
+    ///
+    /// # Errors
+    /// [`PanelError`]: the bus or pin failed, or the shapes do not fit.
+    pub fn draw_rgb(
+        &mut self,
+        x0: u16,
+        y0: u16,
+        image: &[f32],
+        width: usize,
+        window: &Window,
+        row: &mut [u8],
+    ) -> Result<(), PanelError<SPI::Error, DC::Error>> {
+        self.draw(x0, y0, image, 3, width, row, |px| {
+            rgb565(window.gray(px[0]), window.gray(px[1]), window.gray(px[2]))
+        })
+    }
+
+    fn draw(
+        &mut self,
+        x0: u16,
+        y0: u16,
+        image: &[f32],
+        channels: usize,
+        width: usize,
+        row: &mut [u8],
+        pixel: impl Fn(&[f32]) -> u16,
+    ) -> Result<(), PanelError<SPI::Error, DC::Error>> {
+        let stride = width * channels;
+        if width == 0 || image.is_empty() || image.len() % stride != 0 {
             return Err(PanelError::BadShape {
                 len: image.len(),
                 width,
+                channels,
             });
         }
-        let height = image.len() / width;
+        let height = image.len() / stride;
         let got = row.len();
         let row = row
             .get_mut(..2 * width)
@@ -166,9 +217,9 @@ impl<SPI: SpiDevice, DC: OutputPin> DcsPanel<SPI, DC> {
         self.command(CASET, &range_bytes(x0, x1))?;
         self.command(RASET, &range_bytes(y0, y1))?;
         self.command(RAMWR, &[])?;
-        for line in image.chunks_exact(width) {
-            for (px, out) in line.iter().zip(row.chunks_exact_mut(2)) {
-                out.copy_from_slice(&rgb565_gray(window.gray(*px)).to_be_bytes());
+        for line in image.chunks_exact(stride) {
+            for (px, out) in line.chunks_exact(channels).zip(row.chunks_exact_mut(2)) {
+                out.copy_from_slice(&pixel(px).to_be_bytes());
             }
             self.spi.write(row).map_err(PanelError::Spi)?;
         }

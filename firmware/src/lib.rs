@@ -1,13 +1,16 @@
 //! fvr-core on a Cortex-M4F: the firmware's portable parts and, for
 //! `target_os = "none"`, its device runtime.
 //!
-//! The scene ([`scene`]) is an analytic phantom whose f16 spectra `build.rs`
-//! makes on the host, with the core, and keeps in flash ([`stored`]). On the
-//! device each frame is rendered twice, once by `fvr_core::render::render`
-//! and once stage by stage to count instructions ([`frame`]); the image goes
-//! back to the host as a NRRD over semihosting ([`nrrd`]) and to a display
-//! through an `embedded-hal` 1.0 `SpiDevice` ([`display`]), whose bytes a
-//! capture bus ([`capture`]) records for the host to check.
+//! The scene ([`scene`]) is an analytic phantom whose f16 spectra (density,
+//! and `|∇f|` for shaded frames) `build.rs` makes on the host, with the
+//! core, and keeps in flash with the kernel and kernel-derivative tables
+//! ([`stored`]). On the device a plain frame is rendered twice, once by
+//! `fvr_core::render::render` and once stage by stage to count instructions;
+//! a depth-cued or shaded frame once, by
+//! `fvr_core::scene_render::render_scene` ([`frame`]). The image (grey or
+//! RGB) goes back to the host as a NRRD over semihosting ([`nrrd`]) and to
+//! a display through an `embedded-hal` 1.0 `SpiDevice` ([`display`]), whose
+//! bytes a capture bus ([`capture`]) records for the host to check.
 //!
 //! Everything but `device` builds and is tested on the host; `device` needs
 //! `thumbv7em-none-eabihf` (`bash scripts/firmware.sh`).

@@ -14,12 +14,15 @@ pub struct Header {
 }
 
 impl Header {
-    /// The header of a `float` image of `width × height`, raw encoding,
-    /// little endian, with one comment line.
+    /// The header of a `float` image of `width × height` pixels of
+    /// `channels` values, raw encoding, little endian, with one comment
+    /// line: `sizes: W H` for one channel, `sizes: C W H` (channel fastest,
+    /// as the host's `fvr render` writes RGB) otherwise.
     ///
     /// # Errors
     /// `fmt::Error` if the header would exceed [`HEADER_CAP`] bytes.
     pub fn image_f32(
+        channels: usize,
         width: usize,
         height: usize,
         comment: fmt::Arguments<'_>,
@@ -28,11 +31,13 @@ impl Header {
             buf: [0; HEADER_CAP],
             len: 0,
         };
-        write!(
-            h,
-            "NRRD0004\n# {comment}\ntype: float\ndimension: 2\nsizes: {width} {height}\n\
-             endian: little\nencoding: raw\n\n"
-        )?;
+        write!(h, "NRRD0004\n# {comment}\ntype: float\n")?;
+        if channels == 1 {
+            write!(h, "dimension: 2\nsizes: {width} {height}\n")?;
+        } else {
+            write!(h, "dimension: 3\nsizes: {channels} {width} {height}\n")?;
+        }
+        write!(h, "endian: little\nencoding: raw\n\n")?;
         Ok(h)
     }
 

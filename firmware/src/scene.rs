@@ -7,13 +7,26 @@
 //! bit-for-bit comparison). It depends on `fvr_core` and `libm` only.
 //!
 //! # Adding a frame
-//! A [`FrameSpec`] names a stored filter and a view. A depth-cued frame needs
-//! no new table (it reads the same spectrum); a shaded frame with a
-//! directional light needs the `|∇f|` spectrum (paper §3.2, eq. 10): one more
-//! [`StoredKind`] and 512 KiB of flash for a 64³ f16 cube.
+//! A [`FrameSpec`] names a stored filter, a view and what it computes
+//! ([`Shading`]). A plain frame reads the density spectrum. A
+//! [`Shading::Scene`] frame is rendered by `fvr_core::scene_render::render_scene`
+//! and needs, besides the density spectrum:
+//! - with a linear depth cue, the kernel-derivative table of its filter
+//!   (paper eq. 5), listed in [`DERIVATIVES`]: `W·512 + 1` f32 (6 KiB for
+//!   kb3);
+//! - with a light, the `|∇f|` spectrum (paper §3.2, eq. 10), a
+//!   [`StoredKind::GradientMagnitude`] in [`STORED`]: 512 KiB for a 64³ f16
+//!   cube.
+//!
+//! A program names the tables it links (`src/bin/*.rs`); it must name
+//! exactly those its frames read (`frame::check_linked_tables`, run on the
+//! device before any frame), and `build.rs` checks each program's flash
+//! budget from its frames. The buffers are sized from the frames too
+//! ([`buffer_sizes`]).
 
 use fvr_core::filter::FilterKind;
 use fvr_core::geometry::View;
+use fvr_core::scene::{DepthCue, Light, Scene};
 
 /// Side of the phantom's cube (voxels); also the padded spectrum side at
 /// oversampling 1.
@@ -111,27 +124,191 @@ pub fn density(p: [f64; 3]) -> f64 {
         .sum()
 }
 
-/// A spectrum kept in flash: the phantom premultiplied for one filter.
+/// A spectrum kept in flash: the phantom, or its gradient magnitude,
+/// premultiplied for one filter.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StoredKind {
-    /// `F{f·p_m}`: the density, for X-ray and depth-cued views.
+    /// `F{f·p_m}`: the density, for every frame.
     Density(FilterKind),
+    /// `F{|∇f|·p_m}`: the gradient magnitude of the band-limited interpolant
+    /// (`fvr_core::gradient::gradient_magnitude`), for frames with a light.
+    /// It is premultiplied for the same filter (the same β) as the density.
+    GradientMagnitude(FilterKind),
+}
+
+impl StoredKind {
+    /// The interpolation filter it was premultiplied for.
+    pub const fn filter(self) -> FilterKind {
+        match self {
+            StoredKind::Density(kind) | StoredKind::GradientMagnitude(kind) => kind,
+        }
+    }
+
+    /// What was transformed, in file and static names: `density` or
+    /// `gradient`.
+    pub const fn prefix(self) -> &'static str {
+        match self {
+            StoredKind::Density(_) => "density",
+            StoredKind::GradientMagnitude(_) => "gradient",
+        }
+    }
 }
 
 /// Every spectrum `build.rs` makes. Each bin links only the ones its frames
 /// use (the linker drops the rest), so each bin's flash budget is checked
 /// on its own.
-pub const STORED: [StoredKind; 3] = [
+pub const STORED: [StoredKind; 4] = [
     StoredKind::Density(FilterKind::Kb3),
     StoredKind::Density(FilterKind::Kb4),
     StoredKind::Density(FilterKind::Kb6),
+    StoredKind::GradientMagnitude(FilterKind::Kb3),
 ];
 
+/// The filters whose kernel-derivative tables `build.rs` makes (for frames
+/// with a linear depth cue).
+pub const DERIVATIVES: [FilterKind; 1] = [FilterKind::Kb3];
+
+/// A depth cue a frame uses: the part of `fvr_core::scene::DepthCue` this
+/// scene needs, in a form that can be a constant.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Cue {
+    /// No cue: `w = 1`.
+    None,
+    /// `w(t)` linear from `front` at `t = −R` to `back` at `t = +R` (eq. 3).
+    Linear {
+        /// Weight at the front.
+        front: f64,
+        /// Weight at the back.
+        back: f64,
+    },
+}
+
+/// A depth-cued and/or shaded view's scene (the core's
+/// `fvr_core::scene::Scene`, as a constant).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneSpec {
+    /// The depth cue.
+    pub cue: Cue,
+    /// Ambient colour `A_c` (linear RGB).
+    pub ambient: [f64; 3],
+    /// Directional lights.
+    pub lights: &'static [Light],
+}
+
+impl SceneSpec {
+    /// The core's scene.
+    ///
+    /// # Errors
+    /// As `Scene::add_light` and `Scene::validate`: too many lights, a zero
+    /// light vector, a negative or non-finite colour or weight.
+    pub fn scene(&self) -> Result<Scene, fvr_core::Error> {
+        let mut scene = Scene {
+            cue: match self.cue {
+                Cue::None => DepthCue::None,
+                Cue::Linear { front, back } => DepthCue::Linear { front, back },
+            },
+            ambient: self.ambient,
+            ..Scene::xray()
+        };
+        for light in self.lights {
+            scene.add_light(*light)?;
+        }
+        scene.validate()?;
+        Ok(scene)
+    }
+
+    /// `Scene::needs_gradient_spectrum`, as a constant.
+    pub const fn needs_gradient_spectrum(&self) -> bool {
+        let mut i = 0;
+        while i < self.lights.len() {
+            let c = self.lights[i].color;
+            if c[0] != 0.0 || c[1] != 0.0 || c[2] != 0.0 {
+                return true;
+            }
+            i += 1;
+        }
+        false
+    }
+
+    /// `Scene::needs_kernel_derivative`, as a constant.
+    pub const fn needs_kernel_derivative(&self) -> bool {
+        matches!(self.cue, Cue::Linear { front, back } if front != back)
+    }
+
+    /// `Scene::channels`, as a constant (the image buffers are sized by it).
+    pub const fn channels(&self) -> usize {
+        let a = self.ambient;
+        if self.needs_gradient_spectrum() || a[0] != a[1] || a[1] != a[2] {
+            3
+        } else {
+            1
+        }
+    }
+
+    /// `Scene::field_count`, as a constant (the slice-sized scratch grids
+    /// `render_scene` needs; the field buffer is sized by it).
+    pub const fn field_count(&self) -> usize {
+        // A depth-varying cue has terms at the partner point −k.
+        let pair = if self.needs_kernel_derivative() { 2 } else { 1 };
+        if self.channels() == 1 {
+            return pair;
+        }
+        let mut count = pair + 1;
+        if self.needs_gradient_spectrum() {
+            count += pair;
+            // The eq. 14 correction (on in `Scene::xray()`).
+            if pair == 2 {
+                count += pair;
+            }
+        }
+        count
+    }
+}
+
 /// What a frame computes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Shading {
-    /// The X-ray projection `∫ f dt` (paper eq. 1).
+    /// The X-ray projection `∫ f dt` (paper eq. 1), by
+    /// `fvr_core::render::render`.
     Plain,
+    /// A depth-cued and/or shaded image (paper §3), by
+    /// `fvr_core::scene_render::render_scene`.
+    Scene(SceneSpec),
+}
+
+impl Shading {
+    /// Channels of the image: 1 (grey) or 3 (RGB, channel fastest).
+    pub const fn channels(&self) -> usize {
+        match self {
+            Shading::Plain => 1,
+            Shading::Scene(s) => s.channels(),
+        }
+    }
+
+    /// Slice-sized grids of scratch the frame needs (the plain render's
+    /// slice grid is one).
+    pub const fn field_count(&self) -> usize {
+        match self {
+            Shading::Plain => 1,
+            Shading::Scene(s) => s.field_count(),
+        }
+    }
+
+    /// `true` if the frame reads the `|∇f|` spectrum.
+    pub const fn needs_gradient_spectrum(&self) -> bool {
+        match self {
+            Shading::Plain => false,
+            Shading::Scene(s) => s.needs_gradient_spectrum(),
+        }
+    }
+
+    /// `true` if the frame reads the kernel-derivative table.
+    pub const fn needs_kernel_derivative(&self) -> bool {
+        match self {
+            Shading::Plain => false,
+            Shading::Scene(s) => s.needs_kernel_derivative(),
+        }
+    }
 }
 
 /// One image a program renders.
@@ -139,7 +316,7 @@ pub enum Shading {
 pub struct FrameSpec {
     /// Short name, used in file names (`<program>-<name>.nrrd`).
     pub name: &'static str,
-    /// The interpolation filter (and so the stored spectrum) it uses.
+    /// The interpolation filter (and so the stored spectra) it uses.
     pub filter: FilterKind,
     /// What it computes.
     pub shading: Shading,
@@ -147,19 +324,125 @@ pub struct FrameSpec {
     pub view: View,
 }
 
+impl FrameSpec {
+    /// The stored spectra the frame reads: the density, and the `|∇f|`
+    /// spectrum if it has a light.
+    pub const fn spectra(&self) -> (StoredKind, Option<StoredKind>) {
+        let gradient = if self.shading.needs_gradient_spectrum() {
+            Some(StoredKind::GradientMagnitude(self.filter))
+        } else {
+            None
+        };
+        (StoredKind::Density(self.filter), gradient)
+    }
+}
+
+/// Sizes of the buffers a program's frames render into, in f32 elements.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BufferSizes {
+    /// Slice-sized scratch grids: the largest [`Shading::field_count`],
+    /// times `IMAGE_SIDE²`.
+    pub fields: usize,
+    /// An image of the most channels: `channels·IMAGE_SIDE²`.
+    pub image: usize,
+}
+
+/// The buffers `frames` need (for statics sized at compile time).
+pub const fn buffer_sizes(frames: &[FrameSpec]) -> BufferSizes {
+    let (mut fields, mut channels) = (1, 1);
+    let mut i = 0;
+    while i < frames.len() {
+        let s = frames[i].shading;
+        if s.field_count() > fields {
+            fields = s.field_count();
+        }
+        if s.channels() > channels {
+            channels = s.channels();
+        }
+        i += 1;
+    }
+    let grid = IMAGE_SIDE * IMAGE_SIDE;
+    BufferSizes {
+        fields: fields * grid,
+        image: channels * grid,
+    }
+}
+
 /// The view of every frame: oblique, along `(1, 0.3, 0.2)`, as in the host
 /// benchmarks (README, "Speed").
 pub const VIEW: View = View::along([1.0, 0.3, 0.2]);
 
-/// The scene program (`fvr-scene`): the paper's 3³ filter. Depth-cued and
-/// shaded frames of the same view join this list.
-pub const SCENE_FRAMES: [FrameSpec; 1] = [FrameSpec {
-    name: "plain-kb3",
-    filter: FilterKind::Kb3,
-    shading: Shading::Plain,
-    view: VIEW,
-}];
+/// Three coloured lights (linear RGB), none perpendicular to [`VIEW`]
+/// (`d·L/|L|` = 0.24, −0.61 and −0.07 with `d` the unit view direction): red
+/// from above and behind, green from the eye's side (the eq. 14 correction
+/// matters most for it), blue from below, nearly grazing.
+pub const LIGHTS: [Light; 3] = [
+    Light {
+        towards: [0.0, 0.2, 1.0],
+        color: [1.0, 0.2, 0.1],
+    },
+    Light {
+        towards: [-0.8, 0.6, -0.3],
+        color: [0.15, 0.9, 0.2],
+    },
+    Light {
+        towards: [0.3, -1.0, -0.4],
+        color: [0.1, 0.3, 1.0],
+    },
+];
 
+/// The linear depth cue of the cued frames: full weight at the front,
+/// 0.2 at the back (a positive weight everywhere inside the volume on this
+/// view, checked by the host tests).
+pub const LINEAR_CUE: Cue = Cue::Linear {
+    front: 1.0,
+    back: 0.2,
+};
+
+/// The ambient colour of the lit frames.
+pub const AMBIENT: [f64; 3] = [0.15, 0.15, 0.2];
+
+/// The scene program (`fvr-scene`): the paper's 3³ filter, the plain
+/// X-ray view, a depth-cued one (paper fig. 6b), a shaded one with three
+/// coloured lights (fig. 8) and both (fig. 6d).
+pub const SCENE_FRAMES: [FrameSpec; 4] = [
+    FrameSpec {
+        name: "plain-kb3",
+        filter: FilterKind::Kb3,
+        shading: Shading::Plain,
+        view: VIEW,
+    },
+    FrameSpec {
+        name: "cued-kb3",
+        filter: FilterKind::Kb3,
+        shading: Shading::Scene(SceneSpec {
+            cue: LINEAR_CUE,
+            ambient: [1.0; 3],
+            lights: &[],
+        }),
+        view: VIEW,
+    },
+    FrameSpec {
+        name: "lit-kb3",
+        filter: FilterKind::Kb3,
+        shading: Shading::Scene(SceneSpec {
+            cue: Cue::None,
+            ambient: AMBIENT,
+            lights: &LIGHTS,
+        }),
+        view: VIEW,
+    },
+    FrameSpec {
+        name: "lit-cued-kb3",
+        filter: FilterKind::Kb3,
+        shading: Shading::Scene(SceneSpec {
+            cue: LINEAR_CUE,
+            ambient: AMBIENT,
+            lights: &LIGHTS,
+        }),
+        view: VIEW,
+    },
+];
 /// The filter benchmark (`fvr-filter-bench`): the same view with kb3, kb4
 /// and kb6, for instruction counts.
 pub const BENCH_FRAMES: [FrameSpec; 3] = [

@@ -1,11 +1,13 @@
-//! The tables `build.rs` keeps in flash: the scene's f16 spectra, their
-//! kernel tables and the twiddles, each made on the host by the core
-//! (`Spectrum::prepare`, `KernelTable::new`, `Twiddles::new`), so the device
-//! evaluates no transcendental function at all.
+//! The tables `build.rs` keeps in flash: the scene's f16 spectra (density
+//! and, for lit frames, `|∇f|`), their kernel tables, the kernel-derivative
+//! tables for linear depth cues and the twiddles, each made on the host by
+//! the core (`Spectrum::prepare`, `gradient_magnitude`, `KernelTable::new`,
+//! `DerivativeTable::new`, `Twiddles::new`), so the device evaluates no
+//! Bessel series and no transform of the volume.
 
 use fvr_core::dht::Twiddles;
 use fvr_core::f16;
-use fvr_core::filter::{Filter, FilterKind, KernelTable};
+use fvr_core::filter::{DerivativeTable, Filter, FilterKind, KernelTable};
 use fvr_core::spectrum::Spectrum;
 use fvr_core::Result;
 
@@ -35,9 +37,7 @@ pub struct StoredSpectrum {
 impl StoredSpectrum {
     /// The interpolation filter.
     pub fn filter_kind(&self) -> FilterKind {
-        match self.kind {
-            StoredKind::Density(kind) => kind,
-        }
+        self.kind.filter()
     }
 
     /// The filter, as designed on the host.
@@ -64,9 +64,41 @@ impl StoredSpectrum {
         KernelTable::from_values(self.filter()?, self.kernel)
     }
 
-    /// Bytes of flash the spectrum and its kernel table take.
+    /// Bytes of flash the spectrum and its kernel table take (spectra of
+    /// the same filter share one kernel table).
     pub fn flash_bytes(&self) -> usize {
         core::mem::size_of_val(self.data) + core::mem::size_of_val(self.kernel)
+    }
+}
+
+/// A kernel-derivative table in flash (for frames with a linear depth cue).
+#[derive(Debug)]
+pub struct StoredDerivative {
+    /// The interpolation filter.
+    pub kind: FilterKind,
+    /// Oversampling factor of the filter design.
+    pub oversample: u32,
+    /// Kaiser–Bessel β (the density spectrum's).
+    pub beta: f64,
+    /// `k'(i/1024)` for `i = 0 ..= W·512`.
+    pub values: &'static [f32],
+}
+
+impl StoredDerivative {
+    /// The filter, as designed on the host.
+    ///
+    /// # Errors
+    /// A bad oversampling or β (not for tables made by `build.rs`).
+    pub fn filter(&self) -> Result<Filter> {
+        Filter::from_parts(self.kind, self.oversample, self.beta)
+    }
+
+    /// The derivative table, copied from flash (12 KiB of f32 at most).
+    ///
+    /// # Errors
+    /// As `DerivativeTable::from_values`.
+    pub fn table(&self) -> Result<DerivativeTable<f32>> {
+        DerivativeTable::from_values(self.filter()?, self.values)
     }
 }
 
@@ -80,8 +112,13 @@ pub fn twiddles() -> Result<Twiddles<'static, f32>> {
 
 /// Every stored spectrum, for the host-side checks. (Firmware programs name
 /// the ones they use, so that the linker keeps only those.)
-pub fn all() -> [&'static StoredSpectrum; 3] {
-    [&DENSITY_KB3, &DENSITY_KB4, &DENSITY_KB6]
+pub fn all() -> [&'static StoredSpectrum; 4] {
+    [&DENSITY_KB3, &DENSITY_KB4, &DENSITY_KB6, &GRADIENT_KB3]
+}
+
+/// Every stored kernel-derivative table, for the host-side checks.
+pub fn all_derivatives() -> [&'static StoredDerivative; 1] {
+    [&DERIVATIVE_KB3]
 }
 
 /// Decode little-endian f16 bytes at compile time, so a spectrum lands in

@@ -6,7 +6,9 @@ use std::convert::Infallible;
 
 use embedded_hal::spi::{ErrorKind, ErrorType, Operation, SpiDevice};
 use fvr_firmware::capture::{decode_frame, ByteSink, CaptureBus, CaptureError, DecodeError};
-use fvr_firmware::display::{rgb565_gray, DcsPanel, PanelError, Window, CASET, RAMWR, RASET};
+use fvr_firmware::display::{
+    rgb565, rgb565_gray, DcsPanel, PanelError, Window, CASET, RAMWR, RASET,
+};
 
 #[derive(Default)]
 struct Memory(Vec<u8>);
@@ -97,6 +99,34 @@ fn a_recording_decodes_to_the_window_and_the_quantized_image() {
 }
 
 #[test]
+fn an_rgb_frame_sends_one_rgb565_pixel_per_three_values_through_one_window() {
+    // 2 × 2 RGB image: one window over all 12 values, 0..=11 → gain 255/11.
+    let image: Vec<f32> = (0..12).map(|v| v as f32).collect();
+    let window = Window::fit(&image);
+    let bus = CaptureBus::new(Memory::default());
+    let mut panel = DcsPanel::new(bus.spi(), bus.dc());
+    let mut row = [0u8; 4];
+    panel.draw_rgb(3, 4, &image, 2, &window, &mut row).unwrap();
+    let _ = panel.release();
+    let rec = bus.into_inner().0;
+    let mut pixels = vec![0u16; 4];
+    let frame = decode_frame(&rec, &mut pixels).unwrap();
+    assert_eq!((frame.columns, frame.rows), ((3, 4), (4, 5)));
+    let expected: Vec<u16> = image
+        .chunks_exact(3)
+        .map(|p| rgb565(window.gray(p[0]), window.gray(p[1]), window.gray(p[2])))
+        .collect();
+    assert_eq!(pixels, expected);
+    // The first pixel is (0, 23, 46) in 8 bits; the last is (209, 232, 255).
+    assert_eq!(pixels[0], (23 >> 2) << 5 | (46 >> 3));
+    assert_eq!(pixels[3], (209 >> 3) << 11 | (232 >> 2) << 5 | (255 >> 3));
+    // Channels land in their own bits: pure red, green and blue.
+    assert_eq!(rgb565(255, 0, 0), 0xF800);
+    assert_eq!(rgb565(0, 255, 0), 0x07E0);
+    assert_eq!(rgb565(0, 0, 255), 0x001F);
+}
+
+#[test]
 fn window_saturates_and_handles_constant_and_non_finite_images() {
     let w = Window::fit(&[1.0, f32::NAN, 3.0, f32::INFINITY]);
     assert_eq!(
@@ -124,11 +154,19 @@ fn bad_shapes_are_refused_before_anything_is_sent() {
     let mut row = [0u8; 4];
     assert_eq!(
         panel.draw_gray(0, 0, &image, 4, &w, &mut [0u8; 8]),
-        Err(PanelError::BadShape { len: 6, width: 4 })
+        Err(PanelError::BadShape {
+            len: 6,
+            width: 4,
+            channels: 1
+        })
     );
     assert_eq!(
         panel.draw_gray(0, 0, &image, 0, &w, &mut row),
-        Err(PanelError::BadShape { len: 6, width: 0 })
+        Err(PanelError::BadShape {
+            len: 6,
+            width: 0,
+            channels: 1
+        })
     );
     assert_eq!(
         panel.draw_gray(0, 0, &image, 3, &w, &mut row),
@@ -137,6 +175,20 @@ fn bad_shapes_are_refused_before_anything_is_sent() {
     assert_eq!(
         panel.draw_gray(u16::MAX - 1, 0, &image, 3, &w, &mut [0u8; 6]),
         Err(PanelError::OutOfRange)
+    );
+    // Six values are two RGB pixels: not rows of 4 pixels, nor of 3.
+    let err = panel.draw_rgb(0, 0, &image, 3, &w, &mut [0u8; 6]);
+    assert_eq!(
+        err,
+        Err(PanelError::BadShape {
+            len: 6,
+            width: 3,
+            channels: 3
+        })
+    );
+    assert_eq!(
+        err.unwrap_err().to_string(),
+        "6 values do not make rows of 3 pixels of 3 channels"
     );
     let _ = panel.release();
     assert!(bus.into_inner().0.is_empty());

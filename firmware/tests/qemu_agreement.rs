@@ -1,6 +1,8 @@
 //! The firmware's images, rendered on a Cortex-M4F under QEMU, against the
-//! host core's images of the same scene: bit for bit, for the NRRD each
-//! frame wrote and for the display bytes it pushed through the SPI sink.
+//! host core's images of the same scene (plain, depth-cued and shaded, grey
+//! and RGB): bit for bit, for the NRRD each frame wrote and for the display
+//! bytes it pushed through the SPI sink. Each image's distance to its f64
+//! reference is printed too.
 //!
 //! Needs the QEMU outputs, so it is ignored in `cargo test` and run by
 //! `scripts/firmware.sh` as
@@ -12,7 +14,7 @@ use std::path::PathBuf;
 
 use common::{exact_image, host_image, snr_db};
 use fvr_firmware::capture::decode_frame;
-use fvr_firmware::display::{rgb565_gray, Window};
+use fvr_firmware::display::{rgb565, rgb565_gray, Window};
 use fvr_firmware::scene::{IMAGE_SIDE, PROGRAMS};
 use fvr_host::nrrd::parse_nrrd;
 
@@ -31,12 +33,14 @@ fn qemu_images_equal_host_images_bit_for_bit() {
             let bytes = std::fs::read(&path)
                 .unwrap_or_else(|e| panic!("{}: {e} (did the firmware run?)", path.display()));
             let device = parse_nrrd(&bytes).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-            assert_eq!(
-                device.dims,
-                [IMAGE_SIDE, IMAGE_SIDE, 1],
-                "{}",
-                path.display()
-            );
+            let channels = spec.shading.channels();
+            let dims = if channels == 1 {
+                [IMAGE_SIDE, IMAGE_SIDE, 1]
+            } else {
+                [channels, IMAGE_SIDE, IMAGE_SIDE]
+            };
+            assert_eq!(device.dims, dims, "{}", path.display());
+            assert_eq!(host.len(), device.data.len(), "{}", path.display());
             let differing = host
                 .iter()
                 .zip(&device.data)
@@ -45,8 +49,8 @@ fn qemu_images_equal_host_images_bit_for_bit() {
             let exact = exact_image(spec);
             let host_f64: Vec<f64> = host.iter().map(|&v| v as f64).collect();
             println!(
-                "{program} {}: {differing} of {} pixels differ from the host core; \
-                 QEMU vs host {}; QEMU vs exact line integrals {:.1} dB",
+                "{program} {}: {differing} of {} values differ from the host core; \
+                 QEMU vs host {}; QEMU vs its f64 reference {:.1} dB",
                 spec.name,
                 host.len(),
                 if differing == 0 {
@@ -58,7 +62,7 @@ fn qemu_images_equal_host_images_bit_for_bit() {
             );
             if differing != 0 {
                 failures.push(format!(
-                    "{program} {}: {differing} pixels differ",
+                    "{program} {}: {differing} values differ",
                     spec.name
                 ));
             }
@@ -68,13 +72,20 @@ fn qemu_images_equal_host_images_bit_for_bit() {
             let spi = dir.join(format!("{program}-{}.spi", spec.name));
             let recording =
                 std::fs::read(&spi).unwrap_or_else(|e| panic!("{}: {e}", spi.display()));
-            let mut pixels = vec![0u16; host.len()];
+            let mut pixels = vec![0u16; host.len() / channels];
             let decoded = decode_frame(&recording, &mut pixels)
                 .unwrap_or_else(|e| panic!("{}: {e:?}", spi.display()));
             let last = IMAGE_SIDE as u16 - 1;
             assert_eq!((decoded.columns, decoded.rows), ((0, last), (0, last)));
             let window = Window::fit(&host);
-            let expected: Vec<u16> = host.iter().map(|&v| rgb565_gray(window.gray(v))).collect();
+            let expected: Vec<u16> = host
+                .chunks_exact(channels)
+                .map(|p| match p {
+                    [v] => rgb565_gray(window.gray(*v)),
+                    [r, g, b] => rgb565(window.gray(*r), window.gray(*g), window.gray(*b)),
+                    _ => unreachable!("1 or 3 channels"),
+                })
+                .collect();
             if pixels != expected {
                 failures.push(format!("{program} {}: display bytes differ", spec.name));
             }

@@ -1,7 +1,7 @@
 //! Tables stored at build time (e.g. in a firmware's flash) rebuild the same
 //! objects as computing them on the target.
 
-use fvr_core::filter::{Filter, FilterKind, KernelTable};
+use fvr_core::filter::{DerivativeTable, Filter, FilterKind, KernelTable};
 use fvr_core::Error;
 
 #[test]
@@ -56,5 +56,83 @@ fn kernel_table_from_values_rejects_wrong_lengths_and_non_finite_entries() {
             }
         );
         assert_eq!(err.to_string(), "kernel table entry 700 is NaN or infinite");
+    }
+}
+
+#[test]
+fn derivative_table_from_values_equals_the_computed_table_bit_for_bit() {
+    for kind in FilterKind::ALL {
+        if kind == FilterKind::Nearest {
+            continue;
+        }
+        for oversample in [1, 2] {
+            let filter = Filter::new(kind, oversample).unwrap();
+            let computed = DerivativeTable::<f32>::new(filter).unwrap();
+            assert_eq!(
+                computed.values().len(),
+                DerivativeTable::<f32>::len_for(&filter)
+            );
+            let stored = DerivativeTable::from_values(filter, computed.values()).unwrap();
+            assert_eq!(stored.filter(), computed.filter());
+            assert_eq!(stored.values(), computed.values());
+            // Every lookup, on both sides of 0 (the table is odd) and between
+            // the grid points, and the taps at fractional positions.
+            let half_width = kind.width() as f32 / 2.0;
+            for step in -4096..=4096 {
+                let t = half_width * (step as f32 / 4096.0) * 1.0001;
+                assert_eq!(
+                    stored.eval(t).to_bits(),
+                    computed.eval(t).to_bits(),
+                    "{} σ={oversample} t={t}",
+                    kind.name()
+                );
+            }
+            for q in [-7.3f32, -0.5, 0.0, 0.25, 3.999, 12.5] {
+                let (mut a, mut b) = ([0.0; 6], [0.0; 6]);
+                assert_eq!(stored.taps(q, &mut a), computed.taps(q, &mut b));
+                assert_eq!(a.map(f32::to_bits), b.map(f32::to_bits));
+            }
+        }
+    }
+}
+
+#[test]
+fn derivative_table_from_values_rejects_nearest_wrong_lengths_and_non_finite_entries() {
+    let filter = Filter::new(FilterKind::Kb3, 1).unwrap();
+    let good = DerivativeTable::<f32>::new(filter)
+        .unwrap()
+        .values()
+        .to_vec();
+    // Nearest neighbour has no derivative table, stored or computed.
+    let nearest = Filter::new(FilterKind::Nearest, 1).unwrap();
+    let nearest_len = DerivativeTable::<f32>::len_for(&nearest);
+    assert_eq!(
+        DerivativeTable::from_values(nearest, &vec![0.0f32; nearest_len]).unwrap_err(),
+        Error::NoKernelDerivative
+    );
+    let short = &good[..good.len() - 1];
+    assert!(matches!(
+        DerivativeTable::from_values(filter, short),
+        Err(Error::LengthMismatch { what: "kernel derivative table", expected, got })
+            if expected == good.len() && got == good.len() - 1
+    ));
+    // A kb4 derivative table does not serve a kb3 filter.
+    let kb4 = DerivativeTable::<f32>::new(Filter::new(FilterKind::Kb4, 1).unwrap()).unwrap();
+    assert!(DerivativeTable::from_values(filter, kb4.values()).is_err());
+    for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+        let mut values = good.clone();
+        values[1200] = bad;
+        let err = DerivativeTable::from_values(filter, &values).unwrap_err();
+        assert_eq!(
+            err,
+            Error::NonFiniteTableEntry {
+                what: "kernel derivative table",
+                index: 1200
+            }
+        );
+        assert_eq!(
+            err.to_string(),
+            "kernel derivative table entry 1200 is NaN or infinite"
+        );
     }
 }

@@ -11,7 +11,8 @@ fvr_firmware::firmware_main!(
         &fvr_firmware::stored::DENSITY_KB3,
         &fvr_firmware::stored::DENSITY_KB4,
         &fvr_firmware::stored::DENSITY_KB6
-    ]
+    ],
+    []
 );
 
 #[cfg(not(target_os = "none"))]

@@ -2,31 +2,71 @@
 #![allow(dead_code)] // each test binary uses a different part
 
 use fvr_core::geometry::{center, Frame};
-use fvr_firmware::scene::{Blob, FrameSpec, BLOBS, DIMS, IMAGE_SIDE};
-use fvr_firmware::stored::{all, twiddles, StoredSpectrum};
-use fvr_host::phantom::{Gaussian, Phantom};
+use fvr_core::render::{aux_len, grid_len};
+use fvr_core::scene_render::{fields_len, render_scene};
+use fvr_firmware::frame::{tables_for, FrameTables};
+use fvr_firmware::scene::{Blob, FrameSpec, Shading, BLOBS, DIMS, IMAGE_SIDE};
+use fvr_firmware::stored::{all, all_derivatives, twiddles};
+use fvr_host::phantom::{Gaussian, GaussianMixture, Phantom};
+use fvr_host::scene_reference::exact_scene_projection;
 
-/// The stored spectrum a frame renders from.
-pub fn stored_for(spec: &FrameSpec) -> &'static StoredSpectrum {
-    fvr_firmware::frame::spectrum_for(spec, &all()).expect("every stored filter is in all()")
+/// Simpson step (voxels) of the exact references' numerically integrated
+/// `|∇f|` term, as in tests/tests/shading.rs: for Gaussians of σ ≥ 1.8
+/// voxels its fourth-order error is far below every figure measured here.
+pub const GRADIENT_STEP: f64 = 0.05;
+
+/// The flash tables a frame reads, among all the stored ones.
+pub fn tables(spec: &FrameSpec) -> FrameTables {
+    tables_for(spec, &all(), &all_derivatives()).expect("every stored table is in all()")
 }
 
-/// The host core's image of a frame: `fvr_core::render::render` in f32 from
-/// the same flash tables the firmware links.
+/// The host core's image of a frame, `channels·IMAGE_SIDE²` values
+/// (channel fastest): `fvr_core::render::render` or
+/// `fvr_core::scene_render::render_scene` in f32 from the same flash tables
+/// the firmware links.
 pub fn host_image(spec: &FrameSpec) -> Vec<f32> {
-    let stored = stored_for(spec);
-    let spectrum = stored.spectrum().unwrap();
-    let kernel = stored.kernel_table().unwrap();
+    let t = tables(spec);
+    let spectrum = t.density.spectrum().unwrap();
+    let kernel = t.density.kernel_table().unwrap();
     let tw = twiddles().unwrap();
     let n = spectrum.n();
-    let mut grid = vec![0.0f32; fvr_core::render::grid_len(n)];
-    let mut aux = vec![0.0f32; fvr_core::render::aux_len(n)];
-    let mut out = vec![0.0f32; IMAGE_SIDE * IMAGE_SIDE];
-    fvr_core::render::render(
-        &spectrum, &kernel, &spec.view, IMAGE_SIDE, IMAGE_SIDE, &tw, &mut grid, &mut aux, &mut out,
-    )
-    .unwrap();
-    out
+    let mut aux = vec![0.0f32; aux_len(n)];
+    match spec.shading {
+        Shading::Plain => {
+            let mut grid = vec![0.0f32; grid_len(n)];
+            let mut out = vec![0.0f32; IMAGE_SIDE * IMAGE_SIDE];
+            fvr_core::render::render(
+                &spectrum, &kernel, &spec.view, IMAGE_SIDE, IMAGE_SIDE, &tw, &mut grid, &mut aux,
+                &mut out,
+            )
+            .unwrap();
+            out
+        }
+        Shading::Scene(s) => {
+            let scene = s.scene().unwrap();
+            let gradient = t.gradient.map(|g| g.spectrum().unwrap());
+            let derivative = t.derivative.map(|d| d.table().unwrap());
+            let mut fields = vec![0.0f32; fields_len(&scene, n)];
+            let mut out = vec![0.0f32; scene.channels() * IMAGE_SIDE * IMAGE_SIDE];
+            let channels = render_scene(
+                &spectrum,
+                gradient.as_ref(),
+                &kernel,
+                derivative.as_ref(),
+                &scene,
+                &spec.view,
+                IMAGE_SIDE,
+                IMAGE_SIDE,
+                &tw,
+                &mut fields,
+                &mut aux,
+                &mut out,
+            )
+            .unwrap();
+            assert_eq!(channels, s.channels());
+            out
+        }
+    }
 }
 
 fn gaussian(b: &Blob) -> Gaussian {
@@ -38,19 +78,53 @@ fn gaussian(b: &Blob) -> Gaussian {
     }
 }
 
-/// Exact line integrals of the scene's phantom through every pixel.
+/// The scene's phantom as the host's analytic mixture.
+pub fn mixture() -> GaussianMixture {
+    GaussianMixture {
+        components: BLOBS.iter().map(gaussian).collect(),
+    }
+}
+
+/// The f64 reference of a frame: exact line integrals of the phantom
+/// through every pixel for a plain frame; for a cued or shaded one,
+/// `exact_scene_projection` (closed forms, `|∇f|` by Simpson's rule at
+/// [`GRADIENT_STEP`]).
 pub fn exact_image(spec: &FrameSpec) -> Vec<f64> {
     let frame: Frame = spec.view.frame().unwrap();
-    let blobs: Vec<Gaussian> = BLOBS.iter().map(gaussian).collect();
-    let c = center(DIMS);
-    let mut out = Vec::with_capacity(IMAGE_SIDE * IMAGE_SIDE);
-    for row in 0..IMAGE_SIDE {
-        for col in 0..IMAGE_SIDE {
-            let p = frame.pixel_position(c, IMAGE_SIDE, IMAGE_SIDE, col as f64, row as f64);
-            out.push(blobs.iter().map(|g| g.line_integral(p, frame.dir)).sum());
+    let mixture = mixture();
+    match spec.shading {
+        Shading::Plain => {
+            let c = center(DIMS);
+            let mut out = Vec::with_capacity(IMAGE_SIDE * IMAGE_SIDE);
+            for row in 0..IMAGE_SIDE {
+                for col in 0..IMAGE_SIDE {
+                    let p = frame.pixel_position(c, IMAGE_SIDE, IMAGE_SIDE, col as f64, row as f64);
+                    out.push(
+                        mixture
+                            .components
+                            .iter()
+                            .map(|g| g.line_integral(p, frame.dir))
+                            .sum(),
+                    );
+                }
+            }
+            out
+        }
+        Shading::Scene(s) => {
+            let image = exact_scene_projection(
+                &mixture,
+                DIMS,
+                &s.scene().unwrap(),
+                &spec.view,
+                IMAGE_SIDE,
+                IMAGE_SIDE,
+                GRADIENT_STEP,
+            )
+            .unwrap();
+            assert_eq!(image.channels, s.channels());
+            image.data
         }
     }
-    out
 }
 
 /// SNR in dB of `img` against `reference`: 10·log10(Σref² / Σ(img − ref)²).
@@ -63,11 +137,13 @@ pub fn snr_db(reference: &[f64], img: &[f32]) -> f64 {
     10.0 * (s / e).log10()
 }
 
-/// The README's accuracy floor for a filter at oversampling 1 with f16
-/// storage, against exact line integrals (tests/tests/projection.rs).
-pub fn floor_db(filter: fvr_core::filter::FilterKind) -> f64 {
+/// The README's accuracy floor for a frame against its f64 reference
+/// ([`exact_image`]), for a filter at oversampling 1 with f16 storage:
+/// tests/tests/projection.rs for plain frames. Cued and shaded frames use
+/// the same kb3 floor (see tests/scene.rs for why it holds).
+pub fn floor_db(spec: &FrameSpec) -> f64 {
     use fvr_core::filter::FilterKind::*;
-    match filter {
+    match spec.filter {
         Kb3 => 40.0,
         Kb4 => 50.0,
         Kb6 => 65.0,
