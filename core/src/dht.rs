@@ -160,6 +160,17 @@ fn bit_reverse<T>(data: &mut [T]) {
 /// `H(k) = X(k) + cos(πk/m)·Y(k) + sin(πk/m)·Y(m−k)` and
 /// `H(k+m) = X(k) − (same)`, with `Y(m) ≡ Y(0)`.
 pub(crate) fn dht_unchecked<T: Real>(data: &mut [T], tw: &Twiddles<'_, T>) {
+    dht_stages(data, tw, |_| {});
+}
+
+/// [`dht_unchecked`] calling `after_stage` on the whole line after every
+/// butterfly stage (a no-op closure compiles away).
+#[inline(always)]
+fn dht_stages<T: Real, F: FnMut(&mut [T])>(
+    data: &mut [T],
+    tw: &Twiddles<'_, T>,
+    mut after_stage: F,
+) {
     let n = data.len();
     if n <= 1 {
         return;
@@ -187,7 +198,31 @@ pub(crate) fn dht_unchecked<T: Real>(data: &mut [T], tw: &Twiddles<'_, T>) {
                 }
             }
         }
+        after_stage(data);
         m *= 2;
+    }
+}
+
+/// Where the 3D transform rounds to the storage format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Rounding {
+    /// Once per pass: after the x pass, the y pass and the fused z pass.
+    PerPass,
+    /// Also after every radix-2 butterfly stage of every line, as a
+    /// transform computing in the storage format itself would.
+    PerStage,
+}
+
+/// One line's transform, rounding to `S` after each stage if asked.
+#[inline(always)]
+fn line_dht<S: Sample, T: Real>(line: &mut [T], tw: &Twiddles<'_, T>, rounding: Rounding) {
+    match rounding {
+        Rounding::PerPass => dht_unchecked(line, tw),
+        Rounding::PerStage => dht_stages(line, tw, |l| {
+            for v in l.iter_mut() {
+                *v = T::load(v.store::<S>());
+            }
+        }),
     }
 }
 
@@ -314,6 +349,22 @@ pub fn dht_3d<S: Sample, T: Real>(
     scratch: &mut [T],
     tw: &Twiddles<'_, T>,
 ) -> Result<()> {
+    dht_3d_rounding(data, dims, scratch, tw, Rounding::PerPass)
+}
+
+/// [`dht_3d`] with a choice of where to round ([`Rounding`]). With
+/// [`Rounding::PerStage`] every line is also rounded to `S` after each of its
+/// `log₂n` stages, which models arithmetic in the storage format.
+///
+/// # Errors
+/// As [`dht_3d`].
+pub fn dht_3d_rounding<S: Sample, T: Real>(
+    data: &mut [S],
+    dims: [usize; 3],
+    scratch: &mut [T],
+    tw: &Twiddles<'_, T>,
+    rounding: Rounding,
+) -> Result<()> {
     let [nx, ny, nz] = dims;
     for n in dims {
         tw.check(n)?;
@@ -332,7 +383,7 @@ pub fn dht_3d<S: Sample, T: Real>(
         for (l, s) in line.iter_mut().zip(chunk.iter()) {
             *l = T::load(*s);
         }
-        dht_unchecked(line, tw);
+        line_dht::<S, T>(line, tw, rounding);
         for (s, l) in chunk.iter_mut().zip(line.iter()) {
             *s = l.store();
             finite &= s.is_finite();
@@ -348,7 +399,7 @@ pub fn dht_3d<S: Sample, T: Real>(
             for (y, l) in line.iter_mut().enumerate() {
                 *l = T::load(data[base + nx * y]);
             }
-            dht_unchecked(line, tw);
+            line_dht::<S, T>(line, tw, rounding);
             for (y, l) in line.iter().enumerate() {
                 let s: S = l.store();
                 finite &= s.is_finite();
@@ -372,7 +423,7 @@ pub fn dht_3d<S: Sample, T: Real>(
                 for (z, e) in l.iter_mut().enumerate() {
                     *e = T::load(data[base + plane * z]);
                 }
-                dht_unchecked(l, tw);
+                line_dht::<S, T>(l, tw, rounding);
             }
             for w in 0..=nz / 2 {
                 let wm = neg_mod(w, nz);

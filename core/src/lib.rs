@@ -14,6 +14,7 @@
 pub mod dht;
 pub mod error;
 pub mod filter;
+pub mod format;
 pub mod geometry;
 pub mod real;
 pub mod render;

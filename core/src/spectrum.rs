@@ -10,7 +10,9 @@
 //!
 //! # Scaling rule
 //! Stored values are `s·H` with `s = 2^e` chosen so that `s·Σ|g|` lies in
-//! `(2^13, 2^14]`, where `g` is the premultiplied volume. During the
+//! `(2^(t−1), 2^t]`, where `g` is the premultiplied volume and `t` is the
+//! format's [`Sample::SCALE_LOG2`] (`t = 14` for f16, as below; formats of
+//! narrower range use a smaller `t`, so that `2^(t+1)` fits them). During the
 //! transform every stored value is bounded by `2·Σ|g|` (x pass: `√2` times a
 //! line sum; y pass: 2 times a plane sum; final: `√2·Σ|g|`, since
 //! `|cas| ≤ √2`), so nothing exceeds `2^15 < 65504`, the f16 maximum, and the
@@ -18,9 +20,10 @@
 //! far from underflow as the format allows. `s` is a power of two, so scaling
 //! is exact. Renderers divide by `s` at the end.
 
-use crate::dht::{dht_3d, dht_3d_scratch_len, Twiddles};
+use crate::dht::{dht_3d_rounding, dht_3d_scratch_len, Rounding, Twiddles};
 use crate::error::{mismatch, require_len, require_pow2, Error, Result};
 use crate::filter::Filter;
+use crate::format::{BlockExponents, BlockLayout};
 use crate::real::{Real, Sample};
 
 /// A read-only source of voxels for preprocessing.
@@ -98,6 +101,7 @@ pub struct Spectrum<'a, S> {
     scale: f64,
     filter: Filter,
     dims: [usize; 3],
+    blocks: Option<BlockExponents<'a>>,
 }
 
 impl<'a, S: Sample> Spectrum<'a, S> {
@@ -118,6 +122,24 @@ impl<'a, S: Sample> Spectrum<'a, S> {
         storage: &'a mut [S],
         scratch: &mut [T],
         tw: &Twiddles<'_, T>,
+    ) -> Result<Self> {
+        Self::prepare_rounding(volume, filter, storage, scratch, tw, Rounding::PerPass)
+    }
+
+    /// [`Spectrum::prepare`] with a choice of where the transform rounds to
+    /// `S` ([`Rounding`]).
+    ///
+    /// # Errors
+    /// As [`Spectrum::prepare`]; also a scale factor that the arithmetic type
+    /// `T` cannot hold exactly (a volume whose magnitude is beyond about
+    /// `10^±30` for f32).
+    pub fn prepare_rounding<T: Real, V: VoxelSource>(
+        volume: &V,
+        filter: Filter,
+        storage: &'a mut [S],
+        scratch: &mut [T],
+        tw: &Twiddles<'_, T>,
+        rounding: Rounding,
     ) -> Result<Self> {
         let dims = volume.dims();
         let n = padded_size(dims, filter.oversample())?;
@@ -156,11 +178,16 @@ impl<'a, S: Sample> Spectrum<'a, S> {
                 stage: "premultiplication (volume magnitude beyond f64)",
             });
         }
-        let scale = scale_for(bound);
+        let scale = scale_for_target(bound, S::SCALE_LOG2);
 
         // Pass 2: place the scaled, premultiplied volume, circularly shifted.
         storage.fill(S::default());
         let sc = T::from_f64(scale);
+        if sc.to_f64() != scale {
+            return Err(Error::Overflow {
+                stage: "scaling (the volume's magnitude is beyond the arithmetic type's range)",
+            });
+        }
         for k in 0..dims[2] {
             let pz = (k + n - offs[2]) & mask;
             for j in 0..dims[1] {
@@ -174,13 +201,14 @@ impl<'a, S: Sample> Spectrum<'a, S> {
                 }
             }
         }
-        dht_3d(storage, [n, n, n], rest, tw)?;
+        dht_3d_rounding(storage, [n, n, n], rest, tw, rounding)?;
         Ok(Self {
             data: storage,
             n,
             scale,
             filter,
             dims,
+            blocks: None,
         })
     }
 
@@ -216,7 +244,90 @@ impl<'a, S: Sample> Spectrum<'a, S> {
             scale,
             filter,
             dims,
+            blocks: None,
         })
+    }
+
+    /// Rebuild a block-floating-point spectrum: coefficient
+    /// `i` is `data[i]·2^e/s` with `e` its block's exponent (made by
+    /// [`crate::format::encode_blocks`]).
+    ///
+    /// # Errors
+    /// As [`Spectrum::from_parts`]; also `S` not a block mantissa format, or
+    /// exponents that do not match `n` and their layout.
+    pub fn from_blocks(
+        data: &'a [S],
+        blocks: BlockExponents<'a>,
+        n: usize,
+        scale: f64,
+        filter: Filter,
+        dims: [usize; 3],
+    ) -> Result<Self> {
+        if !S::BLOCK_MANTISSA {
+            return Err(Error::UnsupportedFormat {
+                format: S::NAME,
+                reason: "block exponents need an integer mantissa format (q15 or q7)",
+            });
+        }
+        let mut spec = Self::from_parts(data, n, scale, filter, dims)?;
+        BlockExponents::new(blocks.layout(), blocks.exponents(), n)?;
+        spec.blocks = Some(blocks);
+        Ok(spec)
+    }
+
+    /// `Σ_t w[t]·c[line + x[t]]`: the weighted sum of taps on one x-line
+    /// starting at index `line` (a multiple of `n`), with each coefficient's
+    /// block exponent applied. Per-line exponents are applied once, to the
+    /// sum.
+    #[inline(always)]
+    pub fn line_taps<T: Real>(&self, line: usize, xs: &[usize], weights: &[T]) -> T {
+        let data = self.data;
+        let mut acc = T::ZERO;
+        let blocks = match self.blocks {
+            Some(b) if S::BLOCK_MANTISSA => b,
+            _ => {
+                for (x, w) in xs.iter().zip(weights) {
+                    acc += *w * T::load(data[line + x]);
+                }
+                return acc;
+            }
+        };
+        let n = self.n;
+        match blocks.layout() {
+            BlockLayout::Line => {
+                for (x, w) in xs.iter().zip(weights) {
+                    acc += *w * T::load(data[line + x]);
+                }
+                acc * T::exp2i(blocks.exponents()[line / n] as i32)
+            }
+            layout => {
+                let (y, z) = ((line / n) % n, line / (n * n));
+                for (x, w) in xs.iter().zip(weights) {
+                    let e = blocks.exponents()[layout.block_of(n, *x, y, z)];
+                    acc += *w * T::load(data[line + x]) * T::exp2i(e as i32);
+                }
+                acc
+            }
+        }
+    }
+
+    /// The block exponents, for block floating point.
+    pub fn blocks(&self) -> Option<BlockExponents<'a>> {
+        self.blocks
+    }
+
+    /// Coefficient `i` as stored times its block's power of two (`s·H`).
+    pub fn value(&self, i: usize) -> f64 {
+        let v = self.data[i].to_f64();
+        match self.blocks {
+            None => v,
+            Some(b) => {
+                let n = self.n;
+                let (x, y, z) = (i % n, (i / n) % n, i / (n * n));
+                let e = b.exponents()[b.layout().block_of(n, x, y, z)];
+                v * libm::scalbn(1.0, e as i32)
+            }
+        }
     }
 
     /// The stored coefficients, `s·H`, `x` fastest.
@@ -244,9 +355,9 @@ impl<'a, S: Sample> Spectrum<'a, S> {
         self.dims
     }
 
-    /// Bytes of coefficient storage held.
+    /// Bytes of coefficient storage held, block exponents included.
     pub fn bytes(&self) -> usize {
-        core::mem::size_of_val(self.data)
+        core::mem::size_of_val(self.data) + self.blocks.map_or(0, |b| b.exponents().len())
     }
 }
 
@@ -264,18 +375,26 @@ pub fn premultiplier_table<T: Real>(filter: &Filter, n: usize, out: &mut [T]) {
     }
 }
 
-/// The power of two `s` with `s·bound ∈ (2^13, 2^14]` (1 when `bound` is 0).
+/// The power of two `s` with `s·bound ∈ (2^13, 2^14]` (1 when `bound` is 0):
+/// the rule for f16.
 pub fn scale_for(bound: f64) -> f64 {
-    if bound <= 0.0 {
+    scale_for_target(bound, 14)
+}
+
+/// The power of two `s` with `s·bound ∈ (2^(t−1), 2^t]` (1 when `bound` is 0
+/// or not finite), for `t = log2_target`.
+pub fn scale_for_target(bound: f64, log2_target: i32) -> f64 {
+    if !(bound > 0.0 && bound.is_finite()) {
         return 1.0;
     }
-    let e = libm::floor(libm::log2(16384.0 / bound)) as i32;
+    let target = libm::scalbn(1.0, log2_target);
+    let e = libm::floor(libm::log2(target / bound)) as i32;
     let mut s = libm::scalbn(1.0, e);
     // Guard against log2 rounding at exact powers of two.
-    while s * bound > 16384.0 {
+    while s * bound > target {
         s *= 0.5;
     }
-    while s * bound * 2.0 <= 16384.0 {
+    while s * bound * 2.0 <= target {
         s *= 2.0;
     }
     s
