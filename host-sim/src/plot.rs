@@ -250,7 +250,7 @@ impl Scatter<'_> {
         );
         c.text_down(8, top + 20, self.y_label, 2, black);
         for (x, label) in self.x_labels {
-            c.text_down(px(*x) - 2, bottom + 24, label, 1, [60, 60, 60]);
+            c.text_down(px(*x) - 3, bottom + 24, label, 2, [60, 60, 60]);
             c.line((px(*x), bottom), (px(*x), bottom + 4), black, 0);
         }
         // Legend.
