@@ -38,10 +38,15 @@ pub struct PrecisionArgs {
     /// 1 or 2.
     #[arg(long, default_value = "auto")]
     oversample: String,
-    /// Directory for precision.md, precision.csv and precision.png; without
-    /// it the Markdown goes to standard output.
+    /// Directory for precision.md, precision.csv and precision.png (and
+    /// extremes.md); without it the Markdown goes to standard output.
     #[arg(long)]
     out_dir: Option<PathBuf>,
+    /// Measure the stability cases instead (constant, impulse, Nyquist
+    /// checkerboard, u16 65535, 1e-6 scaling, Hounsfield units) at this side,
+    /// at oversampling 1 and at the automatic choice.
+    #[arg(long)]
+    extremes: Option<usize>,
 }
 
 /// Run the study.
@@ -67,6 +72,32 @@ pub fn run(args: &PrecisionArgs) -> Result<(), String> {
         "2" => Oversampling::Fixed(2),
         o => return Err(format!("oversampling `{o}` must be auto, 1 or 2")),
     };
+    if let Some(n) = args.extremes {
+        if n < 2 || n % 2 != 0 || n > 128 {
+            return Err(format!("--extremes {n}: the side must be even, from 2 to 128"));
+        }
+        let mut md = format!(
+            "# Stability at the extremes: measured\n\n\
+             Made by `fvr precision --extremes {n}`: kb4, side {n}, every format; \
+             first at oversampling 1, then at the oversampling chosen automatically.\n\n"
+        );
+        for (title, o) in [("Oversampling 1", Some(1)), ("Automatic oversampling", None)] {
+            let rows = crate::precision::measure_extremes(n, &formats, o)?;
+            md += &format!("## {title}\n\n{}\n", crate::precision::extremes_markdown(&rows));
+        }
+        return match &args.out_dir {
+            None => {
+                print!("{md}");
+                Ok(())
+            }
+            Some(dir) => {
+                std::fs::create_dir_all(dir)
+                    .map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
+                let p = dir.join("extremes.md");
+                std::fs::write(&p, md).map_err(|e| format!("cannot write `{}`: {e}", p.display()))
+            }
+        };
+    }
     let mut specs = Vec::new();
     for v in &args.volumes {
         let is_bare_phantom = !v.contains('@') && phantom_by_name(v).is_some();
@@ -82,6 +113,16 @@ pub fn run(args: &PrecisionArgs) -> Result<(), String> {
     for spec in &specs {
         let t0 = Instant::now();
         let mut subject = Subject::load(spec, kind, oversampling)?;
+        // Formats this grid cannot hold (a brick that does not divide it) are
+        // configuration errors, reported before any transform.
+        let grid = fvr_core::spectrum::padded_size(subject.volume.dims, subject.filter.oversample())
+            .map_err(|e| e.to_string())?;
+        for &f in &formats {
+            for a in crate::precision::modes_for(f) {
+                f.check(a, grid)
+                    .map_err(|e| format!("format {} on {spec}: {e}", FormatName(f)))?;
+            }
+        }
         eprintln!(
             "fvr precision: {spec} (filter {} at oversampling {})",
             kind.name(),
