@@ -199,7 +199,10 @@ pub struct Minifloat16<const E: u32>(pub u16);
 impl<const E: u32> Minifloat16<E> {
     /// The bit layout.
     pub const LAYOUT: FloatLayout = {
-        assert!(E >= 2 && E <= 8, "16-bit minifloats need 2 to 8 exponent bits");
+        assert!(
+            E >= 2 && E <= 8,
+            "16-bit minifloats need 2 to 8 exponent bits"
+        );
         FloatLayout {
             exponent: E,
             mantissa: 15 - E,
@@ -253,7 +256,10 @@ pub struct Minifloat8<const E: u32>(pub u8);
 impl<const E: u32> Minifloat8<E> {
     /// The bit layout.
     pub const LAYOUT: FloatLayout = {
-        assert!(E >= 2 && E <= 5, "8-bit minifloats need 2 to 5 exponent bits");
+        assert!(
+            E >= 2 && E <= 5,
+            "8-bit minifloats need 2 to 5 exponent bits"
+        );
         FloatLayout {
             exponent: E,
             mantissa: 7 - E,
@@ -466,7 +472,10 @@ pub fn encode_blocks<T: Real, M: Sample>(
     }
     let cube = n * n * n;
     let blocks = layout.exponent_count(n)?;
-    for (what, len) in [("block source", src.len()), ("block mantissas", mantissas.len())] {
+    for (what, len) in [
+        ("block source", src.len()),
+        ("block mantissas", mantissas.len()),
+    ] {
         if len != cube {
             return Err(crate::error::mismatch(what, cube, len));
         }
@@ -485,7 +494,9 @@ pub fn encode_blocks<T: Real, M: Sample>(
                 .zip(mantissas.chunks_exact_mut(n))
                 .zip(exponents.iter_mut())
             {
-                let max = line.iter().fold(0.0f64, |a, v| a.max(libm::fabs(v.to_f64())));
+                let max = line
+                    .iter()
+                    .fold(0.0f64, |a, v| a.max(libm::fabs(v.to_f64())));
                 *e = block_exponent::<M>(max)?;
                 let k = libm::scalbn(1.0, -(*e as i32));
                 for (o, v) in out.iter_mut().zip(line) {
@@ -554,7 +565,11 @@ fn block_exponent<M: Sample>(max: f64) -> Result<i8> {
 /// Lengths differ, or a value overflows `S` ([`Error::Overflow`]).
 pub fn encode_elements<T: Real, S: Sample>(src: &[T], factor: f64, dst: &mut [S]) -> Result<()> {
     if src.len() != dst.len() {
-        return Err(crate::error::mismatch("encoded values", src.len(), dst.len()));
+        return Err(crate::error::mismatch(
+            "encoded values",
+            src.len(),
+            dst.len(),
+        ));
     }
     let mut finite = true;
     for (d, v) in dst.iter_mut().zip(src) {
@@ -648,10 +663,7 @@ impl Format {
     pub fn minifloat(exponent: u32, mantissa: u32) -> Result<Self> {
         let bits = 1 + exponent as u64 + mantissa as u64;
         if bits != 16 && bits != 8 {
-            return Err(Error::BadMinifloatSplit {
-                exponent,
-                mantissa,
-            });
+            return Err(Error::BadMinifloatSplit { exponent, mantissa });
         }
         if exponent < 2 {
             return Err(Error::UnsupportedFormat {
@@ -670,7 +682,8 @@ impl Format {
             (_, e) if e <= 5 => Ok(Format::Minifloat8(e)),
             _ => Err(Error::UnsupportedFormat {
                 format: "minifloat",
-                reason: "an 8-bit minifloat keeps at least 2 mantissa bits (at most 5 exponent bits)",
+                reason:
+                    "an 8-bit minifloat keeps at least 2 mantissa bits (at most 5 exponent bits)",
             }),
         }
     }
@@ -720,9 +733,7 @@ impl Format {
         };
         let extra = match blocking {
             Blocking::Volume => 0.0,
-            Blocking::Blocks(l) => {
-                l.exponent_count(n).unwrap_or(0) as f64 / (n * n * n) as f64
-            }
+            Blocking::Blocks(l) => l.exponent_count(n).unwrap_or(0) as f64 / (n * n * n) as f64,
         };
         bits as f64 / 8.0 + extra
     }

@@ -107,9 +107,11 @@ impl Canvas {
     /// # Errors
     /// File creation or encoding failure, with the path.
     pub fn write_png(&self, path: &Path) -> Result<(), String> {
-        let fail = |e: &dyn std::fmt::Display| format!("cannot write PNG `{}`: {e}", path.display());
+        let fail =
+            |e: &dyn std::fmt::Display| format!("cannot write PNG `{}`: {e}", path.display());
         let file = File::create(path).map_err(|e| fail(&e))?;
-        let mut enc = png::Encoder::new(BufWriter::new(file), self.width as u32, self.height as u32);
+        let mut enc =
+            png::Encoder::new(BufWriter::new(file), self.width as u32, self.height as u32);
         enc.set_color(png::ColorType::Rgb);
         enc.set_depth(png::BitDepth::Eight);
         let mut writer = enc.write_header().map_err(|e| fail(&e))?;
@@ -214,11 +216,17 @@ impl Scatter<'_> {
         let mut c = Canvas::new(width, height);
         let black = [0, 0, 0];
         let grey = [200, 200, 200];
-        let longest = self.x_labels.iter().map(|(_, s)| s.len()).max().unwrap_or(0) as i64;
+        let longest = self
+            .x_labels
+            .iter()
+            .map(|(_, s)| s.len())
+            .max()
+            .unwrap_or(0) as i64;
         let (left, right, top) = (70i64, width as i64 - 20, 40i64);
         let bottom = height as i64 - 60 - longest * 12;
         let (x0, x1) = (self.x_range.0.log2(), self.x_range.1.log2());
-        let px = |x: f64| left + ((x.log2() - x0) / (x1 - x0) * (right - left) as f64).round() as i64;
+        let px =
+            |x: f64| left + ((x.log2() - x0) / (x1 - x0) * (right - left) as f64).round() as i64;
         let (y0, y1) = self.y_range;
         let py = |y: f64| bottom - ((y - y0) / (y1 - y0) * (bottom - top) as f64).round() as i64;
         c.text(left, 10, self.title, 2, black);
@@ -227,17 +235,35 @@ impl Scatter<'_> {
         while y <= y1 + 1e-9 {
             c.line((left, py(y)), (right, py(y)), grey, 0);
             let label = format!("{y:.0}");
-            c.text(left - 8 - Canvas::text_width(&label, 2), py(y) - 5, &label, 2, black);
+            c.text(
+                left - 8 - Canvas::text_width(&label, 2),
+                py(y) - 5,
+                &label,
+                2,
+                black,
+            );
             y += self.y_step;
         }
         for &t in self.x_ticks {
             c.line((px(t), top), (px(t), bottom), grey, 0);
             let label = format!("{t}");
-            c.text(px(t) - Canvas::text_width(&label, 2) / 2, bottom + 6, &label, 2, black);
+            c.text(
+                px(t) - Canvas::text_width(&label, 2) / 2,
+                bottom + 6,
+                &label,
+                2,
+                black,
+            );
         }
         for &(v, label) in self.y_lines {
             c.line((left, py(v)), (right, py(v)), [120, 120, 120], 4);
-            c.text(right - Canvas::text_width(label, 2) - 4, py(v) - 12, label, 2, [90, 90, 90]);
+            c.text(
+                right - Canvas::text_width(label, 2) - 4,
+                py(v) - 12,
+                label,
+                2,
+                [90, 90, 90],
+            );
         }
         c.line((left, top), (left, bottom), black, 0);
         c.line((left, bottom), (right, bottom), black, 0);

@@ -284,7 +284,8 @@ impl Subject {
         format: Format,
         arithmetic: Arithmetic,
     ) -> Result<(Vec<Vec<f64>>, f64), String> {
-        let n = padded_size(self.volume.dims, self.filter.oversample()).map_err(|e| e.to_string())?;
+        let n =
+            padded_size(self.volume.dims, self.filter.oversample()).map_err(|e| e.to_string())?;
         format.check(arithmetic, n).map_err(|e| e.to_string())?;
         if arithmetic == Arithmetic::HostOnce && self.host_f32.is_none() {
             self.host_f32 = Some(
@@ -509,8 +510,8 @@ pub fn study_subject(
         ),
         None => None,
     };
-    let grid = padded_size(subject.volume.dims, subject.filter.oversample())
-        .map_err(|e| e.to_string())?;
+    let grid =
+        padded_size(subject.volume.dims, subject.filter.oversample()).map_err(|e| e.to_string())?;
     let mut cells = Vec::new();
     for &format in formats {
         for arithmetic in modes_for(format) {
@@ -689,8 +690,13 @@ mod tests {
     fn block_encoding_errs_by_at_most_half_a_step_of_the_block() {
         let volume = gaussians(16);
         let filter = Filter::new(FilterKind::Kb4, 1).unwrap();
-        let src = StoredSpectrum::<f32>::prepare::<f32>(&volume, filter, Rounding::PerPass).unwrap();
-        for layout in [BlockLayout::Line, BlockLayout::Brick(2), BlockLayout::Brick(4)] {
+        let src =
+            StoredSpectrum::<f32>::prepare::<f32>(&volume, filter, Rounding::PerPass).unwrap();
+        for layout in [
+            BlockLayout::Line,
+            BlockLayout::Brick(2),
+            BlockLayout::Brick(4),
+        ] {
             let q = StoredSpectrum::<Q15>::encode(&src, Blocking::Blocks(layout)).unwrap();
             let q7 = StoredSpectrum::<Q7>::encode(&src, Blocking::Blocks(layout)).unwrap();
             let (spec, spec7) = (q.view(), q7.view());
@@ -702,9 +708,15 @@ mod tests {
                 let v = src.data[i] as f64;
                 block_max[b] = block_max[b].max(v.abs());
                 let e = exps[b] as i32;
-                assert!((spec.value(i) - v).abs() <= 2f64.powi(e - 16), "{layout:?} {i}");
+                assert!(
+                    (spec.value(i) - v).abs() <= 2f64.powi(e - 16),
+                    "{layout:?} {i}"
+                );
                 let e7 = spec7.blocks().unwrap().exponents()[b] as i32;
-                assert!((spec7.value(i) - v).abs() <= 2f64.powi(e7 - 8), "{layout:?} {i}");
+                assert!(
+                    (spec7.value(i) - v).abs() <= 2f64.powi(e7 - 8),
+                    "{layout:?} {i}"
+                );
             }
             for (b, &e) in exps.iter().enumerate() {
                 let m = block_max[b];
@@ -836,10 +848,15 @@ pub fn measure_extremes(
             None => choose_oversampling(&case.volume, kind, KbDesign::Auto)
                 .map_err(|e| e.to_string())?,
         };
-        let filter = choose_filter(&case.volume, kind, o, KbDesign::Auto).map_err(|e| e.to_string())?;
+        let filter =
+            choose_filter(&case.volume, kind, o, KbDesign::Auto).map_err(|e| e.to_string())?;
         let mut subject = Subject::new(case.name, case.volume, None, filter, case.views);
         let (reference, _) = subject.render_format(Format::F64, Arithmetic::PerPass)?;
-        let vmax = subject.volume.data.iter().fold(0.0f64, |m, v| m.max(v.abs() as f64));
+        let vmax = subject
+            .volume
+            .data
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs() as f64));
         let line_scale = subject.size as f64 * vmax;
         for &format in formats {
             for arithmetic in modes_for(format) {

@@ -74,16 +74,24 @@ pub fn run(args: &PrecisionArgs) -> Result<(), String> {
     };
     if let Some(n) = args.extremes {
         if n < 2 || n % 2 != 0 || n > 128 {
-            return Err(format!("--extremes {n}: the side must be even, from 2 to 128"));
+            return Err(format!(
+                "--extremes {n}: the side must be even, from 2 to 128"
+            ));
         }
         let mut md = format!(
             "# Stability at the extremes: measured\n\n\
              Made by `fvr precision --extremes {n}`: kb4, side {n}, every format; \
              first at oversampling 1, then at the oversampling chosen automatically.\n\n"
         );
-        for (title, o) in [("Oversampling 1", Some(1)), ("Automatic oversampling", None)] {
+        for (title, o) in [
+            ("Oversampling 1", Some(1)),
+            ("Automatic oversampling", None),
+        ] {
             let rows = crate::precision::measure_extremes(n, &formats, o)?;
-            md += &format!("## {title}\n\n{}\n", crate::precision::extremes_markdown(&rows));
+            md += &format!(
+                "## {title}\n\n{}\n",
+                crate::precision::extremes_markdown(&rows)
+            );
         }
         return match &args.out_dir {
             None => {
@@ -115,8 +123,9 @@ pub fn run(args: &PrecisionArgs) -> Result<(), String> {
         let mut subject = Subject::load(spec, kind, oversampling)?;
         // Formats this grid cannot hold (a brick that does not divide it) are
         // configuration errors, reported before any transform.
-        let grid = fvr_core::spectrum::padded_size(subject.volume.dims, subject.filter.oversample())
-            .map_err(|e| e.to_string())?;
+        let grid =
+            fvr_core::spectrum::padded_size(subject.volume.dims, subject.filter.oversample())
+                .map_err(|e| e.to_string())?;
         for &f in &formats {
             for a in crate::precision::modes_for(f) {
                 f.check(a, grid)
@@ -128,23 +137,21 @@ pub fn run(args: &PrecisionArgs) -> Result<(), String> {
             kind.name(),
             subject.filter.oversample()
         );
-        let got = study_subject(&mut subject, &formats, |c| {
-            match &c.error {
-                None => eprintln!(
-                    "  {:>10} {:>9}  {:.3} B/voxel  {:7.1} dB vs f64  {}",
-                    FormatName(c.format).to_string(),
-                    c.arithmetic.name(),
-                    c.bytes_per_voxel,
-                    c.snr_f64,
-                    c.snr_exact
-                        .map_or(String::new(), |e| format!("{e:6.1} dB vs exact"))
-                ),
-                Some(e) => eprintln!(
-                    "  {:>10} {:>9}  refused: {e}",
-                    FormatName(c.format).to_string(),
-                    c.arithmetic.name()
-                ),
-            }
+        let got = study_subject(&mut subject, &formats, |c| match &c.error {
+            None => eprintln!(
+                "  {:>10} {:>9}  {:.3} B/voxel  {:7.1} dB vs f64  {}",
+                FormatName(c.format).to_string(),
+                c.arithmetic.name(),
+                c.bytes_per_voxel,
+                c.snr_f64,
+                c.snr_exact
+                    .map_or(String::new(), |e| format!("{e:6.1} dB vs exact"))
+            ),
+            Some(e) => eprintln!(
+                "  {:>10} {:>9}  refused: {e}",
+                FormatName(c.format).to_string(),
+                c.arithmetic.name()
+            ),
         })?;
         eprintln!("  ({:.1} s)", t0.elapsed().as_secs_f64());
         cells.extend(got);
@@ -204,7 +211,10 @@ fn report(cells: &[Cell], args: &PrecisionArgs) -> String {
 /// spread sideways and named under the axis.
 pub fn plot(cells: &[Cell]) -> crate::plot::Canvas {
     let mut formats: Vec<(Format, f64)> = Vec::new();
-    for c in cells.iter().filter(|c| c.error.is_none() && c.format != Format::F64) {
+    for c in cells
+        .iter()
+        .filter(|c| c.error.is_none() && c.format != Format::F64)
+    {
         if !formats.iter().any(|(f, _)| *f == c.format) {
             formats.push((c.format, c.bytes_per_voxel));
         }
@@ -213,8 +223,10 @@ pub fn plot(cells: &[Cell]) -> crate::plot::Canvas {
     let class = |b: f64| b.log2().round() as i64;
     let mut xs: Vec<(Format, f64)> = Vec::new();
     for (f, b) in &formats {
-        let peers: Vec<&(Format, f64)> =
-            formats.iter().filter(|(_, c)| class(*c) == class(*b)).collect();
+        let peers: Vec<&(Format, f64)> = formats
+            .iter()
+            .filter(|(_, c)| class(*c) == class(*b))
+            .collect();
         let i = peers.iter().position(|(g, _)| g == f).unwrap_or(0) as f64;
         let m = peers.len() as f64;
         let spread = (0.7 / m).min(0.12);

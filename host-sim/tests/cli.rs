@@ -248,7 +248,11 @@ fn precision_study_writes_markdown_csv_and_png_with_no_non_finite_pixel() {
         ],
         &dir,
     );
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let csv = std::fs::read_to_string(dir.join("out/precision.csv")).unwrap();
     let lines: Vec<&str> = csv.lines().collect();
     assert!(lines[0].starts_with("volume,size,grid,format,arithmetic,bytes_per_voxel"));
@@ -277,7 +281,13 @@ fn precision_bad_formats_are_named_before_any_work() {
     let out = fvr(&["precision", "--formats", "f24"], &dir);
     assert_error(&out, &["unknown format `f24`"]);
     let out = fvr(
-        &["precision", "--volumes", "gaussians@16", "--formats", "q15-brick6"],
+        &[
+            "precision",
+            "--volumes",
+            "gaussians@16",
+            "--formats",
+            "q15-brick6",
+        ],
         &dir,
     );
     assert_error(&out, &["q15-brick6", "block size 6 does not divide", "16"]);
@@ -288,14 +298,31 @@ fn precision_bad_formats_are_named_before_any_work() {
 #[test]
 fn precision_extremes_table_reports_every_case() {
     let dir = temp_dir("precision-extremes");
-    let out = fvr(&["precision", "--extremes", "8", "--formats", "f16,q15-line"], &dir);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = fvr(
+        &["precision", "--extremes", "8", "--formats", "f16,q15-line"],
+        &dir,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let md = String::from_utf8_lossy(&out.stdout);
-    for case in ["constant 1", "impulse", "nyquist checkerboard", "u16 65535", "gaussians x 1e-6", "shepp-logan in HU"] {
+    for case in [
+        "constant 1",
+        "impulse",
+        "nyquist checkerboard",
+        "u16 65535",
+        "gaussians x 1e-6",
+        "shepp-logan in HU",
+    ] {
         assert!(md.contains(case), "{case} missing");
     }
     // Every row ends with its count of NaN/Inf pixels: zero.
-    let rows: Vec<&str> = md.lines().filter(|l| l.starts_with("| ") && !l.starts_with("| case")).collect();
+    let rows: Vec<&str> = md
+        .lines()
+        .filter(|l| l.starts_with("| ") && !l.starts_with("| case"))
+        .collect();
     assert_eq!(rows.len(), 2 * 6 * 4, "{md}");
     assert!(rows.iter().all(|l| l.ends_with("| 0 |")), "{md}");
 }

@@ -45,7 +45,12 @@ fn check_float_codec<S: Sample>(layout: FloatLayout, bits: u32, make: impl Fn(u3
         if b + 1 == inf {
             // Overflow: from half an ulp above the maximum, values are infinite.
             let ulp = lo - make(b - 1).to_f64();
-            assert_eq!(S::from_f64(lo + 0.5 * ulp), make(inf), "{} overflow", S::NAME);
+            assert_eq!(
+                S::from_f64(lo + 0.5 * ulp),
+                make(inf),
+                "{} overflow",
+                S::NAME
+            );
             assert_eq!(S::from_f64(lo + 0.49 * ulp), make(b), "{} max", S::NAME);
             assert_eq!(S::MAX_FINITE, lo, "{} MAX_FINITE", S::NAME);
             continue;
@@ -53,10 +58,20 @@ fn check_float_codec<S: Sample>(layout: FloatLayout, bits: u32, make: impl Fn(u3
         let mid = 0.5 * (lo + hi);
         let even = if b % 2 == 0 { b } else { b + 1 };
         assert_eq!(S::from_f64(mid), make(even), "{} midpoint {b:#x}", S::NAME);
-        assert_eq!(S::from_f64(-mid), make(even | sign), "{} -midpoint", S::NAME);
+        assert_eq!(
+            S::from_f64(-mid),
+            make(even | sign),
+            "{} -midpoint",
+            S::NAME
+        );
         let q = 0.25 * (hi - lo);
         assert_eq!(S::from_f64(mid - q), make(b), "{} below {b:#x}", S::NAME);
-        assert_eq!(S::from_f64(mid + q), make(b + 1), "{} above {b:#x}", S::NAME);
+        assert_eq!(
+            S::from_f64(mid + q),
+            make(b + 1),
+            "{} above {b:#x}",
+            S::NAME
+        );
     }
     // Underflow: half the smallest subnormal rounds to zero (even), anything
     // above it to the smallest subnormal; −0 keeps its sign.
@@ -124,14 +139,20 @@ fn minifloat_e5m10_is_f16_and_e8m7_is_bf16_bit_for_bit() {
         for v in [0.5 * (lo + hi), lo + 0.3 * (hi - lo), lo + 0.7 * (hi - lo)] {
             assert_eq!(Minifloat16::<5>::from_f64(v).0, f16::from_f64(v).to_bits());
             let v32 = v as f32;
-            assert_eq!(Minifloat16::<5>::from_f32(v32).0, f16::from_f32(v32).to_bits());
+            assert_eq!(
+                Minifloat16::<5>::from_f32(v32).0,
+                f16::from_f32(v32).to_bits()
+            );
         }
     }
     for b in 0..0x7f7fu16 {
         let (lo, hi) = (bf16::from_bits(b).to_f64(), bf16::from_bits(b + 1).to_f64());
         for v in [0.5 * (lo + hi), lo + 0.3 * (hi - lo), lo + 0.7 * (hi - lo)] {
             let v32 = v as f32;
-            assert_eq!(Minifloat16::<8>::from_f32(v32).0, bf16::from_f32(v32).to_bits());
+            assert_eq!(
+                Minifloat16::<8>::from_f32(v32).0,
+                bf16::from_f32(v32).to_bits()
+            );
         }
     }
 }
