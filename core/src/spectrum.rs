@@ -20,10 +20,10 @@
 //! far from underflow as the format allows. `s` is a power of two, so scaling
 //! is exact. Renderers divide by `s` at the end.
 
-use crate::dht::{dht_3d_rounding, dht_3d_scratch_len, Rounding, Twiddles};
+use crate::dht::{dht_3d_scratch_len, dht_3d_store, Elements, LineStore, Pass, Rounding, Twiddles};
 use crate::error::{mismatch, require_len, require_pow2, Error, Result};
 use crate::filter::Filter;
-use crate::format::{BlockExponents, BlockLayout};
+use crate::format::{BlockExponents, BlockLayout, LineBlocks};
 use crate::real::{Real, Sample};
 
 /// A read-only source of voxels for preprocessing.
@@ -143,65 +143,20 @@ impl<'a, S: Sample> Spectrum<'a, S> {
     ) -> Result<Self> {
         let dims = volume.dims();
         let n = padded_size(dims, filter.oversample())?;
-        let cube = n
-            .checked_mul(n)
-            .and_then(|v| v.checked_mul(n))
-            .ok_or(Error::VolumeTooLarge { dims, grid: n })?;
+        let cube = cube_len(dims, n)?;
         require_len("spectrum storage", cube, storage.len())?;
-        require_len("preparation scratch", prepare_scratch_len(n), scratch.len())?;
         let storage = &mut storage[..cube];
-        let (premul, rest) = scratch.split_at_mut(n);
-        premultiplier_table(&filter, n, premul);
-
-        // Pass 1: check finiteness and sum |g| exactly (in f64).
-        let mask = n - 1;
-        let offs = dims.map(|d| d / 2);
-        let pm = |idx: usize, axis: usize| premul[(idx + n - offs[axis]) & mask].to_f64();
-        let mut bound = 0.0f64;
-        for k in 0..dims[2] {
-            for j in 0..dims[1] {
-                let pyz = pm(j, 1) * pm(k, 2);
-                for i in 0..dims[0] {
-                    let v = volume.voxel(i, j, k);
-                    if !v.is_finite() {
-                        return Err(Error::NonFiniteVoxel {
-                            index: [i, j, k],
-                            value: v,
-                        });
-                    }
-                    bound += libm::fabs(v * pm(i, 0) * pyz);
-                }
-            }
-        }
-        if !bound.is_finite() {
-            return Err(Error::Overflow {
-                stage: "premultiplication (volume magnitude beyond f64)",
-            });
-        }
-        let scale = scale_for_target(bound, S::SCALE_LOG2);
-
-        // Pass 2: place the scaled, premultiplied volume, circularly shifted.
         storage.fill(S::default());
-        let sc = T::from_f64(scale);
-        if sc.to_f64() != scale {
-            return Err(Error::Overflow {
-                stage: "scaling (the volume's magnitude is beyond the arithmetic type's range)",
-            });
-        }
-        for k in 0..dims[2] {
-            let pz = (k + n - offs[2]) & mask;
-            for j in 0..dims[1] {
-                let py = (j + n - offs[1]) & mask;
-                let pyz = premul[py] * premul[pz] * sc;
-                let row = n * (py + n * pz);
-                for i in 0..dims[0] {
-                    let px = (i + n - offs[0]) & mask;
-                    let g = T::from_f64(volume.voxel(i, j, k)) * premul[px] * pyz;
-                    storage[row + px] = g.store();
-                }
-            }
-        }
-        dht_3d_rounding(storage, [n, n, n], rest, tw, rounding)?;
+        let scale = prepare_into(
+            volume,
+            &filter,
+            S::SCALE_LOG2,
+            &mut Elements(&mut *storage),
+            n,
+            scratch,
+            tw,
+            rounding,
+        )?;
         Ok(Self {
             data: storage,
             n,
@@ -209,6 +164,65 @@ impl<'a, S: Sample> Spectrum<'a, S> {
             filter,
             dims,
             blocks: None,
+        })
+    }
+
+    /// [`Spectrum::prepare_rounding`] into block floating point with one
+    /// exponent per line, in place ([`LineBlocks`]): `mantissas` needs `n³`
+    /// elements, `exponents` and `exponent_scratch` `n²` each; the finished
+    /// spectrum has per-x-line exponents ([`BlockLayout::Line`]) in
+    /// `exponents`.
+    ///
+    /// # Errors
+    /// As [`Spectrum::prepare_rounding`]; also `S` not a block mantissa.
+    pub fn prepare_line_blocks<T: Real, V: VoxelSource>(
+        volume: &V,
+        filter: Filter,
+        mantissas: &'a mut [S],
+        exponents: &'a mut [i8],
+        exponent_scratch: &mut [i8],
+        scratch: &mut [T],
+        tw: &Twiddles<'_, T>,
+        rounding: Rounding,
+    ) -> Result<Self> {
+        let dims = volume.dims();
+        let n = padded_size(dims, filter.oversample())?;
+        let cube = cube_len(dims, n)?;
+        require_len("spectrum storage", cube, mantissas.len())?;
+        require_len("block exponents", n * n, exponents.len())?;
+        require_len("block exponent scratch", n * n, exponent_scratch.len())?;
+        let mantissas = &mut mantissas[..cube];
+        mantissas.fill(S::default());
+        exponents[..n * n].fill(0);
+        exponent_scratch[..n * n].fill(0);
+        // Table `a` holds the input's and the passes' lines; `b` ends up with
+        // the spectrum's x-lines.
+        let mut store = LineBlocks::new(
+            &mut *mantissas,
+            &mut exponent_scratch[..n * n],
+            &mut exponents[..n * n],
+            n,
+        )?;
+        let scale = prepare_into(
+            volume,
+            &filter,
+            S::SCALE_LOG2,
+            &mut store,
+            n,
+            scratch,
+            tw,
+            rounding,
+        )?;
+        store.finish(&mut scratch[n..2 * n])?;
+        let exponents: &'a [i8] = exponents;
+        let blocks = BlockExponents::new(BlockLayout::Line, &exponents[..n * n], n)?;
+        Ok(Self {
+            data: mantissas,
+            n,
+            scale,
+            filter,
+            dims,
+            blocks: Some(blocks),
         })
     }
 
@@ -359,6 +373,89 @@ impl<'a, S: Sample> Spectrum<'a, S> {
     pub fn bytes(&self) -> usize {
         core::mem::size_of_val(self.data) + self.blocks.map_or(0, |b| b.exponents().len())
     }
+}
+
+fn cube_len(dims: [usize; 3], n: usize) -> Result<usize> {
+    n.checked_mul(n)
+        .and_then(|v| v.checked_mul(n))
+        .ok_or(Error::VolumeTooLarge { dims, grid: n })
+}
+
+/// Premultiply `volume`, place it in `store` (x-line by x-line, circularly
+/// shifted, scaled by the rule for `scale_log2`) and transform it. `store`
+/// must hold zeros. Returns the scale.
+fn prepare_into<T: Real, V: VoxelSource, L: LineStore<T>>(
+    volume: &V,
+    filter: &Filter,
+    scale_log2: i32,
+    store: &mut L,
+    n: usize,
+    scratch: &mut [T],
+    tw: &Twiddles<'_, T>,
+    rounding: Rounding,
+) -> Result<f64> {
+    let dims = volume.dims();
+    require_len("preparation scratch", prepare_scratch_len(n), scratch.len())?;
+    let (premul, rest) = scratch.split_at_mut(n);
+    premultiplier_table(filter, n, premul);
+
+    // Pass 1: check finiteness and sum |g| exactly (in f64).
+    let mask = n - 1;
+    let offs = dims.map(|d| d / 2);
+    let pm = |idx: usize, axis: usize| premul[(idx + n - offs[axis]) & mask].to_f64();
+    let mut bound = 0.0f64;
+    for k in 0..dims[2] {
+        for j in 0..dims[1] {
+            let pyz = pm(j, 1) * pm(k, 2);
+            for i in 0..dims[0] {
+                let v = volume.voxel(i, j, k);
+                if !v.is_finite() {
+                    return Err(Error::NonFiniteVoxel {
+                        index: [i, j, k],
+                        value: v,
+                    });
+                }
+                bound += libm::fabs(v * pm(i, 0) * pyz);
+            }
+        }
+    }
+    if !bound.is_finite() {
+        return Err(Error::Overflow {
+            stage: "premultiplication (volume magnitude beyond f64)",
+        });
+    }
+    let scale = scale_for_target(bound, scale_log2);
+
+    // Pass 2: place the scaled, premultiplied volume, circularly shifted,
+    // one x-line at a time (rows the volume does not reach stay zero).
+    let sc = T::from_f64(scale);
+    if sc.to_f64() != scale {
+        return Err(Error::Overflow {
+            stage: "scaling (the volume's magnitude is beyond the arithmetic type's range)",
+        });
+    }
+    let mut finite = true;
+    for k in 0..dims[2] {
+        let pz = (k + n - offs[2]) & mask;
+        for j in 0..dims[1] {
+            let py = (j + n - offs[1]) & mask;
+            let pyz = premul[py] * premul[pz] * sc;
+            let line = &mut rest[..n];
+            line.fill(T::ZERO);
+            for i in 0..dims[0] {
+                let px = (i + n - offs[0]) & mask;
+                line[px] = T::from_f64(volume.voxel(i, j, k)) * premul[px] * pyz;
+            }
+            finite &= store.store(Pass::X, n * (py + n * pz), 1, line);
+        }
+    }
+    if !finite {
+        return Err(Error::Overflow {
+            stage: "placement of the premultiplied volume",
+        });
+    }
+    dht_3d_store(store, [n, n, n], rest, tw, rounding)?;
+    Ok(scale)
 }
 
 /// Premultiplication factors `1/ĥ(x/n)` for signed positions

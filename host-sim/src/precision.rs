@@ -69,6 +69,46 @@ impl<S: Sample> StoredSpectrum<S> {
         })
     }
 
+    /// Premultiply, pad and transform `volume` in place into block floating
+    /// point with per-line exponents ([`Spectrum::prepare_line_blocks`]).
+    ///
+    /// # Errors
+    /// As [`Spectrum::prepare_line_blocks`], or a spectrum beyond memory.
+    pub fn prepare_line_blocks<T: Real>(
+        volume: &Volume,
+        filter: Filter,
+        rounding: Rounding,
+    ) -> Result<Self, PipelineError> {
+        let n = padded_size(volume.dims, filter.oversample())?;
+        crate::pipeline::check_memory(n, std::mem::size_of::<S>())?;
+        let source = DenseVolume::new(volume.dims, &volume.data)?;
+        let mut data = vec![S::default(); n * n * n];
+        let mut exps = vec![0i8; n * n];
+        let mut exps_scratch = vec![0i8; n * n];
+        let mut scratch = vec![T::ZERO; prepare_scratch_len(n)];
+        let mut tw_buf = vec![T::ZERO; Twiddles::<T>::buffer_len(n)];
+        let tw = Twiddles::new(&mut tw_buf, n)?;
+        let spec = Spectrum::prepare_line_blocks(
+            &source,
+            filter,
+            &mut data,
+            &mut exps,
+            &mut exps_scratch,
+            &mut scratch,
+            &tw,
+            rounding,
+        )?;
+        let (scale, dims) = (spec.scale(), spec.dims());
+        Ok(Self {
+            data,
+            blocks: Some((BlockLayout::Line, exps)),
+            n,
+            scale,
+            filter,
+            dims,
+        })
+    }
+
     /// Round a finished spectrum `src` to `S` once: element by element
     /// (rescaled by a power of two to `S`'s scaling exponent), or with block
     /// exponents.
@@ -201,8 +241,15 @@ pub enum Oversampling {
     Fixed(u32),
 }
 
-/// The three views: along an axis, along (1, 0.3, 0.2) and along (1, 1, 1).
-pub const VIEWS: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [1.0, 0.3, 0.2], [1.0, 1.0, 1.0]];
+/// The four views: along the x axis, along (1, 0.3, 0.2), along (1, 1, 1),
+/// and along the y axis. The last one's slice contains the k_x axis, along
+/// which per-line block exponents put their largest errors.
+pub const VIEWS: [[f64; 3]; 4] = [
+    [1.0, 0.0, 0.0],
+    [1.0, 0.3, 0.2],
+    [1.0, 1.0, 1.0],
+    [0.0, 1.0, 0.0],
+];
 
 impl Subject {
     /// Load `spec` (a phantom name or a file, through [`load_volume`]) and
@@ -343,8 +390,17 @@ impl Subject {
                 } else {
                     Rounding::PerStage
                 };
-                StoredSpectrum::<S>::prepare::<f32>(&self.volume, self.filter, rounding)
-                    .map_err(|e| e.to_string())?
+                match blocking {
+                    Blocking::Blocks(BlockLayout::Line) => {
+                        StoredSpectrum::<S>::prepare_line_blocks::<f32>(
+                            &self.volume,
+                            self.filter,
+                            rounding,
+                        )
+                    }
+                    _ => StoredSpectrum::<S>::prepare::<f32>(&self.volume, self.filter, rounding),
+                }
+                .map_err(|e| e.to_string())?
             }
             Arithmetic::HostOnce => {
                 let src = self.host_f32.as_ref().expect("prepared above");
@@ -463,9 +519,8 @@ pub fn modes_for(format: Format) -> Vec<Arithmetic> {
     match format {
         Format::F64 => vec![Arithmetic::PerPass],
         Format::F32 => vec![Arithmetic::PerPass, Arithmetic::PerStage],
-        Format::Q15(Blocking::Blocks(_)) | Format::Q7(Blocking::Blocks(_)) => {
-            vec![Arithmetic::HostOnce]
-        }
+        Format::Q15(Blocking::Blocks(BlockLayout::Brick(_)))
+        | Format::Q7(Blocking::Blocks(BlockLayout::Brick(_))) => vec![Arithmetic::HostOnce],
         _ => Arithmetic::ALL.to_vec(),
     }
 }

@@ -182,7 +182,7 @@ fn report(cells: &[Cell], args: &PrecisionArgs) -> String {
     let mut s = String::from("# Precision study: measured tables\n\n");
     s += &format!(
         "Made by `fvr precision --filter {} --oversample {}{}` (volumes {}; sizes {}). \
-         SNR is the worst of three views (an axis, (1,0.3,0.2), (1,1,1)), \
+         SNR is the worst of four views (the x axis, (1,0.3,0.2), (1,1,1), the y axis), \
          10·log10(Σref²/Σ(img−ref)²). Bytes per voxel count the spectrum (block \
          exponents included) per voxel of the input volume. The max pixel error \
          is relative to the largest pixel of the f64 image.\n\n",

@@ -256,8 +256,8 @@ fn precision_study_writes_markdown_csv_and_png_with_no_non_finite_pixel() {
     let csv = std::fs::read_to_string(dir.join("out/precision.csv")).unwrap();
     let lines: Vec<&str> = csv.lines().collect();
     assert!(lines[0].starts_with("volume,size,grid,format,arithmetic,bytes_per_voxel"));
-    // 2 volumes × (f16×3 + bf16×3 + e4m11×3 + q15-line + q7-brick2 + e4m3×3 + f32×2).
-    assert_eq!(lines.len(), 1 + 2 * 16, "{csv}");
+    // 2 volumes × (f16×3 + bf16×3 + e4m11×3 + q15-line×3 + q7-brick2 + e4m3×3 + f32×2).
+    assert_eq!(lines.len(), 1 + 2 * 18, "{csv}");
     for line in &lines[1..] {
         let cols: Vec<&str> = line.split(',').collect();
         assert_eq!(cols[9], "0", "non-finite pixels in {line}");
@@ -323,6 +323,7 @@ fn precision_extremes_table_reports_every_case() {
         .lines()
         .filter(|l| l.starts_with("| ") && !l.starts_with("| case"))
         .collect();
-    assert_eq!(rows.len(), 2 * 6 * 4, "{md}");
+    // 2 tables × 6 cases × (f16 and q15-line, 3 arithmetic modes each).
+    assert_eq!(rows.len(), 2 * 6 * 6, "{md}");
     assert!(rows.iter().all(|l| l.ends_with("| 0 |")), "{md}");
 }

@@ -243,10 +243,15 @@ fn a_block_size_that_does_not_divide_the_line_is_a_named_error() {
 
 #[test]
 fn formats_the_target_cannot_prepare_are_refused_at_configuration() {
+    // Per-line exponents follow the passes in place; brick exponents cannot.
     let line = Format::Q15(Blocking::Blocks(BlockLayout::Line));
-    assert!(line.check(Arithmetic::HostOnce, 64).is_ok());
+    let brick = Format::Q7(Blocking::Blocks(BlockLayout::Brick(4)));
+    for a in Arithmetic::ALL {
+        assert!(line.check(a, 64).is_ok());
+    }
+    assert!(brick.check(Arithmetic::HostOnce, 64).is_ok());
     for a in [Arithmetic::PerPass, Arithmetic::PerStage] {
-        let err = line.check(a, 64).unwrap_err();
+        let err = brick.check(a, 64).unwrap_err();
         assert!(err.to_string().contains("host-once"), "{err}");
     }
     assert!(Format::F64.check(Arithmetic::PerStage, 64).is_err());
@@ -279,5 +284,68 @@ fn format_names_and_bytes_per_voxel() {
     for (f, name, bytes) in cases {
         assert_eq!(FormatName(f).to_string(), name);
         assert_eq!(f.bytes_per_voxel(64), bytes, "{name}");
+    }
+}
+
+/// Q15 block floating point prepared in place, one exponent per line: the
+/// input and each of the three passes store every line with its own
+/// exponent, and a final pass re-blocks into x-lines: five roundings, each
+/// of at most half a step `2^-16·max|line|`, i.e. relative RMS at most
+/// `2^-15·√n/√12` of the line (max ≤ ‖line‖). The DHT scales signal and
+/// error alike, so the spectrum's relative RMS error stays within
+/// `√5·2^-15·√n/√12` of the same pipeline in f64.
+#[test]
+fn q15_line_blocks_prepared_in_place_match_the_f64_spectrum_within_five_roundings() {
+    use fvr_core::dht::{Rounding, Twiddles};
+    use fvr_core::filter::{Filter, FilterKind};
+    use fvr_core::spectrum::{prepare_scratch_len, DenseVolume, Spectrum};
+    let n = 16usize;
+    let mut state = 7u64;
+    let data: Vec<f32> = (0..n * n * n)
+        .map(|_| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 40) as f32 / (1u64 << 24) as f32 - 0.3
+        })
+        .collect();
+    let source = DenseVolume::new([n; 3], &data).unwrap();
+    let filter = Filter::new(FilterKind::Kb4, 2).unwrap();
+    let grid = 32;
+    let mut tw64 = vec![0.0f64; Twiddles::<f64>::buffer_len(grid)];
+    let tw64 = Twiddles::new(&mut tw64, grid).unwrap();
+    let mut s64 = vec![0.0f64; prepare_scratch_len(grid)];
+    let mut ref_data = vec![0.0f64; grid * grid * grid];
+    let reference = Spectrum::prepare(&source, filter, &mut ref_data, &mut s64, &tw64).unwrap();
+    let mut tw32 = vec![0.0f32; Twiddles::<f32>::buffer_len(grid)];
+    let tw32 = Twiddles::new(&mut tw32, grid).unwrap();
+    let mut s32 = vec![0.0f32; prepare_scratch_len(grid)];
+    let bound = 5f64.sqrt() * 2f64.powi(-15) * (grid as f64).sqrt() / 12f64.sqrt();
+    for rounding in [Rounding::PerPass, Rounding::PerStage] {
+        let mut m = vec![Q15::default(); grid * grid * grid];
+        let (mut e, mut e2) = (vec![0i8; grid * grid], vec![0i8; grid * grid]);
+        let spec = Spectrum::prepare_line_blocks(
+            &source, filter, &mut m, &mut e, &mut e2, &mut s32, &tw32, rounding,
+        )
+        .unwrap();
+        assert!(spec.blocks().is_some());
+        let (mut num, mut den) = (0.0, 0.0);
+        for i in 0..grid * grid * grid {
+            let r = reference.value(i) / reference.scale();
+            let q = spec.value(i) / spec.scale();
+            num += (q - r) * (q - r);
+            den += r * r;
+        }
+        let rel = (num / den).sqrt();
+        let limit = if rounding == Rounding::PerPass {
+            bound
+        } else {
+            // Per stage: log2(32) = 5 more roundings in each of 3 passes.
+            bound * (20f64 / 5.0).sqrt()
+        };
+        assert!(
+            rel <= limit,
+            "{rounding:?}: relative RMS {rel:e} > {limit:e}"
+        );
     }
 }
