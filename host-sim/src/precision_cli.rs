@@ -248,8 +248,9 @@ pub fn plot(cells: &[Cell]) -> crate::plot::Canvas {
                 Arithmetic::PerStage => 1,
                 Arithmetic::HostOnce => 2,
             };
+            // Modes side by side: per-pass left, per-stage centre, host-once right.
             Some(Point {
-                x,
+                x: x * 2f64.powf(0.012 * (series as f64 - 1.0)),
                 y: c.snr_f64,
                 series,
             })
