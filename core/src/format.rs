@@ -24,8 +24,10 @@
 //! (it is this format's NaN). Stored alone they are fixed-point numbers
 //! whose one exponent is the spectrum's scale. With a [`BlockLayout`] every
 //! block (an x-line, or a `b³` brick) shares an exponent, as fixed-point
-//! DSPs store FFTs: [`encode_blocks`] picks, per block, the smallest power
-//! of two that keeps the block's largest value in range.
+//! DSPs store FFTs: [`encode_blocks`] rounds a finished spectrum once,
+//! picking per block the smallest power of two that keeps the block's
+//! largest value in range, and [`LineBlocks`] lets the in-place transform
+//! do the same line by line, pass by pass.
 
 use crate::dht::{LineStore, Pass};
 use crate::error::{Error, Result};
