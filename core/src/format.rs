@@ -792,7 +792,7 @@ impl core::fmt::Display for FormatName {
 /// transform ([`crate::dht::dht_3d_store`]), as fixed-point DSPs run FFTs.
 ///
 /// Every stored line is one block: its exponent is chosen from the line's
-/// largest value when it is stored ([`block_exponent`]). The transform's
+/// largest value when it is stored (as in [`encode_blocks`]). The transform's
 /// passes run along x, y and z in turn, so the blocks follow them: two
 /// tables of `n²` exponents alternate — x-lines (and the input) in `a`,
 /// y-lines in `b`, z-lines in `a` again — and [`LineBlocks::finish`]
