@@ -93,7 +93,7 @@ pub fn response_difference(
         for x in first..=last {
             let nu = x as f64 / n as f64;
             let (hl, hs) = (large.response(nu), small.response(nu));
-            if !(hl > 0.0 && hs > 0.0) {
+            if hl.is_nan() || hs.is_nan() || hl <= 0.0 || hs <= 0.0 {
                 return Err(Error::InvalidSceneValue {
                     what: "filter response inside the volume (adaptive filtering)",
                     index: x.unsigned_abs() as usize,
@@ -116,7 +116,7 @@ const LOW_OCTAVE: i32 = -160;
 const BINS: usize = (2 * 160 * BINS_PER_OCTAVE) as usize;
 
 fn bin_of(magnitude: f64) -> usize {
-    if !(magnitude > 0.0) {
+    if magnitude.is_nan() || magnitude <= 0.0 {
         return 0;
     }
     let b = libm::floor(libm::log2(magnitude) * BINS_PER_OCTAVE as f64) as i64

@@ -160,6 +160,17 @@ fn bit_reverse<T>(data: &mut [T]) {
 /// `H(k) = X(k) + cos(πk/m)·Y(k) + sin(πk/m)·Y(m−k)` and
 /// `H(k+m) = X(k) − (same)`, with `Y(m) ≡ Y(0)`.
 pub(crate) fn dht_unchecked<T: Real>(data: &mut [T], tw: &Twiddles<'_, T>) {
+    dht_stages(data, tw, |_| {});
+}
+
+/// [`dht_unchecked`] calling `after_stage` on the whole line after every
+/// butterfly stage (a no-op closure compiles away).
+#[inline(always)]
+fn dht_stages<T: Real, F: FnMut(&mut [T])>(
+    data: &mut [T],
+    tw: &Twiddles<'_, T>,
+    mut after_stage: F,
+) {
     let n = data.len();
     if n <= 1 {
         return;
@@ -187,7 +198,87 @@ pub(crate) fn dht_unchecked<T: Real>(data: &mut [T], tw: &Twiddles<'_, T>) {
                 }
             }
         }
+        after_stage(data);
         m *= 2;
+    }
+}
+
+/// Where the 3D transform rounds to the storage format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Rounding {
+    /// Once per pass: after the x pass, the y pass and the fused z pass.
+    PerPass,
+    /// Also after every radix-2 butterfly stage of every line, as a
+    /// transform computing in the storage format itself would.
+    PerStage,
+}
+
+/// The pass of the 3D transform a line is loaded or stored in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pass {
+    /// Lines along x (contiguous); also the placement of the input.
+    X,
+    /// Lines along y.
+    Y,
+    /// Lines along z, fused with the Hao–Bracewell correction.
+    Z,
+}
+
+/// Storage that the 3D transform reads and writes one line at a time.
+///
+/// Element formats ([`Elements`]) round each value on its own; block
+/// floating point ([`crate::format::LineBlocks`]) gives each stored line a
+/// shared exponent, which is why a whole line is stored at once.
+pub trait LineStore<T: Real> {
+    /// Load the values at `base + i·stride`, `i < out.len()`, as `pass` reads them.
+    fn load(&self, pass: Pass, base: usize, stride: usize, out: &mut [T]);
+    /// Round `line` to the storage and write it at `base + i·stride`;
+    /// `false` if a value overflowed.
+    fn store(&mut self, pass: Pass, base: usize, stride: usize, line: &[T]) -> bool;
+    /// Round `line` in place exactly as storing and reloading it would.
+    fn round(&self, line: &mut [T]);
+}
+
+/// Element-wise storage in format `S`.
+#[derive(Debug)]
+pub struct Elements<'a, S>(pub &'a mut [S]);
+
+impl<S: Sample, T: Real> LineStore<T> for Elements<'_, S> {
+    #[inline(always)]
+    fn load(&self, _: Pass, base: usize, stride: usize, out: &mut [T]) {
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = T::load(self.0[base + i * stride]);
+        }
+    }
+    #[inline(always)]
+    fn store(&mut self, _: Pass, base: usize, stride: usize, line: &[T]) -> bool {
+        let mut finite = true;
+        for (i, l) in line.iter().enumerate() {
+            let s: S = l.store();
+            finite &= s.is_finite();
+            self.0[base + i * stride] = s;
+        }
+        finite
+    }
+    #[inline(always)]
+    fn round(&self, line: &mut [T]) {
+        for v in line.iter_mut() {
+            *v = T::load(v.store::<S>());
+        }
+    }
+}
+
+/// One line's transform, rounding through the storage after each stage if asked.
+#[inline(always)]
+fn line_dht<T: Real, L: LineStore<T>>(
+    line: &mut [T],
+    tw: &Twiddles<'_, T>,
+    rounding: Rounding,
+    store: &L,
+) {
+    match rounding {
+        Rounding::PerPass => dht_unchecked(line, tw),
+        Rounding::PerStage => dht_stages(line, tw, |l| store.round(l)),
     }
 }
 
@@ -314,11 +405,42 @@ pub fn dht_3d<S: Sample, T: Real>(
     scratch: &mut [T],
     tw: &Twiddles<'_, T>,
 ) -> Result<()> {
+    dht_3d_rounding(data, dims, scratch, tw, Rounding::PerPass)
+}
+
+/// [`dht_3d`] with a choice of where to round ([`Rounding`]). With
+/// [`Rounding::PerStage`] every line is also rounded to `S` after each of its
+/// `log₂n` stages, which models arithmetic in the storage format.
+///
+/// # Errors
+/// As [`dht_3d`].
+pub fn dht_3d_rounding<S: Sample, T: Real>(
+    data: &mut [S],
+    dims: [usize; 3],
+    scratch: &mut [T],
+    tw: &Twiddles<'_, T>,
+    rounding: Rounding,
+) -> Result<()> {
+    let [nx, ny, nz] = dims;
+    check_len("3D array", nx * ny * nz, data.len())?;
+    dht_3d_store(&mut Elements(data), dims, scratch, tw, rounding)
+}
+
+/// [`dht_3d_rounding`] over any [`LineStore`] holding `nx·ny·nz` values.
+///
+/// # Errors
+/// As [`dht_3d`] (the caller checks the storage's length).
+pub fn dht_3d_store<T: Real, L: LineStore<T>>(
+    store: &mut L,
+    dims: [usize; 3],
+    scratch: &mut [T],
+    tw: &Twiddles<'_, T>,
+    rounding: Rounding,
+) -> Result<()> {
     let [nx, ny, nz] = dims;
     for n in dims {
         tw.check(n)?;
     }
-    check_len("3D array", nx * ny * nz, data.len())?;
     require_len(
         "3D transform scratch",
         dht_3d_scratch_len(dims),
@@ -328,15 +450,11 @@ pub fn dht_3d<S: Sample, T: Real>(
     let mut finite = true;
     // x pass: contiguous lines.
     let line = &mut scratch[..nx];
-    for chunk in data.chunks_exact_mut(nx) {
-        for (l, s) in line.iter_mut().zip(chunk.iter()) {
-            *l = T::load(*s);
-        }
-        dht_unchecked(line, tw);
-        for (s, l) in chunk.iter_mut().zip(line.iter()) {
-            *s = l.store();
-            finite &= s.is_finite();
-        }
+    for row in 0..ny * nz {
+        let base = row * nx;
+        store.load(Pass::X, base, 1, line);
+        line_dht(line, tw, rounding, store);
+        finite &= store.store(Pass::X, base, 1, line);
     }
     overflow_check(finite, "x pass of the 3D transform")?;
 
@@ -345,15 +463,9 @@ pub fn dht_3d<S: Sample, T: Real>(
     for z in 0..nz {
         for x in 0..nx {
             let base = x + nx * ny * z;
-            for (y, l) in line.iter_mut().enumerate() {
-                *l = T::load(data[base + nx * y]);
-            }
-            dht_unchecked(line, tw);
-            for (y, l) in line.iter().enumerate() {
-                let s: S = l.store();
-                finite &= s.is_finite();
-                data[base + nx * y] = s;
-            }
+            store.load(Pass::Y, base, nx, line);
+            line_dht(line, tw, rounding, store);
+            finite &= store.store(Pass::Y, base, nx, line);
         }
     }
     overflow_check(finite, "y pass of the 3D transform")?;
@@ -369,10 +481,8 @@ pub fn dht_3d<S: Sample, T: Real>(
             let bases = [u + nx * v, um + nx * v, u + nx * vm, um + nx * vm];
             for (slot, base) in bases.iter().enumerate() {
                 let l = &mut lines[slot * nz..(slot + 1) * nz];
-                for (z, e) in l.iter_mut().enumerate() {
-                    *e = T::load(data[base + plane * z]);
-                }
-                dht_unchecked(l, tw);
+                store.load(Pass::Z, *base, plane, l);
+                line_dht(l, tw, rounding, store);
             }
             for w in 0..=nz / 2 {
                 let wm = neg_mod(w, nz);
@@ -390,11 +500,7 @@ pub fn dht_3d<S: Sample, T: Real>(
             }
             for (slot, base) in bases.iter().enumerate() {
                 let l = &lines[slot * nz..(slot + 1) * nz];
-                for (z, e) in l.iter().enumerate() {
-                    let s: S = e.store();
-                    finite &= s.is_finite();
-                    data[base + plane * z] = s;
-                }
+                finite &= store.store(Pass::Z, *base, plane, l);
             }
         }
     }

@@ -138,6 +138,28 @@ pub enum Error {
         /// Index of the first bad entry.
         index: usize,
     },
+    /// A minifloat whose sign, exponent and mantissa bits do not add up to
+    /// 16 (or 8).
+    BadMinifloatSplit {
+        /// Exponent bits asked for.
+        exponent: u32,
+        /// Mantissa bits asked for.
+        mantissa: u32,
+    },
+    /// A block size that does not divide the line of the spectrum.
+    BlockSizeMismatch {
+        /// The block (brick) side.
+        block: usize,
+        /// The line length (the spectrum's side).
+        line: usize,
+    },
+    /// A storage format the target cannot store or prepare this way.
+    UnsupportedFormat {
+        /// Which format.
+        format: &'static str,
+        /// Why not.
+        reason: &'static str,
+    },
 }
 
 /// Shorthand for results of this crate.
@@ -225,6 +247,19 @@ impl fmt::Display for Error {
             }
             Error::NonFiniteTableEntry { what, index } => {
                 write!(f, "{what} entry {index} is NaN or infinite")
+            }
+            Error::BadMinifloatSplit { exponent, mantissa } => write!(
+                f,
+                "minifloat split e{exponent}m{mantissa} has 1 + {exponent} + {mantissa} = {} bits; \
+                 sign, exponent and mantissa must add up to 16 (or 8)",
+                1u64 + exponent as u64 + mantissa as u64
+            ),
+            Error::BlockSizeMismatch { block, line } => write!(
+                f,
+                "block size {block} does not divide the spectrum's line of {line} values"
+            ),
+            Error::UnsupportedFormat { format, reason } => {
+                write!(f, "storage format {format} is not supported here: {reason}")
             }
         }
     }

@@ -15,6 +15,7 @@ pub mod adaptive;
 pub mod dht;
 pub mod error;
 pub mod filter;
+pub mod format;
 pub mod geometry;
 pub mod gradient;
 pub mod real;

@@ -52,6 +52,8 @@ pub trait Real:
     fn floor_i64(self) -> i64;
     /// Integer part of a non-negative value, saturating.
     fn trunc_usize(self) -> usize;
+    /// `2^e`, exact for `e` in `[-149, 127]` (f32) or `[-1074, 1023]` (f64).
+    fn exp2i(e: i32) -> Self;
 }
 
 impl Real for f32 {
@@ -105,6 +107,10 @@ impl Real for f32 {
     fn trunc_usize(self) -> usize {
         self as usize
     }
+    #[inline(always)]
+    fn exp2i(e: i32) -> Self {
+        libm::scalbnf(1.0, e)
+    }
 }
 
 impl Real for f64 {
@@ -148,14 +154,34 @@ impl Real for f64 {
     fn trunc_usize(self) -> usize {
         self as usize
     }
+    #[inline(always)]
+    fn exp2i(e: i32) -> Self {
+        libm::scalbn(1.0, e)
+    }
 }
 
 /// Storage format of one spectrum coefficient.
+///
+/// Besides the IEEE types here, [`crate::format`] has bfloat16, 16-bit and
+/// 8-bit minifloats of any exponent width, and the Q15/Q7 mantissas of block
+/// floating point.
 pub trait Sample: Copy + Default + Debug + PartialEq {
     /// Short name, e.g. `"f16"`.
     const NAME: &'static str;
     /// Largest finite value.
     const MAX_FINITE: f64;
+    /// Bits per stored value.
+    const BITS: u32;
+    /// `t` of the scaling rule ([`crate::spectrum`]): spectra are stored as
+    /// `s·H` with `s·Σ|g| ∈ (2^(t−1), 2^t]`. Every value met during the
+    /// transform is then at most `2^(t+1)`, which the format must hold:
+    /// `2^(t+1) ≤ MAX_FINITE`. 14 for f16 (whose maximum is 65504).
+    const SCALE_LOG2: i32;
+    /// `true` for the integer mantissas of block floating point, whose value
+    /// is multiplied by a power of two shared by a block
+    /// ([`crate::format::BlockLayout`]). Without block exponents they are
+    /// fixed-point numbers.
+    const BLOCK_MANTISSA: bool = false;
     /// Round an f32 to this format, to nearest even.
     fn from_f32(v: f32) -> Self;
     /// Round an f64 to this format, to nearest even (one rounding).
@@ -197,6 +223,8 @@ pub fn f16_bits_to_f32(bits: u16) -> f32 {
 
 impl Sample for f16 {
     const NAME: &'static str = "f16";
+    const BITS: u32 = 16;
+    const SCALE_LOG2: i32 = 14;
     const MAX_FINITE: f64 = 65504.0;
     #[inline(always)]
     fn from_f32(v: f32) -> Self {
@@ -222,6 +250,8 @@ impl Sample for f16 {
 
 impl Sample for f32 {
     const NAME: &'static str = "f32";
+    const BITS: u32 = 32;
+    const SCALE_LOG2: i32 = 14;
     const MAX_FINITE: f64 = f32::MAX as f64;
     #[inline(always)]
     fn from_f32(v: f32) -> Self {
@@ -247,6 +277,8 @@ impl Sample for f32 {
 
 impl Sample for f64 {
     const NAME: &'static str = "f64";
+    const BITS: u32 = 64;
+    const SCALE_LOG2: i32 = 14;
     const MAX_FINITE: f64 = f64::MAX;
     #[inline(always)]
     fn from_f32(v: f32) -> Self {

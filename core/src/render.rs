@@ -149,7 +149,6 @@ pub fn extract_slice<S: Sample, T: Real>(
     grid: &mut [T],
 ) {
     let n = spec.n();
-    let data = spec.data();
     let r = frame.right.map(T::from_f64);
     let u = frame.up.map(T::from_f64);
     let nyquist = T::from_usize(n) * T::HALF;
@@ -179,10 +178,7 @@ pub fn extract_slice<S: Sample, T: Real>(
                 let mut acc_y = T::ZERO;
                 for (b, wy) in wts[1][..w].iter().enumerate() {
                     let line = z + ((first[1] + b as i64) as usize & mask) * n;
-                    let mut acc_x = T::ZERO;
-                    for (x, wx) in xs[..w].iter().zip(&wts[0][..w]) {
-                        acc_x += *wx * T::load(data[line + x]);
-                    }
+                    let acc_x = spec.line_taps(line, &xs[..w], &wts[0][..w]);
                     acc_y += *wy * acc_x;
                 }
                 acc += *wz * acc_y;

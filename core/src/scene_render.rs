@@ -93,7 +93,6 @@ fn run_pass<S: Sample, T: Real, const MODE: u8>(
 ) -> Result<()> {
     let n = spec.n();
     let nn = n * n;
-    let data = spec.data();
     let w = tables.kernel.filter().width();
     let mask = n - 1;
     let nyquist = T::from_usize(n) * T::HALF;
@@ -111,11 +110,13 @@ fn run_pass<S: Sample, T: Real, const MODE: u8>(
                 continue;
             }
             let mut wts = [[T::ZERO; MAX_WIDTH]; 3];
-            let mut first = [0i64; 3];
+            let mut taps = [[0usize; MAX_WIDTH]; 3];
             for a in 0..3 {
-                first[a] = tables.kernel.taps(q[a], &mut wts[a]);
+                let first = tables.kernel.taps(q[a], &mut wts[a]);
+                for (t, slot) in taps[a][..w].iter_mut().enumerate() {
+                    *slot = (first + t as i64) as usize & mask;
+                }
             }
-            let index = |a: usize, t: usize| (first[a] + t as i64) as usize & mask;
             let (r0, r1) = match MODE {
                 mode::VALUE_GRADIENT => {
                     let mut dwts = [[T::ZERO; MAX_WIDTH]; 3];
@@ -124,10 +125,10 @@ fn run_pass<S: Sample, T: Real, const MODE: u8>(
                             table.taps(q[a], &mut dwts[a]);
                         }
                     }
-                    value_gradient(data, n, w, &index, &wts, &dwts, geo.dir)
+                    value_gradient(spec, w, &taps, &wts, &dwts, geo.dir)
                 }
-                mode::VALUE_MIRROR => value_mirror(data, n, w, &index, &wts),
-                _ => (value(data, n, w, &index, &wts), T::ZERO),
+                mode::VALUE_MIRROR => value_mirror(spec, w, &taps, &wts),
+                _ => (value(spec, w, &taps, &wts), T::ZERO),
             };
             let i = iy * n + ix;
             for t in targets {
@@ -139,26 +140,18 @@ fn run_pass<S: Sample, T: Real, const MODE: u8>(
 }
 
 type Weights<T> = [[T; MAX_WIDTH]; 3];
+type Taps = [[usize; MAX_WIDTH]; 3];
 
 #[inline(always)]
-fn value<S: Sample, T: Real>(
-    data: &[S],
-    n: usize,
-    w: usize,
-    index: &impl Fn(usize, usize) -> usize,
-    wts: &Weights<T>,
-) -> T {
+fn value<S: Sample, T: Real>(spec: &Spectrum<'_, S>, w: usize, taps: &Taps, wts: &Weights<T>) -> T {
+    let n = spec.n();
     let mut acc = T::ZERO;
     for c in 0..w {
-        let z = index(2, c) * n * n;
+        let z = taps[2][c] * n * n;
         let mut acc_y = T::ZERO;
         for b in 0..w {
-            let line = z + index(1, b) * n;
-            let mut acc_x = T::ZERO;
-            for t in 0..w {
-                acc_x += wts[0][t] * T::load(data[line + index(0, t)]);
-            }
-            acc_y += wts[1][b] * acc_x;
+            let line = z + taps[1][b] * n;
+            acc_y += wts[1][b] * spec.line_taps(line, &taps[0][..w], &wts[0][..w]);
         }
         acc += wts[2][c] * acc_y;
     }
@@ -169,26 +162,22 @@ fn value<S: Sample, T: Real>(
 /// `∂_x = k'⊗k⊗k`, `∂_y = k⊗k'⊗k`, `∂_z = k⊗k⊗k'`.
 #[inline(always)]
 fn value_gradient<S: Sample, T: Real>(
-    data: &[S],
-    n: usize,
+    spec: &Spectrum<'_, S>,
     w: usize,
-    index: &impl Fn(usize, usize) -> usize,
+    taps: &Taps,
     wts: &Weights<T>,
     dwts: &Weights<T>,
     dir: [T; 3],
 ) -> (T, T) {
+    let n = spec.n();
     let (mut value, mut grad) = (T::ZERO, T::ZERO);
     for c in 0..w {
-        let z = index(2, c) * n * n;
+        let z = taps[2][c] * n * n;
         let (mut v_y, mut gx_y, mut gy_y) = (T::ZERO, T::ZERO, T::ZERO);
         for b in 0..w {
-            let line = z + index(1, b) * n;
-            let (mut v_x, mut gx_x) = (T::ZERO, T::ZERO);
-            for t in 0..w {
-                let s = T::load(data[line + index(0, t)]);
-                v_x += wts[0][t] * s;
-                gx_x += dwts[0][t] * s;
-            }
+            let line = z + taps[1][b] * n;
+            let v_x = spec.line_taps(line, &taps[0][..w], &wts[0][..w]);
+            let gx_x = spec.line_taps(line, &taps[0][..w], &dwts[0][..w]);
             v_y += wts[1][b] * v_x;
             gx_y += wts[1][b] * gx_x;
             gy_y += dwts[1][b] * v_x;
@@ -202,29 +191,27 @@ fn value_gradient<S: Sample, T: Real>(
 /// `X(p)` and `X(−p)`: the same weights on the taps `j` and `−j`.
 #[inline(always)]
 fn value_mirror<S: Sample, T: Real>(
-    data: &[S],
-    n: usize,
+    spec: &Spectrum<'_, S>,
     w: usize,
-    index: &impl Fn(usize, usize) -> usize,
+    taps: &Taps,
     wts: &Weights<T>,
 ) -> (T, T) {
+    let n = spec.n();
     let mask = n - 1;
+    let mut xm = [0usize; MAX_WIDTH];
+    for (m, &x) in xm[..w].iter_mut().zip(&taps[0][..w]) {
+        *m = (n - x) & mask;
+    }
     let (mut direct, mut mirror) = (T::ZERO, T::ZERO);
     for c in 0..w {
-        let zi = index(2, c);
+        let zi = taps[2][c];
         let (z, zm) = (zi * n * n, ((n - zi) & mask) * n * n);
         let (mut d_y, mut m_y) = (T::ZERO, T::ZERO);
         for b in 0..w {
-            let yi = index(1, b);
+            let yi = taps[1][b];
             let (line, line_m) = (z + yi * n, zm + ((n - yi) & mask) * n);
-            let (mut d_x, mut m_x) = (T::ZERO, T::ZERO);
-            for t in 0..w {
-                let xi = index(0, t);
-                d_x += wts[0][t] * T::load(data[line + xi]);
-                m_x += wts[0][t] * T::load(data[line_m + ((n - xi) & mask)]);
-            }
-            d_y += wts[1][b] * d_x;
-            m_y += wts[1][b] * m_x;
+            d_y += wts[1][b] * spec.line_taps(line, &taps[0][..w], &wts[0][..w]);
+            m_y += wts[1][b] * spec.line_taps(line_m, &xm[..w], &wts[0][..w]);
         }
         direct += wts[2][c] * d_y;
         mirror += wts[2][c] * m_y;

@@ -232,3 +232,98 @@ fn help_documents_the_geometry_contract_and_every_option() {
         assert!(text.contains(needle), "`{needle}` missing from help");
     }
 }
+
+#[test]
+fn precision_study_writes_markdown_csv_and_png_with_no_non_finite_pixel() {
+    let dir = temp_dir("precision");
+    let out = fvr(
+        &[
+            "precision",
+            "--volumes",
+            "gaussians@16,shepp-logan@16",
+            "--formats",
+            "f16,bf16,e4m11,q15-line,q7-brick2,e4m3,f32",
+            "--out-dir",
+            "out",
+        ],
+        &dir,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(dir.join("out/precision.csv")).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert!(lines[0].starts_with("volume,size,grid,format,arithmetic,bytes_per_voxel"));
+    // 2 volumes × (f16×3 + bf16×3 + e4m11×3 + q15-line×3 + q7-brick2 + e4m3×3 + f32×2).
+    assert_eq!(lines.len(), 1 + 2 * 18, "{csv}");
+    for line in &lines[1..] {
+        let cols: Vec<&str> = line.split(',').collect();
+        assert_eq!(cols[9], "0", "non-finite pixels in {line}");
+        assert_eq!(cols[10], "", "refused: {line}");
+        let snr: f64 = cols[6].parse().unwrap();
+        assert!(snr > 0.0 || cols[3] == "e4m11", "{line}");
+    }
+    let md = std::fs::read_to_string(dir.join("out/precision.md")).unwrap();
+    assert!(md.contains("| q15-line | host-once |"), "{md}");
+    let png = std::fs::read(dir.join("out/precision.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+}
+
+#[test]
+fn precision_bad_formats_are_named_before_any_work() {
+    let dir = temp_dir("precision-bad");
+    let out = fvr(&["precision", "--formats", "e5m11"], &dir);
+    assert_error(&out, &["e5m11", "17 bits", "16"]);
+    let out = fvr(&["precision", "--formats", "e9m6"], &dir);
+    assert_error(&out, &["e9m6", "f32"]);
+    let out = fvr(&["precision", "--formats", "f24"], &dir);
+    assert_error(&out, &["unknown format `f24`"]);
+    let out = fvr(
+        &[
+            "precision",
+            "--volumes",
+            "gaussians@16",
+            "--formats",
+            "q15-brick6",
+        ],
+        &dir,
+    );
+    assert_error(&out, &["q15-brick6", "block size 6 does not divide", "16"]);
+    let out = fvr(&["precision", "--formats", "e4m11-line"], &dir);
+    assert_error(&out, &["only q15 and q7 take block exponents"]);
+}
+
+#[test]
+fn precision_extremes_table_reports_every_case() {
+    let dir = temp_dir("precision-extremes");
+    let out = fvr(
+        &["precision", "--extremes", "8", "--formats", "f16,q15-line"],
+        &dir,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let md = String::from_utf8_lossy(&out.stdout);
+    for case in [
+        "constant 1",
+        "impulse",
+        "nyquist checkerboard",
+        "u16 65535",
+        "gaussians x 1e-6",
+        "shepp-logan in HU",
+    ] {
+        assert!(md.contains(case), "{case} missing");
+    }
+    // Every row ends with its count of NaN/Inf pixels: zero.
+    let rows: Vec<&str> = md
+        .lines()
+        .filter(|l| l.starts_with("| ") && !l.starts_with("| case"))
+        .collect();
+    // 2 tables × 6 cases × (f16 and q15-line, 3 arithmetic modes each).
+    assert_eq!(rows.len(), 2 * 6 * 6, "{md}");
+    assert!(rows.iter().all(|l| l.ends_with("| 0 |")), "{md}");
+}

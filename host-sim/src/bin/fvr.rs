@@ -68,6 +68,10 @@ enum Command {
         #[arg(long, value_delimiter = ',', default_values_t = [64usize, 128])]
         sizes: Vec<usize>,
     },
+    /// The precision study: SNR of every storage format and arithmetic
+    /// against the f64 pipeline and exact line integrals, with bytes per
+    /// voxel; writes a Markdown table, a CSV and a PNG plot.
+    Precision(fvr_host::precision_cli::PrecisionArgs),
 }
 
 #[derive(Args)]
@@ -208,6 +212,7 @@ fn main() -> ExitCode {
         Some(Command::Render(args)) => render(&args),
         Some(Command::Compare { a, b }) => compare(&a, &b),
         Some(Command::Accuracy { sizes }) => accuracy(&sizes),
+        Some(Command::Precision(args)) => fvr_host::precision_cli::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

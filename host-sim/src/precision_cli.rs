@@ -1,0 +1,278 @@
+//! `fvr precision`: arguments, the run, and its three outputs (Markdown,
+//! CSV, PNG plot).
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Args;
+use fvr_core::filter::FilterKind;
+use fvr_core::format::{Arithmetic, Format, FormatName};
+
+use crate::plot::{Point, Scatter};
+use crate::precision::{
+    csv, default_formats, markdown, parse_format, study_subject, summary, Cell, Oversampling,
+    Subject,
+};
+use crate::scene::phantom_by_name;
+
+/// Arguments of `fvr precision`.
+#[derive(Args, Debug)]
+pub struct PrecisionArgs {
+    /// Volumes: built-in phantoms (`gaussians`, `shepp-logan`, `sphere`),
+    /// which are measured at every `--sizes` unless given as `name@N`, or
+    /// NRRD files.
+    #[arg(long, value_delimiter = ',', default_values_t = ["gaussians".to_string(), "shepp-logan".to_string()])]
+    volumes: Vec<String>,
+    /// Sides for phantoms named without `@N`.
+    #[arg(long, value_delimiter = ',', default_values_t = [64usize, 128, 256])]
+    sizes: Vec<usize>,
+    /// Formats: f64, f32, f16, bf16, eEmM (16- or 8-bit minifloat, e.g.
+    /// e4m11, e4m3), q15 and q7 (fixed point), q15-line, q15-brickB, q7-line,
+    /// q7-brickB (block floating point). Default: the full study.
+    #[arg(long, value_delimiter = ',')]
+    formats: Vec<String>,
+    /// Interpolation filter.
+    #[arg(long, default_value = "kb4")]
+    filter: String,
+    /// Oversampling: `auto` (2 where premultiplication is ill-conditioned),
+    /// 1 or 2.
+    #[arg(long, default_value = "auto")]
+    oversample: String,
+    /// Directory for precision.md, precision.csv and precision.png (and
+    /// extremes.md); without it the Markdown goes to standard output.
+    #[arg(long)]
+    out_dir: Option<PathBuf>,
+    /// Measure the stability cases instead (constant, impulse, Nyquist
+    /// checkerboard, u16 65535, 1e-6 scaling, Hounsfield units) at this side,
+    /// at oversampling 1 and at the automatic choice.
+    #[arg(long)]
+    extremes: Option<usize>,
+}
+
+/// Run the study.
+///
+/// # Errors
+/// Bad arguments (named, before any work), unreadable volumes, or output
+/// that cannot be written.
+pub fn run(args: &PrecisionArgs) -> Result<(), String> {
+    // Configuration first: every error here comes before any transform.
+    let formats: Vec<Format> = if args.formats.is_empty() {
+        default_formats()
+    } else {
+        args.formats
+            .iter()
+            .map(|s| parse_format(s))
+            .collect::<Result<_, _>>()?
+    };
+    let kind = FilterKind::from_name(&args.filter)
+        .ok_or_else(|| format!("unknown filter `{}`", args.filter))?;
+    let oversampling = match args.oversample.as_str() {
+        "auto" => Oversampling::Auto,
+        "1" => Oversampling::Fixed(1),
+        "2" => Oversampling::Fixed(2),
+        o => return Err(format!("oversampling `{o}` must be auto, 1 or 2")),
+    };
+    if let Some(n) = args.extremes {
+        if n < 2 || n % 2 != 0 || n > 128 {
+            return Err(format!(
+                "--extremes {n}: the side must be even, from 2 to 128"
+            ));
+        }
+        let mut md = format!(
+            "# Stability at the extremes: measured\n\n\
+             Made by `fvr precision --extremes {n}`: kb4, side {n}, every format; \
+             first at oversampling 1, then at the oversampling chosen automatically.\n\n"
+        );
+        for (title, o) in [
+            ("Oversampling 1", Some(1)),
+            ("Automatic oversampling", None),
+        ] {
+            let rows = crate::precision::measure_extremes(n, &formats, o)?;
+            md += &format!(
+                "## {title}\n\n{}\n",
+                crate::precision::extremes_markdown(&rows)
+            );
+        }
+        return match &args.out_dir {
+            None => {
+                print!("{md}");
+                Ok(())
+            }
+            Some(dir) => {
+                std::fs::create_dir_all(dir)
+                    .map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
+                let p = dir.join("extremes.md");
+                std::fs::write(&p, md).map_err(|e| format!("cannot write `{}`: {e}", p.display()))
+            }
+        };
+    }
+    let mut specs = Vec::new();
+    for v in &args.volumes {
+        let is_bare_phantom = !v.contains('@') && phantom_by_name(v).is_some();
+        if is_bare_phantom {
+            for n in &args.sizes {
+                specs.push(format!("{v}@{n}"));
+            }
+        } else {
+            specs.push(v.clone());
+        }
+    }
+    let mut cells: Vec<Cell> = Vec::new();
+    for spec in &specs {
+        let t0 = Instant::now();
+        let mut subject = Subject::load(spec, kind, oversampling)?;
+        // Formats this grid cannot hold (a brick that does not divide it) are
+        // configuration errors, reported before any transform.
+        let grid =
+            fvr_core::spectrum::padded_size(subject.volume.dims, subject.filter.oversample())
+                .map_err(|e| e.to_string())?;
+        for &f in &formats {
+            for a in crate::precision::modes_for(f) {
+                f.check(a, grid)
+                    .map_err(|e| format!("format {} on {spec}: {e}", FormatName(f)))?;
+            }
+        }
+        eprintln!(
+            "fvr precision: {spec} (filter {} at oversampling {})",
+            kind.name(),
+            subject.filter.oversample()
+        );
+        let got = study_subject(&mut subject, &formats, |c| match &c.error {
+            None => eprintln!(
+                "  {:>10} {:>9}  {:.3} B/voxel  {:7.1} dB vs f64  {}",
+                FormatName(c.format).to_string(),
+                c.arithmetic.name(),
+                c.bytes_per_voxel,
+                c.snr_f64,
+                c.snr_exact
+                    .map_or(String::new(), |e| format!("{e:6.1} dB vs exact"))
+            ),
+            Some(e) => eprintln!(
+                "  {:>10} {:>9}  refused: {e}",
+                FormatName(c.format).to_string(),
+                c.arithmetic.name()
+            ),
+        })?;
+        eprintln!("  ({:.1} s)", t0.elapsed().as_secs_f64());
+        cells.extend(got);
+    }
+    let md = report(&cells, args);
+    match &args.out_dir {
+        None => print!("{md}"),
+        Some(dir) => {
+            std::fs::create_dir_all(dir)
+                .map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
+            let write = |name: &str, text: &str| {
+                let p = dir.join(name);
+                std::fs::write(&p, text).map_err(|e| format!("cannot write `{}`: {e}", p.display()))
+            };
+            write("precision.md", &md)?;
+            write("precision.csv", &csv(&cells))?;
+            plot(&cells).write_png(&dir.join("precision.png"))?;
+            eprintln!(
+                "wrote precision.md, precision.csv and precision.png in {}",
+                dir.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+fn report(cells: &[Cell], args: &PrecisionArgs) -> String {
+    let mut s = String::from("# Precision study: measured tables\n\n");
+    s += &format!(
+        "Made by `fvr precision --filter {} --oversample {}{}` (volumes {}; sizes {}). \
+         SNR is the worst of four views (the x axis, (1,0.3,0.2), (1,1,1), the y axis), \
+         10·log10(Σref²/Σ(img−ref)²). Bytes per voxel count the spectrum (block \
+         exponents included) per voxel of the input volume. The max pixel error \
+         is relative to the largest pixel of the f64 image.\n\n",
+        args.filter,
+        args.oversample,
+        if args.formats.is_empty() {
+            String::new()
+        } else {
+            format!(" --formats {}", args.formats.join(","))
+        },
+        args.volumes.join(", "),
+        args.sizes
+            .iter()
+            .map(|n| n.to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    s += "## SNR against the f64 pipeline (dB), by volume\n\n";
+    s += &summary(cells);
+    s += "\n## Every cell\n\n";
+    s += &markdown(cells);
+    s
+}
+
+/// SNR against f64 over bytes per voxel; formats that share a size are
+/// spread sideways and named under the axis.
+pub fn plot(cells: &[Cell]) -> crate::plot::Canvas {
+    let mut formats: Vec<(Format, f64)> = Vec::new();
+    for c in cells
+        .iter()
+        .filter(|c| c.error.is_none() && c.format != Format::F64)
+    {
+        if !formats.iter().any(|(f, _)| *f == c.format) {
+            formats.push((c.format, c.bytes_per_voxel));
+        }
+    }
+    // Spread formats of the same (rounded) size over ±0.35 octave.
+    let class = |b: f64| b.log2().round() as i64;
+    let mut xs: Vec<(Format, f64)> = Vec::new();
+    for (f, b) in &formats {
+        let peers: Vec<&(Format, f64)> = formats
+            .iter()
+            .filter(|(_, c)| class(*c) == class(*b))
+            .collect();
+        let i = peers.iter().position(|(g, _)| g == f).unwrap_or(0) as f64;
+        let m = peers.len() as f64;
+        let spread = (0.7 / m).min(0.12);
+        let x = 2f64.powf(class(*b) as f64 + (i - (m - 1.0) / 2.0) * spread);
+        xs.push((*f, x));
+    }
+    let series = [
+        ("per-pass", [31, 119, 180]),
+        ("per-stage", [214, 39, 40]),
+        ("host-once", [44, 160, 44]),
+    ];
+    let points: Vec<Point> = cells
+        .iter()
+        .filter(|c| c.error.is_none() && c.snr_f64.is_finite())
+        .filter_map(|c| {
+            let x = xs.iter().find(|(f, _)| *f == c.format)?.1;
+            let series = match c.arithmetic {
+                Arithmetic::PerPass => 0,
+                Arithmetic::PerStage => 1,
+                Arithmetic::HostOnce => 2,
+            };
+            // Modes side by side: per-pass left, per-stage centre, host-once right.
+            Some(Point {
+                x: x * 2f64.powf(0.012 * (series as f64 - 1.0)),
+                y: c.snr_f64,
+                series,
+            })
+        })
+        .collect();
+    let labels: Vec<(f64, String)> = xs
+        .iter()
+        .map(|(f, x)| (*x, FormatName(*f).to_string()))
+        .collect();
+    let top = points.iter().map(|p| p.y).fold(60.0f64, f64::max);
+    let scatter = Scatter {
+        title: "SNR VS THE F64 PIPELINE, EVERY VOLUME AND SIZE",
+        x_label: "SPECTRUM BYTES PER VOXEL (LOG SCALE)",
+        y_label: "SNR DB",
+        x_range: (0.6, 6.0),
+        y_range: (0.0, (top / 20.0).ceil() * 20.0),
+        x_ticks: &[1.0, 2.0, 4.0],
+        y_step: 20.0,
+        y_lines: &[(40.0, "40 DB"), (50.0, "50 DB (PAPER)"), (75.0, "75 DB")],
+        series: &series,
+        x_labels: &labels,
+        points: &points,
+    };
+    scatter.draw(1000, 700)
+}
