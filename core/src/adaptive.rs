@@ -23,8 +23,12 @@
 //! nearest the slice point. Marks are a bitset: `n³` bits, `n³/8` bytes
 //! (256 KiB at 128³, 1/16 of an f16 spectrum).
 
-use crate::error::{require_len, Error, Result};
-use crate::filter::Filter;
+use crate::error::{mismatch, require_len, Error, Result};
+use crate::filter::{Filter, KernelTable, MAX_WIDTH};
+use crate::geometry::Frame;
+use crate::real::{Real, Sample};
+use crate::render::signed_index;
+use crate::spectrum::Spectrum;
 
 /// `u32` words of a bitset over `n³` samples.
 pub const fn marks_words(n: usize) -> usize {
@@ -207,5 +211,135 @@ pub fn mark(
             }
         }
     }
-    Ok((0..total).filter(|&i| words[i >> 5] >> (i & 31) & 1 == 1).count())
+    Ok((0..total)
+        .filter(|&i| words[i >> 5] >> (i & 31) & 1 == 1)
+        .count())
+}
+
+/// One cheaper filter of an adaptive chain: its kernel, the marks of the
+/// samples it may stand in for, and its DC gain correction
+/// `ĥ_large(0)/ĥ_small(0)`.
+#[derive(Clone, Copy, Debug)]
+pub struct AdaptiveLevel<'k, 'm, T> {
+    /// The cheaper kernel.
+    pub kernel: &'k KernelTable<T>,
+    /// Samples where it may be used.
+    pub marks: Marks<'m>,
+    /// Gain applied to its output.
+    pub gain: T,
+}
+
+/// What an adaptive extraction did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct AdaptiveStats {
+    /// Slice samples inside the Nyquist cube (the others are zero).
+    pub samples: u64,
+    /// Samples per filter: index 0 the large filter, then the levels in
+    /// order.
+    pub per_filter: [u64; 1 + MAX_LEVELS],
+    /// Filter taps read.
+    pub taps: u64,
+    /// Filter taps the large filter alone would have read.
+    pub full_taps: u64,
+}
+
+/// Most cheaper filters in a chain.
+pub const MAX_LEVELS: usize = 2;
+
+/// [`crate::render::extract_slice`] with adaptive filtering: at each slice
+/// point, the spectrum sample nearest to it is looked up in each level's
+/// marks (cheapest first); the first level that marks it filters the point,
+/// otherwise the large `kernel` does.
+///
+/// # Errors
+/// More than [`MAX_LEVELS`] levels, marks of another side than the
+/// spectrum's, a kernel for another filter than the spectrum's, or a short
+/// grid.
+pub fn extract_slice_adaptive<S: Sample, T: Real>(
+    spec: &Spectrum<'_, S>,
+    kernel: &KernelTable<T>,
+    levels: &[AdaptiveLevel<'_, '_, T>],
+    frame: &Frame,
+    grid: &mut [T],
+) -> Result<AdaptiveStats> {
+    let n = spec.n();
+    if levels.len() > MAX_LEVELS {
+        return Err(Error::TooMany {
+            what: "adaptive filter levels",
+            given: levels.len(),
+            capacity: MAX_LEVELS,
+        });
+    }
+    if kernel.filter() != spec.filter() {
+        return Err(Error::FilterMismatch);
+    }
+    for level in levels {
+        if level.marks.n() != n {
+            return Err(mismatch("adaptive marks side", n, level.marks.n()));
+        }
+    }
+    require_len("slice grid", n * n, grid.len())?;
+    let r = frame.right.map(T::from_f64);
+    let u = frame.up.map(T::from_f64);
+    let nyquist = T::from_usize(n) * T::HALF;
+    let mask = n - 1;
+    let mut stats = AdaptiveStats::default();
+    let w_large = kernel.filter().width() as u64;
+    for (iy, row) in grid[..n * n].chunks_exact_mut(n).enumerate() {
+        let ky = T::from_i32(signed_index(iy, n) as i32);
+        for (ix, g) in row.iter_mut().enumerate() {
+            let kx = T::from_i32(signed_index(ix, n) as i32);
+            let q: [T; 3] = core::array::from_fn(|a| kx * r[a] + ky * u[a]);
+            if q.iter().any(|&c| c > nyquist || -c > nyquist) {
+                *g = T::ZERO;
+                continue;
+            }
+            stats.samples += 1;
+            stats.full_taps += w_large * w_large * w_large;
+            let nearest: [usize; 3] =
+                core::array::from_fn(|a| (q[a] + T::HALF).floor_i64() as usize & mask);
+            let index = nearest[0] + n * (nearest[1] + n * nearest[2]);
+            let (table, gain, slot) = levels
+                .iter()
+                .enumerate()
+                .find(|(_, l)| l.marks.get(index))
+                .map_or((kernel, T::ONE, 0), |(i, l)| (l.kernel, l.gain, i + 1));
+            stats.per_filter[slot] += 1;
+            let w = table.filter().width();
+            stats.taps += (w * w * w) as u64;
+            *g = gain * interpolate(spec, table, q, mask);
+        }
+    }
+    Ok(stats)
+}
+
+/// The separable interpolation of `spec` at `q` with `table`'s kernel.
+#[inline(always)]
+fn interpolate<S: Sample, T: Real>(
+    spec: &Spectrum<'_, S>,
+    table: &KernelTable<T>,
+    q: [T; 3],
+    mask: usize,
+) -> T {
+    let n = spec.n();
+    let w = table.filter().width();
+    let mut wts = [[T::ZERO; MAX_WIDTH]; 3];
+    let mut taps = [[0usize; MAX_WIDTH]; 3];
+    for a in 0..3 {
+        let first = table.taps(q[a], &mut wts[a]);
+        for (t, slot) in taps[a][..w].iter_mut().enumerate() {
+            *slot = (first + t as i64) as usize & mask;
+        }
+    }
+    let mut acc = T::ZERO;
+    for c in 0..w {
+        let z = taps[2][c] * n * n;
+        let mut acc_y = T::ZERO;
+        for b in 0..w {
+            let line = z + taps[1][b] * n;
+            acc_y += wts[1][b] * spec.line_taps(line, &taps[0][..w], &wts[0][..w]);
+        }
+        acc += wts[2][c] * acc_y;
+    }
+    acc
 }

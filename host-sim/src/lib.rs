@@ -2,6 +2,7 @@
 //! references, agreement in dB and the `fvr` command-line program.
 
 pub mod accuracy;
+pub mod adaptive;
 pub mod image;
 pub mod nrrd;
 pub mod phantom;

@@ -1,0 +1,177 @@
+//! Adaptive filtering (paper §4): the tolerance holds, the marks are what
+//! the paper defines, and the statistics add up.
+
+use fvr_core::adaptive::{mark, marks_words, threshold_for, Marks};
+use fvr_core::filter::{Filter, FilterKind};
+use fvr_core::geometry::View;
+use fvr_host::adaptive::{parse_chain, parse_tolerance, AdaptiveMarks};
+use fvr_host::phantom::{sample, GaussianMixture, SheppLogan};
+use fvr_host::pipeline::{AnySpectrum, OwnedSpectrum};
+use fvr_host::reference::snr_db;
+use half::f16;
+
+/// The guarantee: the adaptive image is never further from the full-filter
+/// image than the tolerance, over volumes, views, filters and tolerances.
+#[test]
+fn adaptive_images_stay_within_the_requested_tolerance() {
+    let n = 64;
+    let volumes = [
+        (
+            "gaussians:1",
+            sample(&GaussianMixture::random(1, n, 8), [n; 3]),
+        ),
+        (
+            "gaussians:2",
+            sample(&GaussianMixture::random(2, n, 8), [n; 3]),
+        ),
+        (
+            "blobs",
+            sample(&GaussianMixture::random_with(4, n, 24, 0.05), [n; 3]),
+        ),
+        ("shepp-logan", sample(&SheppLogan::new([n; 3]), [n; 3])),
+    ];
+    let views = [
+        View::along([1.0, 0.3, 0.2]),
+        View::along([0.0, 1.0, 0.0]),
+        View::along([1.0, 1.0, 1.0]),
+    ];
+    let mut substituted = 0u64;
+    for (name, volume) in &volumes {
+        for kind in [FilterKind::Kb4, FilterKind::Kb6] {
+            let filter = Filter::new(kind, 2).unwrap();
+            let spec = OwnedSpectrum::<f16>::prepare::<f32>(volume, filter).unwrap();
+            let any = AnySpectrum::F16(spec.clone());
+            for view in &views {
+                let full = any.render(view, n, n).unwrap();
+                for tol in [30.0, 40.0, 50.0, 60.0] {
+                    let marks =
+                        AdaptiveMarks::build(&spec, tol, &[FilterKind::Nearest], None).unwrap();
+                    let (image, stats) = marks.render::<f16, f32>(&spec, view, n, n).unwrap();
+                    substituted += stats.per_filter[1];
+                    let snr = snr_db(&full, &image);
+                    assert!(
+                        snr >= tol,
+                        "{name} {kind:?} {view:?} tolerance {tol}: {snr:.1} dB"
+                    );
+                }
+            }
+        }
+    }
+    // The sweep must exercise the substitution, not only the full filter.
+    assert!(substituted > 100_000, "{substituted}");
+}
+
+/// The conservative marking of the paper: marked iff the sample and all
+/// samples within Chebyshev distance r (circularly) are below τ.
+#[test]
+fn marks_match_the_definition_by_brute_force() {
+    let n = 8;
+    let mut state = 0x1234_5678_u64;
+    let values: Vec<f64> = (0..n * n * n)
+        .map(|_| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let u = (state >> 11) as f64 / (1u64 << 53) as f64;
+            // Mostly weak, some strong.
+            if u < 0.9 {
+                u * 0.1
+            } else {
+                u * 10.0
+            }
+        })
+        .collect();
+    for radius in [0usize, 1, 2] {
+        let tau = 0.05;
+        let mut words = vec![0u32; marks_words(n)];
+        let mut line = vec![false; n];
+        let count = mark(n, |i| values[i], tau, radius, &mut words, &mut line).unwrap();
+        let marks = Marks::new(&words, n).unwrap();
+        let mut expected = 0;
+        for z in 0..n {
+            for y in 0..n {
+                for x in 0..n {
+                    let r = radius as i64;
+                    let all = (-r..=r).all(|dz| {
+                        (-r..=r).all(|dy| {
+                            (-r..=r).all(|dx| {
+                                let i =
+                                    |c: usize, d: i64| (c as i64 + d).rem_euclid(n as i64) as usize;
+                                values[i(x, dx) + n * (i(y, dy) + n * i(z, dz))] < tau
+                            })
+                        })
+                    });
+                    assert_eq!(
+                        marks.get(x + n * (y + n * z)),
+                        all,
+                        "r {radius} at {x},{y},{z}"
+                    );
+                    expected += usize::from(all);
+                }
+            }
+        }
+        assert_eq!(count, expected);
+        assert_eq!(marks.count(), expected);
+    }
+}
+
+/// Eq. 16 with the budget: the samples below τ hold at most the allowed
+/// energy, and τ is within one ⅛-octave bin of the largest such threshold.
+#[test]
+fn threshold_meets_the_energy_budget_and_is_nearly_the_largest() {
+    let values: Vec<f64> = (1..=5000).map(|i| 1.0 / (i as f64).powf(1.5)).collect();
+    let total: f64 = values.iter().map(|v| v * v).sum();
+    for (h_d, budget) in [(1.0, 1e-3), (2.5, 1e-4), (0.3, 1e-6)] {
+        let tau = threshold_for(values.len(), |i| values[i], h_d, budget);
+        let below = |t: f64| {
+            values
+                .iter()
+                .filter(|v| v.abs() < t)
+                .map(|v| v * v)
+                .sum::<f64>()
+        };
+        assert!(h_d * h_d * below(tau) <= budget * total);
+        assert!(h_d * h_d * below(tau * 2f64.powf(0.25)) > budget * total);
+    }
+}
+
+#[test]
+fn statistics_add_up_and_report_no_effect() {
+    let n = 32;
+    let volume = sample(&GaussianMixture::random(3, n, 6), [n; 3]);
+    let filter = Filter::new(FilterKind::Kb4, 2).unwrap();
+    let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+    let view = View::along([1.0, 0.4, 0.1]);
+    let marks = AdaptiveMarks::build(&spec, 40.0, &parse_chain("nearest").unwrap(), None).unwrap();
+    let (_, stats) = marks.render::<f16, f32>(&spec, &view, n, n).unwrap();
+    assert_eq!(stats.per_filter.iter().sum::<u64>(), stats.samples);
+    assert_eq!(stats.full_taps, stats.samples * 64);
+    assert_eq!(stats.taps, stats.per_filter[0] * 64 + stats.per_filter[1]);
+    assert!(stats.taps < stats.full_taps);
+    assert_eq!(marks.bytes(), 64 * 64 * 64 / 8);
+
+    let tight = AdaptiveMarks::build(&spec, 400.0, &[FilterKind::Nearest], None).unwrap();
+    let (_, s) = tight.render::<f16, f32>(&spec, &view, n, n).unwrap();
+    assert!(tight.effect(&s).unwrap().contains("no effect"));
+    let loose = AdaptiveMarks::build(&spec, 1e-9, &[FilterKind::Nearest], Some(1e-9)).unwrap();
+    let (_, s) = loose.render::<f16, f32>(&spec, &view, n, n).unwrap();
+    assert!(loose.effect(&s).unwrap().contains("so loose"), "{:?}", s);
+}
+
+#[test]
+fn bad_tolerances_and_chains_are_refused() {
+    for bad in ["0", "-5", "nan", "inf", "abc", ""] {
+        let err = parse_tolerance(bad).unwrap_err();
+        assert!(err.contains("positive number of dB"), "{err}");
+    }
+    assert_eq!(parse_tolerance(" 40 ").unwrap(), 40.0);
+    assert!(parse_chain("kb9").unwrap_err().contains("kb9"));
+    assert!(parse_chain("nearest,linear,cubic").is_err());
+    let volume = sample(&GaussianMixture::random(3, 16, 2), [16; 3]);
+    let spec =
+        OwnedSpectrum::<f16>::prepare::<f32>(&volume, Filter::new(FilterKind::Kb3, 2).unwrap())
+            .unwrap();
+    let err = AdaptiveMarks::build(&spec, 40.0, &[FilterKind::Kb4], None).unwrap_err();
+    assert!(err.contains("not cheaper"), "{err}");
+    assert!(AdaptiveMarks::build(&spec, 40.0, &[FilterKind::Nearest], Some(-1.0)).is_err());
+}
