@@ -592,6 +592,20 @@ impl<T: Real> KernelTable<T> {
         }
         j0
     }
+
+    /// [`KernelTable::taps`] for a width known at compile time (`W` must be
+    /// the filter's width): the same weights and `j0`, in a fixed array, so
+    /// tap loops unroll.
+    #[inline(always)]
+    pub fn taps_fixed<const W: usize>(&self, q: T, weights: &mut [T; W]) -> i64 {
+        let j0 = (q - T::from_usize(W) * T::HALF).floor_i64() + 1;
+        let mut d = q - T::from_i32(j0 as i32);
+        for wt in weights.iter_mut() {
+            *wt = self.eval(d);
+            d -= T::ONE;
+        }
+        j0
+    }
 }
 
 /// The kernel derivative `k'` tabulated like [`KernelTable`] (odd: the table
@@ -704,6 +718,18 @@ impl<T: Real> DerivativeTable<T> {
         } else {
             v
         }
+    }
+
+    /// [`DerivativeTable::taps`] for a width known at compile time.
+    #[inline(always)]
+    pub fn taps_fixed<const W: usize>(&self, q: T, weights: &mut [T; W]) -> i64 {
+        let j0 = (q - T::from_usize(W) * T::HALF).floor_i64() + 1;
+        let mut d = q - T::from_i32(j0 as i32);
+        for wt in weights.iter_mut() {
+            *wt = self.eval(d);
+            d -= T::ONE;
+        }
+        j0
     }
 
     /// Derivative weights `k'(q − j0 − m)`, `m = 0 … W−1`, at the same taps

@@ -17,6 +17,7 @@
 use crate::dht::{dht_2d, neg_mod, Twiddles};
 use crate::error::{require_len, Error, Result};
 use crate::filter::{KernelTable, MAX_WIDTH};
+use crate::format::BlockLayout;
 use crate::geometry::{dot, Frame, View};
 use crate::real::{Real, Sample};
 use crate::spectrum::Spectrum;
@@ -148,11 +149,141 @@ pub fn extract_slice<S: Sample, T: Real>(
     frame: &Frame,
     grid: &mut [T],
 ) {
+    match kernel.filter().width() {
+        1 => extract_width::<1, S, T>(spec, kernel, frame, grid),
+        2 => extract_width::<2, S, T>(spec, kernel, frame, grid),
+        3 => extract_width::<3, S, T>(spec, kernel, frame, grid),
+        4 => extract_width::<4, S, T>(spec, kernel, frame, grid),
+        5 => extract_width::<5, S, T>(spec, kernel, frame, grid),
+        _ => extract_width::<MAX_WIDTH, S, T>(spec, kernel, frame, grid),
+    }
+}
+
+/// How x-lines are read in the extraction's inner loops.
+#[derive(Clone, Copy)]
+pub(crate) enum LineReads<'a> {
+    /// Plain coefficients.
+    Plain,
+    /// One block exponent per x-line.
+    LineExponents(&'a [i8]),
+    /// Anything else (bricks): through [`Spectrum::line_taps`].
+    General,
+}
+
+impl<'a> LineReads<'a> {
+    /// The reads for `spec`.
+    pub(crate) fn of<S: Sample>(spec: &Spectrum<'a, S>) -> Self {
+        match spec.blocks() {
+            Some(b) if S::BLOCK_MANTISSA => match b.layout() {
+                BlockLayout::Line => LineReads::LineExponents(b.exponents()),
+                _ => LineReads::General,
+            },
+            _ => LineReads::Plain,
+        }
+    }
+
+    /// Whether a run of `W` taps from `x0` can be read contiguously.
+    #[inline(always)]
+    pub(crate) fn contiguous<const W: usize>(self, x0: usize, n: usize) -> bool {
+        x0 + W <= n && !matches!(self, LineReads::General)
+    }
+
+    /// `Σ_t w[t]·c[line + xs[t]]` with block exponents applied: one
+    /// contiguous run from `x0` when `contiguous`, else through
+    /// [`Spectrum::line_taps`] at the wrapped indices `xs`.
+    #[inline(always)]
+    pub(crate) fn sum<const W: usize, S: Sample, T: Real>(
+        self,
+        spec: &Spectrum<'_, S>,
+        line: usize,
+        x0: usize,
+        contiguous: bool,
+        xs: &[usize; W],
+        weights: &[T; W],
+    ) -> T {
+        let run = if contiguous {
+            spec.data()
+                .get(line + x0..line + x0 + W)
+                .and_then(|s| <&[S; W]>::try_from(s).ok())
+        } else {
+            None
+        };
+        match run {
+            Some(run) => {
+                let mut sum = T::ZERO;
+                for (wt, v) in weights.iter().zip(run) {
+                    sum += *wt * T::load(*v);
+                }
+                match self {
+                    LineReads::LineExponents(e) => sum * T::exp2i(e[line / spec.n()] as i32),
+                    _ => sum,
+                }
+            }
+            None => spec.line_taps(line, xs, weights),
+        }
+    }
+
+    /// Two weighted sums over the same taps, each coefficient read once
+    /// (the value and a derivative of [`LineReads::sum`]).
+    #[inline(always)]
+    pub(crate) fn sum2<const W: usize, S: Sample, T: Real>(
+        self,
+        spec: &Spectrum<'_, S>,
+        line: usize,
+        x0: usize,
+        contiguous: bool,
+        xs: &[usize; W],
+        first: &[T; W],
+        second: &[T; W],
+    ) -> (T, T) {
+        let run = if contiguous {
+            spec.data()
+                .get(line + x0..line + x0 + W)
+                .and_then(|s| <&[S; W]>::try_from(s).ok())
+        } else {
+            None
+        };
+        match run {
+            Some(run) => {
+                let (mut a, mut b) = (T::ZERO, T::ZERO);
+                for t in 0..W {
+                    let v = T::load(run[t]);
+                    a += first[t] * v;
+                    b += second[t] * v;
+                }
+                match self {
+                    LineReads::LineExponents(e) => {
+                        let scale = T::exp2i(e[line / spec.n()] as i32);
+                        (a * scale, b * scale)
+                    }
+                    _ => (a, b),
+                }
+            }
+            None => (
+                spec.line_taps(line, xs, first),
+                spec.line_taps(line, xs, second),
+            ),
+        }
+    }
+}
+
+/// [`extract_slice`] for filter width `W`. The inner loop reads the `W`
+/// x-taps of a line as one contiguous run when they do not wrap around the
+/// cube (all but the outermost slice samples), with the loops unrolled;
+/// sums are taken in the same order as the general path, so results are
+/// bit-identical to it.
+fn extract_width<const W: usize, S: Sample, T: Real>(
+    spec: &Spectrum<'_, S>,
+    kernel: &KernelTable<T>,
+    frame: &Frame,
+    grid: &mut [T],
+) {
     let n = spec.n();
+    let nn = n * n;
+    let reads = LineReads::of(spec);
     let r = frame.right.map(T::from_f64);
     let u = frame.up.map(T::from_f64);
     let nyquist = T::from_usize(n) * T::HALF;
-    let w = kernel.filter().width();
     let mask = n - 1;
     for (iy, row) in grid.chunks_exact_mut(n).enumerate() {
         let ky = T::from_i32(signed_index(iy, n) as i32);
@@ -163,25 +294,26 @@ pub fn extract_slice<S: Sample, T: Real>(
                 *g = T::ZERO;
                 continue;
             }
-            let mut wts = [[T::ZERO; MAX_WIDTH]; 3];
-            let mut first = [0i64; 3];
-            for a in 0..3 {
-                first[a] = kernel.taps(q[a], &mut wts[a]);
-            }
-            let mut xs = [0usize; MAX_WIDTH];
-            for (t, x) in xs[..w].iter_mut().enumerate() {
-                *x = (first[0] + t as i64) as usize & mask;
+            let (mut wx, mut wy, mut wz) = ([T::ZERO; W], [T::ZERO; W], [T::ZERO; W]);
+            let jx = kernel.taps_fixed(q[0], &mut wx);
+            let jy = kernel.taps_fixed(q[1], &mut wy);
+            let jz = kernel.taps_fixed(q[2], &mut wz);
+            let x0 = jx as usize & mask;
+            let contiguous = reads.contiguous::<W>(x0, n);
+            let mut xs = [0usize; W];
+            for (t, x) in xs.iter_mut().enumerate() {
+                *x = (jx + t as i64) as usize & mask;
             }
             let mut acc = T::ZERO;
-            for (c, wz) in wts[2][..w].iter().enumerate() {
-                let z = ((first[2] + c as i64) as usize & mask) * n * n;
+            for (c, wzc) in wz.iter().enumerate() {
+                let z = ((jz + c as i64) as usize & mask) * nn;
                 let mut acc_y = T::ZERO;
-                for (b, wy) in wts[1][..w].iter().enumerate() {
-                    let line = z + ((first[1] + b as i64) as usize & mask) * n;
-                    let acc_x = spec.line_taps(line, &xs[..w], &wts[0][..w]);
-                    acc_y += *wy * acc_x;
+                for (b, wyb) in wy.iter().enumerate() {
+                    let line = z + ((jy + b as i64) as usize & mask) * n;
+                    let acc_x = reads.sum(spec, line, x0, contiguous, &xs, &wx);
+                    acc_y += *wyb * acc_x;
                 }
-                acc += *wz * acc_y;
+                acc += *wzc * acc_y;
             }
             *g = acc;
         }

@@ -40,6 +40,7 @@ use crate::error::{require_len, Error, Result};
 use crate::filter::{DerivativeTable, KernelTable, MAX_WIDTH};
 use crate::geometry::View;
 use crate::real::{Real, Sample};
+use crate::render::LineReads;
 use crate::render::{aux_len, check_image, extract_slice, finish_channel, placement, signed_index};
 use crate::scene::{Scene, ViewPlan};
 use crate::spectrum::Spectrum;
@@ -91,15 +92,41 @@ fn run_pass<S: Sample, T: Real, const MODE: u8>(
     fields: &mut [T],
     targets: &[Target<T>],
 ) -> Result<()> {
+    if MODE == mode::VALUE_GRADIENT && tables.derivative.is_none() {
+        return Err(Error::NoKernelDerivative);
+    }
+    match tables.kernel.filter().width() {
+        1 => run_pass_width::<1, S, T, MODE>(spec, tables, geo, fields, targets),
+        2 => run_pass_width::<2, S, T, MODE>(spec, tables, geo, fields, targets),
+        3 => run_pass_width::<3, S, T, MODE>(spec, tables, geo, fields, targets),
+        4 => run_pass_width::<4, S, T, MODE>(spec, tables, geo, fields, targets),
+        5 => run_pass_width::<5, S, T, MODE>(spec, tables, geo, fields, targets),
+        _ => run_pass_width::<MAX_WIDTH, S, T, MODE>(spec, tables, geo, fields, targets),
+    }
+    Ok(())
+}
+
+/// Per-axis taps of one sample point: weights, first index, wrapped
+/// indices.
+struct Axis<T, const W: usize> {
+    weights: [T; W],
+    derivative: [T; W],
+    first: usize,
+    index: [usize; W],
+}
+
+fn run_pass_width<const W: usize, S: Sample, T: Real, const MODE: u8>(
+    spec: &Spectrum<'_, S>,
+    tables: &Tables<'_, T>,
+    geo: &PassGeometry<T>,
+    fields: &mut [T],
+    targets: &[Target<T>],
+) {
     let n = spec.n();
     let nn = n * n;
-    let w = tables.kernel.filter().width();
     let mask = n - 1;
     let nyquist = T::from_usize(n) * T::HALF;
-    let derivative = match (MODE, tables.derivative) {
-        (mode::VALUE_GRADIENT, None) => return Err(Error::NoKernelDerivative),
-        (_, d) => d,
-    };
+    let reads = LineReads::of(spec);
     for iy in 0..n {
         let ky = T::from_i32(signed_index(iy, n) as i32);
         for ix in 0..n {
@@ -109,26 +136,26 @@ fn run_pass<S: Sample, T: Real, const MODE: u8>(
             if q.iter().any(|&c| c > nyquist || -c > nyquist) {
                 continue;
             }
-            let mut wts = [[T::ZERO; MAX_WIDTH]; 3];
-            let mut taps = [[0usize; MAX_WIDTH]; 3];
-            for a in 0..3 {
-                let first = tables.kernel.taps(q[a], &mut wts[a]);
-                for (t, slot) in taps[a][..w].iter_mut().enumerate() {
-                    *slot = (first + t as i64) as usize & mask;
-                }
-            }
-            let (r0, r1) = match MODE {
-                mode::VALUE_GRADIENT => {
-                    let mut dwts = [[T::ZERO; MAX_WIDTH]; 3];
-                    if let Some(table) = derivative {
-                        for a in 0..3 {
-                            table.taps(q[a], &mut dwts[a]);
-                        }
+            let axes: [Axis<T, W>; 3] = core::array::from_fn(|a| {
+                let mut weights = [T::ZERO; W];
+                let j0 = tables.kernel.taps_fixed(q[a], &mut weights);
+                let mut derivative = [T::ZERO; W];
+                if MODE == mode::VALUE_GRADIENT {
+                    if let Some(table) = tables.derivative {
+                        table.taps_fixed(q[a], &mut derivative);
                     }
-                    value_gradient(spec, w, &taps, &wts, &dwts, geo.dir)
                 }
-                mode::VALUE_MIRROR => value_mirror(spec, w, &taps, &wts),
-                _ => (value(spec, w, &taps, &wts), T::ZERO),
+                Axis {
+                    weights,
+                    derivative,
+                    first: j0 as usize & mask,
+                    index: core::array::from_fn(|t| (j0 + t as i64) as usize & mask),
+                }
+            });
+            let (r0, r1) = match MODE {
+                mode::VALUE_GRADIENT => value_gradient(spec, reads, &axes, geo.dir),
+                mode::VALUE_MIRROR => value_mirror(spec, reads, &axes),
+                _ => (value(spec, reads, &axes), T::ZERO),
             };
             let i = iy * n + ix;
             for t in targets {
@@ -136,24 +163,27 @@ fn run_pass<S: Sample, T: Real, const MODE: u8>(
             }
         }
     }
-    Ok(())
 }
 
-type Weights<T> = [[T; MAX_WIDTH]; 3];
-type Taps = [[usize; MAX_WIDTH]; 3];
-
 #[inline(always)]
-fn value<S: Sample, T: Real>(spec: &Spectrum<'_, S>, w: usize, taps: &Taps, wts: &Weights<T>) -> T {
+fn value<const W: usize, S: Sample, T: Real>(
+    spec: &Spectrum<'_, S>,
+    reads: LineReads<'_>,
+    axes: &[Axis<T, W>; 3],
+) -> T {
     let n = spec.n();
+    let [x, y, z] = axes;
+    let contiguous = reads.contiguous::<W>(x.first, n);
     let mut acc = T::ZERO;
-    for c in 0..w {
-        let z = taps[2][c] * n * n;
+    for c in 0..W {
+        let plane = z.index[c] * n * n;
         let mut acc_y = T::ZERO;
-        for b in 0..w {
-            let line = z + taps[1][b] * n;
-            acc_y += wts[1][b] * spec.line_taps(line, &taps[0][..w], &wts[0][..w]);
+        for b in 0..W {
+            let line = plane + y.index[b] * n;
+            acc_y +=
+                y.weights[b] * reads.sum(spec, line, x.first, contiguous, &x.index, &x.weights);
         }
-        acc += wts[2][c] * acc_y;
+        acc += z.weights[c] * acc_y;
     }
     acc
 }
@@ -161,60 +191,83 @@ fn value<S: Sample, T: Real>(spec: &Spectrum<'_, S>, w: usize, taps: &Taps, wts:
 /// `X(p)` and `(d·∇X)(p)` from one neighbourhood: the separable gradient
 /// `∂_x = k'⊗k⊗k`, `∂_y = k⊗k'⊗k`, `∂_z = k⊗k⊗k'`.
 #[inline(always)]
-fn value_gradient<S: Sample, T: Real>(
+fn value_gradient<const W: usize, S: Sample, T: Real>(
     spec: &Spectrum<'_, S>,
-    w: usize,
-    taps: &Taps,
-    wts: &Weights<T>,
-    dwts: &Weights<T>,
+    reads: LineReads<'_>,
+    axes: &[Axis<T, W>; 3],
     dir: [T; 3],
 ) -> (T, T) {
     let n = spec.n();
+    let [x, y, z] = axes;
+    let contiguous = reads.contiguous::<W>(x.first, n);
     let (mut value, mut grad) = (T::ZERO, T::ZERO);
-    for c in 0..w {
-        let z = taps[2][c] * n * n;
+    for c in 0..W {
+        let plane = z.index[c] * n * n;
         let (mut v_y, mut gx_y, mut gy_y) = (T::ZERO, T::ZERO, T::ZERO);
-        for b in 0..w {
-            let line = z + taps[1][b] * n;
-            let v_x = spec.line_taps(line, &taps[0][..w], &wts[0][..w]);
-            let gx_x = spec.line_taps(line, &taps[0][..w], &dwts[0][..w]);
-            v_y += wts[1][b] * v_x;
-            gx_y += wts[1][b] * gx_x;
-            gy_y += dwts[1][b] * v_x;
+        for b in 0..W {
+            let line = plane + y.index[b] * n;
+            let (v_x, gx_x) = reads.sum2(
+                spec,
+                line,
+                x.first,
+                contiguous,
+                &x.index,
+                &x.weights,
+                &x.derivative,
+            );
+            v_y += y.weights[b] * v_x;
+            gx_y += y.weights[b] * gx_x;
+            gy_y += y.derivative[b] * v_x;
         }
-        value += wts[2][c] * v_y;
-        grad += wts[2][c] * (dir[0] * gx_y + dir[1] * gy_y) + dir[2] * dwts[2][c] * v_y;
+        value += z.weights[c] * v_y;
+        grad += z.weights[c] * (dir[0] * gx_y + dir[1] * gy_y) + dir[2] * z.derivative[c] * v_y;
     }
     (value, grad)
 }
 
 /// `X(p)` and `X(−p)`: the same weights on the taps `j` and `−j`.
 #[inline(always)]
-fn value_mirror<S: Sample, T: Real>(
+fn value_mirror<const W: usize, S: Sample, T: Real>(
     spec: &Spectrum<'_, S>,
-    w: usize,
-    taps: &Taps,
-    wts: &Weights<T>,
+    reads: LineReads<'_>,
+    axes: &[Axis<T, W>; 3],
 ) -> (T, T) {
     let n = spec.n();
     let mask = n - 1;
-    let mut xm = [0usize; MAX_WIDTH];
-    for (m, &x) in xm[..w].iter_mut().zip(&taps[0][..w]) {
-        *m = (n - x) & mask;
+    let [x, y, z] = axes;
+    // The mirrored x-taps run backwards: −j for j = j0 … j0+W−1. Reversed
+    // weights read them forwards from −(j0+W−1).
+    let mut mirror_index = [0usize; W];
+    let mut mirror_weights = [T::ZERO; W];
+    for t in 0..W {
+        mirror_index[t] = (n - x.index[W - 1 - t]) & mask;
+        mirror_weights[t] = x.weights[W - 1 - t];
     }
+    let mirror_first = mirror_index[0];
+    let contiguous = reads.contiguous::<W>(x.first, n);
+    let mirror_contiguous =
+        reads.contiguous::<W>(mirror_first, n) && mirror_index[W - 1] == mirror_first + W - 1;
     let (mut direct, mut mirror) = (T::ZERO, T::ZERO);
-    for c in 0..w {
-        let zi = taps[2][c];
-        let (z, zm) = (zi * n * n, ((n - zi) & mask) * n * n);
+    for c in 0..W {
+        let zi = z.index[c];
+        let (plane, plane_m) = (zi * n * n, ((n - zi) & mask) * n * n);
         let (mut d_y, mut m_y) = (T::ZERO, T::ZERO);
-        for b in 0..w {
-            let yi = taps[1][b];
-            let (line, line_m) = (z + yi * n, zm + ((n - yi) & mask) * n);
-            d_y += wts[1][b] * spec.line_taps(line, &taps[0][..w], &wts[0][..w]);
-            m_y += wts[1][b] * spec.line_taps(line_m, &xm[..w], &wts[0][..w]);
+        for b in 0..W {
+            let yi = y.index[b];
+            let (line, line_m) = (plane + yi * n, plane_m + ((n - yi) & mask) * n);
+            d_y += y.weights[b] * reads.sum(spec, line, x.first, contiguous, &x.index, &x.weights);
+            m_y += y.weights[b]
+                * reads.sum(
+                    spec,
+                    line_m,
+                    mirror_first,
+                    mirror_contiguous,
+                    &mirror_index,
+                    &mirror_weights,
+                );
         }
-        direct += wts[2][c] * d_y;
-        mirror += wts[2][c] * m_y;
+        direct += z.weights[c] * d_y;
+        mirror += z.weights[c] * m_y;
     }
     (direct, mirror)
 }
