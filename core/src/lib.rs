@@ -18,6 +18,7 @@ pub mod filter;
 pub mod format;
 pub mod geometry;
 pub mod gradient;
+pub mod progressive;
 pub mod real;
 pub mod render;
 pub mod scene;

@@ -40,9 +40,21 @@ pub struct Placement {
 /// The transform origin is voxel `⌊n_a/2⌋`, the centre is `n_a/2`; their
 /// difference `δ` (0 or ½ per axis) projects to `(δ·r, δ·u)` on the image.
 pub fn placement(dims: [usize; 3], frame: &Frame, width: usize, height: usize) -> Placement {
+    placement_at_pitch(dims, frame, width, height, 1.0)
+}
+
+/// [`placement`] for pixels `pitch` voxels apart (progressive previews):
+/// pixel `(col, row)` sits at `c + (col − W/2)·pitch·r + (H/2 − row)·pitch·u`.
+pub fn placement_at_pitch(
+    dims: [usize; 3],
+    frame: &Frame,
+    width: usize,
+    height: usize,
+    pitch: f64,
+) -> Placement {
     let delta = dims.map(|d| (d % 2) as f64 * 0.5);
-    let a0 = -(width as f64) / 2.0 + dot(delta, frame.right);
-    let b0 = height as f64 / 2.0 + dot(delta, frame.up);
+    let a0 = -(width as f64) / 2.0 + dot(delta, frame.right) / pitch;
+    let b0 = height as f64 / 2.0 + dot(delta, frame.up) / pitch;
     let (col0, row0) = (libm::floor(a0), libm::floor(b0));
     Placement {
         col0: col0 as i64,
@@ -149,13 +161,27 @@ pub fn extract_slice<S: Sample, T: Real>(
     frame: &Frame,
     grid: &mut [T],
 ) {
+    extract_central_slice(spec, kernel, frame, spec.n(), grid);
+}
+
+/// [`extract_slice`] restricted to the central `m × m` frequencies
+/// (`m ≤ n`, a power of two): the slice of a preview at pitch `n/m`
+/// ([`crate::progressive`]). `grid` holds `m²` values, `kx` fastest.
+pub fn extract_central_slice<S: Sample, T: Real>(
+    spec: &Spectrum<'_, S>,
+    kernel: &KernelTable<T>,
+    frame: &Frame,
+    m: usize,
+    grid: &mut [T],
+) {
+    let grid = &mut grid[..m * m];
     match kernel.filter().width() {
-        1 => extract_width::<1, S, T>(spec, kernel, frame, grid),
-        2 => extract_width::<2, S, T>(spec, kernel, frame, grid),
-        3 => extract_width::<3, S, T>(spec, kernel, frame, grid),
-        4 => extract_width::<4, S, T>(spec, kernel, frame, grid),
-        5 => extract_width::<5, S, T>(spec, kernel, frame, grid),
-        _ => extract_width::<MAX_WIDTH, S, T>(spec, kernel, frame, grid),
+        1 => extract_width::<1, S, T>(spec, kernel, frame, m, grid),
+        2 => extract_width::<2, S, T>(spec, kernel, frame, m, grid),
+        3 => extract_width::<3, S, T>(spec, kernel, frame, m, grid),
+        4 => extract_width::<4, S, T>(spec, kernel, frame, m, grid),
+        5 => extract_width::<5, S, T>(spec, kernel, frame, m, grid),
+        _ => extract_width::<MAX_WIDTH, S, T>(spec, kernel, frame, m, grid),
     }
 }
 
@@ -276,6 +302,7 @@ fn extract_width<const W: usize, S: Sample, T: Real>(
     spec: &Spectrum<'_, S>,
     kernel: &KernelTable<T>,
     frame: &Frame,
+    m: usize,
     grid: &mut [T],
 ) {
     let n = spec.n();
@@ -285,10 +312,10 @@ fn extract_width<const W: usize, S: Sample, T: Real>(
     let u = frame.up.map(T::from_f64);
     let nyquist = T::from_usize(n) * T::HALF;
     let mask = n - 1;
-    for (iy, row) in grid.chunks_exact_mut(n).enumerate() {
-        let ky = T::from_i32(signed_index(iy, n) as i32);
+    for (iy, row) in grid.chunks_exact_mut(m).enumerate() {
+        let ky = T::from_i32(signed_index(iy, m) as i32);
         for (ix, g) in row.iter_mut().enumerate() {
-            let kx = T::from_i32(signed_index(ix, n) as i32);
+            let kx = T::from_i32(signed_index(ix, m) as i32);
             let q: [T; 3] = core::array::from_fn(|a| kx * r[a] + ky * u[a]);
             if q.iter().any(|&c| c > nyquist || -c > nyquist) {
                 *g = T::ZERO;
