@@ -2,6 +2,8 @@
 //! references, agreement in dB and the `fvr` command-line program.
 
 pub mod accuracy;
+pub mod datasets;
+pub mod formats;
 pub mod image;
 pub mod nrrd;
 pub mod phantom;
