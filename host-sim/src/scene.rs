@@ -131,8 +131,8 @@ pub fn load_volume_with_progress(
             return v;
         }
         return Err(format!(
-            "`{spec}` is neither a file, a data set nor a built-in phantom; files can be {FORMATS_HELP}; \
-             {DATASETS_HELP}; {PHANTOM_HELP}"
+            "`{spec}` is neither a file nor a built-in phantom, and no data set has that name; \
+             files can be {FORMATS_HELP}; {DATASETS_HELP}; {PHANTOM_HELP}"
         ));
     }
     read_volume_with_progress(path, progress).map_err(|e| e.to_string())
