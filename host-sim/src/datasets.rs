@@ -12,8 +12,10 @@
 
 use std::path::{Path, PathBuf};
 
+use indicatif::ProgressBar;
+
 use crate::formats::den::parse_den;
-use crate::formats::read_volume;
+use crate::formats::read_volume_with_progress;
 use crate::volume::Volume;
 
 /// Environment variable that points at the CT head's `.inv3` file.
@@ -82,9 +84,23 @@ pub fn ct_head_path() -> Result<PathBuf, String> {
 /// # Errors
 /// The data set is not installed, or its file cannot be read.
 pub fn load_dataset(name: &str) -> Option<Result<Volume, String>> {
+    load_dataset_with_progress(name, &ProgressBar::hidden())
+}
+
+/// [`load_dataset`], advancing `progress` by the bytes read from disk.
+///
+/// # Errors
+/// As [`load_dataset`].
+pub fn load_dataset_with_progress(
+    name: &str,
+    progress: &ProgressBar,
+) -> Option<Result<Volume, String>> {
     match name {
         "brainsmall" => Some(parse_den(BRAINSMALL_DEN_GZ).map_err(|e| format!("brainsmall: {e}"))),
-        "ct-head" => Some(ct_head_path().and_then(|p| read_volume(&p).map_err(|e| e.to_string()))),
+        "ct-head" => Some(
+            ct_head_path()
+                .and_then(|p| read_volume_with_progress(&p, progress).map_err(|e| e.to_string())),
+        ),
         _ => None,
     }
 }

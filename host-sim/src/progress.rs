@@ -52,7 +52,7 @@ pub fn count(len: u64, message: &str) -> ProgressBar {
     }
     styled(
         ProgressBar::new(len),
-        "{msg:>12} [{bar:30}] {pos}/{len} ({per_sec}, {eta})",
+        "{msg:>12} [{bar:30}] {pos}/{len} ({eta})",
         message,
     )
 }

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use indicatif::ProgressBar;
 
-use crate::datasets::{load_dataset, DATASETS_HELP};
+use crate::datasets::{load_dataset_with_progress, DATASETS_HELP};
 use crate::formats::{read_volume_with_progress, FORMATS_HELP};
 use crate::nrrd::{read_raw, Endian, SampleType};
 use crate::phantom::{sample, GaussianMixture, Phantom, SheppLogan, Sphere};
@@ -127,7 +127,7 @@ pub fn load_volume_with_progress(
         return read_raw(path, r.dims, r.ty, r.endian).map_err(|e| e.to_string());
     }
     if !path.exists() {
-        if let Some(v) = load_dataset(spec) {
+        if let Some(v) = load_dataset_with_progress(spec, progress) {
             return v;
         }
         return Err(format!(

@@ -369,3 +369,45 @@ fn bad_inputs_and_options_exit_2_with_the_file_and_field() {
     );
     assert_error(&out, &["LOW < HIGH"]);
 }
+
+#[test]
+fn renders_a_dicom_series_directory() {
+    let dir = temp_dir("dicom");
+    let series = dir.join("series");
+    std::fs::create_dir_all(&series).unwrap();
+    let orientation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    for k in 0..6u32 {
+        let pixels: Vec<i16> = (0..64).map(|i| ((i * 7 + k * 13) % 50) as i16).collect();
+        let bytes = fvr_host::formats::dicom::encode_ct_slice(
+            "1.2.3.4",
+            k + 1,
+            [8, 8],
+            [0.5, 0.5],
+            [0.0, 0.0, 1.25 * k as f64],
+            orientation,
+            -10.0,
+            &pixels,
+        );
+        std::fs::write(series.join(format!("IM{k:04}")), bytes).unwrap();
+    }
+    let out = fvr(
+        &[
+            "render",
+            "series",
+            "--dir",
+            "1,0.3,0.2",
+            "--out",
+            "s.png",
+            "--stats",
+        ],
+        &dir,
+    );
+    assert_ok(&out);
+    assert!(stdout(&out).contains("8x8x6"), "{}", stdout(&out));
+    std::fs::write(series.join("IM0002"), b"broken").unwrap();
+    let out = fvr(
+        &["render", "series", "--dir", "1,0,0", "--out", "s.png"],
+        &dir,
+    );
+    assert_error(&out, &["series", "missing slices"]);
+}

@@ -458,7 +458,7 @@ fn prepare_with_progress(
     let result = choose_filter(volume, kind, oversample, design)
         .map_err(|e| e.to_string())
         .and_then(|filter| {
-            bar.set_message("3D transform");
+            bar.set_message("preprocess");
             AnySpectrum::prepare(volume, filter, precision).map_err(|e| e.to_string())
         });
     bar.finish_and_clear();

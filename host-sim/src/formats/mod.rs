@@ -10,6 +10,7 @@
 //! | NIfTI-1 ([`nifti`]) | `.nii`, `.nii.gz`, `.hdr` + `.img` | `sizeof_hdr` 348 and `n+1`/`ni1` | `pixdim`, in `xyzt_units` |
 //! | VolPack density ([`den`]) | `.den`, `.den.gz` | version 1 (either byte order) | none (1 mm) |
 //! | InVesalius project ([`inv3`]) | `.inv3` | gzip of a tar holding `main.plist` | `spacing` in `main.plist` |
+//! | DICOM series ([`dicom`]) | a directory, or one `.dcm` file of the series | `DICM` at byte 128 | `PixelSpacing` and slice positions |
 //!
 //! Headerless raw files have no magic: read them with
 //! [`crate::nrrd::read_raw`] and an explicit layout.
@@ -21,6 +22,7 @@
 //! an [`IoError`] that names the file and the field.
 
 pub mod den;
+pub mod dicom;
 pub mod inv3;
 pub mod nifti;
 mod plist;
@@ -58,6 +60,8 @@ pub enum Format {
     Den,
     /// InVesalius 3 project (`.inv3`).
     Inv3,
+    /// DICOM series (a directory, or one file of the series).
+    Dicom,
 }
 
 impl Format {
@@ -68,6 +72,7 @@ impl Format {
             Format::Nifti => "NIfTI-1",
             Format::Den => "VolPack .den",
             Format::Inv3 => "InVesalius .inv3",
+            Format::Dicom => "DICOM series",
         }
     }
 
@@ -81,6 +86,7 @@ impl Format {
             "nii" | "hdr" => Format::Nifti,
             "den" => Format::Den,
             "inv3" => Format::Inv3,
+            "dcm" | "dicom" => Format::Dicom,
             _ => return None,
         })
     }
@@ -95,6 +101,9 @@ impl Format {
         if nifti::has_magic(head) {
             return Some(Format::Nifti);
         }
+        if !gzip && dicom::has_magic(head) {
+            return Some(Format::Dicom);
+        }
         if gzip && head.get(257..262) == Some(b"ustar") {
             return Some(Format::Inv3);
         }
@@ -107,7 +116,8 @@ impl Format {
 
 /// The supported formats, for error messages.
 pub const FORMATS_HELP: &str = "NRRD (.nrrd, .nhdr), NIfTI-1 (.nii, .nii.gz, .hdr/.img), \
-VolPack (.den, .den.gz) or InVesalius (.inv3); headerless raw files need --raw-dims";
+VolPack (.den, .den.gz), InVesalius (.inv3) or a DICOM series (a directory, or one of its files); \
+headerless raw files need --raw-dims";
 
 /// Recognise the format of the file at `path` by its magic bytes, then by
 /// its extension.
@@ -116,6 +126,9 @@ VolPack (.den, .den.gz) or InVesalius (.inv3); headerless raw files need --raw-d
 /// The file cannot be read, or neither its content nor its name is of a
 /// supported format.
 pub fn detect(path: &Path) -> Result<Format, IoError> {
+    if path.is_dir() {
+        return Ok(Format::Dicom);
+    }
     let go = || -> Result<Format, IoError> {
         let mut reader = BufReader::new(File::open(path)?);
         let (head, gzip) = sniff(&mut reader)?;
@@ -185,6 +198,7 @@ pub fn read_volume_with_progress(path: &Path, progress: &ProgressBar) -> Result<
         Format::Nifti => nifti::read_nifti_with_progress(path, progress),
         Format::Den => den::read_den_with_progress(path, progress),
         Format::Inv3 => inv3::read_inv3_with_progress(path, progress),
+        Format::Dicom => dicom::read_dicom_with_progress(path, progress),
     }
 }
 
