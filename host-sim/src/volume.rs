@@ -65,6 +65,25 @@ impl Volume {
         self.data[self.index(i, j, k)]
     }
 
+    /// Make `background` the zero of the volume: every sample becomes
+    /// `max(x − background, 0)`.
+    ///
+    /// An X-ray sums the samples along each ray, so empty space must be 0.
+    /// CT in Hounsfield units has air at −1024: without this, air would
+    /// count as negative density and the volume's box would show.
+    ///
+    /// # Errors
+    /// A `background` that is not finite.
+    pub fn subtract_background(&mut self, background: f64) -> Result<(), String> {
+        if !background.is_finite() {
+            return Err(format!("background {background} must be a finite number"));
+        }
+        for v in &mut self.data {
+            *v = ((*v as f64 - background).max(0.0)) as f32;
+        }
+        Ok(())
+    }
+
     /// Physical extent `dims × spacing` in mm per axis.
     pub fn extent_mm(&self) -> [f64; 3] {
         [0, 1, 2].map(|a| self.dims[a] as f64 * self.spacing[a])

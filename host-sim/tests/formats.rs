@@ -651,3 +651,13 @@ fn ct_head_reads_with_its_shape_spacing_and_hounsfield_range() {
     let loaded = fvr_host::scene::load_volume("ct-head", None).expect("by name");
     assert_eq!(loaded.data, vol.data);
 }
+
+#[test]
+fn background_becomes_zero_and_lower_values_clamp() {
+    let mut v = Volume::new([4, 1, 1], vec![-1024.0, -1000.0, 0.0, 2000.0]);
+    v.subtract_background(-1024.0).unwrap();
+    assert_eq!(v.data, vec![0.0, 24.0, 1024.0, 3024.0]);
+    v.subtract_background(100.0).unwrap();
+    assert_eq!(v.data, vec![0.0, 0.0, 924.0, 2924.0]);
+    assert!(v.subtract_background(f64::NAN).is_err());
+}

@@ -126,6 +126,10 @@ struct RenderArgs {
     /// Byte order of a raw file: little or big.
     #[arg(long, default_value = "little", value_parser = parse_endian)]
     raw_endian: Endian,
+    /// Value of empty space: voxels become max(value - B, 0) before
+    /// rendering. Use -1024 for CT in Hounsfield units (air).
+    #[arg(long, allow_hyphen_values = true)]
+    background: Option<f64>,
 }
 
 /// How a PNG is made from the rendered values (render and turntable).
@@ -212,6 +216,10 @@ struct TurntableArgs {
     /// Byte order of a raw file: little or big.
     #[arg(long, default_value = "little", value_parser = parse_endian)]
     raw_endian: Endian,
+    /// Value of empty space: voxels become max(value - B, 0) before
+    /// rendering. Use -1024 for CT in Hounsfield units (air).
+    #[arg(long, allow_hyphen_values = true)]
+    background: Option<f64>,
 }
 
 fn volume_help() -> String {
@@ -327,6 +335,7 @@ fn default_scene() -> Result<(), String> {
         raw_dims: None,
         raw_type: SampleType::U8,
         raw_endian: Endian::Little,
+        background: None,
     };
     println!("fvr: rendering the default scene (run `fvr --help` for options)");
     render(&args)
@@ -352,7 +361,10 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         endian: args.raw_endian,
     });
     let t0 = Instant::now();
-    let volume = load_with_progress(&args.volume, raw)?;
+    let mut volume = load_with_progress(&args.volume, raw)?;
+    if let Some(b) = args.background {
+        volume.subtract_background(b)?;
+    }
     let t_load = t0.elapsed();
     let t1 = Instant::now();
     let spec = prepare_with_progress(
@@ -474,7 +486,10 @@ fn turntable(args: &TurntableArgs) -> Result<(), String> {
         endian: args.raw_endian,
     });
     let t0 = Instant::now();
-    let volume = load_with_progress(&args.volume, raw)?;
+    let mut volume = load_with_progress(&args.volume, raw)?;
+    if let Some(b) = args.background {
+        volume.subtract_background(b)?;
+    }
     let t_load = t0.elapsed();
     let t1 = Instant::now();
     let spec = prepare_with_progress(
