@@ -6,10 +6,10 @@
 //! - `matrix.shape`: `[z, y, x]` (NumPy C order, so `x` is fastest);
 //! - `spacing`: `[x, y, z]` in mm.
 //!
-//! The samples are read straight from the archive as it is decompressed;
-//! the members after them (surfaces, measurements) are not read, so the
-//! gzip CRC of the whole archive is not verified — damage before the end
-//! of the matrix is still reported.
+//! The samples are read straight from the archive as it is decompressed.
+//! The rest of the archive is then read through (not kept) so that a
+//! truncated or corrupt archive is reported even when the damage lies
+//! after the matrix: the gzip CRC covers the whole file.
 
 use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
@@ -164,42 +164,57 @@ fn read_inv3_from<R: BufRead>(reader: R) -> Result<Volume, IoError> {
     let mut info: Option<MatrixInfo> = None;
     // The samples, if their member came before `main.plist`.
     let mut early: Option<(String, Vec<u8>)> = None;
+    let mut volume: Option<Volume> = None;
     for entry in archive.entries().map_err(tar_error)? {
         let entry = entry.map_err(tar_error)?;
+        if volume.is_some() {
+            // Read through the rest, so that damage anywhere is reported.
+            continue;
+        }
         let name = member_name(&entry);
         if name == MAIN_PLIST {
-            let text = read_plist(entry)?;
-            let parsed = parse_main_plist(&text)?;
+            let parsed = parse_main_plist(&read_plist(entry)?)?;
             if let Some((early_name, bytes)) = early.take() {
                 if early_name == parsed.filename {
-                    return decode_matrix(&parsed, bytes.as_slice(), bytes.len() as u64);
+                    volume = Some(decode_matrix(
+                        &parsed,
+                        bytes.as_slice(),
+                        bytes.len() as u64,
+                    )?);
                 }
             }
             info = Some(parsed);
         } else if let Some(info) = &info {
             if name == info.filename {
                 let size = entry.size();
-                return decode_matrix(info, entry, size);
+                volume = Some(decode_matrix(info, entry, size)?);
             }
         } else if name == "matrix.dat" && early.is_none() {
             early = Some((name, read_member(entry)?));
         }
     }
-    Err(match info {
-        None => format_error(
-            ARCHIVE,
-            MAIN_PLIST,
-            "the archive has no main.plist: not an InVesalius project",
-        ),
-        Some(info) => format_error(
-            ARCHIVE,
-            "matrix.filename",
-            format!(
-                "main.plist names `{}`, which is not in the archive",
-                excerpt(&info.filename)
+    let Some(volume) = volume else {
+        return Err(match info {
+            None => format_error(
+                ARCHIVE,
+                MAIN_PLIST,
+                "the archive has no main.plist: not an InVesalius project",
             ),
-        ),
-    })
+            Some(info) => format_error(
+                ARCHIVE,
+                "matrix.filename",
+                format!(
+                    "main.plist names `{}`, which is not in the archive",
+                    excerpt(&info.filename)
+                ),
+            ),
+        });
+    };
+    // The end-of-archive padding and the gzip trailer (CRC, size).
+    let mut rest = archive.into_inner();
+    std::io::copy(&mut rest, &mut std::io::sink()).map_err(tar_error)?;
+    rest.finish()?;
+    Ok(volume)
 }
 
 /// The last component of a member's path (`tmpXYZ/main.plist` → `main.plist`).
