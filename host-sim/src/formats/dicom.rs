@@ -347,7 +347,7 @@ pub fn read_dicom(path: &Path) -> Result<Volume, IoError> {
     read_dicom_with_progress(path, &ProgressBar::hidden())
 }
 
-/// [`read_dicom`], advancing `progress` by one per file.
+/// [`read_dicom`], advancing `progress` by the bytes of each file read.
 pub fn read_dicom_with_progress(path: &Path, progress: &ProgressBar) -> Result<Volume, IoError> {
     let go = || -> Result<Volume, IoError> {
         let (dir, wanted) = if path.is_dir() {
@@ -371,10 +371,11 @@ pub fn read_dicom_with_progress(path: &Path, progress: &ProgressBar) -> Result<V
             })
             .collect();
         files.sort();
-        progress.set_length(files.len() as u64);
+        let size = |p: &PathBuf| fs::metadata(p).map_or(0, |m| m.len());
+        progress.set_length(files.iter().map(size).sum());
         let mut slices = Vec::new();
         for file in files {
-            progress.inc(1);
+            progress.inc(size(&file));
             let read_one = || -> Result<Option<Slice>, IoError> {
                 let mut head = [0u8; 132];
                 let mut f = fs::File::open(&file)?;
