@@ -7,6 +7,10 @@ cd "$(dirname "$0")/.."
 echo "== toolchain: thumbv7em-none-eabihf target (the core must build for Cortex-M4F)"
 rustup target add thumbv7em-none-eabihf
 
+echo "== data: the InVesalius CT head (GPL-2: installed from Debian, never committed)"
+FVR_CT_HEAD="$(bash scripts/fetch-ct-head.sh)"
+export FVR_CT_HEAD
+
 echo "== no_std core for thumbv7em-none-eabihf"
 cargo build --locked -p fvr-core --target thumbv7em-none-eabihf --release
 

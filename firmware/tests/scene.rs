@@ -58,7 +58,7 @@ fn phantom_volume() -> Volume {
             }
         }
     }
-    Volume { dims: DIMS, data }
+    Volume::new(DIMS, data)
 }
 
 /// Every frame against its f64 reference: exact line integrals for plain

@@ -3,16 +3,21 @@
 
 pub mod accuracy;
 pub mod adaptive;
+pub mod datasets;
+pub mod formats;
 pub mod image;
 pub mod nrrd;
+pub mod output;
 pub mod phantom;
 pub mod pipeline;
 pub mod plot;
 pub mod precision;
 pub mod precision_cli;
+pub mod progress;
 pub mod raycast;
 pub mod reference;
 pub mod scene;
 pub mod scene_reference;
 pub mod shaded;
+pub mod turntable;
 pub mod volume;

@@ -1,9 +1,11 @@
 //! NRRD and raw volume I/O.
 //!
-//! Reads NRRD files with an attached header (`.nrrd`), raw or gzip encoded,
-//! of any of the common integer and floating point sample types, into an
-//! `f32` [`Volume`]; reads headerless raw files given their layout; and
-//! writes `float` NRRD files.
+//! Reads NRRD files with an attached header (`.nrrd`) or a detached one
+//! (`.nhdr` with `data file:`), raw or gzip encoded, of any of the common
+//! integer and floating point sample types, into an `f32` [`Volume`] with
+//! its voxel spacing (from `spacings`, or the lengths of the
+//! `space directions` vectors); reads headerless raw files given their
+//! layout; and writes `float` NRRD files.
 //!
 //! Input is untrusted: malformed headers, truncated or corrupt data and
 //! NaN/Inf samples are reported as [`IoError`]s, never panics. Before
@@ -17,6 +19,12 @@
 //!   as in Teem. `byte skip: -1` is not supported.
 //! - Field names are case-insensitive; unknown fields and `key:=value` pairs
 //!   are ignored; a field given twice is an error.
+//! - `data file` names one file, relative to the header's directory unless
+//!   absolute; `line skip` and `byte skip` then apply to that file. The
+//!   multi-file forms (`LIST`, format strings) are refused.
+//! - `space directions` of an oblique or sheared grid keep only their
+//!   lengths: the volume is rendered as an axis-aligned grid with those
+//!   spacings.
 //! - Bytes after the expected data are ignored. For gzip, the last member
 //!   read is decompressed to its end (within the margin) so that its CRC is
 //!   verified.
@@ -32,14 +40,18 @@ use std::io::{self, BufRead, BufReader, Read};
 use std::path::Path;
 
 use flate2::bufread::MultiGzDecoder;
+use indicatif::ProgressBar;
 
 use crate::volume::Volume;
 
 pub use error::IoError;
 pub use samples::{Encoding, Endian, SampleType};
 
+pub(crate) use error::{excerpt, format_error};
+pub(crate) use header::{geometry, Layout};
+
 use error::invalid_argument;
-use header::{geometry, read_header, Layout};
+use header::read_header;
 
 /// Memory limit when `/proc/meminfo` cannot be read: 8 GiB.
 pub const DEFAULT_MEMORY_LIMIT: u64 = 8 << 30;
@@ -50,6 +62,9 @@ const GZIP_MARGIN: u64 = 4096;
 
 /// Bytes converted per step when streaming samples (a multiple of 8).
 const CHUNK_BYTES: usize = 1 << 16;
+
+/// Samples allocated before any are read; the buffer then grows with the data.
+const INITIAL_SAMPLES: usize = 1 << 24;
 
 /// Read buffer for files.
 const FILE_BUFFER_BYTES: usize = 1 << 16;
@@ -78,7 +93,7 @@ fn mem_available(meminfo: &str) -> Option<u64> {
 
 /// Refuse volumes whose decoding would need more than `limit` bytes: the
 /// `f32` output plus the raw samples.
-fn check_memory(count: usize, ty: SampleType, limit: u64) -> Result<(), IoError> {
+pub(crate) fn check_memory(count: usize, ty: SampleType, limit: u64) -> Result<(), IoError> {
     let per_sample = 4 + ty.size_bytes() as u64;
     let needed = (count as u64).saturating_mul(per_sample);
     if needed > limit {
@@ -87,18 +102,43 @@ fn check_memory(count: usize, ty: SampleType, limit: u64) -> Result<(), IoError>
     Ok(())
 }
 
-/// Read a NRRD file (attached header, `.nrrd`) into a volume of `f32`.
+/// Read a NRRD file (attached header `.nrrd`, or detached header `.nhdr`
+/// with its data file) into a volume of `f32`.
 ///
 /// Dimension 1 gives dims `[n0, 1, 1]`, dimension 2 gives `[n0, n1, 1]`;
 /// dimension 4 or more is an error. Errors carry the path.
 pub fn read_nrrd(path: &Path) -> Result<Volume, IoError> {
-    read_nrrd_limited(path, memory_limit_bytes())
+    read_nrrd_with_progress(path, &ProgressBar::hidden())
 }
 
-fn read_nrrd_limited(path: &Path, limit: u64) -> Result<Volume, IoError> {
+/// [`read_nrrd`], advancing `progress` by the bytes read from the file
+/// that holds the samples (its length is set to that file's size).
+pub fn read_nrrd_with_progress(path: &Path, progress: &ProgressBar) -> Result<Volume, IoError> {
+    read_nrrd_limited(path, memory_limit_bytes(), progress)
+}
+
+fn read_nrrd_limited(path: &Path, limit: u64, progress: &ProgressBar) -> Result<Volume, IoError> {
     let open = || -> Result<Volume, IoError> {
-        let mut reader = BufReader::with_capacity(FILE_BUFFER_BYTES, File::open(path)?);
-        read_nrrd_from(&mut reader, limit)
+        let file = File::open(path)?;
+        progress.set_length(file.metadata().map(|m| m.len()).unwrap_or(0));
+        let mut reader = BufReader::with_capacity(FILE_BUFFER_BYTES, progress.wrap_read(file));
+        let layout = read_header(&mut reader)?;
+        check_memory(layout.count, layout.ty, limit)?;
+        let Some(name) = &layout.data_file else {
+            return read_data(&mut reader, &layout);
+        };
+        let data_path = match path.parent() {
+            Some(dir) => dir.join(name),
+            None => Path::new(name).to_path_buf(),
+        };
+        let read_detached = || -> Result<Volume, IoError> {
+            let file = File::open(&data_path)?;
+            progress.set_position(0);
+            progress.set_length(file.metadata().map(|m| m.len()).unwrap_or(0));
+            let mut data = BufReader::with_capacity(FILE_BUFFER_BYTES, progress.wrap_read(file));
+            read_data(&mut data, &layout)
+        };
+        read_detached().map_err(|e| e.in_file(&data_path))
     };
     open().map_err(|e| e.in_file(path))
 }
@@ -119,15 +159,26 @@ fn parse_nrrd_limited(bytes: &[u8], limit: u64) -> Result<Volume, IoError> {
 fn read_nrrd_from<R: BufRead>(reader: &mut R, limit: u64) -> Result<Volume, IoError> {
     let layout = read_header(reader)?;
     check_memory(layout.count, layout.ty, limit)?;
+    if let Some(file) = &layout.data_file {
+        return Err(IoError::DetachedData {
+            file: excerpt(file),
+        });
+    }
+    read_data(reader, &layout)
+}
+
+/// Read the samples `layout` describes from `reader`, which is positioned
+/// at the start of the data (after the header, or at the start of a
+/// detached data file).
+fn read_data<R: BufRead>(reader: &mut R, layout: &Layout) -> Result<Volume, IoError> {
     skip_lines(reader, layout.line_skip)?;
     let data = match layout.encoding {
-        Encoding::Raw => read_raw_data(reader, &layout)?,
-        Encoding::Gzip => read_gzip_data(reader, &layout)?,
+        Encoding::Raw => read_raw_data(reader, layout)?,
+        Encoding::Gzip => read_gzip_data(reader, layout)?,
     };
-    Ok(Volume {
-        dims: layout.dims,
-        data,
-    })
+    let mut volume = Volume::new(layout.dims, data);
+    volume.spacing = layout.spacing;
+    Ok(volume)
 }
 
 fn read_raw_data<R: Read>(reader: &mut R, layout: &Layout) -> Result<Vec<f32>, IoError> {
@@ -135,7 +186,10 @@ fn read_raw_data<R: Read>(reader: &mut R, layout: &Layout) -> Result<Vec<f32>, I
     decode_stream(reader, layout, Source::Raw)
 }
 
-fn read_gzip_data<R: BufRead>(reader: &mut R, layout: &Layout) -> Result<Vec<f32>, IoError> {
+pub(crate) fn read_gzip_data<R: BufRead>(
+    reader: &mut R,
+    layout: &Layout,
+) -> Result<Vec<f32>, IoError> {
     let bound = layout
         .byte_skip
         .saturating_add(layout.data_bytes as u64)
@@ -149,8 +203,10 @@ fn read_gzip_data<R: BufRead>(reader: &mut R, layout: &Layout) -> Result<Vec<f32
 
 /// Where sample bytes come from, for error reporting.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Source {
+pub(crate) enum Source {
+    /// Uncompressed bytes.
     Raw,
+    /// Decompressed gzip data.
     Gzip,
 }
 
@@ -174,7 +230,7 @@ impl Source {
 }
 
 /// Read until `buf` is full or the input ends; the number of bytes read.
-fn read_full<R: Read>(reader: &mut R, buf: &mut [u8]) -> io::Result<usize> {
+pub(crate) fn read_full<R: Read>(reader: &mut R, buf: &mut [u8]) -> io::Result<usize> {
     let mut filled = 0;
     while filled < buf.len() {
         let rest = buf.get_mut(filled..).unwrap_or_default();
@@ -243,13 +299,15 @@ fn skip_line<R: BufRead>(reader: &mut R) -> io::Result<bool> {
 
 /// Read `layout.data_bytes` bytes of samples from `reader` and convert them
 /// to `f32`, checking that they are finite.
-fn decode_stream<R: Read>(
+pub(crate) fn decode_stream<R: Read>(
     reader: &mut R,
     layout: &Layout,
     source: Source,
 ) -> Result<Vec<f32>, IoError> {
     let total = layout.data_bytes;
-    let mut out = Vec::with_capacity(layout.count);
+    // Capacity grows with the data actually read (doubling, capped at the
+    // count), so a short file that claims a huge volume costs little.
+    let mut out = Vec::with_capacity(layout.count.min(INITIAL_SAMPLES));
     let mut buf = vec![0u8; CHUNK_BYTES.min(total)];
     let mut done = 0;
     while done < total {
@@ -260,6 +318,11 @@ fn decode_stream<R: Read>(
             return Err(source.truncated(total, done + got));
         }
         let first = out.len();
+        let needed = first + want / layout.ty.size_bytes();
+        if needed > out.capacity() {
+            let target = out.capacity().saturating_mul(2).clamp(needed, layout.count);
+            out.reserve_exact(target - first);
+        }
         samples::decode_into(chunk, layout.ty, layout.endian, &mut out);
         check_finite(&out, first, chunk, layout)?;
         done += want;
@@ -345,18 +408,9 @@ fn read_raw_from<R: Read>(
     }
     let (dims, count, data_bytes) = geometry(&dims, ty)?;
     check_memory(count, ty, limit)?;
-    let layout = Layout {
-        dims,
-        count,
-        data_bytes,
-        ty,
-        endian,
-        encoding: Encoding::Raw,
-        line_skip: 0,
-        byte_skip: 0,
-    };
+    let layout = Layout::samples(dims, count, data_bytes, ty, endian);
     let data = decode_stream(reader, &layout, Source::Raw)?;
-    Ok(Volume { dims, data })
+    Ok(Volume::new(dims, data))
 }
 
 /// Check that `sizes` (1 to 3 positive sizes) describe `len` samples.

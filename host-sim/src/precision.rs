@@ -841,18 +841,12 @@ pub fn extreme_cases(n: usize) -> Vec<ExtremeCase> {
         },
         ExtremeCase {
             name: "gaussians x 1e-6",
-            volume: Volume {
-                dims,
-                data: gauss.data.iter().map(|v| v * 1e-6).collect(),
-            },
+            volume: Volume::new(dims, gauss.data.iter().map(|v| v * 1e-6).collect()),
             views: views(),
         },
         ExtremeCase {
             name: "shepp-logan in HU",
-            volume: Volume {
-                dims,
-                data: sl.data.iter().map(|v| 1000.0 * v - 1000.0).collect(),
-            },
+            volume: Volume::new(dims, sl.data.iter().map(|v| 1000.0 * v - 1000.0).collect()),
             views: views(),
         },
     ]

@@ -1,8 +1,12 @@
-//! Volumes by name: files on disk or built-in phantoms.
+//! Volumes by name: files on disk, named data sets or built-in phantoms.
 
 use std::path::Path;
 
-use crate::nrrd::{read_nrrd, read_raw, Endian, SampleType};
+use indicatif::ProgressBar;
+
+use crate::datasets::{load_dataset_with_progress, DATASETS_HELP};
+use crate::formats::{read_volume_with_progress, FORMATS_HELP};
+use crate::nrrd::{read_raw, Endian, SampleType};
 use crate::phantom::{sample, GaussianMixture, Phantom, SheppLogan, Sphere};
 use crate::volume::Volume;
 
@@ -106,12 +110,26 @@ pub struct RawLayout {
     pub endian: Endian,
 }
 
-/// Load a volume: a built-in phantom name, a raw file when `raw` is given,
-/// or a NRRD file.
+/// Load a volume: a built-in phantom (`gaussians@64`), a named data set
+/// (`brainsmall`, `ct-head`: [`crate::datasets`]), a raw file when `raw` is
+/// given, or a volume file of any format [`crate::formats`] reads.
 ///
 /// # Errors
-/// Unknown names, unreadable or malformed files, with the reason.
+/// Unknown names, missing data sets, unreadable or malformed files, with
+/// the file and the field at fault.
 pub fn load_volume(spec: &str, raw: Option<RawLayout>) -> Result<Volume, String> {
+    load_volume_with_progress(spec, raw, &ProgressBar::hidden())
+}
+
+/// [`load_volume`], advancing `progress` by the bytes read from disk.
+///
+/// # Errors
+/// As [`load_volume`].
+pub fn load_volume_with_progress(
+    spec: &str,
+    raw: Option<RawLayout>,
+    progress: &ProgressBar,
+) -> Result<Volume, String> {
     if let Some(p) = phantom_by_name(spec) {
         return p.map(|p| p.volume);
     }
@@ -120,9 +138,13 @@ pub fn load_volume(spec: &str, raw: Option<RawLayout>) -> Result<Volume, String>
         return read_raw(path, r.dims, r.ty, r.endian).map_err(|e| e.to_string());
     }
     if !path.exists() {
+        if let Some(v) = load_dataset_with_progress(spec, progress) {
+            return v;
+        }
         return Err(format!(
-            "`{spec}` is neither a file nor a built-in phantom ({PHANTOM_HELP})"
+            "`{spec}` is neither a file nor a built-in phantom, and no data set has that name; \
+             files can be {FORMATS_HELP}; {DATASETS_HELP}; {PHANTOM_HELP}"
         ));
     }
-    read_nrrd(path).map_err(|e| e.to_string())
+    read_volume_with_progress(path, progress).map_err(|e| e.to_string())
 }

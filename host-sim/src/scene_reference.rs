@@ -260,6 +260,7 @@ pub fn spatial_scene_projection(
     let to_volume = |data: Vec<f64>| Volume {
         dims,
         data: data.into_iter().map(|v| v as f32).collect(),
+        spacing: volume.spacing,
     };
     let (partials, magnitude) = if lit {
         let g = spectral_gradient(volume)?;

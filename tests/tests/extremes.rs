@@ -125,6 +125,7 @@ fn constant_volume_projects_to_c_times_n_along_an_axis_up_to_kb4_aliasing_in_f64
     let volume = Volume {
         dims: [N; 3],
         data: vec![c; N * N * N],
+        spacing: fvr_host::volume::DEFAULT_SPACING,
     };
     assert_eq!(
         choose_oversampling(&volume, FilterKind::Kb4, KbDesign::Auto),
@@ -311,6 +312,7 @@ fn volume_scaled_by_2_pow_minus_20_is_bit_identical_and_by_1e_minus_6_or_1e_minu
         let scaled = Volume {
             dims: base.dims,
             data: base.data.iter().map(|v| v * factor).collect(),
+            spacing: fvr_host::volume::DEFAULT_SPACING,
         };
         let mut b = Subject::new("scaled", scaled, None, filter, views.clone());
         let (rb, _) = b.render_format(Format::F64, Arithmetic::PerPass).unwrap();
@@ -458,6 +460,7 @@ fn sizes_1_2_and_4_work_in_every_format() {
             data: (0..n * n * n)
                 .map(|_| rng.next_f64() as f32 + 0.5)
                 .collect(),
+            spacing: fvr_host::volume::DEFAULT_SPACING,
         };
         for o in [1u32, 2] {
             let filter = choose_filter(&volume, FilterKind::Kb4, o, KbDesign::Auto).unwrap();

@@ -8,15 +8,19 @@ use clap::{Args, Parser, Subcommand};
 use fvr_core::filter::FilterKind;
 use fvr_core::geometry::{View, DEFAULT_UP};
 use fvr_core::scene::{Light, Scene, MAX_LIGHTS};
+use fvr_host::datasets::DATASETS_HELP;
+use fvr_host::formats::FORMATS_HELP;
 use fvr_host::nrrd::{read_nrrd, Endian, SampleType};
-use fvr_host::pipeline::{choose_filter, KbDesign, Precision};
+use fvr_host::output::{write_apng, write_png, Bits, Colormap, Style, Window};
+use fvr_host::pipeline::{choose_filter, AnySpectrum, KbDesign, Precision};
 use fvr_host::reference::{exact_projection, max_abs_error, snr_db};
-use fvr_host::scene::{load_volume, phantom_by_name, RawLayout, PHANTOM_HELP};
+use fvr_host::scene::{load_volume_with_progress, phantom_by_name, RawLayout, PHANTOM_HELP};
 use fvr_host::scene_reference::exact_scene_projection;
 use fvr_host::shaded::{
     light_ring, negative_cue_share, parse_depth_cue, parse_light, parse_light_ring, parse_rgb,
     SceneRenderer, SceneSpectra, DEFAULT_PROFILE_HARMONICS, DEPTH_CUE_HELP,
 };
+use fvr_host::{progress, turntable};
 
 /// Below this estimated storage SNR the renderer warns (see
 /// `OwnedSpectrum::storage_snr_estimate_db`).
@@ -35,7 +39,15 @@ GEOMETRY CONTRACT
   Pixel (col,row), row 0 at the top, of a W x H image sits at
   p = c + (col - W/2) r + (H/2 - row) u, and its value is the line integral
   of the band-limited interpolant of the voxels along p + t d, in voxel units.
-  A zero d or u0, or u0 parallel to d, is an error.";
+  A zero d or u0, or u0 parallel to d, is an error.
+
+EXIT STATUS
+  0  success (also for --help and --version)
+  2  any error: bad arguments, unreadable or malformed input, a render that
+     cannot be done; the reason is printed on stderr as `fvr: error: ...`
+     (argument errors are explained by the parser, with a usage line).
+
+Progress bars go to stderr only when it is a terminal; --quiet turns them off.";
 
 /// Frequency-domain volume rendering (Totsuka & Levoy 1993): X-ray
 /// projections, depth cueing and shading from a 16-bit Hartley spectrum.
@@ -45,6 +57,9 @@ GEOMETRY CONTRACT
 #[derive(Parser)]
 #[command(name = "fvr", version, after_help = GEOMETRY)]
 struct Cli {
+    /// No progress bars (they are shown only when stderr is a terminal anyway).
+    #[arg(long, global = true)]
+    quiet: bool,
     #[command(subcommand)]
     command: Option<Command>,
 }
@@ -54,6 +69,10 @@ enum Command {
     /// Render the projection of a volume along a view direction.
     #[command(after_help = GEOMETRY)]
     Render(Box<RenderArgs>),
+    /// Render a turntable animation (APNG): one preprocessing pass, then
+    /// FRAMES X-ray views on a full turn about the up axis.
+    #[command(after_help = GEOMETRY)]
+    Turntable(TurntableArgs),
     /// Print the SNR in dB of image B against reference image A (NRRD files).
     Compare {
         /// Reference image.
@@ -76,8 +95,8 @@ enum Command {
 
 #[derive(Args)]
 struct RenderArgs {
-    /// A NRRD file (.nrrd), a raw file with --raw-dims, or a built-in phantom.
-    #[arg(help = format!("Volume: a NRRD file, a raw file (with --raw-dims), or a {PHANTOM_HELP}"))]
+    /// A volume file, a raw file with --raw-dims, a data set, or a built-in phantom.
+    #[arg(help = volume_help())]
     volume: String,
     /// View direction X,Y,Z, from the eye into the scene.
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
@@ -129,9 +148,12 @@ struct RenderArgs {
     #[arg(long)]
     no_cue_correction: bool,
     /// Output file: .nrrd (float32; sizes W H, or 3 W H for RGB) or .png
-    /// (auto-windowed 8-bit grey or RGB).
+    /// (grey: windowed, see --bits, --window/--level, --percentiles and
+    /// --colormap; RGB: 8-bit, one percentile window over all channels).
     #[arg(long)]
     out: PathBuf,
+    #[command(flatten)]
+    png: PngArgs,
     /// Print timing, memory and filter details.
     #[arg(long)]
     stats: bool,
@@ -147,6 +169,115 @@ struct RenderArgs {
     /// Byte order of a raw file: little or big.
     #[arg(long, default_value = "little", value_parser = parse_endian)]
     raw_endian: Endian,
+    /// Value of empty space: voxels become max(value - B, 0) before
+    /// rendering. Use -1024 for CT in Hounsfield units (air).
+    #[arg(long, allow_hyphen_values = true)]
+    background: Option<f64>,
+}
+
+/// How a PNG is made from the rendered values (render and turntable).
+#[derive(Args, Clone)]
+struct PngArgs {
+    /// PNG bits per channel: 8 or 16.
+    #[arg(long, default_value = "8")]
+    bits: Bits,
+    /// Window width W: values in [L - W/2, L + W/2] span black to white
+    /// (needs --level). Default: automatic, from --percentiles.
+    #[arg(long, requires = "level", allow_hyphen_values = true)]
+    window: Option<f64>,
+    /// Window level (centre) L; needs --window.
+    #[arg(long, requires = "window", allow_hyphen_values = true)]
+    level: Option<f64>,
+    /// Automatic window: the LOW,HIGH percentiles of the pixel values.
+    #[arg(long, value_parser = parse_percentiles, default_value = "0.5,99.5", conflicts_with = "window")]
+    percentiles: (f64, f64),
+    /// Colormap for the X-ray image: gray, bone or hot (MATLAB's maps, as
+    /// tabulated in matplotlib).
+    #[arg(long, default_value = "gray")]
+    colormap: Colormap,
+}
+
+impl PngArgs {
+    fn style(&self) -> Result<Style, String> {
+        let window = match (self.window, self.level) {
+            (Some(w), Some(l)) => Window::from_width_level(w, l)?,
+            _ => Window::from_percentiles(self.percentiles.0, self.percentiles.1)?,
+        };
+        Ok(Style {
+            bits: self.bits,
+            window,
+            colormap: self.colormap,
+        })
+    }
+}
+
+#[derive(Args)]
+struct TurntableArgs {
+    /// A volume file, a raw file with --raw-dims, a data set, or a built-in phantom.
+    #[arg(help = volume_help())]
+    volume: String,
+    /// Number of frames in the turn.
+    #[arg(long, default_value_t = 72, value_parser = clap::value_parser!(u32).range(1..=3600))]
+    frames: u32,
+    /// Frames per second of the animation.
+    #[arg(long, default_value_t = 24, value_parser = clap::value_parser!(u16).range(1..=1000))]
+    fps: u16,
+    /// View direction X,Y,Z of the first frame; later frames turn it about --up.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,-1,0")]
+    dir: [f64; 3],
+    /// Turntable axis and up hint X,Y,Z.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,1")]
+    up: [f64; 3],
+    /// Image size W or WxH in pixels of one voxel; at most the padded grid.
+    /// Default: the padded grid divided by the oversampling.
+    #[arg(long, value_parser = parse_size)]
+    size: Option<(usize, usize)>,
+    /// Interpolation filter: nearest, linear, cubic, kb3, kb4, kb5, kb6.
+    #[arg(long, value_parser = parse_filter, default_value = "kb4")]
+    filter: FilterKind,
+    /// Oversampling of the spectrum grid: 1 or 2.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=2))]
+    oversample: u32,
+    /// Spectrum storage and arithmetic: f16 (f32 arithmetic), f32 or f64.
+    #[arg(long, default_value = "f16")]
+    precision: Precision,
+    /// Kaiser-Bessel shape: `auto` fits beta to the volume's energy
+    /// distribution; a number is the design oversampling of Beatty's formula.
+    #[arg(long, default_value = "auto")]
+    kb_design: KbDesign,
+    /// Output file: .apng or .png (an animated PNG either way).
+    #[arg(long, default_value = "spin.apng")]
+    out: PathBuf,
+    #[command(flatten)]
+    png: PngArgs,
+    /// Read VOLUME as a headerless raw file of these sizes X,Y,Z.
+    #[arg(long, value_parser = parse_dims)]
+    raw_dims: Option<[usize; 3]>,
+    /// Sample type of a raw file: u8, i8, u16, i16, u32, i32, f32, f64.
+    #[arg(long, default_value = "u8")]
+    raw_type: SampleType,
+    /// Byte order of a raw file: little or big.
+    #[arg(long, default_value = "little", value_parser = parse_endian)]
+    raw_endian: Endian,
+    /// Value of empty space: voxels become max(value - B, 0) before
+    /// rendering. Use -1024 for CT in Hounsfield units (air).
+    #[arg(long, allow_hyphen_values = true)]
+    background: Option<f64>,
+}
+
+fn volume_help() -> String {
+    format!(
+        "Volume: a file ({FORMATS_HELP}), a raw file (with --raw-dims), one of the {DATASETS_HELP}, or one of the {PHANTOM_HELP}"
+    )
+}
+
+fn parse_percentiles(s: &str) -> Result<(f64, f64), String> {
+    let bad = || format!("expected percentiles LOW,HIGH with 0 <= LOW < HIGH <= 100, got `{s}`");
+    let (lo, hi) = s.split_once(',').ok_or_else(bad)?;
+    let lo = lo.trim().parse::<f64>().map_err(|_| bad())?;
+    let hi = hi.trim().parse::<f64>().map_err(|_| bad())?;
+    Window::from_percentiles(lo, hi).map_err(|_| bad())?;
+    Ok((lo, hi))
 }
 
 fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
@@ -207,9 +338,11 @@ fn parse_endian(s: &str) -> Result<Endian, String> {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    progress::set_quiet(cli.quiet);
     let result = match cli.command {
         None => default_scene(),
         Some(Command::Render(args)) => render(&args),
+        Some(Command::Turntable(args)) => turntable(&args),
         Some(Command::Compare { a, b }) => compare(&a, &b),
         Some(Command::Accuracy { sizes }) => accuracy(&sizes),
         Some(Command::Precision(args)) => fvr_host::precision_cli::run(&args),
@@ -240,11 +373,19 @@ fn default_scene() -> Result<(), String> {
         light_ring: Some((3, 30.0)),
         no_cue_correction: false,
         out: PathBuf::from("fvr-default.png"),
+        png: PngArgs {
+            bits: Bits::Eight,
+            window: None,
+            level: None,
+            percentiles: fvr_host::image::AUTO_WINDOW_PERCENTILES,
+            colormap: Colormap::Gray,
+        },
         stats: true,
         exact: false,
         raw_dims: None,
         raw_type: SampleType::U8,
         raw_endian: Endian::Little,
+        background: None,
     };
     println!(
         "fvr: rendering the default scene: 24 Gaussian blobs lit by red, green and blue lights \
@@ -266,20 +407,28 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         up: args.up,
     };
     view.frame().map_err(|e| e.to_string())?;
+    let style = args.png.style()?;
     let raw = args.raw_dims.map(|dims| RawLayout {
         dims,
         ty: args.raw_type,
         endian: args.raw_endian,
     });
     let t0 = Instant::now();
-    let volume = load_volume(&args.volume, raw)?;
+    let mut volume = load_with_progress(&args.volume, raw)?;
+    if let Some(b) = args.background {
+        volume.subtract_background(b)?;
+    }
     let t_load = t0.elapsed();
     let scene = build_scene(args)?;
     let t1 = Instant::now();
-    let filter = choose_filter(&volume, args.filter, args.oversample, args.kb_design)
-        .map_err(|e| e.to_string())?;
-    let spectra = SceneSpectra::prepare(&volume, filter, args.precision, &scene)
-        .map_err(|e| e.to_string())?;
+    let (spectra, filter) = prepare_scene_with_progress(
+        &volume,
+        args.filter,
+        args.oversample,
+        args.kb_design,
+        args.precision,
+        &scene,
+    )?;
     let t_prep = t1.elapsed();
     let volume_sum: f64 = volume.data.iter().map(|&v| v as f64).sum();
     let storage_snr = spectra.density.storage_snr_estimate_db(volume_sum);
@@ -312,7 +461,11 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         .map_err(|e| e.to_string())?;
     let t_view = t2.elapsed();
     if ext == "png" {
-        image.write_png(&args.out)?;
+        if image.channels == 1 {
+            write_png(&args.out, w, h, &image.data, &style)?;
+        } else {
+            image.write_png(&args.out)?;
+        }
     } else {
         image.write_nrrd(&args.out)?;
     }
@@ -423,6 +576,115 @@ fn build_scene(args: &RenderArgs) -> Result<Scene, String> {
     }
     scene.validate().map_err(|e| e.to_string())?;
     Ok(scene)
+}
+
+/// Load a volume with a progress bar on the bytes read.
+fn load_with_progress(
+    spec: &str,
+    raw: Option<RawLayout>,
+) -> Result<fvr_host::volume::Volume, String> {
+    let bar = progress::bytes("loading");
+    let volume = load_volume_with_progress(spec, raw, &bar);
+    bar.finish_and_clear();
+    volume
+}
+
+/// Fit the filter and prepare the scene's spectra, with a spinner.
+fn prepare_scene_with_progress(
+    volume: &fvr_host::volume::Volume,
+    kind: FilterKind,
+    oversample: u32,
+    design: KbDesign,
+    precision: Precision,
+    scene: &Scene,
+) -> Result<(SceneSpectra, fvr_core::filter::Filter), String> {
+    let bar = progress::spinner("fitting filter");
+    let result = choose_filter(volume, kind, oversample, design)
+        .map_err(|e| e.to_string())
+        .and_then(|filter| {
+            bar.set_message(if scene.needs_gradient_spectrum() {
+                "preprocess (density and |grad f| spectra)"
+            } else {
+                "preprocess"
+            });
+            SceneSpectra::prepare(volume, filter, precision, scene)
+                .map(|s| (s, filter))
+                .map_err(|e| e.to_string())
+        });
+    bar.finish_and_clear();
+    result
+}
+
+/// Fit the filter and prepare the spectrum, with a spinner (the core's
+/// preparation is one call with no progress of its own).
+fn prepare_with_progress(
+    volume: &fvr_host::volume::Volume,
+    kind: FilterKind,
+    oversample: u32,
+    design: KbDesign,
+    precision: Precision,
+) -> Result<AnySpectrum, String> {
+    let bar = progress::spinner("fitting filter");
+    let result = choose_filter(volume, kind, oversample, design)
+        .map_err(|e| e.to_string())
+        .and_then(|filter| {
+            bar.set_message("preprocess");
+            AnySpectrum::prepare(volume, filter, precision).map_err(|e| e.to_string())
+        });
+    bar.finish_and_clear();
+    result
+}
+
+fn turntable(args: &TurntableArgs) -> Result<(), String> {
+    let views = turntable::orbit(args.dir, args.up, args.frames as usize)?;
+    let style = args.png.style()?;
+    let raw = args.raw_dims.map(|dims| RawLayout {
+        dims,
+        ty: args.raw_type,
+        endian: args.raw_endian,
+    });
+    let t0 = Instant::now();
+    let mut volume = load_with_progress(&args.volume, raw)?;
+    if let Some(b) = args.background {
+        volume.subtract_background(b)?;
+    }
+    let t_load = t0.elapsed();
+    let t1 = Instant::now();
+    let spec = prepare_with_progress(
+        &volume,
+        args.filter,
+        args.oversample,
+        args.kb_design,
+        args.precision,
+    )?;
+    let t_prep = t1.elapsed();
+    let n = spec.n();
+    let side = n / args.oversample as usize;
+    let (w, h) = args.size.unwrap_or((side, side));
+    let bar = progress::count(views.len() as u64, "frames");
+    let t2 = Instant::now();
+    let frames = turntable::render_views(&spec, &views, w, h, &bar);
+    let t_views = t2.elapsed();
+    bar.finish_and_clear();
+    let frames = frames.map_err(|e| e.to_string())?;
+    write_apng(&args.out, w, h, &frames, args.fps, &style)?;
+    let secs = t_views.as_secs_f64();
+    println!(
+        "wrote {} ({} frames, {w}x{h}, {} fps)",
+        args.out.display(),
+        frames.len(),
+        args.fps
+    );
+    println!(
+        "  load {:.1} ms, preprocess {:.1} ms ({n}^3 {}), {} views in {:.1} ms = {:.1} views/s",
+        t_load.as_secs_f64() * 1e3,
+        t_prep.as_secs_f64() * 1e3,
+        args.precision,
+        frames.len(),
+        secs * 1e3,
+        frames.len() as f64 / secs.max(1e-9)
+    );
+    Ok(())
 }
 
 fn compare(a: &Path, b: &Path) -> Result<(), String> {

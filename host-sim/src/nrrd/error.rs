@@ -1,4 +1,5 @@
-//! The error type of NRRD and raw volume I/O.
+//! The error type of volume I/O: NRRD, raw, and the other formats of
+//! [`crate::formats`].
 
 use std::fmt;
 use std::io;
@@ -43,7 +44,8 @@ pub enum IoError {
         /// What is wrong with the value.
         problem: String,
     },
-    /// The header refers to a detached data file, which is not supported.
+    /// The header refers to a detached data file, but was parsed from memory
+    /// without a path to resolve it against.
     DetachedData {
         /// The value of the `data file` field.
         file: String,
@@ -81,6 +83,20 @@ pub enum IoError {
         /// What is wrong.
         problem: String,
     },
+    /// A malformed or unsupported field of a format other than NRRD.
+    Format {
+        /// The format and the part of the file, e.g. `NIfTI-1 header`.
+        format: &'static str,
+        /// The field, e.g. `pixdim`.
+        field: &'static str,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// A file whose format could not be recognised.
+    UnknownFormat {
+        /// What was seen, and what is supported.
+        problem: String,
+    },
     /// Another error, while reading or writing the file at `path`.
     File {
         /// The file.
@@ -92,7 +108,7 @@ pub enum IoError {
 
 impl IoError {
     /// Attach a file path to this error.
-    pub(super) fn in_file(self, path: &std::path::Path) -> Self {
+    pub(crate) fn in_file(self, path: &std::path::Path) -> Self {
         IoError::File {
             path: path.to_path_buf(),
             source: Box::new(self),
@@ -132,7 +148,7 @@ impl fmt::Display for IoError {
             IoError::Field { field, problem } => write!(f, "NRRD field `{field}`: {problem}"),
             IoError::DetachedData { file } => write!(
                 f,
-                "NRRD field `data file`: detached data files are not supported yet (header refers to `{file}`)"
+                "NRRD field `data file`: the samples are in the separate file `{file}`, which can only be found from the header's path (read the header as a file)"
             ),
             IoError::Truncated { expected, found, gzip } => {
                 let after = if *gzip { " after gzip decompression" } else { "" };
@@ -145,7 +161,7 @@ impl fmt::Display for IoError {
                 Gib(*limit)
             ),
             IoError::Gzip { source } => {
-                write!(f, "NRRD data (`encoding: gzip`): corrupt gzip stream: {source}")
+                write!(f, "corrupt or truncated gzip stream: {source}")
             }
             IoError::NonFinite { voxel: [i, j, k], value } if value.is_finite() => write!(
                 f,
@@ -156,6 +172,10 @@ impl fmt::Display for IoError {
                 "non-finite sample {value} at voxel ({i}, {j}, {k}); NaN/Inf data would corrupt the rendering"
             ),
             IoError::InvalidArgument { problem } => f.write_str(problem),
+            IoError::Format { format, field, problem } => {
+                write!(f, "{format} field `{field}`: {problem}")
+            }
+            IoError::UnknownFormat { problem } => f.write_str(problem),
             IoError::File { path, source } => write!(f, "{}: {source}", path.display()),
         }
     }
@@ -182,7 +202,7 @@ impl fmt::Display for Gib {
 
 /// A header value fit for an error message: at most 60 characters, control
 /// characters escaped.
-pub(super) fn excerpt(s: &str) -> String {
+pub(crate) fn excerpt(s: &str) -> String {
     const MAX_CHARS: usize = 60;
     let mut out = String::new();
     for (n, c) in s.chars().enumerate() {
@@ -197,6 +217,20 @@ pub(super) fn excerpt(s: &str) -> String {
         }
     }
     out
+}
+
+/// A malformed or unsupported field of a non-NRRD format.
+#[cold]
+pub(crate) fn format_error(
+    format: &'static str,
+    field: &'static str,
+    problem: impl Into<String>,
+) -> IoError {
+    IoError::Format {
+        format,
+        field,
+        problem: problem.into(),
+    }
 }
 
 /// A malformed or unsupported field value.

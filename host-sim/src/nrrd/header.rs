@@ -1,4 +1,4 @@
-//! Reading and validating an attached NRRD header.
+//! Reading and validating a NRRD header (attached, or detached in a `.nhdr`).
 
 use std::io::{BufRead, Read};
 
@@ -11,10 +11,10 @@ const MAX_LINE_BYTES: usize = 1 << 20;
 const MAX_HEADER_BYTES: usize = 16 << 20;
 
 /// Everything needed to decode the data that follows a header.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub(super) struct Layout {
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Layout {
     /// Volume dimensions, padded with 1s.
-    pub dims: [usize; 3],
+    pub(crate) dims: [usize; 3],
     /// Number of samples.
     pub count: usize,
     /// Bytes of sample data (`count` times the sample size).
@@ -29,6 +29,37 @@ pub(super) struct Layout {
     pub line_skip: u64,
     /// Bytes to skip before the data (after decompression for gzip).
     pub byte_skip: u64,
+    /// Voxel spacing from `spacings` or the lengths of `space directions`
+    /// (1 for axes without one).
+    pub spacing: [f64; 3],
+    /// The `data file` field: the data is in this file, relative to the
+    /// header's directory, not after the header.
+    pub data_file: Option<String>,
+}
+
+impl Layout {
+    /// The layout of `count` bare samples of `ty` (no skips, raw encoding,
+    /// unit spacing), `dims` padded to 3 with `count` their product.
+    pub(crate) fn samples(
+        dims: [usize; 3],
+        count: usize,
+        data_bytes: usize,
+        ty: SampleType,
+        endian: Endian,
+    ) -> Self {
+        Layout {
+            dims,
+            count,
+            data_bytes,
+            ty,
+            endian,
+            encoding: Encoding::Raw,
+            line_skip: 0,
+            byte_skip: 0,
+            spacing: crate::volume::DEFAULT_SPACING,
+            data_file: None,
+        }
+    }
 }
 
 /// The raw values of the fields this reader cares about.
@@ -42,6 +73,8 @@ struct Fields {
     byte_skip: Option<String>,
     line_skip: Option<String>,
     data_file: Option<String>,
+    spacings: Option<String>,
+    space_directions: Option<String>,
 }
 
 impl Fields {
@@ -57,6 +90,8 @@ impl Fields {
             "byte skip" | "byteskip" => ("byte skip", &mut self.byte_skip),
             "line skip" | "lineskip" => ("line skip", &mut self.line_skip),
             "data file" | "datafile" => ("data file", &mut self.data_file),
+            "spacings" => ("spacings", &mut self.spacings),
+            "space directions" => ("space directions", &mut self.space_directions),
             _ => return None,
         })
     }
@@ -80,11 +115,6 @@ impl Fields {
 
     /// Check and convert the fields.
     fn into_layout(self) -> Result<Layout, IoError> {
-        if let Some(file) = self.data_file {
-            return Err(IoError::DetachedData {
-                file: excerpt(&file),
-            });
-        }
         let ty = SampleType::from_nrrd_field(&required(self.ty, "type")?)?;
         let dimension = parse_dimension(&required(self.dimension, "dimension")?)?;
         let sizes = parse_sizes(&required(self.sizes, "sizes")?, dimension)?;
@@ -96,6 +126,16 @@ impl Fields {
         let byte_skip = parse_skip(self.byte_skip.as_deref(), "byte skip")?;
         let line_skip = parse_skip(self.line_skip.as_deref(), "line skip")?;
         let (dims, count, data_bytes) = geometry(&sizes, ty)?;
+        let spacing = match (self.spacings, self.space_directions) {
+            // The format forbids both; `space directions` is the fuller one.
+            (_, Some(d)) => parse_space_directions(&d, dimension)?,
+            (Some(s), None) => parse_spacings(&s, dimension)?,
+            (None, None) => crate::volume::DEFAULT_SPACING,
+        };
+        let data_file = match self.data_file {
+            Some(f) => Some(parse_data_file(&f)?),
+            None => None,
+        };
         Ok(Layout {
             dims,
             count,
@@ -105,6 +145,8 @@ impl Fields {
             encoding,
             line_skip,
             byte_skip,
+            spacing,
+            data_file,
         })
     }
 }
@@ -146,6 +188,106 @@ fn parse_sizes(value: &str, dimension: usize) -> Result<Vec<usize>, IoError> {
     }
 }
 
+/// The `spacings` field: one finite positive number per axis.
+fn parse_spacings(value: &str, dimension: usize) -> Result<[f64; 3], IoError> {
+    let words: Vec<&str> = value.split_whitespace().collect();
+    if words.len() != dimension {
+        return Err(field_error(
+            "spacings",
+            format!(
+                "expected {dimension} number{}, got `{}`",
+                if dimension == 1 { "" } else { "s" },
+                excerpt(value.trim())
+            ),
+        ));
+    }
+    let mut spacing = crate::volume::DEFAULT_SPACING;
+    for (slot, word) in spacing.iter_mut().zip(&words) {
+        *slot = word
+            .parse::<f64>()
+            .map_err(|_| field_error("spacings", format!("`{}` is not a number", excerpt(word))))?;
+    }
+    crate::volume::check_spacing(spacing).map_err(|e| field_error("spacings", e.to_string()))
+}
+
+/// The `space directions` field: per axis a vector `(x,y,z)` (or `none`);
+/// the spacing is its length. Only the lengths are kept: rendering happens
+/// in index space, scaled per axis.
+fn parse_space_directions(value: &str, dimension: usize) -> Result<[f64; 3], IoError> {
+    let bad = |why: String| field_error("space directions", why);
+    let mut spacing = crate::volume::DEFAULT_SPACING;
+    let mut rest = value.trim();
+    let mut axis = 0;
+    while !rest.is_empty() {
+        if axis == dimension {
+            return Err(bad(format!(
+                "more than {dimension} vectors in `{}`",
+                excerpt(value.trim())
+            )));
+        }
+        if let Some(after) = rest.strip_prefix("none") {
+            rest = after.trim_start();
+            axis += 1;
+            continue;
+        }
+        let inner = rest
+            .strip_prefix('(')
+            .and_then(|r| r.split_once(')'))
+            .ok_or_else(|| {
+                bad(format!(
+                    "expected vectors `(x,y,z)` or `none`, got `{}`",
+                    excerpt(rest)
+                ))
+            })?;
+        let components: Option<Vec<f64>> = inner
+            .0
+            .split(',')
+            .map(|c| c.trim().parse::<f64>().ok())
+            .collect();
+        let components = components.filter(|c| !c.is_empty()).ok_or_else(|| {
+            bad(format!(
+                "vector `({})` of axis {axis} is not a list of numbers",
+                excerpt(inner.0)
+            ))
+        })?;
+        let length = components.iter().map(|c| c * c).sum::<f64>().sqrt();
+        if !(length.is_finite() && length > 0.0) {
+            return Err(bad(format!(
+                "vector `({})` of axis {axis} has length {length}; it must be finite and non-zero",
+                excerpt(inner.0)
+            )));
+        }
+        spacing[axis] = length;
+        rest = inner.1.trim_start();
+        axis += 1;
+    }
+    if axis != dimension {
+        return Err(bad(format!(
+            "expected {dimension} vectors (or `none`), got {axis}"
+        )));
+    }
+    Ok(spacing)
+}
+
+/// The `data file` field: a single file name. The multi-file forms
+/// (`LIST`, or a format string with min, max and step) are refused.
+fn parse_data_file(value: &str) -> Result<String, IoError> {
+    let name = value.trim();
+    if name.is_empty() {
+        return Err(field_error("data file", "is empty"));
+    }
+    if name == "LIST" || name.starts_with("LIST ") || name.split_whitespace().count() > 1 {
+        return Err(field_error(
+            "data file",
+            format!(
+                "`{}` names several data files; only a single detached data file is supported",
+                excerpt(name)
+            ),
+        ));
+    }
+    Ok(name.to_owned())
+}
+
 fn parse_skip(value: Option<&str>, field: &'static str) -> Result<u64, IoError> {
     let Some(value) = value else { return Ok(0) };
     match value.trim().parse::<i64>() {
@@ -162,7 +304,7 @@ fn parse_skip(value: Option<&str>, field: &'static str) -> Result<u64, IoError> 
 }
 
 /// Dimensions padded to 3, sample count and data bytes, with overflow checks.
-pub(super) fn geometry(
+pub(crate) fn geometry(
     sizes: &[usize],
     ty: SampleType,
 ) -> Result<([usize; 3], usize, usize), IoError> {
@@ -278,7 +420,8 @@ pub(super) fn read_header<R: BufRead>(reader: &mut R) -> Result<Layout, IoError>
         parse_line(&mut fields, &line, lines.line)?;
     }
     let layout = fields.into_layout()?;
-    if !terminated {
+    // A detached header (`.nhdr`) may end at the end of its file.
+    if !terminated && layout.data_file.is_none() {
         return Err(header_error(
             lines.line,
             "end of file before the blank line that ends the header (no data follows)",

@@ -267,7 +267,7 @@ fn unsupported_encodings_are_named() {
 }
 
 #[test]
-fn detached_data_files_are_refused() {
+fn detached_data_files_need_the_header_path() {
     for key in ["data file", "datafile"] {
         let fields =
             format!("type: uchar\ndimension: 1\nsizes: 1\nencoding: raw\n{key}: vol.raw\n");
@@ -275,7 +275,7 @@ fn detached_data_files_are_refused() {
         bytes.splice(0..0, b"NRRD0004\n".iter().copied());
         let msg = parse_msg(&bytes);
         assert!(
-            msg.contains("detached data files are not supported yet"),
+            msg.contains("separate file") && msg.contains("header's path"),
             "{msg}"
         );
         assert!(msg.contains("vol.raw"), "{msg}");

@@ -1,0 +1,178 @@
+//! DICOM series: slice sorting, spacing, rescale, series selection and bad
+//! input, on series written by `encode_ct_slice`.
+
+use std::path::{Path, PathBuf};
+
+use fvr_host::formats::dicom::{encode_ct_slice, parse_slice, read_dicom};
+use fvr_host::formats::{detect, read_volume, Format};
+
+const AXIAL: [f64; 6] = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("fvr-dicom-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Pixels of slice `k`: distinct per pixel and slice.
+fn pixels(k: usize, n: usize) -> Vec<i16> {
+    (0..n).map(|i| (100 * k + i) as i16).collect()
+}
+
+/// Write slices `k` at depth `depths[k]` along `normal`, file names in the
+/// order given by `names` (so the directory order is not the slice order).
+fn write_series(dir: &Path, series: &str, depths: &[f64], orientation: [f64; 6], names: &[&str]) {
+    let row = [orientation[0], orientation[1], orientation[2]];
+    let col = [orientation[3], orientation[4], orientation[5]];
+    let normal = [
+        row[1] * col[2] - row[2] * col[1],
+        row[2] * col[0] - row[0] * col[2],
+        row[0] * col[1] - row[1] * col[0],
+    ];
+    for (k, &d) in depths.iter().enumerate() {
+        let position = [
+            10.0 + d * normal[0],
+            -20.0 + d * normal[1],
+            5.0 + d * normal[2],
+        ];
+        let bytes = encode_ct_slice(
+            series,
+            k as u32 + 1,
+            [5, 3],
+            [0.7, 0.6],
+            position,
+            orientation,
+            -1024.0,
+            &pixels(k, 15),
+        );
+        std::fs::write(dir.join(names[k]), bytes).unwrap();
+    }
+}
+
+fn err_of(path: &Path) -> String {
+    match read_dicom(path) {
+        Ok(v) => panic!("expected an error, got {:?}", v.dims),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn a_series_is_sorted_by_position_with_spacing_and_rescale() {
+    let dir = temp_dir("axial");
+    // Depths out of file-name order: c=0, a=2.5, d=5, b=7.5.
+    write_series(
+        &dir,
+        "1.2.3",
+        &[2.5, 7.5, 0.0, 5.0],
+        AXIAL,
+        &["a.dcm", "b.dcm", "c.dcm", "d.dcm"],
+    );
+    std::fs::write(dir.join("notes.txt"), "not DICOM").unwrap();
+    assert_eq!(detect(&dir).unwrap(), Format::Dicom);
+    let vol = read_volume(&dir).expect("series");
+    assert_eq!(vol.dims, [5, 3, 4]);
+    assert_eq!(vol.spacing, [0.6, 0.7, 2.5]);
+    // Slice order by depth is files c, a, d, b = written slices 2, 0, 3, 1.
+    for (z, k) in [2usize, 0, 3, 1].into_iter().enumerate() {
+        for i in 0..15 {
+            let expected = pixels(k, 15)[i] as f32 - 1024.0;
+            assert_eq!(vol.get(i % 5, i / 5, z), expected, "z {z} pixel {i}");
+        }
+    }
+    // One file of the series reads the whole series.
+    assert_eq!(
+        read_volume(&dir.join("b.dcm")).expect("one file").data,
+        vol.data
+    );
+}
+
+#[test]
+fn an_oblique_series_sorts_along_its_normal() {
+    let dir = temp_dir("coronal");
+    // Rows along x, columns along -z: the normal is +y.
+    let coronal = [1.0, 0.0, 0.0, 0.0, 0.0, -1.0];
+    write_series(
+        &dir,
+        "9.9",
+        &[3.0, 0.0, 1.5],
+        coronal,
+        &["1.dcm", "2.dcm", "3.dcm"],
+    );
+    let vol = read_dicom(&dir).expect("coronal");
+    assert_eq!(vol.spacing, [0.6, 0.7, 1.5]);
+    assert_eq!(vol.get(0, 0, 0), pixels(1, 15)[0] as f32 - 1024.0);
+    assert_eq!(vol.get(0, 0, 2), pixels(0, 15)[0] as f32 - 1024.0);
+}
+
+#[test]
+fn one_file_picks_its_series_and_a_mixed_directory_is_refused() {
+    let dir = temp_dir("two-series");
+    write_series(&dir, "1.1", &[0.0, 1.0, 2.0], AXIAL, &["a1", "a2", "a3"]);
+    write_series(&dir, "2.2", &[0.0, 3.0], AXIAL, &["b1", "b2"]);
+    assert_eq!(read_dicom(&dir.join("b2")).unwrap().dims, [5, 3, 2]);
+    assert_eq!(read_dicom(&dir.join("a1")).unwrap().dims, [5, 3, 3]);
+    let msg = err_of(&dir);
+    assert!(
+        msg.contains("2 series") && msg.contains("1.1") && msg.contains("2.2"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn gaps_duplicates_and_mismatches_are_refused() {
+    let gap = temp_dir("gap");
+    write_series(
+        &gap,
+        "1",
+        &[0.0, 1.0, 2.0, 4.0],
+        AXIAL,
+        &["1", "2", "3", "4"],
+    );
+    let msg = err_of(&gap);
+    assert!(
+        msg.contains("ImagePositionPatient") && msg.contains("missing slices"),
+        "{msg}"
+    );
+    let dup = temp_dir("dup");
+    write_series(&dup, "1", &[0.0, 1.0, 1.0], AXIAL, &["1", "2", "3"]);
+    assert!(err_of(&dup).contains("share a position"));
+    let size = temp_dir("size");
+    write_series(&size, "1", &[0.0, 1.0], AXIAL, &["1", "2"]);
+    let other = encode_ct_slice(
+        "1",
+        3,
+        [4, 3],
+        [0.7, 0.6],
+        [10.0, -20.0, 7.0],
+        AXIAL,
+        0.0,
+        &[0; 12],
+    );
+    std::fs::write(size.join("3"), other).unwrap();
+    assert!(err_of(&size).contains("Rows"), "{}", err_of(&size));
+    let zero = temp_dir("zero-spacing");
+    let flat = encode_ct_slice("1", 1, [2, 2], [0.0, 0.5], [0.0; 3], AXIAL, 0.0, &[0; 4]);
+    std::fs::write(zero.join("1"), flat).unwrap();
+    let msg = err_of(&zero);
+    assert!(
+        msg.contains("PixelSpacing") && msg.contains("zero"),
+        "{msg}"
+    );
+    let empty = temp_dir("empty");
+    std::fs::write(empty.join("readme"), "nothing here").unwrap();
+    assert!(err_of(&empty).contains("no DICOM image"));
+}
+
+#[test]
+fn corrupt_files_are_named() {
+    let dir = temp_dir("corrupt");
+    write_series(&dir, "1", &[0.0, 1.0], AXIAL, &["good", "bad"]);
+    let bytes = std::fs::read(dir.join("bad")).unwrap();
+    std::fs::write(dir.join("bad"), &bytes[..bytes.len() - 7]).unwrap();
+    let msg = err_of(&dir);
+    assert!(msg.contains("bad") && msg.contains("DICOM"), "{msg}");
+    let e = parse_slice(&bytes[..200]).unwrap_err().to_string();
+    assert!(e.contains("DICOM"), "{e}");
+    assert!(parse_slice(b"hello").is_err());
+}

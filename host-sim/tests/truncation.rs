@@ -1,0 +1,99 @@
+//! Every prefix of a valid file is refused with an error, never a panic or
+//! a volume: a deterministic, exhaustive companion to the fuzzers in
+//! `fuzz/` that runs in every test pass.
+
+use std::io::Write;
+
+use fvr_host::formats::den::{encode_den, parse_den};
+use fvr_host::formats::dicom::{encode_ct_slice, parse_slice};
+use fvr_host::formats::inv3::{encode_inv3_i16, parse_inv3};
+use fvr_host::formats::nifti::{encode_nifti_f32, parse_nifti};
+use fvr_host::nrrd::IoError;
+use fvr_host::nrrd::{encode_nrrd, parse_nrrd, Encoding, Endian, SampleType};
+use fvr_host::volume::Volume;
+
+fn gzip(bytes: &[u8]) -> Vec<u8> {
+    let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+    e.write_all(bytes).unwrap();
+    e.finish().unwrap()
+}
+
+/// `parse` accepts `whole` and refuses every strict prefix of it.
+fn every_prefix_is_refused(
+    name: &str,
+    whole: &[u8],
+    parse: impl Fn(&[u8]) -> Result<Volume, IoError>,
+) {
+    let full = parse(whole).unwrap_or_else(|e| panic!("{name}: the whole file fails: {e}"));
+    assert!(!full.data.is_empty());
+    for len in 0..whole.len() {
+        if let Ok(v) = parse(&whole[..len]) {
+            panic!(
+                "{name}: a prefix of {len} of {} bytes gave a volume of {:?}",
+                whole.len(),
+                v.dims
+            );
+        }
+    }
+}
+
+#[test]
+fn prefixes_of_every_format_are_errors() {
+    let den = encode_den(
+        [3, 4, 5],
+        &(0..60).map(|i| i as u8).collect::<Vec<_>>(),
+        Endian::Big,
+    );
+    every_prefix_is_refused("den", &den, parse_den);
+    every_prefix_is_refused("den.gz", &gzip(&den), parse_den);
+    let data: Vec<f32> = (0..24).map(|i| i as f32 * 0.5).collect();
+    let nii = encode_nifti_f32(
+        [4, 3, 2],
+        [0.5, 1.0, 2.0],
+        (2.0, 1.0),
+        &data,
+        Endian::Little,
+    );
+    every_prefix_is_refused("nii", &nii, parse_nifti);
+    every_prefix_is_refused("nii.gz", &gzip(&nii), parse_nifti);
+    let inv3 = encode_inv3_i16(
+        [3, 2, 2],
+        [0.9, 0.9, 1.5],
+        &[-1024, 0, 5, 7, 9, 11, 13, 15, 17, 19, 21, 3033],
+    );
+    every_prefix_is_refused("inv3", &inv3, parse_inv3);
+    let values: Vec<f64> = (0..12).map(|i| i as f64).collect();
+    for encoding in [Encoding::Raw, Encoding::Gzip] {
+        let nrrd = encode_nrrd(&[3, 2, 2], SampleType::I16, encoding, Endian::Big, &values);
+        every_prefix_is_refused("nrrd", &nrrd, parse_nrrd);
+    }
+}
+
+#[test]
+fn prefixes_of_a_dicom_slice_are_errors() {
+    let orientation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    let bytes = encode_ct_slice(
+        "1.2",
+        1,
+        [3, 2],
+        [0.5, 0.5],
+        [0.0; 3],
+        orientation,
+        -1024.0,
+        &[1, 2, 3, 4, 5, 6],
+    );
+    let slice = parse_slice(&bytes).expect("whole slice");
+    assert_eq!(
+        slice.pixels,
+        vec![-1023.0, -1022.0, -1021.0, -1020.0, -1019.0, -1018.0]
+    );
+    for len in 0..bytes.len() {
+        if let Ok(s) = parse_slice(&bytes[..len]) {
+            panic!(
+                "a prefix of {len} of {} bytes gave a slice of {:?}",
+                bytes.len(),
+                s.size
+            );
+        }
+    }
+}
