@@ -476,4 +476,52 @@ impl AnySpectrum {
             AnySpectrum::F64(s) => go::<_, f64>(s, view, width, height),
         }
     }
+
+    /// The progressive preview at `level` ([`fvr_core::progressive`]):
+    /// a `width × height` image at pitch `2^level` voxels.
+    ///
+    /// # Errors
+    /// As [`fvr_core::progressive::render_level`].
+    pub fn render_level(
+        &self,
+        view: &View,
+        width: usize,
+        height: usize,
+        level: u32,
+    ) -> Result<Vec<f64>, fvr_core::Error> {
+        fn go<S: Sample, T: Real>(
+            s: &OwnedSpectrum<S>,
+            view: &View,
+            w: usize,
+            h: usize,
+            level: u32,
+        ) -> Result<Vec<f64>, fvr_core::Error> {
+            let n = s.n();
+            let m = (n >> level.min(usize::BITS - 1)).max(1);
+            let mut tw_buf = vec![T::ZERO; Twiddles::<T>::buffer_len(n)];
+            let tw = Twiddles::new(&mut tw_buf, n)?;
+            let kernel = KernelTable::<T>::new(s.filter());
+            let mut grid = vec![T::ZERO; m * m];
+            let mut aux = vec![T::ZERO; aux_len(m)];
+            let mut out = vec![T::ZERO; w * h];
+            fvr_core::progressive::render_level(
+                &s.view(),
+                &kernel,
+                view,
+                w,
+                h,
+                level,
+                &tw,
+                &mut grid,
+                &mut aux,
+                &mut out,
+            )?;
+            Ok(out.into_iter().map(T::to_f64).collect())
+        }
+        match self {
+            AnySpectrum::F16(s) => go::<_, f32>(s, view, width, height, level),
+            AnySpectrum::F32(s) => go::<_, f32>(s, view, width, height, level),
+            AnySpectrum::F64(s) => go::<_, f64>(s, view, width, height, level),
+        }
+    }
 }

@@ -163,3 +163,80 @@ fn bad_scene_values_exit_2_naming_the_problem() {
         assert_error(&out, &needles);
     }
 }
+
+#[test]
+fn adaptive_and_preview_options_report_and_refuse_conflicts() {
+    let dir = temp_dir("adaptive");
+    let base = [
+        "render",
+        "gaussians@32",
+        "--dir",
+        "1,0.3,0.2",
+        "--oversample",
+        "2",
+    ];
+    let mut args = base.to_vec();
+    args.extend(["--adaptive", "40", "--stats-json", "--out", "a.nrrd"]);
+    let out = fvr(&args, &dir);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json = stdout
+        .lines()
+        .find(|l| l.starts_with('{'))
+        .expect("a JSON line");
+    for key in [
+        "\"taps_ratio\"",
+        "\"snr_vs_full_db\"",
+        "\"levels\"",
+        "\"marks_bytes\"",
+    ] {
+        assert!(json.contains(key), "{key} not in {json}");
+    }
+    let snr: f64 = json
+        .split("\"snr_vs_full_db\": ")
+        .nth(1)
+        .and_then(|r| r.split([',', '}']).next())
+        .and_then(|v| v.trim().parse().ok())
+        .expect("an SNR");
+    assert!(snr >= 40.0, "{json}");
+
+    let mut preview = base.to_vec();
+    preview.extend(["--preview-level", "1", "--out", "p.nrrd"]);
+    let out = fvr(&preview, &dir);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // 32³ at oversampling 2: a 32² image by default, 16² at level 1.
+    assert_eq!(read_nrrd(&dir.join("p.nrrd")).unwrap().dims, [16, 16, 1]);
+
+    let cases: Vec<(Vec<&str>, Vec<&str>)> = vec![
+        (vec!["--adaptive", "0"], vec!["positive number of dB"]),
+        (vec!["--adaptive", "abc"], vec!["positive number of dB"]),
+        (vec!["--adaptive", "-3"], vec!["positive number of dB"]),
+        (
+            vec!["--adaptive", "40", "--adaptive-chain", "kb6"],
+            vec!["not cheaper"],
+        ),
+        (
+            vec!["--adaptive", "40", "--preview-level", "1"],
+            vec!["cannot be combined"],
+        ),
+        (
+            vec!["--adaptive", "40", "--light", "0,1,0:1,1,1"],
+            vec!["plain X-ray views"],
+        ),
+        (vec!["--preview-level", "9"], vec!["progressive levels"]),
+    ];
+    for (extra, needles) in cases {
+        let mut a = base.to_vec();
+        a.extend(extra.iter().copied());
+        a.extend(["--out", "x.png"]);
+        assert_error(&fvr(&a, &dir), &needles);
+    }
+}

@@ -8,6 +8,7 @@ use clap::{Args, Parser, Subcommand};
 use fvr_core::filter::FilterKind;
 use fvr_core::geometry::{View, DEFAULT_UP};
 use fvr_core::scene::{Light, Scene, MAX_LIGHTS};
+use fvr_host::adaptive::{parse_chain, parse_tolerance};
 use fvr_host::datasets::DATASETS_HELP;
 use fvr_host::formats::FORMATS_HELP;
 use fvr_host::nrrd::{read_nrrd, Endian, SampleType};
@@ -157,6 +158,29 @@ struct RenderArgs {
     /// Print timing, memory and filter details.
     #[arg(long)]
     stats: bool,
+    /// Print the statistics as one JSON object instead (implies --stats).
+    #[arg(long)]
+    stats_json: bool,
+    /// Adaptive filtering (paper §4): use a cheaper filter wherever the
+    /// spectrum is weak, keeping the image within DB decibels of the
+    /// full-filter image (eq. 16). Plain X-ray views only.
+    #[arg(long, value_name = "DB", value_parser = parse_tolerance, allow_hyphen_values = true)]
+    adaptive: Option<f64>,
+    /// The cheaper filters of --adaptive, cheapest first (1 or 2 of nearest,
+    /// linear, cubic, kb3, ...; each narrower than --filter).
+    #[arg(long, default_value = "nearest")]
+    adaptive_chain: String,
+    /// Use this response difference h_d in eq. 16 instead of the one computed
+    /// for the filter pair (the paper used 0.3). A smaller value than the
+    /// filters' own voids the guarantee; --stats then shows the SNR reached.
+    #[arg(long, value_name = "H")]
+    adaptive_hd: Option<f64>,
+    /// Progressive preview level: 0 full resolution; L renders the image at
+    /// 1/2^L of the size from the central 1/4^L of the slice (4^L times fewer
+    /// interpolations). Plain X-ray views only. (`--level` is the PNG
+    /// window level, as in radiology viewers.)
+    #[arg(long, value_name = "L", default_value_t = 0)]
+    preview_level: u32,
     /// For a built-in phantom, also print the SNR against its exact line integrals.
     #[arg(long)]
     exact: bool,
@@ -381,6 +405,11 @@ fn default_scene() -> Result<(), String> {
             colormap: Colormap::Gray,
         },
         stats: true,
+        stats_json: false,
+        adaptive: None,
+        adaptive_chain: "nearest".into(),
+        adaptive_hd: None,
+        preview_level: 0,
         exact: false,
         raw_dims: None,
         raw_type: SampleType::U8,
@@ -455,11 +484,66 @@ fn render(args: &RenderArgs) -> Result<(), String> {
     let (w, h) = args
         .size
         .unwrap_or((n / args.oversample as usize, n / args.oversample as usize));
+    let plain_view = scene.channels() == 1 && !scene.has_partner_terms();
+    if (args.preview_level > 0 || args.adaptive.is_some()) && !plain_view {
+        return Err(
+            "--preview-level and --adaptive work on plain X-ray views: leave out --depth-cue, \
+                    --light, --light-ring and a coloured --ambient"
+                .into(),
+        );
+    }
+    if args.preview_level > 0 && args.adaptive.is_some() {
+        return Err("--preview-level and --adaptive cannot be combined: choose one".into());
+    }
+    let mut adaptive_report = None;
     let t2 = Instant::now();
-    let image = spectra
-        .render(&scene, &view, w, h)
-        .map_err(|e| e.to_string())?;
-    let t_view = t2.elapsed();
+    let (image, w, h) = if args.preview_level > 0 {
+        let (pw, ph) = fvr_core::progressive::preview_size(w, h, args.preview_level);
+        let data = spectra
+            .density
+            .render_level(&view, pw, ph, args.preview_level)
+            .map_err(|e| e.to_string())?;
+        (
+            fvr_host::shaded::Image {
+                channels: 1,
+                width: pw,
+                height: ph,
+                data: data.into_iter().map(|v| v * scene.ambient[0]).collect(),
+            },
+            pw,
+            ph,
+        )
+    } else if let Some(tolerance) = args.adaptive {
+        let report = adaptive_render(
+            &spectra.density,
+            &view,
+            w,
+            h,
+            tolerance,
+            &parse_chain(&args.adaptive_chain)?,
+            args.adaptive_hd,
+        )?;
+        let data = report.image.iter().map(|v| v * scene.ambient[0]).collect();
+        adaptive_report = Some(report);
+        (
+            fvr_host::shaded::Image {
+                channels: 1,
+                width: w,
+                height: h,
+                data,
+            },
+            w,
+            h,
+        )
+    } else {
+        let image = spectra
+            .render(&scene, &view, w, h)
+            .map_err(|e| e.to_string())?;
+        (image, w, h)
+    };
+    let t_view = adaptive_report
+        .as_ref()
+        .map_or(t2.elapsed(), |r| r.view_time);
     if ext == "png" {
         if image.channels == 1 {
             write_png(&args.out, w, h, &image.data, &style)?;
@@ -471,7 +555,7 @@ fn render(args: &RenderArgs) -> Result<(), String> {
     }
     let kind = if image.channels == 1 { "grey" } else { "RGB" };
     println!("wrote {} ({w}x{h} {kind})", args.out.display());
-    if args.stats {
+    if args.stats && !args.stats_json {
         let d = volume.dims;
         println!(
             "  volume        {}x{}x{} ({})",
@@ -519,6 +603,49 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         println!("  load          {:.1} ms", t_load.as_secs_f64() * 1e3);
         println!("  preprocess    {:.1} ms", t_prep.as_secs_f64() * 1e3);
         println!("  view          {:.2} ms", t_view.as_secs_f64() * 1e3);
+        if args.preview_level > 0 {
+            println!(
+                "  level         {} ({w}x{h} at pitch {} voxels, central 1/{} of the slice)",
+                args.preview_level,
+                1u64 << args.preview_level,
+                1u64 << (2 * args.preview_level)
+            );
+        }
+        if let Some(r) = &adaptive_report {
+            r.print_human();
+        }
+    }
+    if args.stats_json {
+        let mut fields = vec![
+            ("volume", json_str(&args.volume)),
+            ("dims", format!("{:?}", volume.dims)),
+            ("image", format!("[{w}, {h}, {}]", image.channels)),
+            ("spectrum_side", n.to_string()),
+            ("precision", json_str(args.precision.name())),
+            ("spectrum_bytes", spectra.density.bytes().to_string()),
+            (
+                "gradient_spectrum_bytes",
+                spectra
+                    .gradient
+                    .as_ref()
+                    .map_or("null".into(), |g| g.bytes().to_string()),
+            ),
+            ("filter", json_str(filter.kind().name())),
+            ("oversample", filter.oversample().to_string()),
+            ("storage_snr_db", json_num(storage_snr)),
+            ("load_ms", json_num(t_load.as_secs_f64() * 1e3)),
+            ("preprocess_ms", json_num(t_prep.as_secs_f64() * 1e3)),
+            ("view_ms", json_num(t_view.as_secs_f64() * 1e3)),
+            ("preview_level", args.preview_level.to_string()),
+        ];
+        if let Some(r) = &adaptive_report {
+            fields.push(("adaptive", r.json()));
+        }
+        let body: Vec<String> = fields
+            .iter()
+            .map(|(k, v)| format!("{}: {v}", json_str(k)))
+            .collect();
+        println!("{{{}}}", body.join(", "));
     }
     if args.exact {
         let plain = scene.channels() == 1 && !scene.has_partner_terms();
@@ -712,4 +839,166 @@ fn accuracy(sizes: &[usize]) -> Result<(), String> {
     let rows = fvr_host::accuracy::accuracy_table(sizes).map_err(|e| e.to_string())?;
     print!("{}", fvr_host::accuracy::markdown(&rows));
     Ok(())
+}
+
+fn json_str(s: &str) -> String {
+    let mut out = String::from("\"");
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            c if (c as u32) < 0x20 => out.push_str(&format!("\\u{:04x}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
+fn json_num(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v}")
+    } else {
+        "null".into()
+    }
+}
+
+/// An adaptive render with what it did.
+struct AdaptiveReport {
+    image: Vec<f64>,
+    marks: fvr_host::adaptive::AdaptiveMarks,
+    stats: fvr_core::adaptive::AdaptiveStats,
+    mark_time: std::time::Duration,
+    view_time: std::time::Duration,
+    full_view_time: std::time::Duration,
+    snr_vs_full: f64,
+}
+
+impl AdaptiveReport {
+    fn print_human(&self) {
+        let s = &self.stats;
+        let pct = |v: u64, of: u64| 100.0 * v as f64 / of.max(1) as f64;
+        println!(
+            "  adaptive      {} dB: {} of {} taps ({:.1}%), {:.2} ms per view against {:.2} ms \
+             with the full filter; image {:.1} dB from the full-filter image",
+            self.marks.tolerance_db,
+            s.taps,
+            s.full_taps,
+            pct(s.taps, s.full_taps),
+            self.view_time.as_secs_f64() * 1e3,
+            self.full_view_time.as_secs_f64() * 1e3,
+            self.snr_vs_full
+        );
+        println!(
+            "  samples       {:.1}% on the full filter",
+            pct(s.per_filter[0], s.samples)
+        );
+        for (i, l) in self.marks.levels.iter().enumerate() {
+            println!(
+                "  samples       {:.1}% on {} (h_d {:.3}, threshold {:.3e}, {} of {} spectrum samples marked)",
+                pct(s.per_filter[i + 1], s.samples),
+                l.filter.kind().name(),
+                l.h_d,
+                l.threshold,
+                l.marked,
+                l.words.len() * 32
+            );
+        }
+        println!(
+            "  marks         {} bytes (1 bit per voxel per level), built in {:.1} ms",
+            self.marks.bytes(),
+            self.mark_time.as_secs_f64() * 1e3
+        );
+        if let Some(note) = self.marks.effect(s) {
+            println!("  note          {note}");
+        }
+    }
+
+    fn json(&self) -> String {
+        let s = &self.stats;
+        let levels: Vec<String> = self
+            .marks
+            .levels
+            .iter()
+            .enumerate()
+            .map(|(i, l)| {
+                format!(
+                    "{{\"filter\": {}, \"h_d\": {}, \"threshold\": {}, \"marked\": {}, \"samples\": {}}}",
+                    json_str(l.filter.kind().name()),
+                    json_num(l.h_d),
+                    json_num(l.threshold),
+                    l.marked,
+                    s.per_filter[i + 1]
+                )
+            })
+            .collect();
+        format!(
+            "{{\"tolerance_db\": {}, \"taps\": {}, \"full_taps\": {}, \"taps_ratio\": {}, \
+             \"samples\": {}, \"full_filter_samples\": {}, \"levels\": [{}], \"marks_bytes\": {}, \
+             \"mark_ms\": {}, \"view_ms\": {}, \"full_view_ms\": {}, \"snr_vs_full_db\": {}, \
+             \"note\": {}}}",
+            json_num(self.marks.tolerance_db),
+            s.taps,
+            s.full_taps,
+            json_num(s.taps as f64 / s.full_taps.max(1) as f64),
+            s.samples,
+            s.per_filter[0],
+            levels.join(", "),
+            self.marks.bytes(),
+            json_num(self.mark_time.as_secs_f64() * 1e3),
+            json_num(self.view_time.as_secs_f64() * 1e3),
+            json_num(self.full_view_time.as_secs_f64() * 1e3),
+            json_num(self.snr_vs_full),
+            self.marks.effect(s).map_or("null".into(), |n| json_str(&n))
+        )
+    }
+}
+
+/// Mark the spectrum, render adaptively, and render with the full filter
+/// for comparison.
+fn adaptive_render(
+    spec: &AnySpectrum,
+    view: &View,
+    w: usize,
+    h: usize,
+    tolerance: f64,
+    chain: &[FilterKind],
+    h_d: Option<f64>,
+) -> Result<AdaptiveReport, String> {
+    fn go<S: fvr_core::real::Sample, T: fvr_core::real::Real>(
+        any: &AnySpectrum,
+        spec: &fvr_host::pipeline::OwnedSpectrum<S>,
+        view: &View,
+        w: usize,
+        h: usize,
+        tolerance: f64,
+        chain: &[FilterKind],
+        h_d: Option<f64>,
+    ) -> Result<AdaptiveReport, String> {
+        let t0 = Instant::now();
+        let marks = fvr_host::adaptive::AdaptiveMarks::build(spec, tolerance, chain, h_d)?;
+        let mark_time = t0.elapsed();
+        let t1 = Instant::now();
+        let (image, stats) = marks
+            .render::<S, T>(spec, view, w, h)
+            .map_err(|e| e.to_string())?;
+        let view_time = t1.elapsed();
+        let t2 = Instant::now();
+        let full = any.render(view, w, h).map_err(|e| e.to_string())?;
+        let full_view_time = t2.elapsed();
+        Ok(AdaptiveReport {
+            snr_vs_full: snr_db(&full, &image),
+            image,
+            marks,
+            stats,
+            mark_time,
+            view_time,
+            full_view_time,
+        })
+    }
+    match spec {
+        AnySpectrum::F16(s) => go::<_, f32>(spec, s, view, w, h, tolerance, chain, h_d),
+        AnySpectrum::F32(s) => go::<_, f32>(spec, s, view, w, h, tolerance, chain, h_d),
+        AnySpectrum::F64(s) => go::<_, f64>(spec, s, view, w, h, tolerance, chain, h_d),
+    }
 }
