@@ -18,3 +18,15 @@ p=blobs@128:4
 "$fvr" render "$p" "${view[@]}" --light 0,0.6,1:1,1,1 --ambient 0.02 --depth-cue linear:1,0.15 \
     --out "$out/phantom-6d-shaded-depth-cued.png"
 "$fvr" render "$p" "${view[@]}" --light-ring 3 --ambient 0.05 --out "$out/phantom-8-three-lights.png"
+
+# The InVesalius CT head (GPL-2; installed from Debian at run time, never
+# committed), air set to zero, resampled to cubic voxels of 1.9 mm (128 along
+# its longest side), lateral view.
+ct=(ct-head --background -1024 --resample 128 --dir 1,0.25,0 --up 0,0,1)
+bash scripts/fetch-ct-head.sh > /dev/null
+"$fvr" render "${ct[@]}" --out "$out/ct-6a-xray.png"
+"$fvr" render "${ct[@]}" --depth-cue linear:1,0.25 --out "$out/ct-6b-depth-cued.png"
+"$fvr" render "${ct[@]}" --light 0,-1,0.4:1,1,1 --ambient 0.03 --out "$out/ct-6c-shaded.png"
+"$fvr" render "${ct[@]}" --light 0,-1,0.4:1,1,1 --ambient 0.03 --depth-cue linear:1,0.25 \
+    --out "$out/ct-6d-shaded-depth-cued.png"
+"$fvr" render "${ct[@]}" --light-ring 3 --ambient 0.03 --out "$out/ct-8-three-lights.png"

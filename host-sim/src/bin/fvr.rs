@@ -158,6 +158,11 @@ struct RenderArgs {
     /// Print timing, memory and filter details.
     #[arg(long)]
     stats: bool,
+    /// Resample to cubic voxels with N samples along the longest physical
+    /// side (trilinear) before rendering: for anisotropic data such as CT
+    /// (0.957 x 0.957 x 1.5 mm), which is otherwise rendered in voxel units.
+    #[arg(long, value_name = "N")]
+    resample: Option<usize>,
     /// Print the statistics as one JSON object instead (implies --stats).
     #[arg(long)]
     stats_json: bool,
@@ -405,6 +410,7 @@ fn default_scene() -> Result<(), String> {
             colormap: Colormap::Gray,
         },
         stats: true,
+        resample: None,
         stats_json: false,
         adaptive: None,
         adaptive_chain: "nearest".into(),
@@ -446,6 +452,9 @@ fn render(args: &RenderArgs) -> Result<(), String> {
     let mut volume = load_with_progress(&args.volume, raw)?;
     if let Some(b) = args.background {
         volume.subtract_background(b)?;
+    }
+    if let Some(largest) = args.resample {
+        volume = volume.resample_isotropic(largest)?;
     }
     let t_load = t0.elapsed();
     let scene = build_scene(args)?;
