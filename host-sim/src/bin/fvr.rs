@@ -92,6 +92,27 @@ enum Command {
     /// against the f64 pipeline and exact line integrals, with bytes per
     /// voxel; writes a Markdown table, a CSV and a PNG plot.
     Precision(fvr_host::precision_cli::PrecisionArgs),
+    /// The paper's Table 1 measured here: filter taps and time per view with
+    /// and without adaptive filtering, and the spatial-domain ray caster, on
+    /// the CT head (resampled to 128 along its longest side), a 256³ volume
+    /// and a phantom. Prints Markdown.
+    AdaptiveTable {
+        /// Tolerance in dB.
+        #[arg(long, default_value_t = 40.0, value_parser = parse_tolerance)]
+        tolerance: f64,
+        /// Large filter (the spectrum's).
+        #[arg(long, value_parser = parse_filter, default_value = "kb3")]
+        filter: FilterKind,
+        /// Oversampling of the spectrum.
+        #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=2))]
+        oversample: u32,
+        /// Volumes (ct-head is resampled to 128).
+        #[arg(long, value_delimiter = ',', default_values_t = ["ct-head".to_string(), "blobs@256".to_string(), "gaussians@128".to_string(), "shepp-logan@128".to_string()])]
+        volumes: Vec<String>,
+        /// Timed runs per measurement (the median is reported).
+        #[arg(long, default_value_t = 5)]
+        runs: usize,
+    },
 }
 
 #[derive(Args)]
@@ -374,6 +395,13 @@ fn main() -> ExitCode {
         Some(Command::Turntable(args)) => turntable(&args),
         Some(Command::Compare { a, b }) => compare(&a, &b),
         Some(Command::Accuracy { sizes }) => accuracy(&sizes),
+        Some(Command::AdaptiveTable {
+            tolerance,
+            filter,
+            oversample,
+            volumes,
+            runs,
+        }) => adaptive_table(tolerance, filter, oversample, &volumes, runs),
         Some(Command::Precision(args)) => fvr_host::precision_cli::run(&args),
     };
     match result {
@@ -1010,4 +1038,35 @@ fn adaptive_render(
         AnySpectrum::F32(s) => go::<_, f32>(spec, s, view, w, h, tolerance, chain, h_d),
         AnySpectrum::F64(s) => go::<_, f64>(spec, s, view, w, h, tolerance, chain, h_d),
     }
+}
+
+fn adaptive_table(
+    tolerance: f64,
+    kind: FilterKind,
+    oversample: u32,
+    volumes: &[String],
+    runs: usize,
+) -> Result<(), String> {
+    let filter = fvr_core::filter::Filter::new(kind, oversample).map_err(|e| e.to_string())?;
+    let view = View::along([1.0, 0.3, 0.2]);
+    let mut rows = Vec::new();
+    for name in volumes {
+        let mut volume = load_with_progress(name, None)?;
+        if name == "ct-head" {
+            volume.subtract_background(-1024.0)?;
+            volume = volume.resample_isotropic(128)?;
+        }
+        rows.push(fvr_host::adaptive::table1_row(
+            name,
+            &volume,
+            filter,
+            &[FilterKind::Nearest],
+            tolerance,
+            &view,
+            runs.max(1),
+        )?);
+        eprintln!("fvr: measured {name}");
+    }
+    print!("{}", fvr_host::adaptive::table1_markdown(&rows, tolerance));
+    Ok(())
 }
