@@ -176,3 +176,35 @@ fn corrupt_files_are_named() {
     assert!(e.contains("DICOM"), "{e}");
     assert!(parse_slice(b"hello").is_err());
 }
+
+/// Found by `cargo fuzz run dicom`: an element declaring more bytes than
+/// the file holds made `dicom-object` zero-fill the declared length first
+/// (1.6 s and gigabytes for a 742-byte file). Now refused before parsing.
+#[test]
+fn fuzz_regression_declared_lengths_beyond_the_file_are_refused() {
+    let found = include_bytes!("data/fuzz/dicom-declared-length-4955-001a.dcm");
+    let e = parse_slice(found).unwrap_err().to_string();
+    assert!(
+        e.contains("element (4955,001A) declares 11826 bytes") && e.contains("554"),
+        "{e}"
+    );
+    // The same for pixel data whose length is patched to nearly 4 GiB.
+    let orientation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    let mut bytes = encode_ct_slice(
+        "1",
+        1,
+        [2, 2],
+        [1.0, 1.0],
+        [0.0; 3],
+        orientation,
+        0.0,
+        &[1, 2, 3, 4],
+    );
+    let at = bytes
+        .windows(4)
+        .rposition(|w| w == [0xE0, 0x7F, 0x10, 0x00])
+        .expect("pixel data tag");
+    bytes[at + 8..at + 12].copy_from_slice(&0xFFFF_FF00u32.to_le_bytes());
+    let e = parse_slice(&bytes).unwrap_err().to_string();
+    assert!(e.contains("(7FE0,0010) declares 4294967040 bytes"), "{e}");
+}

@@ -77,8 +77,14 @@ pub struct Slice {
 /// Not DICOM, unreadable attributes, pixel data that is missing, colour,
 /// multi-frame or cannot be decoded; each names the attribute.
 pub fn parse_slice(bytes: &[u8]) -> Result<Slice, IoError> {
-    let obj = open(bytes)?;
+    let obj = open_bytes(bytes)?;
     slice_from(&obj)
+}
+
+/// Parse a whole file held in memory, after [`check_lengths`].
+fn open_bytes(bytes: &[u8]) -> Result<DefaultDicomObject, IoError> {
+    check_lengths(bytes)?;
+    open(bytes)
 }
 
 fn open<R: Read>(reader: R) -> Result<DefaultDicomObject, IoError> {
@@ -86,6 +92,201 @@ fn open<R: Read>(reader: R) -> Result<DefaultDicomObject, IoError> {
         .read_preamble(ReadPreamble::Auto)
         .from_reader(reader)
         .map_err(|e| format_error(FORMAT, "file meta", format!("cannot parse the file: {e}")))
+}
+
+/// Transfer syntaxes whose data set is not explicit VR little endian.
+const IMPLICIT_VR_LITTLE_ENDIAN: &str = "1.2.840.10008.1.2";
+const EXPLICIT_VR_BIG_ENDIAN: &str = "1.2.840.10008.1.2.2";
+const DEFLATED_EXPLICIT_VR_LITTLE_ENDIAN: &str = "1.2.840.10008.1.2.1.99";
+
+/// Refuse a file in which an element declares more bytes than the file
+/// holds after it.
+///
+/// `dicom-object` allocates (and zero-fills) each value's declared length
+/// before reading it, so without this check a 1 kB file could make it
+/// allocate 4 GiB. The walk follows the element headers of the file meta
+/// group and of the data set (explicit or implicit VR, either byte order;
+/// a deflated data set is left to the decoder, whose output is bounded by
+/// the compressed size), descending into sequences and items, and skipping
+/// encapsulated pixel data fragments.
+fn check_lengths(bytes: &[u8]) -> Result<(), IoError> {
+    let start = if bytes.get(128..132) == Some(b"DICM") {
+        132
+    } else if bytes.starts_with(b"DICM") {
+        4
+    } else {
+        return Ok(()); // Not Part 10: the parser reports it.
+    };
+    let mut walk = Walk {
+        bytes,
+        pos: start,
+        explicit: true,
+        big_endian: false,
+        fragments: false,
+    };
+    // File meta group: explicit VR little endian, group 0002.
+    let mut syntax = String::new();
+    while walk.peek_group() == Some(0x0002) {
+        match walk.element()? {
+            Some(((0x0002, 0x0010), value)) => {
+                syntax = String::from_utf8_lossy(value)
+                    .trim_end_matches(['\0', ' '])
+                    .to_owned();
+            }
+            Some(_) => {}
+            None => return Ok(()),
+        }
+    }
+    match syntax.as_str() {
+        DEFLATED_EXPLICIT_VR_LITTLE_ENDIAN => return Ok(()),
+        IMPLICIT_VR_LITTLE_ENDIAN => walk.explicit = false,
+        EXPLICIT_VR_BIG_ENDIAN => walk.big_endian = true,
+        _ => {}
+    }
+    while walk.element()?.is_some() {}
+    Ok(())
+}
+
+/// A cursor over DICOM element headers (see [`check_lengths`]).
+struct Walk<'a> {
+    bytes: &'a [u8],
+    pos: usize,
+    explicit: bool,
+    big_endian: bool,
+    /// Inside encapsulated pixel data: items are raw fragments.
+    fragments: bool,
+}
+
+impl<'a> Walk<'a> {
+    fn u16_at(&self, at: usize) -> Option<u16> {
+        let b = self.bytes.get(at..at + 2)?;
+        Some(if self.big_endian {
+            u16::from_be_bytes([b[0], b[1]])
+        } else {
+            u16::from_le_bytes([b[0], b[1]])
+        })
+    }
+
+    fn u32_at(&self, at: usize) -> Option<u32> {
+        let b = self.bytes.get(at..at + 4)?;
+        let a = [b[0], b[1], b[2], b[3]];
+        Some(if self.big_endian {
+            u32::from_be_bytes(a)
+        } else {
+            u32::from_le_bytes(a)
+        })
+    }
+
+    fn peek_group(&self) -> Option<u16> {
+        // The meta group is little endian whatever the data set is.
+        let b = self.bytes.get(self.pos..self.pos + 2)?;
+        Some(u16::from_le_bytes([b[0], b[1]]))
+    }
+
+    /// Step over one element header (and its value when it has a defined
+    /// length and is not a sequence or item); the tag and value, or `None`
+    /// at the end of the input or of what can be walked.
+    #[allow(clippy::type_complexity)]
+    fn element(&mut self) -> Result<Option<((u16, u16), &'a [u8])>, IoError> {
+        let at = self.pos;
+        let (Some(group), Some(elem)) = (self.u16_at(at), self.u16_at(at + 2)) else {
+            return Ok(None);
+        };
+        let tag = (group, elem);
+        const UNDEFINED: u32 = u32::MAX;
+        // Items and delimiters have no VR, in every transfer syntax.
+        if group == 0xFFFE {
+            let Some(len) = self.u32_at(at + 4) else {
+                return Ok(None);
+            };
+            self.pos = at + 8;
+            match elem {
+                0xE000 if self.fragments && len != UNDEFINED => self.skip(tag, len)?,
+                0xE0DD => self.fragments = false,
+                // An item of elements: walk into it.
+                _ => {}
+            }
+            return Ok(Some((tag, &[])));
+        }
+        let (vr, len, header) = if self.explicit {
+            let Some(vr) = self.bytes.get(at + 4..at + 6) else {
+                return Ok(None);
+            };
+            let long = matches!(
+                vr,
+                b"OB"
+                    | b"OD"
+                    | b"OF"
+                    | b"OL"
+                    | b"OV"
+                    | b"OW"
+                    | b"SQ"
+                    | b"UC"
+                    | b"UN"
+                    | b"UR"
+                    | b"UT"
+                    | b"SV"
+                    | b"UV"
+            );
+            let len = if long {
+                self.u32_at(at + 8)
+            } else {
+                self.u16_at(at + 6).map(u32::from)
+            };
+            let Some(len) = len else {
+                return Ok(None);
+            };
+            (Some(vr), len, if long { 12 } else { 8 })
+        } else {
+            let Some(len) = self.u32_at(at + 4) else {
+                return Ok(None);
+            };
+            (None, len, 8)
+        };
+        self.pos = at + header;
+        if len == UNDEFINED {
+            if tag == (0x7FE0, 0x0010) {
+                self.fragments = true;
+            } else if vr.is_some_and(|v| v != b"SQ" && v != b"UN") {
+                return Err(format_error(
+                    FORMAT,
+                    "element length",
+                    format!(
+                        "element ({group:04X},{elem:04X}) has an undefined length but is not a sequence or pixel data"
+                    ),
+                ));
+            }
+            // A sequence of undefined length: walk into its items.
+            return Ok(Some((tag, &[])));
+        }
+        if vr == Some(b"SQ") {
+            self.check(tag, len)?;
+            return Ok(Some((tag, &[])));
+        }
+        let value_at = self.pos;
+        self.skip(tag, len)?;
+        Ok(Some((tag, &self.bytes[value_at..self.pos])))
+    }
+
+    fn check(&self, (group, elem): (u16, u16), len: u32) -> Result<(), IoError> {
+        let left = self.bytes.len().saturating_sub(self.pos);
+        if len as usize > left {
+            return Err(format_error(
+                FORMAT,
+                "element length",
+                format!(
+                    "element ({group:04X},{elem:04X}) declares {len} bytes but the file has only {left} after it: truncated or corrupt"
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    fn skip(&mut self, tag: (u16, u16), len: u32) -> Result<(), IoError> {
+        self.check(tag, len)?;
+        self.pos += len as usize;
+        Ok(())
+    }
 }
 
 fn has_pixel_data(obj: &DefaultDicomObject) -> bool {
@@ -354,7 +555,7 @@ pub fn read_dicom_with_progress(path: &Path, progress: &ProgressBar) -> Result<V
             (path.to_path_buf(), None)
         } else {
             let bytes = fs::read(path)?;
-            let obj = open(bytes.as_slice())?;
+            let obj = open_bytes(&bytes)?;
             let uid =
                 text(&obj, tags::SERIES_INSTANCE_UID, "SeriesInstanceUID")?.unwrap_or_default();
             let dir = path
@@ -384,7 +585,7 @@ pub fn read_dicom_with_progress(path: &Path, progress: &ProgressBar) -> Result<V
                     return Ok(None);
                 }
                 let bytes = fs::read(&file)?;
-                let obj = open(bytes.as_slice())?;
+                let obj = open_bytes(&bytes)?;
                 if !has_pixel_data(&obj) {
                     return Ok(None);
                 }
