@@ -124,9 +124,18 @@ fn check_lengths(bytes: &[u8]) -> Result<(), IoError> {
         big_endian: false,
         fragments: false,
     };
-    // File meta group: explicit VR little endian, group 0002.
+    // File meta group: explicit VR little endian, starting with its group
+    // length (0002,0000); like `dicom-object`, read elements until that many
+    // bytes have been read.
     let mut syntax = String::new();
-    while walk.peek_group() == Some(0x0002) {
+    let group_length = match walk.element()? {
+        Some(((0x0002, 0x0000), v)) if v.len() == 4 => {
+            u32::from_le_bytes([v[0], v[1], v[2], v[3]]) as usize
+        }
+        _ => return Ok(()), // The parser reports the malformed meta group.
+    };
+    let meta_start = walk.pos;
+    while walk.pos - meta_start < group_length {
         match walk.element()? {
             Some(((0x0002, 0x0010), value)) => {
                 syntax = String::from_utf8_lossy(value)
@@ -177,12 +186,6 @@ impl<'a> Walk<'a> {
         })
     }
 
-    fn peek_group(&self) -> Option<u16> {
-        // The meta group is little endian whatever the data set is.
-        let b = self.bytes.get(self.pos..self.pos + 2)?;
-        Some(u16::from_le_bytes([b[0], b[1]]))
-    }
-
     /// Step over one element header (and its value when it has a defined
     /// length and is not a sequence or item); the tag and value, or `None`
     /// at the end of the input or of what can be walked.
@@ -212,21 +215,32 @@ impl<'a> Walk<'a> {
             let Some(vr) = self.bytes.get(at + 4..at + 6) else {
                 return Ok(None);
             };
-            let long = matches!(
+            // The VRs with a 2-byte length (PS3.5 7.1.2); any other code,
+            // unknown ones included (read as UN, as `dicom-encoding` does),
+            // has 2 reserved bytes and a 4-byte length.
+            let long = !matches!(
                 vr,
-                b"OB"
-                    | b"OD"
-                    | b"OF"
-                    | b"OL"
-                    | b"OV"
-                    | b"OW"
-                    | b"SQ"
-                    | b"UC"
-                    | b"UN"
-                    | b"UR"
-                    | b"UT"
-                    | b"SV"
-                    | b"UV"
+                b"AE"
+                    | b"AS"
+                    | b"AT"
+                    | b"CS"
+                    | b"DA"
+                    | b"DS"
+                    | b"DT"
+                    | b"FL"
+                    | b"FD"
+                    | b"IS"
+                    | b"LO"
+                    | b"LT"
+                    | b"PN"
+                    | b"SH"
+                    | b"SL"
+                    | b"SS"
+                    | b"ST"
+                    | b"TM"
+                    | b"UI"
+                    | b"UL"
+                    | b"US"
             );
             let len = if long {
                 self.u32_at(at + 8)
