@@ -208,3 +208,43 @@ fn fuzz_regression_declared_lengths_beyond_the_file_are_refused() {
     let e = parse_slice(&bytes).unwrap_err().to_string();
     assert!(e.contains("(7FE0,0010) declares 4294967040 bytes"), "{e}");
 }
+
+/// Found by `cargo fuzz run dicom`: a BitsStored of 0 made
+/// `dicom-pixeldata` panic building its lookup table
+/// (`assertion failed: bits_stored != 0 && bits_stored <= 32`).
+#[test]
+fn fuzz_regression_bits_stored_out_of_range_is_an_error_not_a_panic() {
+    let found = include_bytes!("data/fuzz/dicom-bits-stored-zero-panic.dcm");
+    let e = parse_slice(found).unwrap_err().to_string();
+    assert!(e.contains("Bits"), "{e}");
+    // BitsStored 0 and 33 in an otherwise valid slice.
+    let orientation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    let good = encode_ct_slice(
+        "1",
+        1,
+        [2, 2],
+        [1.0, 1.0],
+        [0.0; 3],
+        orientation,
+        -5.0,
+        &[1, 2, 3, 4],
+    );
+    assert_eq!(
+        parse_slice(&good).unwrap().pixels,
+        vec![-4.0, -3.0, -2.0, -1.0]
+    );
+    // (0028,0101) US, length 2, value 16.
+    let at = good
+        .windows(8)
+        .position(|w| w == [0x28, 0x00, 0x01, 0x01, b'U', b'S', 2, 0])
+        .expect("BitsStored");
+    for bad in [0u16, 33] {
+        let mut bytes = good.clone();
+        bytes[at + 8..at + 10].copy_from_slice(&bad.to_le_bytes());
+        let e = parse_slice(&bytes).unwrap_err().to_string();
+        assert!(
+            e.contains("`BitsStored`") && e.contains(&format!("is {bad}")),
+            "{e}"
+        );
+    }
+}

@@ -31,7 +31,7 @@ use std::path::{Path, PathBuf};
 use dicom_dictionary_std::tags;
 use dicom_object::file::ReadPreamble;
 use dicom_object::{DefaultDicomObject, OpenFileOptions};
-use dicom_pixeldata::PixelDecoder;
+use dicom_pixeldata::{ConvertOptions, ModalityLutOption, PixelDecoder};
 use indicatif::ProgressBar;
 
 use crate::nrrd::{excerpt, format_error, IoError};
@@ -327,6 +327,10 @@ fn slice_from(obj: &DefaultDicomObject) -> Result<Slice, IoError> {
     )?
     .unwrap_or(vec![1.0, 0.0, 0.0, 0.0, 1.0, 0.0]);
     let thickness = floats(obj, tags::SLICE_THICKNESS, "SliceThickness", 1)?.map(|v| v[0]);
+    let slope = floats(obj, tags::RESCALE_SLOPE, "RescaleSlope", 1)?.map_or(1.0, |v| v[0]);
+    let intercept =
+        floats(obj, tags::RESCALE_INTERCEPT, "RescaleIntercept", 1)?.map_or(0.0, |v| v[0]);
+    check_bits(obj)?;
     let decoded = obj
         .decode_pixel_data()
         .map_err(|e| format_error(FORMAT, "PixelData", format!("cannot be decoded: {e}")))?;
@@ -358,9 +362,16 @@ fn slice_from(obj: &DefaultDicomObject) -> Result<Slice, IoError> {
             format!("Columns x Rows is {size:?}; both must be at least 1"),
         ));
     }
-    let pixels: Vec<f32> = decoded
-        .to_vec()
+    // The modality LUT is applied here rather than by `dicom-pixeldata`,
+    // whose lookup table (2^BitsStored entries) panics on a BitsStored of 0
+    // or above 32 (found by `cargo fuzz run dicom`).
+    let raw: Vec<f64> = decoded
+        .to_vec_with_options(&ConvertOptions::new().with_modality_lut(ModalityLutOption::None))
         .map_err(|e| format_error(FORMAT, "PixelData", format!("cannot be converted: {e}")))?;
+    let pixels: Vec<f32> = raw
+        .iter()
+        .map(|&x| (slope * x + intercept) as f32)
+        .collect();
     if pixels.len() != size[0] * size[1] {
         return Err(format_error(
             FORMAT,
@@ -388,6 +399,38 @@ fn slice_from(obj: &DefaultDicomObject) -> Result<Slice, IoError> {
         thickness,
         pixels,
     })
+}
+
+/// `BitsAllocated` 8 or 16, and `1 <= BitsStored <= BitsAllocated`, the
+/// greyscale layouts decoded here.
+fn check_bits(obj: &DefaultDicomObject) -> Result<(), IoError> {
+    let int = |tag, name: &'static str| -> Result<Option<i64>, IoError> {
+        match obj.get(tag) {
+            None => Ok(None),
+            Some(e) => e
+                .to_int::<i64>()
+                .map(Some)
+                .map_err(|err| format_error(FORMAT, name, format!("is not an integer: {err}"))),
+        }
+    };
+    let allocated = int(tags::BITS_ALLOCATED, "BitsAllocated")?
+        .ok_or_else(|| format_error(FORMAT, "BitsAllocated", "is missing"))?;
+    if allocated != 8 && allocated != 16 {
+        return Err(format_error(
+            FORMAT,
+            "BitsAllocated",
+            format!("is {allocated}: only 8- and 16-bit greyscale samples are supported"),
+        ));
+    }
+    let stored = int(tags::BITS_STORED, "BitsStored")?.unwrap_or(allocated);
+    if !(1..=allocated).contains(&stored) {
+        return Err(format_error(
+            FORMAT,
+            "BitsStored",
+            format!("is {stored}; it must be 1 to BitsAllocated ({allocated})"),
+        ));
+    }
+    Ok(())
 }
 
 fn text(
