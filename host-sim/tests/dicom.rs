@@ -248,3 +248,36 @@ fn fuzz_regression_bits_stored_out_of_range_is_an_error_not_a_panic() {
         );
     }
 }
+
+/// Sizes that the pixel data cannot hold are refused before decoding (the
+/// decoder allocates the decoded size first; `cargo fuzz run dicom` ran out
+/// of memory on such inputs).
+#[test]
+fn sizes_beyond_the_pixel_data_are_refused_before_decoding() {
+    let orientation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    let good = encode_ct_slice(
+        "1",
+        1,
+        [2, 2],
+        [1.0, 1.0],
+        [0.0; 3],
+        orientation,
+        0.0,
+        &[1, 2, 3, 4],
+    );
+    // (0028,0010) Rows, US, length 2.
+    let at = good
+        .windows(8)
+        .position(|w| w == [0x28, 0x00, 0x10, 0x00, b'U', b'S', 2, 0])
+        .expect("Rows");
+    let mut bytes = good.clone();
+    bytes[at + 8..at + 10].copy_from_slice(&65535u16.to_le_bytes());
+    let e = parse_slice(&bytes).unwrap_err().to_string();
+    assert!(
+        e.contains("65535 rows x 2 columns") && e.contains("pixel data holds (8)"),
+        "{e}"
+    );
+    bytes[at + 8..at + 10].copy_from_slice(&0u16.to_le_bytes());
+    let e = parse_slice(&bytes).unwrap_err().to_string();
+    assert!(e.contains("`Rows`: is 0"), "{e}");
+}

@@ -331,6 +331,7 @@ fn slice_from(obj: &DefaultDicomObject) -> Result<Slice, IoError> {
     let intercept =
         floats(obj, tags::RESCALE_INTERCEPT, "RescaleIntercept", 1)?.map_or(0.0, |v| v[0]);
     check_bits(obj)?;
+    check_pixel_size(obj)?;
     let decoded = obj
         .decode_pixel_data()
         .map_err(|e| format_error(FORMAT, "PixelData", format!("cannot be decoded: {e}")))?;
@@ -428,6 +429,81 @@ fn check_bits(obj: &DefaultDicomObject) -> Result<(), IoError> {
             FORMAT,
             "BitsStored",
             format!("is {stored}; it must be 1 to BitsAllocated ({allocated})"),
+        ));
+    }
+    Ok(())
+}
+
+/// Largest ratio accepted between decoded and encapsulated (compressed)
+/// pixel bytes; deflate's limit is about 1032.
+const MAX_COMPRESSION_RATIO: u64 = 1024;
+
+/// Refuse `Rows × Columns × NumberOfFrames × SamplesPerPixel ×
+/// BitsAllocated/8` bytes that the pixel data cannot hold: more than its
+/// length when native, or more than [`MAX_COMPRESSION_RATIO`] times its
+/// bytes when encapsulated, or more than the memory limit. The decoder
+/// allocates the decoded size up front, so a 1 kB file could otherwise
+/// claim gigabytes.
+fn check_pixel_size(obj: &DefaultDicomObject) -> Result<(), IoError> {
+    let int = |tag, name: &'static str, default: i64| -> Result<i64, IoError> {
+        match obj.get(tag) {
+            None => Ok(default),
+            Some(e) => e
+                .to_int::<i64>()
+                .map_err(|err| format_error(FORMAT, name, format!("is not an integer: {err}"))),
+        }
+    };
+    let rows = int(tags::ROWS, "Rows", 0)?;
+    let columns = int(tags::COLUMNS, "Columns", 0)?;
+    let frames = int(tags::NUMBER_OF_FRAMES, "NumberOfFrames", 1)?;
+    let samples = int(tags::SAMPLES_PER_PIXEL, "SamplesPerPixel", 1)?;
+    let bytes = int(tags::BITS_ALLOCATED, "BitsAllocated", 16)? / 8;
+    for (v, name) in [
+        (rows, "Rows"),
+        (columns, "Columns"),
+        (frames, "NumberOfFrames"),
+        (samples, "SamplesPerPixel"),
+    ] {
+        if v < 1 {
+            return Err(format_error(
+                FORMAT,
+                name,
+                format!("is {v}; it must be at least 1"),
+            ));
+        }
+    }
+    let needed = [rows, columns, frames, samples, bytes.max(1)]
+        .iter()
+        .try_fold(1u64, |acc, &v| acc.checked_mul(v as u64))
+        .unwrap_or(u64::MAX);
+    let Some(pixel_data) = obj.get(tags::PIXEL_DATA) else {
+        return Ok(());
+    };
+    let (available, what) = match pixel_data.value().fragments() {
+        Some(fragments) => (
+            fragments
+                .iter()
+                .map(|f| f.len() as u64)
+                .sum::<u64>()
+                .saturating_mul(MAX_COMPRESSION_RATIO),
+            "the compressed fragments can hold",
+        ),
+        None => (
+            pixel_data
+                .value()
+                .primitive()
+                .map_or(0, |p| p.calculate_byte_len() as u64),
+            "the pixel data holds",
+        ),
+    };
+    let limit = crate::nrrd::memory_limit_bytes();
+    if needed > available || needed > limit {
+        return Err(format_error(
+            FORMAT,
+            "Rows",
+            format!(
+                "{rows} rows x {columns} columns x {frames} frames x {samples} samples x {bytes} bytes = {needed} bytes, more than {what} ({available}) or the memory limit ({limit})"
+            ),
         ));
     }
     Ok(())
