@@ -273,6 +273,25 @@ impl<'a> Walk<'a> {
             // A sequence of undefined length: walk into its items.
             return Ok(Some((tag, &[])));
         }
+        // Binary numbers: `dicom-parser` reads whole values, so a length
+        // that is not a multiple of the value size would put it out of step
+        // with the element boundaries (and with this walk).
+        let size = match vr {
+            Some(b"SS" | b"US") => 2,
+            Some(b"FL" | b"SL" | b"UL" | b"AT" | b"OF" | b"OL") => 4,
+            Some(b"FD" | b"SV" | b"UV" | b"OD" | b"OV") => 8,
+            _ => 1,
+        };
+        if len % size != 0 {
+            return Err(format_error(
+                FORMAT,
+                "element length",
+                format!(
+                    "element ({group:04X},{elem:04X}) of {}-byte values has length {len}, not a multiple of {size}",
+                    size
+                ),
+            ));
+        }
         if vr == Some(b"SQ") {
             self.check(tag, len)?;
             return Ok(Some((tag, &[])));
