@@ -23,6 +23,16 @@
 //!
 //! Not supported: multi-frame objects (enhanced CT/MR), colour images,
 //! gantry tilt (it shows as a mismatch of orientation and position).
+//!
+//! Hostile input: `dicom-object` 0.10 allocates each value's declared
+//! length before reading it, and `dicom-pixeldata` the decoded image size.
+//! Before handing a file over, this module walks the element headers
+//! (explicit VR in either byte order, implicit VR little endian) and refuses
+//! lengths beyond the end of the file, and refuses image sizes the pixel
+//! data cannot hold. The walk follows the standard; where a corrupt file
+//! makes the parser read it differently (seen under fuzzing with implicit
+//! VR files) a declared length of up to 4 GiB can still be allocated, and
+//! fail, before the error is returned: memory and time, not a crash.
 
 use std::fs;
 use std::io::Read;
