@@ -176,3 +176,108 @@ fn corrupt_files_are_named() {
     assert!(e.contains("DICOM"), "{e}");
     assert!(parse_slice(b"hello").is_err());
 }
+
+/// Found by `cargo fuzz run dicom`: an element declaring more bytes than
+/// the file holds made `dicom-object` zero-fill the declared length first
+/// (1.6 s and gigabytes for a 742-byte file). Now refused before parsing.
+#[test]
+fn fuzz_regression_declared_lengths_beyond_the_file_are_refused() {
+    let found = include_bytes!("data/fuzz/dicom-declared-length-beyond-file.dcm");
+    let e = parse_slice(found).unwrap_err().to_string();
+    assert!(
+        e.contains("declares 1396899936 bytes but the file has only 250"),
+        "{e}"
+    );
+    // The same for pixel data whose length is patched to nearly 4 GiB.
+    let orientation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    let mut bytes = encode_ct_slice(
+        "1",
+        1,
+        [2, 2],
+        [1.0, 1.0],
+        [0.0; 3],
+        orientation,
+        0.0,
+        &[1, 2, 3, 4],
+    );
+    let at = bytes
+        .windows(4)
+        .rposition(|w| w == [0xE0, 0x7F, 0x10, 0x00])
+        .expect("pixel data tag");
+    bytes[at + 8..at + 12].copy_from_slice(&0xFFFF_FF00u32.to_le_bytes());
+    let e = parse_slice(&bytes).unwrap_err().to_string();
+    assert!(e.contains("(7FE0,0010) declares 4294967040 bytes"), "{e}");
+}
+
+/// Found by `cargo fuzz run dicom`: a BitsStored of 0 made
+/// `dicom-pixeldata` panic building its lookup table
+/// (`assertion failed: bits_stored != 0 && bits_stored <= 32`).
+#[test]
+fn fuzz_regression_bits_stored_out_of_range_is_an_error_not_a_panic() {
+    let found = include_bytes!("data/fuzz/dicom-bits-stored-zero-panic.dcm");
+    let e = parse_slice(found).unwrap_err().to_string();
+    assert!(e.contains("Bits"), "{e}");
+    // BitsStored 0 and 33 in an otherwise valid slice.
+    let orientation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    let good = encode_ct_slice(
+        "1",
+        1,
+        [2, 2],
+        [1.0, 1.0],
+        [0.0; 3],
+        orientation,
+        -5.0,
+        &[1, 2, 3, 4],
+    );
+    assert_eq!(
+        parse_slice(&good).unwrap().pixels,
+        vec![-4.0, -3.0, -2.0, -1.0]
+    );
+    // (0028,0101) US, length 2, value 16.
+    let at = good
+        .windows(8)
+        .position(|w| w == [0x28, 0x00, 0x01, 0x01, b'U', b'S', 2, 0])
+        .expect("BitsStored");
+    for bad in [0u16, 33] {
+        let mut bytes = good.clone();
+        bytes[at + 8..at + 10].copy_from_slice(&bad.to_le_bytes());
+        let e = parse_slice(&bytes).unwrap_err().to_string();
+        assert!(
+            e.contains("`BitsStored`") && e.contains(&format!("is {bad}")),
+            "{e}"
+        );
+    }
+}
+
+/// Sizes that the pixel data cannot hold are refused before decoding (the
+/// decoder allocates the decoded size first; `cargo fuzz run dicom` ran out
+/// of memory on such inputs).
+#[test]
+fn sizes_beyond_the_pixel_data_are_refused_before_decoding() {
+    let orientation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    let good = encode_ct_slice(
+        "1",
+        1,
+        [2, 2],
+        [1.0, 1.0],
+        [0.0; 3],
+        orientation,
+        0.0,
+        &[1, 2, 3, 4],
+    );
+    // (0028,0010) Rows, US, length 2.
+    let at = good
+        .windows(8)
+        .position(|w| w == [0x28, 0x00, 0x10, 0x00, b'U', b'S', 2, 0])
+        .expect("Rows");
+    let mut bytes = good.clone();
+    bytes[at + 8..at + 10].copy_from_slice(&65535u16.to_le_bytes());
+    let e = parse_slice(&bytes).unwrap_err().to_string();
+    assert!(
+        e.contains("65535 rows x 2 columns") && e.contains("pixel data holds (8)"),
+        "{e}"
+    );
+    bytes[at + 8..at + 10].copy_from_slice(&0u16.to_le_bytes());
+    let e = parse_slice(&bytes).unwrap_err().to_string();
+    assert!(e.contains("`Rows`: is 0"), "{e}");
+}

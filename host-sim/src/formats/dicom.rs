@@ -23,6 +23,16 @@
 //!
 //! Not supported: multi-frame objects (enhanced CT/MR), colour images,
 //! gantry tilt (it shows as a mismatch of orientation and position).
+//!
+//! Hostile input: `dicom-object` 0.10 allocates each value's declared
+//! length before reading it, and `dicom-pixeldata` the decoded image size.
+//! Before handing a file over, this module walks the element headers
+//! (explicit VR in either byte order, implicit VR little endian) and refuses
+//! lengths beyond the end of the file, and refuses image sizes the pixel
+//! data cannot hold. The walk follows the standard; where a corrupt file
+//! makes the parser read it differently (seen under fuzzing with implicit
+//! VR files) a declared length of up to 4 GiB can still be allocated, and
+//! fail, before the error is returned: memory and time, not a crash.
 
 use std::fs;
 use std::io::Read;
@@ -31,7 +41,7 @@ use std::path::{Path, PathBuf};
 use dicom_dictionary_std::tags;
 use dicom_object::file::ReadPreamble;
 use dicom_object::{DefaultDicomObject, OpenFileOptions};
-use dicom_pixeldata::PixelDecoder;
+use dicom_pixeldata::{ConvertOptions, ModalityLutOption, PixelDecoder};
 use indicatif::ProgressBar;
 
 use crate::nrrd::{excerpt, format_error, IoError};
@@ -77,8 +87,14 @@ pub struct Slice {
 /// Not DICOM, unreadable attributes, pixel data that is missing, colour,
 /// multi-frame or cannot be decoded; each names the attribute.
 pub fn parse_slice(bytes: &[u8]) -> Result<Slice, IoError> {
-    let obj = open(bytes)?;
+    let obj = open_bytes(bytes)?;
     slice_from(&obj)
+}
+
+/// Parse a whole file held in memory, after [`check_lengths`].
+fn open_bytes(bytes: &[u8]) -> Result<DefaultDicomObject, IoError> {
+    check_lengths(bytes)?;
+    open(bytes)
 }
 
 fn open<R: Read>(reader: R) -> Result<DefaultDicomObject, IoError> {
@@ -86,6 +102,234 @@ fn open<R: Read>(reader: R) -> Result<DefaultDicomObject, IoError> {
         .read_preamble(ReadPreamble::Auto)
         .from_reader(reader)
         .map_err(|e| format_error(FORMAT, "file meta", format!("cannot parse the file: {e}")))
+}
+
+/// Transfer syntaxes whose data set is not explicit VR little endian.
+const IMPLICIT_VR_LITTLE_ENDIAN: &str = "1.2.840.10008.1.2";
+const EXPLICIT_VR_BIG_ENDIAN: &str = "1.2.840.10008.1.2.2";
+const DEFLATED_EXPLICIT_VR_LITTLE_ENDIAN: &str = "1.2.840.10008.1.2.1.99";
+
+/// Refuse a file in which an element declares more bytes than the file
+/// holds after it.
+///
+/// `dicom-object` allocates (and zero-fills) each value's declared length
+/// before reading it, so without this check a 1 kB file could make it
+/// allocate 4 GiB. The walk follows the element headers of the file meta
+/// group and of the data set (explicit or implicit VR, either byte order;
+/// a deflated data set is left to the decoder, whose output is bounded by
+/// the compressed size), descending into sequences and items, and skipping
+/// encapsulated pixel data fragments.
+fn check_lengths(bytes: &[u8]) -> Result<(), IoError> {
+    let start = if bytes.get(128..132) == Some(b"DICM") {
+        132
+    } else if bytes.starts_with(b"DICM") {
+        4
+    } else {
+        return Ok(()); // Not Part 10: the parser reports it.
+    };
+    let mut walk = Walk {
+        bytes,
+        pos: start,
+        explicit: true,
+        big_endian: false,
+        fragments: false,
+    };
+    // File meta group: explicit VR little endian, starting with its group
+    // length (0002,0000); like `dicom-object`, read elements until that many
+    // bytes have been read.
+    let mut syntax = String::new();
+    let group_length = match walk.element()? {
+        Some(((0x0002, 0x0000), v)) if v.len() == 4 => {
+            u32::from_le_bytes([v[0], v[1], v[2], v[3]]) as usize
+        }
+        _ => return Ok(()), // The parser reports the malformed meta group.
+    };
+    let meta_start = walk.pos;
+    while walk.pos - meta_start < group_length {
+        match walk.element()? {
+            Some(((0x0002, 0x0010), value)) => {
+                syntax = String::from_utf8_lossy(value)
+                    .trim_end_matches(['\0', ' '])
+                    .to_owned();
+            }
+            Some(_) => {}
+            None => return Ok(()),
+        }
+    }
+    match syntax.as_str() {
+        DEFLATED_EXPLICIT_VR_LITTLE_ENDIAN => return Ok(()),
+        IMPLICIT_VR_LITTLE_ENDIAN => walk.explicit = false,
+        EXPLICIT_VR_BIG_ENDIAN => walk.big_endian = true,
+        _ => {}
+    }
+    while walk.element()?.is_some() {}
+    Ok(())
+}
+
+/// A cursor over DICOM element headers (see [`check_lengths`]).
+struct Walk<'a> {
+    bytes: &'a [u8],
+    pos: usize,
+    explicit: bool,
+    big_endian: bool,
+    /// Inside encapsulated pixel data: items are raw fragments.
+    fragments: bool,
+}
+
+impl<'a> Walk<'a> {
+    fn u16_at(&self, at: usize) -> Option<u16> {
+        let b = self.bytes.get(at..at + 2)?;
+        Some(if self.big_endian {
+            u16::from_be_bytes([b[0], b[1]])
+        } else {
+            u16::from_le_bytes([b[0], b[1]])
+        })
+    }
+
+    fn u32_at(&self, at: usize) -> Option<u32> {
+        let b = self.bytes.get(at..at + 4)?;
+        let a = [b[0], b[1], b[2], b[3]];
+        Some(if self.big_endian {
+            u32::from_be_bytes(a)
+        } else {
+            u32::from_le_bytes(a)
+        })
+    }
+
+    /// Step over one element header (and its value when it has a defined
+    /// length and is not a sequence or item); the tag and value, or `None`
+    /// at the end of the input or of what can be walked.
+    #[allow(clippy::type_complexity)]
+    fn element(&mut self) -> Result<Option<((u16, u16), &'a [u8])>, IoError> {
+        let at = self.pos;
+        let (Some(group), Some(elem)) = (self.u16_at(at), self.u16_at(at + 2)) else {
+            return Ok(None);
+        };
+        let tag = (group, elem);
+        const UNDEFINED: u32 = u32::MAX;
+        // Items and delimiters have no VR, in every transfer syntax.
+        if group == 0xFFFE {
+            let Some(len) = self.u32_at(at + 4) else {
+                return Ok(None);
+            };
+            self.pos = at + 8;
+            match elem {
+                0xE000 if self.fragments && len != UNDEFINED => self.skip(tag, len)?,
+                0xE0DD => self.fragments = false,
+                // An item of elements: walk into it.
+                _ => {}
+            }
+            return Ok(Some((tag, &[])));
+        }
+        let (vr, len, header) = if self.explicit {
+            let Some(vr) = self.bytes.get(at + 4..at + 6) else {
+                return Ok(None);
+            };
+            // The VRs with a 2-byte length (PS3.5 7.1.2); any other code,
+            // unknown ones included (read as UN, as `dicom-encoding` does),
+            // has 2 reserved bytes and a 4-byte length.
+            let long = !matches!(
+                vr,
+                b"AE"
+                    | b"AS"
+                    | b"AT"
+                    | b"CS"
+                    | b"DA"
+                    | b"DS"
+                    | b"DT"
+                    | b"FL"
+                    | b"FD"
+                    | b"IS"
+                    | b"LO"
+                    | b"LT"
+                    | b"PN"
+                    | b"SH"
+                    | b"SL"
+                    | b"SS"
+                    | b"ST"
+                    | b"TM"
+                    | b"UI"
+                    | b"UL"
+                    | b"US"
+            );
+            let len = if long {
+                self.u32_at(at + 8)
+            } else {
+                self.u16_at(at + 6).map(u32::from)
+            };
+            let Some(len) = len else {
+                return Ok(None);
+            };
+            (Some(vr), len, if long { 12 } else { 8 })
+        } else {
+            let Some(len) = self.u32_at(at + 4) else {
+                return Ok(None);
+            };
+            (None, len, 8)
+        };
+        self.pos = at + header;
+        if len == UNDEFINED {
+            if tag == (0x7FE0, 0x0010) {
+                self.fragments = true;
+            } else if vr.is_some_and(|v| v != b"SQ" && v != b"UN") {
+                return Err(format_error(
+                    FORMAT,
+                    "element length",
+                    format!(
+                        "element ({group:04X},{elem:04X}) has an undefined length but is not a sequence or pixel data"
+                    ),
+                ));
+            }
+            // A sequence of undefined length: walk into its items.
+            return Ok(Some((tag, &[])));
+        }
+        // Binary numbers: `dicom-parser` reads whole values, so a length
+        // that is not a multiple of the value size would put it out of step
+        // with the element boundaries (and with this walk).
+        let size = match vr {
+            Some(b"SS" | b"US") => 2,
+            Some(b"FL" | b"SL" | b"UL" | b"AT" | b"OF" | b"OL") => 4,
+            Some(b"FD" | b"SV" | b"UV" | b"OD" | b"OV") => 8,
+            _ => 1,
+        };
+        if len % size != 0 {
+            return Err(format_error(
+                FORMAT,
+                "element length",
+                format!(
+                    "element ({group:04X},{elem:04X}) of {}-byte values has length {len}, not a multiple of {size}",
+                    size
+                ),
+            ));
+        }
+        if vr == Some(b"SQ") {
+            self.check(tag, len)?;
+            return Ok(Some((tag, &[])));
+        }
+        let value_at = self.pos;
+        self.skip(tag, len)?;
+        Ok(Some((tag, &self.bytes[value_at..self.pos])))
+    }
+
+    fn check(&self, (group, elem): (u16, u16), len: u32) -> Result<(), IoError> {
+        let left = self.bytes.len().saturating_sub(self.pos);
+        if len as usize > left {
+            return Err(format_error(
+                FORMAT,
+                "element length",
+                format!(
+                    "element ({group:04X},{elem:04X}) declares {len} bytes but the file has only {left} after it: truncated or corrupt"
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    fn skip(&mut self, tag: (u16, u16), len: u32) -> Result<(), IoError> {
+        self.check(tag, len)?;
+        self.pos += len as usize;
+        Ok(())
+    }
 }
 
 fn has_pixel_data(obj: &DefaultDicomObject) -> bool {
@@ -112,6 +356,11 @@ fn slice_from(obj: &DefaultDicomObject) -> Result<Slice, IoError> {
     )?
     .unwrap_or(vec![1.0, 0.0, 0.0, 0.0, 1.0, 0.0]);
     let thickness = floats(obj, tags::SLICE_THICKNESS, "SliceThickness", 1)?.map(|v| v[0]);
+    let slope = floats(obj, tags::RESCALE_SLOPE, "RescaleSlope", 1)?.map_or(1.0, |v| v[0]);
+    let intercept =
+        floats(obj, tags::RESCALE_INTERCEPT, "RescaleIntercept", 1)?.map_or(0.0, |v| v[0]);
+    check_bits(obj)?;
+    check_pixel_size(obj)?;
     let decoded = obj
         .decode_pixel_data()
         .map_err(|e| format_error(FORMAT, "PixelData", format!("cannot be decoded: {e}")))?;
@@ -143,9 +392,16 @@ fn slice_from(obj: &DefaultDicomObject) -> Result<Slice, IoError> {
             format!("Columns x Rows is {size:?}; both must be at least 1"),
         ));
     }
-    let pixels: Vec<f32> = decoded
-        .to_vec()
+    // The modality LUT is applied here rather than by `dicom-pixeldata`,
+    // whose lookup table (2^BitsStored entries) panics on a BitsStored of 0
+    // or above 32 (found by `cargo fuzz run dicom`).
+    let raw: Vec<f64> = decoded
+        .to_vec_with_options(&ConvertOptions::new().with_modality_lut(ModalityLutOption::None))
         .map_err(|e| format_error(FORMAT, "PixelData", format!("cannot be converted: {e}")))?;
+    let pixels: Vec<f32> = raw
+        .iter()
+        .map(|&x| (slope * x + intercept) as f32)
+        .collect();
     if pixels.len() != size[0] * size[1] {
         return Err(format_error(
             FORMAT,
@@ -173,6 +429,113 @@ fn slice_from(obj: &DefaultDicomObject) -> Result<Slice, IoError> {
         thickness,
         pixels,
     })
+}
+
+/// `BitsAllocated` 8 or 16, and `1 <= BitsStored <= BitsAllocated`, the
+/// greyscale layouts decoded here.
+fn check_bits(obj: &DefaultDicomObject) -> Result<(), IoError> {
+    let int = |tag, name: &'static str| -> Result<Option<i64>, IoError> {
+        match obj.get(tag) {
+            None => Ok(None),
+            Some(e) => e
+                .to_int::<i64>()
+                .map(Some)
+                .map_err(|err| format_error(FORMAT, name, format!("is not an integer: {err}"))),
+        }
+    };
+    let allocated = int(tags::BITS_ALLOCATED, "BitsAllocated")?
+        .ok_or_else(|| format_error(FORMAT, "BitsAllocated", "is missing"))?;
+    if allocated != 8 && allocated != 16 {
+        return Err(format_error(
+            FORMAT,
+            "BitsAllocated",
+            format!("is {allocated}: only 8- and 16-bit greyscale samples are supported"),
+        ));
+    }
+    let stored = int(tags::BITS_STORED, "BitsStored")?.unwrap_or(allocated);
+    if !(1..=allocated).contains(&stored) {
+        return Err(format_error(
+            FORMAT,
+            "BitsStored",
+            format!("is {stored}; it must be 1 to BitsAllocated ({allocated})"),
+        ));
+    }
+    Ok(())
+}
+
+/// Largest ratio accepted between decoded and encapsulated (compressed)
+/// pixel bytes; deflate's limit is about 1032.
+const MAX_COMPRESSION_RATIO: u64 = 1024;
+
+/// Refuse `Rows × Columns × NumberOfFrames × SamplesPerPixel ×
+/// BitsAllocated/8` bytes that the pixel data cannot hold: more than its
+/// length when native, or more than [`MAX_COMPRESSION_RATIO`] times its
+/// bytes when encapsulated, or more than the memory limit. The decoder
+/// allocates the decoded size up front, so a 1 kB file could otherwise
+/// claim gigabytes.
+fn check_pixel_size(obj: &DefaultDicomObject) -> Result<(), IoError> {
+    let int = |tag, name: &'static str, default: i64| -> Result<i64, IoError> {
+        match obj.get(tag) {
+            None => Ok(default),
+            Some(e) => e
+                .to_int::<i64>()
+                .map_err(|err| format_error(FORMAT, name, format!("is not an integer: {err}"))),
+        }
+    };
+    let rows = int(tags::ROWS, "Rows", 0)?;
+    let columns = int(tags::COLUMNS, "Columns", 0)?;
+    let frames = int(tags::NUMBER_OF_FRAMES, "NumberOfFrames", 1)?;
+    let samples = int(tags::SAMPLES_PER_PIXEL, "SamplesPerPixel", 1)?;
+    let bytes = int(tags::BITS_ALLOCATED, "BitsAllocated", 16)? / 8;
+    for (v, name) in [
+        (rows, "Rows"),
+        (columns, "Columns"),
+        (frames, "NumberOfFrames"),
+        (samples, "SamplesPerPixel"),
+    ] {
+        if v < 1 {
+            return Err(format_error(
+                FORMAT,
+                name,
+                format!("is {v}; it must be at least 1"),
+            ));
+        }
+    }
+    let needed = [rows, columns, frames, samples, bytes.max(1)]
+        .iter()
+        .try_fold(1u64, |acc, &v| acc.checked_mul(v as u64))
+        .unwrap_or(u64::MAX);
+    let Some(pixel_data) = obj.get(tags::PIXEL_DATA) else {
+        return Ok(());
+    };
+    let (available, what) = match pixel_data.value().fragments() {
+        Some(fragments) => (
+            fragments
+                .iter()
+                .map(|f| f.len() as u64)
+                .sum::<u64>()
+                .saturating_mul(MAX_COMPRESSION_RATIO),
+            "the compressed fragments can hold",
+        ),
+        None => (
+            pixel_data
+                .value()
+                .primitive()
+                .map_or(0, |p| p.calculate_byte_len() as u64),
+            "the pixel data holds",
+        ),
+    };
+    let limit = crate::nrrd::memory_limit_bytes();
+    if needed > available || needed > limit {
+        return Err(format_error(
+            FORMAT,
+            "Rows",
+            format!(
+                "{rows} rows x {columns} columns x {frames} frames x {samples} samples x {bytes} bytes = {needed} bytes, more than {what} ({available}) or the memory limit ({limit})"
+            ),
+        ));
+    }
+    Ok(())
 }
 
 fn text(
@@ -354,7 +717,7 @@ pub fn read_dicom_with_progress(path: &Path, progress: &ProgressBar) -> Result<V
             (path.to_path_buf(), None)
         } else {
             let bytes = fs::read(path)?;
-            let obj = open(bytes.as_slice())?;
+            let obj = open_bytes(&bytes)?;
             let uid =
                 text(&obj, tags::SERIES_INSTANCE_UID, "SeriesInstanceUID")?.unwrap_or_default();
             let dir = path
@@ -384,7 +747,7 @@ pub fn read_dicom_with_progress(path: &Path, progress: &ProgressBar) -> Result<V
                     return Ok(None);
                 }
                 let bytes = fs::read(&file)?;
-                let obj = open(bytes.as_slice())?;
+                let obj = open_bytes(&bytes)?;
                 if !has_pixel_data(&obj) {
                     return Ok(None);
                 }
