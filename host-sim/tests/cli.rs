@@ -1,33 +1,9 @@
 //! The `fvr` program end to end: outputs, and clear errors on bad input.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+mod common;
+use common::{assert_error, fvr, temp_dir};
 
 use fvr_host::nrrd::{encode_nrrd, Encoding, Endian, SampleType};
-
-fn fvr(args: &[&str], dir: &std::path::Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fvr"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("fvr runs")
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("fvr-cli-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// Exit status 2 and a message on stderr containing every `needle`.
-fn assert_error(out: &Output, needles: &[&str]) {
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "stderr: {stderr}");
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    for n in needles {
-        assert!(stderr.contains(n), "`{n}` not in: {stderr}");
-    }
-}
 
 #[test]
 fn no_arguments_renders_the_default_scene_and_says_where() {

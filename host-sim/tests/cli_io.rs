@@ -1,26 +1,15 @@
 //! The `fvr` program's inputs and outputs end to end: file formats, PNG
 //! options, turntables, help, version, exit codes and progress output.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+use common::{assert_error, fvr, temp_dir};
+
+use std::path::Path;
+use std::process::Output;
 
 use fvr_host::formats::den::encode_den;
 use fvr_host::formats::nifti::encode_nifti_f32;
 use fvr_host::nrrd::Endian;
-
-fn fvr(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fvr"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("fvr runs")
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("fvr-cli-io-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn stdout(out: &Output) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
@@ -34,16 +23,6 @@ fn assert_ok(out: &Output) {
     assert!(out.status.success(), "stderr: {}", stderr(out));
 }
 
-/// Exit status 2, a message on stderr containing every needle, no panic.
-fn assert_error(out: &Output, needles: &[&str]) {
-    let err = stderr(out);
-    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
-    assert!(!err.contains("panicked"), "{err}");
-    for n in needles {
-        assert!(err.contains(n), "`{n}` not in: {err}");
-    }
-}
-
 fn png_info(path: &Path) -> png::Info<'static> {
     let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
     decoder.read_info().unwrap().info().clone()
@@ -51,7 +30,7 @@ fn png_info(path: &Path) -> png::Info<'static> {
 
 #[test]
 fn version_and_help_document_the_exit_status() {
-    let dir = temp_dir("help");
+    let dir = temp_dir("io-help");
     let out = fvr(&["--version"], &dir);
     assert_ok(&out);
     assert_eq!(
@@ -117,7 +96,7 @@ fn option_defaults(help: &str) -> Vec<(String, String)> {
 
 #[test]
 fn turntable_options_match_render_options() {
-    let dir = temp_dir("options");
+    let dir = temp_dir("io-options");
     let render = option_defaults(&stdout(&fvr(&["render", "--help"], &dir)));
     let spin = option_defaults(&stdout(&fvr(&["turntable", "--help"], &dir)));
     let shared = [
@@ -149,7 +128,7 @@ fn turntable_options_match_render_options() {
 
 #[test]
 fn renders_nifti_den_and_named_volumes_to_styled_pngs() {
-    let dir = temp_dir("formats");
+    let dir = temp_dir("io-formats");
     let data: Vec<f32> = (0..16 * 16 * 8).map(|i| ((i * 37) % 101) as f32).collect();
     let nii = encode_nifti_f32(
         [16, 16, 8],
@@ -224,7 +203,7 @@ fn renders_nifti_den_and_named_volumes_to_styled_pngs() {
 
 #[test]
 fn the_ct_head_renders_by_name() {
-    let dir = temp_dir("ct");
+    let dir = temp_dir("io-ct");
     let out = fvr(
         &[
             "render", "ct-head", "--dir", "0,1,0", "--out", "ct.png", "--size", "128", "--quiet",
@@ -239,7 +218,7 @@ fn the_ct_head_renders_by_name() {
 
 #[test]
 fn turntable_writes_an_apng_and_reports_views_per_second() {
-    let dir = temp_dir("spin");
+    let dir = temp_dir("io-spin");
     let out = fvr(
         &[
             "turntable",
@@ -281,7 +260,7 @@ fn turntable_writes_an_apng_and_reports_views_per_second() {
 
 #[test]
 fn bad_inputs_and_options_exit_2_with_the_file_and_field() {
-    let dir = temp_dir("bad");
+    let dir = temp_dir("io-bad");
     let good = encode_nifti_f32([4, 4, 4], [1.0; 3], (1.0, 0.0), &[1.0; 64], Endian::Little);
     let mut gz = {
         use std::io::Write;
@@ -372,7 +351,7 @@ fn bad_inputs_and_options_exit_2_with_the_file_and_field() {
 
 #[test]
 fn renders_a_dicom_series_directory() {
-    let dir = temp_dir("dicom");
+    let dir = temp_dir("io-dicom");
     let series = dir.join("series");
     std::fs::create_dir_all(&series).unwrap();
     let orientation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];

@@ -1,39 +1,16 @@
 //! `fvr render` with depth cues and lights: RGB outputs, memory report, and
 //! clear errors on bad scene values.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+use common::{assert_error, fvr, temp_dir};
 
 use fvr_host::nrrd::read_nrrd;
-
-fn fvr(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fvr"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("fvr runs")
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("fvr-cli-scene-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn assert_error(out: &Output, needles: &[&str]) {
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "stderr: {stderr}");
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    for n in needles {
-        assert!(stderr.contains(n), "`{n}` not in: {stderr}");
-    }
-}
 
 const BASE: [&str; 5] = ["render", "gaussians@32", "--dir", "1,0.4,-0.3", "--stats"];
 
 #[test]
 fn lit_and_cued_render_writes_rgb_nrrd_and_reports_memory() {
-    let dir = temp_dir("rgb");
+    let dir = temp_dir("scene-rgb");
     let mut args = BASE.to_vec();
     args.extend([
         "--light",
@@ -85,7 +62,7 @@ fn lit_and_cued_render_writes_rgb_nrrd_and_reports_memory() {
 
 #[test]
 fn light_ring_and_profile_cue_render_png() {
-    let dir = temp_dir("ring");
+    let dir = temp_dir("scene-ring");
     std::fs::write(dir.join("profile.txt"), "# front to back\n0.2, 1\n0.2\n").unwrap();
     let mut args = BASE.to_vec();
     args.extend([
@@ -111,7 +88,7 @@ fn light_ring_and_profile_cue_render_png() {
 
 #[test]
 fn bad_scene_values_exit_2_naming_the_problem() {
-    let dir = temp_dir("bad");
+    let dir = temp_dir("scene-bad");
     let cases: Vec<(Vec<&str>, Vec<&str>)> = vec![
         (
             vec!["--light", "0,0,0:1,1,1"],
@@ -166,7 +143,7 @@ fn bad_scene_values_exit_2_naming_the_problem() {
 
 #[test]
 fn adaptive_and_preview_options_report_and_refuse_conflicts() {
-    let dir = temp_dir("adaptive");
+    let dir = temp_dir("scene-adaptive");
     let base = [
         "render",
         "gaussians@32",
