@@ -1,0 +1,104 @@
+//! Cued and shaded rendering reads spectra stored in block floating point
+//! (per-line exponents in place, per-brick exponents from the host) through
+//! the same line reader as the plain projection.
+
+use fvr_core::dht::{Rounding, Twiddles};
+use fvr_core::filter::{DerivativeTable, Filter, FilterKind, KernelTable};
+use fvr_core::format::{BlockLayout, Blocking, Q15};
+use fvr_core::geometry::View;
+use fvr_core::render::aux_len;
+use fvr_core::scene::{DepthCue, Light, Scene};
+use fvr_core::scene_render::{fields_len, render_scene};
+use fvr_core::spectrum::Spectrum;
+use fvr_host::phantom::{sample, GaussianMixture};
+use fvr_host::precision::StoredSpectrum;
+use fvr_host::reference::snr_db;
+use fvr_host::shaded::gradient_volume;
+
+fn render<S: fvr_core::real::Sample>(
+    density: &Spectrum<'_, S>,
+    gradient: &Spectrum<'_, S>,
+    scene: &Scene,
+    view: &View,
+) -> Vec<f32> {
+    let n = density.n();
+    let filter = *density.filter();
+    let kernel = KernelTable::<f32>::new(filter);
+    let derivative = DerivativeTable::<f32>::new(filter).unwrap();
+    let mut tw_buf = vec![0.0f32; Twiddles::<f32>::buffer_len(n)];
+    let tw = Twiddles::new(&mut tw_buf, n).unwrap();
+    let mut fields = vec![0.0f32; fields_len(scene, n)];
+    let mut aux = vec![0.0f32; aux_len(n)];
+    let mut out = vec![0.0f32; 3 * n * n];
+    render_scene(
+        density,
+        Some(gradient),
+        &kernel,
+        Some(&derivative),
+        scene,
+        view,
+        n,
+        n,
+        &tw,
+        &mut fields,
+        &mut aux,
+        &mut out,
+    )
+    .unwrap();
+    out
+}
+
+#[test]
+fn block_floating_point_spectra_render_cued_and_shaded_scenes() {
+    let n = 32;
+    let volume = sample(&GaussianMixture::random(8, n, 6), [n; 3]);
+    let gradient = gradient_volume(&volume).unwrap();
+    let filter = Filter::new(FilterKind::Kb4, 1).unwrap();
+    let mut scene = Scene {
+        cue: DepthCue::Linear {
+            front: 1.0,
+            back: 0.3,
+        },
+        ambient: [0.2; 3],
+        ..Scene::xray()
+    };
+    scene
+        .add_light(Light {
+            towards: [0.2, 1.0, 0.3],
+            color: [1.0, 0.5, 0.2],
+        })
+        .unwrap();
+    let view = View::along([1.0, 0.4, -0.2]);
+
+    let reference = {
+        let d = StoredSpectrum::<f32>::prepare::<f32>(&volume, filter, Rounding::PerPass).unwrap();
+        let g =
+            StoredSpectrum::<f32>::prepare::<f32>(&gradient, filter, Rounding::PerPass).unwrap();
+        render(&d.view(), &g.view(), &scene, &view)
+    };
+    let to_f64 = |v: &[f32]| v.iter().map(|&x| x as f64).collect::<Vec<_>>();
+
+    // Per-line exponents, prepared in place: the contiguous fast path.
+    let d = StoredSpectrum::<Q15>::prepare_line_blocks::<f32>(&volume, filter, Rounding::PerPass)
+        .unwrap();
+    let g = StoredSpectrum::<Q15>::prepare_line_blocks::<f32>(&gradient, filter, Rounding::PerPass)
+        .unwrap();
+    let line = render(&d.view(), &g.view(), &scene, &view);
+    let snr_line = snr_db(&to_f64(&reference), &to_f64(&line));
+
+    // Per-brick exponents, encoded from the f32 spectrum: the general path.
+    let d32 = StoredSpectrum::<f32>::prepare::<f32>(&volume, filter, Rounding::PerPass).unwrap();
+    let g32 = StoredSpectrum::<f32>::prepare::<f32>(&gradient, filter, Rounding::PerPass).unwrap();
+    let layout = Blocking::Blocks(BlockLayout::Brick(4));
+    let db = StoredSpectrum::<Q15>::encode(&d32, layout).unwrap();
+    let gb = StoredSpectrum::<Q15>::encode(&g32, layout).unwrap();
+    let brick = render(&db.view(), &gb.view(), &scene, &view);
+    let snr_brick = snr_db(&to_f64(&reference), &to_f64(&brick));
+
+    eprintln!("per-line {snr_line:.1} dB, per-brick {snr_brick:.1} dB");
+    // Q15 rounds at 2^-15 of each block's range: the plain study measures
+    // 71-99 dB for these layouts, so 60 dB leaves margin for the scene's
+    // extra passes while failing on any exponent misapplied (0 dB or worse).
+    assert!(snr_line >= 60.0, "per-line Q15: {snr_line:.1} dB");
+    assert!(snr_brick >= 60.0, "per-brick Q15: {snr_brick:.1} dB");
+}
