@@ -476,92 +476,55 @@ pub(crate) fn gauss_legendre_16(a: f64, b: f64, f: impl Fn(f64) -> f64) -> f64 {
 pub const TABLE_RESOLUTION: usize = 1024;
 const TABLE_CAP: usize = MAX_WIDTH / 2 * TABLE_RESOLUTION + 2;
 
-/// A kernel tabulated at `1/1024` steps over `[0, W/2]`, read with linear
-/// interpolation.
-///
-/// # Accuracy
-/// Linear interpolation errs by at most `Δ²/8·max|k''|` with `Δ = 1/1024`:
-/// about `1.2e-7·max|k''|`. For the widest, sharpest kernel here (kb6 at
-/// σ = 2, β ≈ 13.9, `max|k''| ≈ 11`) that is 1.3e-6 of `k(0)`, below −115 dB.
-/// Nearest and linear kernels are reproduced exactly (their breakpoints lie
-/// on the grid).
+/// Samples `g(i/1024)`, `i = 0 ..= W·512`, of an even or odd function over
+/// `[0, W/2]`, read with linear interpolation: the storage and lookup shared
+/// by [`KernelTable`] and [`DerivativeTable`].
 #[derive(Clone, Debug)]
-pub struct KernelTable<T> {
-    filter: Filter,
+struct Samples<T> {
     values: [T; TABLE_CAP],
     len: usize,
 }
 
-impl<T: Real> KernelTable<T> {
-    /// Tabulate `filter`'s kernel.
-    pub fn new(filter: Filter) -> Self {
-        let len = Self::len_for(&filter);
-        let mut values = [T::ZERO; TABLE_CAP];
-        for (i, v) in values[..len].iter_mut().enumerate() {
-            let t = i as f64 / TABLE_RESOLUTION as f64;
-            *v = T::from_f64(match filter.kind {
-                // The table runs over |t|; the half-open nearest support is
-                // handled by the tap selection, which never asks for |t| > ½.
-                FilterKind::Nearest => 1.0,
-                _ => filter.kernel(t),
-            });
-        }
-        Self {
-            filter,
-            values,
-            len,
-        }
-    }
-
-    /// Entries a table for `filter` holds: `W·1024/2 + 1`, the samples
-    /// `k(i/1024)` for `i = 0 ..= W·512`.
-    pub const fn len_for(filter: &Filter) -> usize {
+impl<T: Real> Samples<T> {
+    /// Entries for `filter`: `W·1024/2 + 1`.
+    const fn len_for(filter: &Filter) -> usize {
         filter.kind.width() * TABLE_RESOLUTION / 2 + 1
     }
 
-    /// Rebuild a table from the values [`KernelTable::values`] returned for
-    /// the same filter, e.g. a table in flash generated at build time, so a
-    /// target without fast f64 never evaluates the Bessel series. The result
-    /// equals `KernelTable::new(filter)` bit for bit when `values` came from
-    /// it.
+    /// Tabulate `g` over `[0, W/2]`.
+    fn tabulate(filter: &Filter, g: impl Fn(f64) -> f64) -> Self {
+        let len = Self::len_for(filter);
+        let mut values = [T::ZERO; TABLE_CAP];
+        for (i, v) in values[..len].iter_mut().enumerate() {
+            *v = T::from_f64(g(i as f64 / TABLE_RESOLUTION as f64));
+        }
+        Self { values, len }
+    }
+
+    /// Wrap stored `values` of the `what` table for `filter`.
     ///
     /// # Errors
-    /// `values.len()` other than [`KernelTable::len_for`]`(&filter)`, or a
-    /// NaN or infinite entry (named by its index).
-    pub fn from_values(filter: Filter, values: &[T]) -> Result<Self> {
-        let len = Self::len_for(&filter);
+    /// The wrong length, or a NaN or infinite entry (named by its index).
+    fn from_values(what: &'static str, filter: &Filter, values: &[T]) -> Result<Self> {
+        let len = Self::len_for(filter);
         if values.len() != len {
-            return Err(crate::error::mismatch("kernel table", len, values.len()));
+            return Err(crate::error::mismatch(what, len, values.len()));
         }
         if let Some(index) = values.iter().position(|v| !v.is_finite()) {
-            return Err(Error::NonFiniteTableEntry {
-                what: "kernel table",
-                index,
-            });
+            return Err(Error::NonFiniteTableEntry { what, index });
         }
         let mut table = [T::ZERO; TABLE_CAP];
         table[..len].copy_from_slice(values);
-        Ok(Self {
-            filter,
-            values: table,
-            len,
-        })
+        Ok(Self { values: table, len })
     }
 
-    /// The tabulated samples `k(i/1024)`, `i = 0 ..= W·512`.
-    pub fn values(&self) -> &[T] {
+    fn values(&self) -> &[T] {
         &self.values[..self.len]
     }
 
-    /// The filter tabulated.
-    pub fn filter(&self) -> &Filter {
-        &self.filter
-    }
-
-    /// Kernel at distance `t`, `|t| ≤ W/2`.
+    /// `g(a)` for `a ≥ 0`, 0 beyond the table.
     #[inline(always)]
-    pub fn eval(&self, t: T) -> T {
-        let a = if t < T::ZERO { -t } else { t };
+    fn lerp(&self, a: T) -> T {
         let x = a * T::from_usize(TABLE_RESOLUTION);
         let i = x.trunc_usize();
         if i + 1 >= self.len {
@@ -574,23 +537,92 @@ impl<T: Real> KernelTable<T> {
         let f = x - T::from_usize(i);
         self.values[i] + f * (self.values[i + 1] - self.values[i])
     }
+}
+
+/// The taps of a sample at fractional index `q` for a filter of width
+/// `weights.len()`: returns `j0 = ⌊q − W/2⌋ + 1` (may be negative) and
+/// writes `eval(q − j0 − m)` for `m = 0 … W−1`.
+#[inline(always)]
+fn tap_weights<T: Real>(q: T, weights: &mut [T], eval: impl Fn(T) -> T) -> i64 {
+    let j0 = (q - T::from_usize(weights.len()) * T::HALF).floor_i64() + 1;
+    // q − j0 in (W/2 − 1, W/2]; exact in T because j0 is small.
+    let mut d = q - T::from_i32(j0 as i32);
+    for wt in weights.iter_mut() {
+        *wt = eval(d);
+        d -= T::ONE;
+    }
+    j0
+}
+
+/// A kernel tabulated at `1/1024` steps over `[0, W/2]`, read with linear
+/// interpolation.
+///
+/// # Accuracy
+/// Linear interpolation errs by at most `Δ²/8·max|k''|` with `Δ = 1/1024`:
+/// about `1.2e-7·max|k''|`. For the widest, sharpest kernel here (kb6 at
+/// σ = 2, β ≈ 13.9, `max|k''| ≈ 11`) that is 1.3e-6 of `k(0)`, below −115 dB.
+/// Nearest and linear kernels are reproduced exactly (their breakpoints lie
+/// on the grid).
+#[derive(Clone, Debug)]
+pub struct KernelTable<T> {
+    filter: Filter,
+    samples: Samples<T>,
+}
+
+impl<T: Real> KernelTable<T> {
+    /// Tabulate `filter`'s kernel.
+    pub fn new(filter: Filter) -> Self {
+        // The table runs over |t|; the half-open nearest support is handled
+        // by the tap selection, which never asks for |t| > ½.
+        let samples = Samples::tabulate(&filter, |t| match filter.kind {
+            FilterKind::Nearest => 1.0,
+            _ => filter.kernel(t),
+        });
+        Self { filter, samples }
+    }
+
+    /// Entries a table for `filter` holds: `W·1024/2 + 1`, the samples
+    /// `k(i/1024)` for `i = 0 ..= W·512`.
+    pub const fn len_for(filter: &Filter) -> usize {
+        Samples::<T>::len_for(filter)
+    }
+
+    /// Rebuild a table from the values [`KernelTable::values`] returned for
+    /// the same filter, e.g. a table in flash generated at build time, so a
+    /// target without fast f64 never evaluates the Bessel series. The result
+    /// equals `KernelTable::new(filter)` bit for bit when `values` came from
+    /// it.
+    ///
+    /// # Errors
+    /// `values.len()` other than [`KernelTable::len_for`]`(&filter)`, or a
+    /// NaN or infinite entry (named by its index).
+    pub fn from_values(filter: Filter, values: &[T]) -> Result<Self> {
+        let samples = Samples::from_values("kernel table", &filter, values)?;
+        Ok(Self { filter, samples })
+    }
+
+    /// The tabulated samples `k(i/1024)`, `i = 0 ..= W·512`.
+    pub fn values(&self) -> &[T] {
+        self.samples.values()
+    }
+
+    /// The filter tabulated.
+    pub fn filter(&self) -> &Filter {
+        &self.filter
+    }
+
+    /// Kernel at distance `t`, `|t| ≤ W/2` (the kernel is even).
+    #[inline(always)]
+    pub fn eval(&self, t: T) -> T {
+        self.samples.lerp(if t < T::ZERO { -t } else { t })
+    }
 
     /// Per-axis taps for a sample at fractional index `q`: the first tap's
     /// index `j0 = ⌊q − W/2⌋ + 1` (may be negative) and the weights
     /// `k(q − j0 − m)` for `m = 0 … W−1`, written to `weights`.
     #[inline(always)]
     pub fn taps(&self, q: T, weights: &mut [T; MAX_WIDTH]) -> i64 {
-        let w = self.filter.width();
-        let lo = (q - T::from_usize(w) * T::HALF).floor_i64();
-        let j0 = lo + 1;
-        // q − j0 in (W/2 − 1, W/2]; exact in T because j0 is small.
-        let d0 = q - T::from_i32(j0 as i32);
-        let mut d = d0;
-        for wt in weights[..w].iter_mut() {
-            *wt = self.eval(d);
-            d -= T::ONE;
-        }
-        j0
+        tap_weights(q, &mut weights[..self.filter.width()], |d| self.eval(d))
     }
 
     /// [`KernelTable::taps`] for a width known at compile time (`W` must be
@@ -598,13 +630,7 @@ impl<T: Real> KernelTable<T> {
     /// tap loops unroll.
     #[inline(always)]
     pub fn taps_fixed<const W: usize>(&self, q: T, weights: &mut [T; W]) -> i64 {
-        let j0 = (q - T::from_usize(W) * T::HALF).floor_i64() + 1;
-        let mut d = q - T::from_i32(j0 as i32);
-        for wt in weights.iter_mut() {
-            *wt = self.eval(d);
-            d -= T::ONE;
-        }
-        j0
+        tap_weights(q, weights, |d| self.eval(d))
     }
 }
 
@@ -618,8 +644,7 @@ impl<T: Real> KernelTable<T> {
 #[derive(Clone, Debug)]
 pub struct DerivativeTable<T> {
     filter: Filter,
-    values: [T; TABLE_CAP],
-    len: usize,
+    samples: Samples<T>,
 }
 
 impl<T: Real> DerivativeTable<T> {
@@ -631,22 +656,14 @@ impl<T: Real> DerivativeTable<T> {
         if filter.kind == FilterKind::Nearest {
             return Err(Error::NoKernelDerivative);
         }
-        let len = Self::len_for(&filter);
-        let mut values = [T::ZERO; TABLE_CAP];
-        for (i, v) in values[..len].iter_mut().enumerate() {
-            *v = T::from_f64(filter.kernel_derivative(i as f64 / TABLE_RESOLUTION as f64));
-        }
-        Ok(Self {
-            filter,
-            values,
-            len,
-        })
+        let samples = Samples::tabulate(&filter, |t| filter.kernel_derivative(t));
+        Ok(Self { filter, samples })
     }
 
     /// Entries a table for `filter` holds: `W·1024/2 + 1`, the samples
     /// `k'(i/1024)` for `i = 0 ..= W·512` (as [`KernelTable::len_for`]).
     pub const fn len_for(filter: &Filter) -> usize {
-        KernelTable::<T>::len_for(filter)
+        Samples::<T>::len_for(filter)
     }
 
     /// Rebuild a table from the values [`DerivativeTable::values`] returned
@@ -664,32 +681,13 @@ impl<T: Real> DerivativeTable<T> {
         if filter.kind == FilterKind::Nearest {
             return Err(Error::NoKernelDerivative);
         }
-        let len = Self::len_for(&filter);
-        if values.len() != len {
-            return Err(crate::error::mismatch(
-                "kernel derivative table",
-                len,
-                values.len(),
-            ));
-        }
-        if let Some(index) = values.iter().position(|v| !v.is_finite()) {
-            return Err(Error::NonFiniteTableEntry {
-                what: "kernel derivative table",
-                index,
-            });
-        }
-        let mut table = [T::ZERO; TABLE_CAP];
-        table[..len].copy_from_slice(values);
-        Ok(Self {
-            filter,
-            values: table,
-            len,
-        })
+        let samples = Samples::from_values("kernel derivative table", &filter, values)?;
+        Ok(Self { filter, samples })
     }
 
     /// The tabulated samples `k'(i/1024)`, `i = 0 ..= W·512`.
     pub fn values(&self) -> &[T] {
-        &self.values[..self.len]
+        self.samples.values()
     }
 
     /// The filter whose derivative is tabulated.
@@ -697,52 +695,26 @@ impl<T: Real> DerivativeTable<T> {
         &self.filter
     }
 
-    /// `k'(t)` for `|t| ≤ W/2` (0 beyond).
+    /// `k'(t)` for `|t| ≤ W/2` (0 beyond; the derivative is odd).
     #[inline(always)]
     pub fn eval(&self, t: T) -> T {
-        let (a, negative) = if t < T::ZERO { (-t, true) } else { (t, false) };
-        let x = a * T::from_usize(TABLE_RESOLUTION);
-        let i = x.trunc_usize();
-        let v = if i + 1 >= self.len {
-            if i < self.len {
-                self.values[i]
-            } else {
-                T::ZERO
-            }
+        if t < T::ZERO {
+            -self.samples.lerp(-t)
         } else {
-            let f = x - T::from_usize(i);
-            self.values[i] + f * (self.values[i + 1] - self.values[i])
-        };
-        if negative {
-            -v
-        } else {
-            v
+            self.samples.lerp(t)
         }
-    }
-
-    /// [`DerivativeTable::taps`] for a width known at compile time.
-    #[inline(always)]
-    pub fn taps_fixed<const W: usize>(&self, q: T, weights: &mut [T; W]) -> i64 {
-        let j0 = (q - T::from_usize(W) * T::HALF).floor_i64() + 1;
-        let mut d = q - T::from_i32(j0 as i32);
-        for wt in weights.iter_mut() {
-            *wt = self.eval(d);
-            d -= T::ONE;
-        }
-        j0
     }
 
     /// Derivative weights `k'(q − j0 − m)`, `m = 0 … W−1`, at the same taps
     /// as [`KernelTable::taps`]; returns `j0`.
     #[inline(always)]
     pub fn taps(&self, q: T, weights: &mut [T; MAX_WIDTH]) -> i64 {
-        let w = self.filter.width();
-        let j0 = (q - T::from_usize(w) * T::HALF).floor_i64() + 1;
-        let mut d = q - T::from_i32(j0 as i32);
-        for wt in weights[..w].iter_mut() {
-            *wt = self.eval(d);
-            d -= T::ONE;
-        }
-        j0
+        tap_weights(q, &mut weights[..self.filter.width()], |d| self.eval(d))
+    }
+
+    /// [`DerivativeTable::taps`] for a width known at compile time.
+    #[inline(always)]
+    pub fn taps_fixed<const W: usize>(&self, q: T, weights: &mut [T; W]) -> i64 {
+        tap_weights(q, weights, |d| self.eval(d))
     }
 }
