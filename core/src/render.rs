@@ -214,6 +214,32 @@ impl<'a> LineReads<'a> {
         x0 + W <= n && !matches!(self, LineReads::General)
     }
 
+    /// The `W` coefficients from `line + x0` as one run, when `contiguous`
+    /// (one bounds check for the run).
+    #[inline(always)]
+    fn run<'s, const W: usize, S: Sample>(
+        spec: &Spectrum<'s, S>,
+        line: usize,
+        x0: usize,
+        contiguous: bool,
+    ) -> Option<&'s [S; W]> {
+        if !contiguous {
+            return None;
+        }
+        spec.data()
+            .get(line + x0..line + x0 + W)
+            .and_then(|s| <&[S; W]>::try_from(s).ok())
+    }
+
+    /// The block exponent's power of two for `line`, if lines carry one.
+    #[inline(always)]
+    fn line_scale<S: Sample, T: Real>(self, spec: &Spectrum<'_, S>, line: usize) -> Option<T> {
+        match self {
+            LineReads::LineExponents(e) => Some(T::exp2i(e[line / spec.n()] as i32)),
+            _ => None,
+        }
+    }
+
     /// `Σ_t w[t]·c[line + xs[t]]` with block exponents applied: one
     /// contiguous run from `x0` when `contiguous`, else through
     /// [`Spectrum::line_taps`] at the wrapped indices `xs`.
@@ -227,25 +253,16 @@ impl<'a> LineReads<'a> {
         xs: &[usize; W],
         weights: &[T; W],
     ) -> T {
-        let run = if contiguous {
-            spec.data()
-                .get(line + x0..line + x0 + W)
-                .and_then(|s| <&[S; W]>::try_from(s).ok())
-        } else {
-            None
+        let Some(run) = Self::run::<W, S>(spec, line, x0, contiguous) else {
+            return spec.line_taps(line, xs, weights);
         };
-        match run {
-            Some(run) => {
-                let mut sum = T::ZERO;
-                for (wt, v) in weights.iter().zip(run) {
-                    sum += *wt * T::load(*v);
-                }
-                match self {
-                    LineReads::LineExponents(e) => sum * T::exp2i(e[line / spec.n()] as i32),
-                    _ => sum,
-                }
-            }
-            None => spec.line_taps(line, xs, weights),
+        let mut sum = T::ZERO;
+        for (wt, v) in weights.iter().zip(run) {
+            sum += *wt * T::load(*v);
+        }
+        match self.line_scale::<S, T>(spec, line) {
+            Some(scale) => sum * scale,
+            None => sum,
         }
     }
 
@@ -262,33 +279,21 @@ impl<'a> LineReads<'a> {
         first: &[T; W],
         second: &[T; W],
     ) -> (T, T) {
-        let run = if contiguous {
-            spec.data()
-                .get(line + x0..line + x0 + W)
-                .and_then(|s| <&[S; W]>::try_from(s).ok())
-        } else {
-            None
-        };
-        match run {
-            Some(run) => {
-                let (mut a, mut b) = (T::ZERO, T::ZERO);
-                for t in 0..W {
-                    let v = T::load(run[t]);
-                    a += first[t] * v;
-                    b += second[t] * v;
-                }
-                match self {
-                    LineReads::LineExponents(e) => {
-                        let scale = T::exp2i(e[line / spec.n()] as i32);
-                        (a * scale, b * scale)
-                    }
-                    _ => (a, b),
-                }
-            }
-            None => (
+        let Some(run) = Self::run::<W, S>(spec, line, x0, contiguous) else {
+            return (
                 spec.line_taps(line, xs, first),
                 spec.line_taps(line, xs, second),
-            ),
+            );
+        };
+        let (mut a, mut b) = (T::ZERO, T::ZERO);
+        for t in 0..W {
+            let v = T::load(run[t]);
+            a += first[t] * v;
+            b += second[t] * v;
+        }
+        match self.line_scale::<S, T>(spec, line) {
+            Some(scale) => (a * scale, b * scale),
+            None => (a, b),
         }
     }
 }
