@@ -130,19 +130,8 @@ struct RenderArgs {
     /// Default: the padded grid divided by the oversampling.
     #[arg(long, value_parser = parse_size)]
     size: Option<(usize, usize)>,
-    /// Interpolation filter: nearest, linear, cubic, kb3, kb4, kb5, kb6.
-    #[arg(long, value_parser = parse_filter, default_value = "kb4")]
-    filter: FilterKind,
-    /// Oversampling of the spectrum grid: 1 or 2.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=2))]
-    oversample: u32,
-    /// Spectrum storage and arithmetic: f16 (f32 arithmetic), f32 or f64.
-    #[arg(long, default_value = "f16")]
-    precision: Precision,
-    /// Kaiser-Bessel shape: `auto` fits beta to the volume's energy
-    /// distribution; a number is the design oversampling of Beatty's formula.
-    #[arg(long, default_value = "auto")]
-    kb_design: KbDesign,
+    #[command(flatten)]
+    spectrum: SpectrumArgs,
     /// Depth cue: none, linear:FRONT,BACK, sine:FRONT,BACK, profile:W0,W1,...,
     /// profile:@FILE or profile:gauss:C,S (details with --help).
     #[arg(long, default_value = "none", long_help = DEPTH_CUE_HELP)]
@@ -210,19 +199,8 @@ struct RenderArgs {
     /// For a built-in phantom, also print the SNR against its exact line integrals.
     #[arg(long)]
     exact: bool,
-    /// Read VOLUME as a headerless raw file of these sizes X,Y,Z.
-    #[arg(long, value_parser = parse_dims)]
-    raw_dims: Option<[usize; 3]>,
-    /// Sample type of a raw file: u8, i8, u16, i16, u32, i32, f32, f64.
-    #[arg(long, default_value = "u8")]
-    raw_type: SampleType,
-    /// Byte order of a raw file: little or big.
-    #[arg(long, default_value = "little", value_parser = parse_endian)]
-    raw_endian: Endian,
-    /// Value of empty space: voxels become max(value - B, 0) before
-    /// rendering. Use -1024 for CT in Hounsfield units (air).
-    #[arg(long, allow_hyphen_values = true)]
-    background: Option<f64>,
+    #[command(flatten)]
+    input: InputArgs,
 }
 
 /// How a PNG is made from the rendered values (render and turntable).
@@ -282,6 +260,20 @@ struct TurntableArgs {
     /// Default: the padded grid divided by the oversampling.
     #[arg(long, value_parser = parse_size)]
     size: Option<(usize, usize)>,
+    #[command(flatten)]
+    spectrum: SpectrumArgs,
+    /// Output file: .apng or .png (an animated PNG either way).
+    #[arg(long, default_value = "spin.apng")]
+    out: PathBuf,
+    #[command(flatten)]
+    png: PngArgs,
+    #[command(flatten)]
+    input: InputArgs,
+}
+
+/// How the spectrum is made (render and turntable).
+#[derive(Args, Clone, Copy)]
+struct SpectrumArgs {
     /// Interpolation filter: nearest, linear, cubic, kb3, kb4, kb5, kb6.
     #[arg(long, value_parser = parse_filter, default_value = "kb4")]
     filter: FilterKind,
@@ -295,11 +287,22 @@ struct TurntableArgs {
     /// distribution; a number is the design oversampling of Beatty's formula.
     #[arg(long, default_value = "auto")]
     kb_design: KbDesign,
-    /// Output file: .apng or .png (an animated PNG either way).
-    #[arg(long, default_value = "spin.apng")]
-    out: PathBuf,
-    #[command(flatten)]
-    png: PngArgs,
+}
+
+impl Default for SpectrumArgs {
+    fn default() -> Self {
+        Self {
+            filter: FilterKind::Kb4,
+            oversample: 1,
+            precision: Precision::F16,
+            kb_design: KbDesign::Auto,
+        }
+    }
+}
+
+/// How the volume is read (render and turntable).
+#[derive(Args, Clone, Copy)]
+struct InputArgs {
     /// Read VOLUME as a headerless raw file of these sizes X,Y,Z.
     #[arg(long, value_parser = parse_dims)]
     raw_dims: Option<[usize; 3]>,
@@ -313,6 +316,33 @@ struct TurntableArgs {
     /// rendering. Use -1024 for CT in Hounsfield units (air).
     #[arg(long, allow_hyphen_values = true)]
     background: Option<f64>,
+}
+
+impl Default for InputArgs {
+    fn default() -> Self {
+        Self {
+            raw_dims: None,
+            raw_type: SampleType::U8,
+            raw_endian: Endian::Little,
+            background: None,
+        }
+    }
+}
+
+impl InputArgs {
+    /// Load `spec` with a progress bar, then subtract the background.
+    fn load(&self, spec: &str) -> Result<fvr_host::volume::Volume, String> {
+        let raw = self.raw_dims.map(|dims| RawLayout {
+            dims,
+            ty: self.raw_type,
+            endian: self.raw_endian,
+        });
+        let mut volume = load_with_progress(spec, raw)?;
+        if let Some(b) = self.background {
+            volume.subtract_background(b)?;
+        }
+        Ok(volume)
+    }
 }
 
 fn volume_help() -> String {
@@ -419,10 +449,7 @@ fn default_scene() -> Result<(), String> {
         dir: [1.0, 0.45, -0.3],
         up: DEFAULT_UP,
         size: None,
-        filter: FilterKind::Kb4,
-        oversample: 1,
-        precision: Precision::F16,
-        kb_design: KbDesign::Auto,
+        spectrum: SpectrumArgs::default(),
         depth_cue: "none".into(),
         cue_harmonics: DEFAULT_PROFILE_HARMONICS,
         ambient: Some([0.05; 3]),
@@ -445,10 +472,7 @@ fn default_scene() -> Result<(), String> {
         adaptive_hd: None,
         preview_level: 0,
         exact: false,
-        raw_dims: None,
-        raw_type: SampleType::U8,
-        raw_endian: Endian::Little,
-        background: None,
+        input: InputArgs::default(),
     };
     println!(
         "fvr: rendering the default scene: 24 Gaussian blobs lit by red, green and blue lights \
@@ -471,16 +495,8 @@ fn render(args: &RenderArgs) -> Result<(), String> {
     };
     view.frame().map_err(|e| e.to_string())?;
     let style = args.png.style()?;
-    let raw = args.raw_dims.map(|dims| RawLayout {
-        dims,
-        ty: args.raw_type,
-        endian: args.raw_endian,
-    });
     let t0 = Instant::now();
-    let mut volume = load_with_progress(&args.volume, raw)?;
-    if let Some(b) = args.background {
-        volume.subtract_background(b)?;
-    }
+    let mut volume = args.input.load(&args.volume)?;
     if let Some(largest) = args.resample {
         volume = volume.resample_isotropic(largest)?;
     }
@@ -489,10 +505,10 @@ fn render(args: &RenderArgs) -> Result<(), String> {
     let t1 = Instant::now();
     let (spectra, filter) = prepare_scene_with_progress(
         &volume,
-        args.filter,
-        args.oversample,
-        args.kb_design,
-        args.precision,
+        args.spectrum.filter,
+        args.spectrum.oversample,
+        args.spectrum.kb_design,
+        args.spectrum.precision,
         &scene,
     )?;
     let t_prep = t1.elapsed();
@@ -503,9 +519,9 @@ fn render(args: &RenderArgs) -> Result<(), String> {
             "fvr: warning: premultiplying for {} at oversample {} amplifies this volume's edges; \
              the {} spectrum is estimated to hold only {storage_snr:.1} dB. \
              Use --oversample 2, --filter cubic, or --precision f32.",
-            args.filter.name(),
-            args.oversample,
-            args.precision
+            args.spectrum.filter.name(),
+            args.spectrum.oversample,
+            args.spectrum.precision
         );
     }
     let (lowest, share) = negative_cue_share(&volume, &scene, &view).map_err(|e| e.to_string())?;
@@ -518,9 +534,10 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         );
     }
     let n = spectra.density.n();
-    let (w, h) = args
-        .size
-        .unwrap_or((n / args.oversample as usize, n / args.oversample as usize));
+    let (w, h) = args.size.unwrap_or((
+        n / args.spectrum.oversample as usize,
+        n / args.spectrum.oversample as usize,
+    ));
     let plain_view = scene.channels() == 1 && !scene.has_partner_terms();
     if (args.preview_level > 0 || args.adaptive.is_some()) && !plain_view {
         return Err(
@@ -600,9 +617,9 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         );
         println!(
             "  spectrum      {n}^3 {} = {} bytes ({} bytes/voxel)",
-            args.precision,
+            args.spectrum.precision,
             spectra.density.bytes(),
-            args.precision.bytes()
+            args.spectrum.precision.bytes()
         );
         match &spectra.gradient {
             Some(g) => println!(
@@ -611,7 +628,7 @@ fn render(args: &RenderArgs) -> Result<(), String> {
             ),
             None => println!("  |grad f|      not built (no light needs it)"),
         }
-        let working = match args.precision {
+        let working = match args.spectrum.precision {
             Precision::F64 => SceneRenderer::<f64>::new(n, filter, &scene).map(|r| r.bytes()),
             _ => SceneRenderer::<f32>::new(n, filter, &scene).map(|r| r.bytes()),
         }
@@ -658,7 +675,7 @@ fn render(args: &RenderArgs) -> Result<(), String> {
             ("dims", format!("{:?}", volume.dims)),
             ("image", format!("[{w}, {h}, {}]", image.channels)),
             ("spectrum_side", n.to_string()),
-            ("precision", json_str(args.precision.name())),
+            ("precision", json_str(args.spectrum.precision.name())),
             ("spectrum_bytes", spectra.density.bytes().to_string()),
             (
                 "gradient_spectrum_bytes",
@@ -802,28 +819,20 @@ fn prepare_with_progress(
 fn turntable(args: &TurntableArgs) -> Result<(), String> {
     let views = turntable::orbit(args.dir, args.up, args.frames as usize)?;
     let style = args.png.style()?;
-    let raw = args.raw_dims.map(|dims| RawLayout {
-        dims,
-        ty: args.raw_type,
-        endian: args.raw_endian,
-    });
     let t0 = Instant::now();
-    let mut volume = load_with_progress(&args.volume, raw)?;
-    if let Some(b) = args.background {
-        volume.subtract_background(b)?;
-    }
+    let volume = args.input.load(&args.volume)?;
     let t_load = t0.elapsed();
     let t1 = Instant::now();
     let spec = prepare_with_progress(
         &volume,
-        args.filter,
-        args.oversample,
-        args.kb_design,
-        args.precision,
+        args.spectrum.filter,
+        args.spectrum.oversample,
+        args.spectrum.kb_design,
+        args.spectrum.precision,
     )?;
     let t_prep = t1.elapsed();
     let n = spec.n();
-    let side = n / args.oversample as usize;
+    let side = n / args.spectrum.oversample as usize;
     let (w, h) = args.size.unwrap_or((side, side));
     let bar = progress::count(views.len() as u64, "frames");
     let t2 = Instant::now();
@@ -843,7 +852,7 @@ fn turntable(args: &TurntableArgs) -> Result<(), String> {
         "  load {:.1} ms, preprocess {:.1} ms ({n}^3 {}), {} views in {:.1} ms = {:.1} views/s",
         t_load.as_secs_f64() * 1e3,
         t_prep.as_secs_f64() * 1e3,
-        args.precision,
+        args.spectrum.precision,
         frames.len(),
         secs * 1e3,
         frames.len() as f64 / secs.max(1e-9)
