@@ -17,6 +17,7 @@ pub mod progress;
 pub mod raycast;
 pub mod reference;
 pub mod scene;
+pub mod scene_file;
 pub mod scene_reference;
 pub mod shaded;
 pub mod turntable;
