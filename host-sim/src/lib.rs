@@ -20,5 +20,6 @@ pub mod scene;
 pub mod scene_file;
 pub mod scene_reference;
 pub mod shaded;
+pub mod teapot;
 pub mod turntable;
 pub mod volume;

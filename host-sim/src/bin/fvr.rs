@@ -77,8 +77,9 @@ valid key. Examples: the examples/ directory of the repository.";
 /// Frequency-domain volume rendering (Totsuka & Levoy 1993): X-ray
 /// projections, depth cueing and shading from a 16-bit Hartley spectrum.
 /// With no subcommand, renders the built-in default scene to
-/// `fvr-default.png`: `fvr render blobs@128:4 --dir 1,0.45,-0.3 --light-ring 3
-/// --ambient 0.05 --stats`.
+/// `fvr-default.png`: the Utah teapot lit by three coloured lights, as
+/// `fvr render teapot@128 --dir 0.3,1,-0.45 --light-ring 3 --ambient 0.1
+/// --out fvr-default.png --stats`.
 #[derive(Parser)]
 #[command(name = "fvr", version, after_help = GEOMETRY)]
 struct Cli {
