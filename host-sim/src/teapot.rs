@@ -45,13 +45,13 @@ pub const TEAPOT_SUPERSAMPLING: usize = 4;
 /// inscribed sphere.
 pub const TEAPOT_RADIUS_FRACTION: f64 = 0.45;
 
-/// Patches of each part, as ranges of [`TEAPOT_PATCHES`]: body (rim, body,
-/// bottom), handle, spout, lid.
-pub const TEAPOT_PARTS: [(&str, &[std::ops::Range<usize>]); 4] = [
-    ("body", &[0..12, 28..32]),
-    ("handle", &[12..16]),
-    ("spout", &[16..20]),
-    ("lid", &[20..28]),
+/// Patches of each part, as half-open index ranges `(start, end)` of
+/// [`TEAPOT_PATCHES`]: body (rim, body, bottom), handle, spout, lid.
+pub const TEAPOT_PARTS: [(&str, &[(usize, usize)]); 4] = [
+    ("body", &[(0, 12), (28, 32)]),
+    ("handle", &[(12, 16)]),
+    ("spout", &[(16, 20)]),
+    ("lid", &[(20, 28)]),
 ];
 
 /// The 306 control points (x, y, z) of the teapot, z up, spout towards +x,
@@ -502,9 +502,9 @@ fn patch_grid(p: usize, m: usize) -> Vec<[f64; 3]> {
 }
 
 /// Triangles of the patches in `ranges`, each patch cut into `m × m` quads.
-fn tessellate(ranges: &[std::ops::Range<usize>], m: usize) -> Vec<[[f64; 3]; 3]> {
+fn tessellate(ranges: &[(usize, usize)], m: usize) -> Vec<[[f64; 3]; 3]> {
     let mut triangles = Vec::new();
-    for p in ranges.iter().flat_map(|r| r.clone()) {
+    for p in ranges.iter().flat_map(|&(start, end)| start..end) {
         let g = patch_grid(p, m);
         let at = |i: usize, j: usize| g[i * (m + 1) + j];
         for i in 0..m {

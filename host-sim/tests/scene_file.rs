@@ -170,3 +170,86 @@ fn turntable_reads_the_scene() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("does not use the scene's [shading]"));
     assert!(dir.join("spin.apng").is_file());
 }
+
+/// Every scene in `examples/` parses, and those that need no download render
+/// (smaller, into a temporary directory).
+#[test]
+fn example_scenes_parse_and_render() {
+    let examples = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
+    let dir = temp_dir("scenefile-examples");
+    let mut rendered = 0;
+    let mut scenes: Vec<_> = std::fs::read_dir(&examples)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    scenes.sort();
+    assert!(scenes.len() >= 4, "{scenes:?}");
+    for path in &scenes {
+        let scene = fvr_host::scene_file::SceneFile::load(path)
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let spec = scene
+            .volume
+            .spec
+            .as_deref()
+            .expect("every example names its volume");
+        if spec == "ct-head" {
+            continue; // fetched at run time; the parse above is the check
+        }
+        let name = path.file_stem().unwrap().to_string_lossy().into_owned();
+        let path = path.to_string_lossy().into_owned();
+        let out = if scene.turntable.frames.is_some() {
+            let out_file = format!("{name}.apng");
+            fvr(
+                &[
+                    "turntable",
+                    "--scene",
+                    &path,
+                    "--frames",
+                    "2",
+                    "--size",
+                    "32",
+                    "--out",
+                    &out_file,
+                ],
+                &dir,
+            )
+        } else {
+            let ext = scene
+                .output
+                .path
+                .as_ref()
+                .and_then(|p| p.extension())
+                .unwrap();
+            let out_file = format!("{name}.{}", ext.to_string_lossy());
+            fvr(
+                &[
+                    "render", "--scene", &path, "--size", "32", "--out", &out_file,
+                ],
+                &dir,
+            )
+        };
+        let stdout = ok(&out);
+        assert!(stdout.contains("wrote"), "{name}: {stdout}");
+        rendered += 1;
+    }
+    assert!(rendered >= 3);
+}
+
+#[test]
+fn teapot_names_are_checked() {
+    let dir = temp_dir("scenefile-teapot");
+    let base = ["--dir", "0,1,0", "--out", "t.png"];
+    for (spec, needle) in [
+        ("teapot@4", "teapot size 4 must be from 8"),
+        ("teapot@x", "teapot size `x` must be an integer"),
+        ("teapot:3", "`teapot` takes no seed"),
+    ] {
+        let mut args = vec!["render", spec];
+        args.extend(base);
+        assert_error(&fvr(&args, &dir), &[needle]);
+    }
+    let mut args = vec!["render", "teapot@24"];
+    args.extend(base);
+    assert!(ok(&fvr(&args, &dir)).contains("wrote t.png (32x32 grey)"));
+}
