@@ -253,3 +253,42 @@ fn teapot_names_are_checked() {
     args.extend(base);
     assert!(ok(&fvr(&args, &dir)).contains("wrote t.png (32x32 grey)"));
 }
+
+#[test]
+fn turntable_stats_json_is_one_object_with_views_per_second() {
+    let dir = temp_dir("scenefile-turntable-json");
+    let out = fvr(
+        &[
+            "turntable",
+            "sphere@16",
+            "--frames",
+            "4",
+            "--stats-json",
+            "--out",
+            "s.apng",
+        ],
+        &dir,
+    );
+    let stdout = ok(&out);
+    let json = stdout
+        .lines()
+        .find(|l| l.starts_with('{'))
+        .expect("a JSON line");
+    assert!(
+        json.ends_with('}') && !stdout.contains("views/s"),
+        "{stdout}"
+    );
+    let number = |key: &str| -> f64 {
+        let rest = &json[json.find(&format!("\"{key}\": ")).expect(key) + key.len() + 4..];
+        rest[..rest.find([',', '}']).unwrap()].parse().expect(key)
+    };
+    assert_eq!(number("frames"), 4.0);
+    assert_eq!(number("spectrum_side"), 16.0);
+    let (views_ms, per_second) = (number("views_ms"), number("views_per_second"));
+    assert!(views_ms > 0.0 && per_second > 0.0);
+    assert!(
+        (per_second * views_ms / 1e3 - 4.0).abs() < 1e-6 * 4.0,
+        "{json}"
+    );
+    assert!(json.contains("\"volume\": \"sphere@16\""), "{json}");
+}

@@ -298,6 +298,10 @@ struct TurntableArgs {
     /// Output file: .apng or .png (an animated PNG either way).
     #[arg(long, default_value = "spin.apng")]
     out: PathBuf,
+    /// Print the timings (load, preprocess, views, views per second) as one
+    /// JSON object instead of the summary line.
+    #[arg(long)]
+    stats_json: bool,
     #[command(flatten)]
     png: PngArgs,
     #[command(flatten)]
@@ -1077,15 +1081,44 @@ fn turntable(args: &TurntableArgs) -> Result<(), String> {
         frames.len(),
         args.fps
     );
-    println!(
-        "  load {:.1} ms, preprocess {:.1} ms ({n}^3 {}), {} views in {:.1} ms = {:.1} views/s",
-        t_load.as_secs_f64() * 1e3,
-        t_prep.as_secs_f64() * 1e3,
-        args.spectrum.precision,
-        frames.len(),
-        secs * 1e3,
-        frames.len() as f64 / secs.max(1e-9)
-    );
+    let views_per_second = frames.len() as f64 / secs.max(1e-9);
+    if args.stats_json {
+        let fields = [
+            ("volume", json_str(volume_spec)),
+            ("dims", format!("{:?}", volume.dims)),
+            ("image", format!("[{w}, {h}]")),
+            ("frames", frames.len().to_string()),
+            ("fps", args.fps.to_string()),
+            ("spectrum_side", n.to_string()),
+            ("precision", json_str(args.spectrum.precision.name())),
+            ("spectrum_bytes", spec.bytes().to_string()),
+            ("filter", json_str(args.spectrum.filter.name())),
+            ("oversample", args.spectrum.oversample.to_string()),
+            ("load_ms", json_num(t_load.as_secs_f64() * 1e3)),
+            ("preprocess_ms", json_num(t_prep.as_secs_f64() * 1e3)),
+            ("views_ms", json_num(secs * 1e3)),
+            (
+                "ms_per_view",
+                json_num(secs * 1e3 / frames.len().max(1) as f64),
+            ),
+            ("views_per_second", json_num(views_per_second)),
+        ];
+        let body: Vec<String> = fields
+            .iter()
+            .map(|(k, v)| format!("{}: {v}", json_str(k)))
+            .collect();
+        println!("{{{}}}", body.join(", "));
+    } else {
+        println!(
+            "  load {:.1} ms, preprocess {:.1} ms ({n}^3 {}), {} views in {:.1} ms = {:.1} views/s",
+            t_load.as_secs_f64() * 1e3,
+            t_prep.as_secs_f64() * 1e3,
+            args.spectrum.precision,
+            frames.len(),
+            secs * 1e3,
+            views_per_second
+        );
+    }
     Ok(())
 }
 
