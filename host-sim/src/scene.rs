@@ -8,6 +8,7 @@ use crate::datasets::{load_dataset_with_progress, DATASETS_HELP};
 use crate::formats::{read_volume_with_progress, FORMATS_HELP};
 use crate::nrrd::{read_raw, Endian, SampleType};
 use crate::phantom::{sample, GaussianMixture, Phantom, SheppLogan, Sphere};
+use crate::teapot::{voxelize_teapot, DEFAULT_TEAPOT_SIZE};
 use crate::volume::Volume;
 
 /// Default side of built-in phantoms.
@@ -27,7 +28,8 @@ pub const BLOB_SIGMA_FRACTION: f64 = 0.05;
 pub const PHANTOM_HELP: &str = "built-in phantoms: `gaussians[@N][:SEED]` (8 random anisotropic \
 Gaussians, sigma 1.5 to 0.12 N voxels, inside the sphere of radius 0.4 N), `blobs[@N][:SEED]` (24 \
 smaller ones, sigma 1.5 to 0.05 N), `shepp-logan[@N]` (modified 3D \
-Shepp-Logan), `sphere[@N]` (uniform ball of radius 0.3 N); N defaults to 64";
+Shepp-Logan), `sphere[@N]` (uniform ball of radius 0.3 N); N defaults to 64; and \
+`teapot[@N]` (Newell's Utah teapot voxelized from its 32 Bezier patches, N defaults to 128)";
 
 /// A phantom with its sampled volume.
 pub struct PhantomVolume {
@@ -99,6 +101,25 @@ fn build_phantom(
     Ok(PhantomVolume { phantom, volume })
 }
 
+/// Parse `teapot[@N]` into the voxelized Utah teapot ([`crate::teapot`]),
+/// or `None` if `spec` names something else.
+///
+/// # Errors
+/// A malformed or out-of-range size.
+pub fn teapot_by_name(spec: &str) -> Option<Result<Volume, String>> {
+    let size = match spec.strip_prefix("teapot")? {
+        "" => Ok(DEFAULT_TEAPOT_SIZE),
+        rest => match rest.strip_prefix('@') {
+            Some(n) => n.parse::<usize>().map_err(|_| {
+                format!("teapot size `{n}` must be an integer from 8 to {MAX_PHANTOM_SIZE}")
+            }),
+            None if rest.starts_with(':') => Err("phantom `teapot` takes no seed".to_string()),
+            None => return None,
+        },
+    };
+    Some(size.and_then(|n| voxelize_teapot(n).map(|t| t.volume)))
+}
+
 /// Layout of a headerless raw file.
 #[derive(Clone, Copy, Debug)]
 pub struct RawLayout {
@@ -132,6 +153,9 @@ pub fn load_volume_with_progress(
 ) -> Result<Volume, String> {
     if let Some(p) = phantom_by_name(spec) {
         return p.map(|p| p.volume);
+    }
+    if let Some(t) = teapot_by_name(spec) {
+        return t;
     }
     let path = Path::new(spec);
     if let Some(r) = raw {

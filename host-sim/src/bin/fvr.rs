@@ -4,7 +4,8 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-use clap::{Args, Parser, Subcommand};
+use clap::parser::ValueSource;
+use clap::{ArgMatches, Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 use fvr_core::filter::FilterKind;
 use fvr_core::geometry::{View, DEFAULT_UP};
 use fvr_core::scene::{Light, Scene, MAX_LIGHTS};
@@ -16,6 +17,7 @@ use fvr_host::output::{write_apng, write_png, Bits, Colormap, Style, Window};
 use fvr_host::pipeline::{choose_filter, AnySpectrum, KbDesign, Precision};
 use fvr_host::reference::{exact_projection, max_abs_error, snr_db};
 use fvr_host::scene::{load_volume_with_progress, phantom_by_name, RawLayout, PHANTOM_HELP};
+use fvr_host::scene_file::{parse_endian, SceneFile};
 use fvr_host::scene_reference::exact_scene_projection;
 use fvr_host::shaded::{
     light_ring, negative_cue_share, parse_depth_cue, parse_light, parse_light_ring, parse_rgb,
@@ -50,11 +52,34 @@ EXIT STATUS
 
 Progress bars go to stderr only when it is a terminal; --quiet turns them off.";
 
+const SCENE_HELP: &str = "\
+Scene file (TOML) holding any of the render settings, so that a render can be
+shared and reproduced. Precedence: a flag given on the command line, then the
+scene's value, then the flag's default. Each flag replaces the scene key of the
+same name (--light replaces all [[lights]]; a VOLUME replaces the scene's volume
+and its raw layout). Relative paths in the scene (volume.path, output.path,
+turntable.path, profile:@FILE) are relative to the scene file's directory.
+
+  [volume]     path = \"head.nii.gz\" | builtin = \"teapot@128\", raw_dims = [X, Y, Z],
+               raw_type, raw_endian, background, resample
+  [camera]     dir = [X, Y, Z], up = [X, Y, Z], size = N | [W, H]
+  [spectrum]   filter, oversample, precision, kb_design
+  [shading]    ambient = G | [R, G, B], depth_cue = \"linear:1,0.3\", cue_harmonics,
+               cue_correction = true
+  [light_ring] count, tilt
+  [[lights]]   direction = [X, Y, Z], color = G | [R, G, B]      (repeatable)
+  [output]     path, bits = 8 | 16, window, level, percentiles = [LO, HI], colormap
+  [turntable]  frames, fps, path                                (turntable only)
+
+Unknown keys and wrong types are errors naming the file, the key and the closest
+valid key. Examples: the examples/ directory of the repository.";
+
 /// Frequency-domain volume rendering (Totsuka & Levoy 1993): X-ray
 /// projections, depth cueing and shading from a 16-bit Hartley spectrum.
 /// With no subcommand, renders the built-in default scene to
-/// `fvr-default.png`: `fvr render blobs@128:4 --dir 1,0.45,-0.3 --light-ring 3
-/// --ambient 0.05 --stats`.
+/// `fvr-default.png`: the Utah teapot lit by three coloured lights, as
+/// `fvr render teapot@128 --dir 0.3,1,-0.45 --light-ring 3 --ambient 0.1
+/// --out fvr-default.png --stats`.
 #[derive(Parser)]
 #[command(name = "fvr", version, after_help = GEOMETRY)]
 struct Cli {
@@ -118,11 +143,15 @@ enum Command {
 #[derive(Args)]
 struct RenderArgs {
     /// A volume file, a raw file with --raw-dims, a data set, or a built-in phantom.
-    #[arg(help = volume_help())]
-    volume: String,
+    #[arg(help = volume_help(), required_unless_present = "scene")]
+    volume: Option<String>,
+    /// Scene file (TOML) with any of the settings below; flags given on the
+    /// command line override the scene's values.
+    #[arg(long, value_name = "FILE.toml", long_help = SCENE_HELP)]
+    scene: Option<PathBuf>,
     /// View direction X,Y,Z, from the eye into the scene.
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
-    dir: [f64; 3],
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, required_unless_present = "scene")]
+    dir: Option<[f64; 3]>,
     /// Up hint X,Y,Z.
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,1")]
     up: [f64; 3],
@@ -161,8 +190,8 @@ struct RenderArgs {
     /// Output file: .nrrd (float32; sizes W H, or 3 W H for RGB) or .png
     /// (grey: windowed, see --bits, --window/--level, --percentiles and
     /// --colormap; RGB: 8-bit, one percentile window over all channels).
-    #[arg(long)]
-    out: PathBuf,
+    #[arg(long, required_unless_present = "scene")]
+    out: Option<PathBuf>,
     #[command(flatten)]
     png: PngArgs,
     /// Print timing, memory and filter details.
@@ -242,8 +271,12 @@ impl PngArgs {
 #[derive(Args)]
 struct TurntableArgs {
     /// A volume file, a raw file with --raw-dims, a data set, or a built-in phantom.
-    #[arg(help = volume_help())]
-    volume: String,
+    #[arg(help = volume_help(), required_unless_present = "scene")]
+    volume: Option<String>,
+    /// Scene file (TOML): its volume, camera, spectrum, output window and
+    /// [turntable] settings; flags given on the command line override them.
+    #[arg(long, value_name = "FILE.toml", long_help = SCENE_HELP)]
+    scene: Option<PathBuf>,
     /// Number of frames in the turn.
     #[arg(long, default_value_t = 72, value_parser = clap::value_parser!(u32).range(1..=3600))]
     frames: u32,
@@ -265,6 +298,10 @@ struct TurntableArgs {
     /// Output file: .apng or .png (an animated PNG either way).
     #[arg(long, default_value = "spin.apng")]
     out: PathBuf,
+    /// Print the timings (load, preprocess, views, views per second) as one
+    /// JSON object instead of the summary line.
+    #[arg(long)]
+    stats_json: bool,
     #[command(flatten)]
     png: PngArgs,
     #[command(flatten)]
@@ -408,21 +445,35 @@ fn parse_filter(s: &str) -> Result<FilterKind, String> {
     })
 }
 
-fn parse_endian(s: &str) -> Result<Endian, String> {
-    match s {
-        "little" => Ok(Endian::Little),
-        "big" => Ok(Endian::Big),
-        _ => Err(format!("unknown byte order `{s}`: expected little or big")),
-    }
-}
-
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let matches = Cli::command().get_matches();
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     progress::set_quiet(cli.quiet);
+    let given = |sub: &str, id: &str| {
+        matches
+            .subcommand_matches(sub)
+            .is_some_and(|m| given_on_command_line(m, id))
+    };
     let result = match cli.command {
         None => default_scene(),
-        Some(Command::Render(args)) => render(&args),
-        Some(Command::Turntable(args)) => turntable(&args),
+        Some(Command::Render(mut args)) => args
+            .scene
+            .clone()
+            .map_or(Ok(()), |path| {
+                SceneFile::load(&path).map(|scene| {
+                    apply_scene_to_render(&mut args, &scene, &|id| given("render", id))
+                })
+            })
+            .and_then(|()| render(&args)),
+        Some(Command::Turntable(mut args)) => args
+            .scene
+            .clone()
+            .map_or(Ok(()), |path| {
+                SceneFile::load(&path).map(|scene| {
+                    apply_scene_to_turntable(&mut args, &scene, &|id| given("turntable", id))
+                })
+            })
+            .and_then(|()| turntable(&args)),
         Some(Command::Compare { a, b }) => compare(&a, &b),
         Some(Command::Accuracy { sizes }) => accuracy(&sizes),
         Some(Command::AdaptiveTable {
@@ -443,20 +494,25 @@ fn main() -> ExitCode {
     }
 }
 
+/// The scene `fvr` renders with no subcommand (output relative to the
+/// working directory).
+const DEFAULT_SCENE: &str = include_str!("../default-scene.toml");
+
 fn default_scene() -> Result<(), String> {
-    let args = RenderArgs {
-        volume: "blobs@128:4".into(),
-        dir: [1.0, 0.45, -0.3],
+    let mut args = RenderArgs {
+        volume: None,
+        scene: None,
+        dir: None,
         up: DEFAULT_UP,
         size: None,
         spectrum: SpectrumArgs::default(),
         depth_cue: "none".into(),
         cue_harmonics: DEFAULT_PROFILE_HARMONICS,
-        ambient: Some([0.05; 3]),
+        ambient: None,
         lights: Vec::new(),
-        light_ring: Some((3, 30.0)),
+        light_ring: None,
         no_cue_correction: false,
-        out: PathBuf::from("fvr-default.png"),
+        out: None,
         png: PngArgs {
             bits: Bits::Eight,
             window: None,
@@ -474,29 +530,207 @@ fn default_scene() -> Result<(), String> {
         exact: false,
         input: InputArgs::default(),
     };
+    let scene = SceneFile::parse(DEFAULT_SCENE, "the default scene", Path::new(""))?;
+    apply_scene_to_render(&mut args, &scene, &|_| false);
     println!(
-        "fvr: rendering the default scene: 24 Gaussian blobs lit by red, green and blue lights \
+        "fvr: rendering the default scene: the Utah teapot lit by red, green and blue lights \
          120 degrees apart, as in the paper's figure 8 (run `fvr --help` for options)"
     );
     render(&args)
 }
 
+/// Whether the argument `id` was given on the command line (not defaulted).
+fn given_on_command_line(matches: &ArgMatches, id: &str) -> bool {
+    matches.try_get_raw(id).is_ok() && matches.value_source(id) == Some(ValueSource::CommandLine)
+}
+
+/// Set `slot` to the scene's `value` unless the flag `id` was given.
+fn fill<T>(given: &dyn Fn(&str) -> bool, id: &str, slot: &mut T, value: Option<T>) {
+    if let (false, Some(v)) = (given(id), value) {
+        *slot = v;
+    }
+}
+
+/// Fill the volume settings from the scene. A VOLUME given on the command
+/// line drops the scene's raw layout, which describes the scene's file.
+fn apply_scene_to_input(
+    volume: &mut Option<String>,
+    input: &mut InputArgs,
+    scene: &SceneFile,
+    given: &dyn Fn(&str) -> bool,
+) {
+    let v = &scene.volume;
+    if !given("volume") {
+        fill(given, "volume", volume, v.spec.clone().map(Some));
+        fill(given, "raw_dims", &mut input.raw_dims, v.raw_dims.map(Some));
+        fill(given, "raw_type", &mut input.raw_type, v.raw_type);
+        fill(given, "raw_endian", &mut input.raw_endian, v.raw_endian);
+    }
+    fill(
+        given,
+        "background",
+        &mut input.background,
+        v.background.map(Some),
+    );
+}
+
+fn apply_scene_to_spectrum(
+    spectrum: &mut SpectrumArgs,
+    scene: &SceneFile,
+    given: &dyn Fn(&str) -> bool,
+) {
+    let s = &scene.spectrum;
+    fill(given, "filter", &mut spectrum.filter, s.filter);
+    fill(given, "oversample", &mut spectrum.oversample, s.oversample);
+    fill(given, "precision", &mut spectrum.precision, s.precision);
+    fill(given, "kb_design", &mut spectrum.kb_design, s.kb_design);
+}
+
+/// Fill the PNG settings. `--percentiles` on the command line also drops
+/// the scene's window and level, which would otherwise take precedence.
+fn apply_scene_to_png(png: &mut PngArgs, scene: &SceneFile, given: &dyn Fn(&str) -> bool) {
+    let o = &scene.output;
+    fill(given, "bits", &mut png.bits, o.bits);
+    if !given("percentiles") && !given("window") && !given("level") {
+        fill(given, "window", &mut png.window, o.window.map(Some));
+        fill(given, "level", &mut png.level, o.level.map(Some));
+    }
+    fill(given, "percentiles", &mut png.percentiles, o.percentiles);
+    fill(given, "colormap", &mut png.colormap, o.colormap);
+}
+
+/// Fill every render setting the command line did not give from the scene
+/// (precedence: flags, then the scene, then the flags' defaults). Each flag
+/// replaces the scene key of the same name: `--light` replaces all of the
+/// scene's `[[lights]]`, `--light-ring` its `[light_ring]`.
+fn apply_scene_to_render(args: &mut RenderArgs, scene: &SceneFile, given: &dyn Fn(&str) -> bool) {
+    apply_scene_to_input(&mut args.volume, &mut args.input, scene, given);
+    fill(
+        given,
+        "resample",
+        &mut args.resample,
+        scene.volume.resample.map(Some),
+    );
+    let c = &scene.camera;
+    fill(given, "dir", &mut args.dir, c.dir.map(Some));
+    fill(given, "up", &mut args.up, c.up);
+    fill(given, "size", &mut args.size, c.size.map(Some));
+    apply_scene_to_spectrum(&mut args.spectrum, scene, given);
+    let sh = &scene.shading;
+    fill(
+        given,
+        "depth_cue",
+        &mut args.depth_cue,
+        sh.depth_cue.clone(),
+    );
+    fill(
+        given,
+        "cue_harmonics",
+        &mut args.cue_harmonics,
+        sh.cue_harmonics,
+    );
+    fill(given, "ambient", &mut args.ambient, sh.ambient.map(Some));
+    fill(
+        given,
+        "no_cue_correction",
+        &mut args.no_cue_correction,
+        sh.cue_correction.map(|on| !on),
+    );
+    fill(given, "lights", &mut args.lights, scene.lights.clone());
+    fill(
+        given,
+        "light_ring",
+        &mut args.light_ring,
+        scene.light_ring.map(Some),
+    );
+    fill(
+        given,
+        "out",
+        &mut args.out,
+        scene.output.path.clone().map(Some),
+    );
+    apply_scene_to_png(&mut args.png, scene, given);
+}
+
+/// Fill the turntable settings the command line did not give from the
+/// scene: volume, camera, spectrum, output window and `[turntable]`. Scene
+/// keys a turntable does not use are named on stderr.
+fn apply_scene_to_turntable(
+    args: &mut TurntableArgs,
+    scene: &SceneFile,
+    given: &dyn Fn(&str) -> bool,
+) {
+    apply_scene_to_input(&mut args.volume, &mut args.input, scene, given);
+    let c = &scene.camera;
+    fill(given, "dir", &mut args.dir, c.dir);
+    fill(given, "up", &mut args.up, c.up);
+    fill(given, "size", &mut args.size, c.size.map(Some));
+    apply_scene_to_spectrum(&mut args.spectrum, scene, given);
+    apply_scene_to_png(&mut args.png, scene, given);
+    let t = &scene.turntable;
+    fill(given, "frames", &mut args.frames, t.frames);
+    fill(given, "fps", &mut args.fps, t.fps);
+    fill(given, "out", &mut args.out, t.path.clone());
+    let unused: Vec<&str> = [
+        ("volume.resample", scene.volume.resample.is_some()),
+        (
+            "[shading]",
+            scene.shading != fvr_host::scene_file::ShadingSection::default(),
+        ),
+        (
+            "[[lights]]",
+            scene.lights.as_ref().is_some_and(|l| !l.is_empty()),
+        ),
+        ("[light_ring]", scene.light_ring.is_some()),
+        ("output.path", scene.output.path.is_some()),
+    ]
+    .into_iter()
+    .filter_map(|(name, set)| set.then_some(name))
+    .collect();
+    if !unused.is_empty() {
+        eprintln!(
+            "fvr: note: the turntable renders X-ray views and does not use the scene's {}",
+            unused.join(", ")
+        );
+    }
+}
+
+impl RenderArgs {
+    fn volume_spec(&self) -> Result<&str, String> {
+        self.volume.as_deref().ok_or_else(|| {
+            "no volume: give VOLUME, or `volume.path` or `volume.builtin` in the scene".into()
+        })
+    }
+
+    fn view(&self) -> Result<View, String> {
+        let dir = self.dir.ok_or_else(|| {
+            "no view direction: give --dir, or `camera.dir` in the scene".to_string()
+        })?;
+        Ok(View { dir, up: self.up })
+    }
+
+    fn out_path(&self) -> Result<&Path, String> {
+        self.out
+            .as_deref()
+            .ok_or_else(|| "no output file: give --out, or `output.path` in the scene".into())
+    }
+}
+
 fn render(args: &RenderArgs) -> Result<(), String> {
-    let ext = args.out.extension().and_then(|e| e.to_str()).unwrap_or("");
+    let out = args.out_path()?;
+    let volume_spec = args.volume_spec()?;
+    let ext = out.extension().and_then(|e| e.to_str()).unwrap_or("");
     if ext != "png" && ext != "nrrd" {
         return Err(format!(
             "output `{}` must end in .png or .nrrd",
-            args.out.display()
+            out.display()
         ));
     }
-    let view = View {
-        dir: args.dir,
-        up: args.up,
-    };
+    let view = args.view()?;
     view.frame().map_err(|e| e.to_string())?;
     let style = args.png.style()?;
     let t0 = Instant::now();
-    let mut volume = args.input.load(&args.volume)?;
+    let mut volume = args.input.load(volume_spec)?;
     if let Some(largest) = args.resample {
         volume = volume.resample_isotropic(largest)?;
     }
@@ -600,20 +834,20 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         .map_or(t2.elapsed(), |r| r.view_time);
     if ext == "png" {
         if image.channels == 1 {
-            write_png(&args.out, w, h, &image.data, &style)?;
+            write_png(out, w, h, &image.data, &style)?;
         } else {
-            image.write_png(&args.out)?;
+            image.write_png(out)?;
         }
     } else {
-        image.write_nrrd(&args.out)?;
+        image.write_nrrd(out)?;
     }
     let kind = if image.channels == 1 { "grey" } else { "RGB" };
-    println!("wrote {} ({w}x{h} {kind})", args.out.display());
+    println!("wrote {} ({w}x{h} {kind})", out.display());
     if args.stats && !args.stats_json {
         let d = volume.dims;
         println!(
             "  volume        {}x{}x{} ({})",
-            d[0], d[1], d[2], args.volume
+            d[0], d[1], d[2], volume_spec
         );
         println!(
             "  spectrum      {n}^3 {} = {} bytes ({} bytes/voxel)",
@@ -671,7 +905,7 @@ fn render(args: &RenderArgs) -> Result<(), String> {
     }
     if args.stats_json {
         let mut fields = vec![
-            ("volume", json_str(&args.volume)),
+            ("volume", json_str(volume_spec)),
             ("dims", format!("{:?}", volume.dims)),
             ("image", format!("[{w}, {h}, {}]", image.channels)),
             ("spectrum_side", n.to_string()),
@@ -703,7 +937,7 @@ fn render(args: &RenderArgs) -> Result<(), String> {
     }
     if args.exact {
         let plain = scene.channels() == 1 && !scene.has_partner_terms();
-        match phantom_by_name(&args.volume) {
+        match phantom_by_name(volume_spec) {
             Some(Ok(p)) if plain => {
                 let exact = exact_projection(p.phantom.as_ref(), volume.dims, &view, w, h)
                     .map_err(|e| e.to_string())?;
@@ -733,11 +967,7 @@ fn build_scene(args: &RenderArgs) -> Result<Scene, String> {
     let cue = parse_depth_cue(&args.depth_cue, args.cue_harmonics)?;
     let mut lights = args.lights.clone();
     if let Some((count, tilt)) = args.light_ring {
-        let view = View {
-            dir: args.dir,
-            up: args.up,
-        };
-        lights.extend(light_ring(&view, count, tilt).map_err(|e| e.to_string())?);
+        lights.extend(light_ring(&args.view()?, count, tilt).map_err(|e| e.to_string())?);
     }
     let default_ambient = if lights.is_empty() { 1.0 } else { 0.2 };
     let mut scene = Scene {
@@ -820,7 +1050,10 @@ fn turntable(args: &TurntableArgs) -> Result<(), String> {
     let views = turntable::orbit(args.dir, args.up, args.frames as usize)?;
     let style = args.png.style()?;
     let t0 = Instant::now();
-    let volume = args.input.load(&args.volume)?;
+    let volume_spec = args.volume.as_deref().ok_or_else(|| {
+        "no volume: give VOLUME, or `volume.path` or `volume.builtin` in the scene".to_string()
+    })?;
+    let volume = args.input.load(volume_spec)?;
     let t_load = t0.elapsed();
     let t1 = Instant::now();
     let spec = prepare_with_progress(
@@ -848,15 +1081,44 @@ fn turntable(args: &TurntableArgs) -> Result<(), String> {
         frames.len(),
         args.fps
     );
-    println!(
-        "  load {:.1} ms, preprocess {:.1} ms ({n}^3 {}), {} views in {:.1} ms = {:.1} views/s",
-        t_load.as_secs_f64() * 1e3,
-        t_prep.as_secs_f64() * 1e3,
-        args.spectrum.precision,
-        frames.len(),
-        secs * 1e3,
-        frames.len() as f64 / secs.max(1e-9)
-    );
+    let views_per_second = frames.len() as f64 / secs.max(1e-9);
+    if args.stats_json {
+        let fields = [
+            ("volume", json_str(volume_spec)),
+            ("dims", format!("{:?}", volume.dims)),
+            ("image", format!("[{w}, {h}]")),
+            ("frames", frames.len().to_string()),
+            ("fps", args.fps.to_string()),
+            ("spectrum_side", n.to_string()),
+            ("precision", json_str(args.spectrum.precision.name())),
+            ("spectrum_bytes", spec.bytes().to_string()),
+            ("filter", json_str(args.spectrum.filter.name())),
+            ("oversample", args.spectrum.oversample.to_string()),
+            ("load_ms", json_num(t_load.as_secs_f64() * 1e3)),
+            ("preprocess_ms", json_num(t_prep.as_secs_f64() * 1e3)),
+            ("views_ms", json_num(secs * 1e3)),
+            (
+                "ms_per_view",
+                json_num(secs * 1e3 / frames.len().max(1) as f64),
+            ),
+            ("views_per_second", json_num(views_per_second)),
+        ];
+        let body: Vec<String> = fields
+            .iter()
+            .map(|(k, v)| format!("{}: {v}", json_str(k)))
+            .collect();
+        println!("{{{}}}", body.join(", "));
+    } else {
+        println!(
+            "  load {:.1} ms, preprocess {:.1} ms ({n}^3 {}), {} views in {:.1} ms = {:.1} views/s",
+            t_load.as_secs_f64() * 1e3,
+            t_prep.as_secs_f64() * 1e3,
+            args.spectrum.precision,
+            frames.len(),
+            secs * 1e3,
+            views_per_second
+        );
+    }
     Ok(())
 }
 
@@ -1078,4 +1340,210 @@ fn adaptive_table(
     }
     print!("{}", fvr_host::adaptive::table1_markdown(&rows, tolerance));
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A scene that sets every key `fvr render` reads.
+    const FULL_SCENE: &str = r#"
+        [volume]
+        path = "v.raw"
+        raw_dims = [4, 5, 6]
+        raw_type = "u16"
+        raw_endian = "big"
+        background = -1024
+        resample = 96
+        [camera]
+        dir = [1, 0.5, -0.25]
+        up = [0, 1, 0]
+        size = [64, 32]
+        [spectrum]
+        filter = "cubic"
+        oversample = 2
+        precision = "f32"
+        kb_design = 1.5
+        [shading]
+        ambient = 0.1
+        depth_cue = "linear:1,0.3"
+        cue_harmonics = 6
+        cue_correction = false
+        [light_ring]
+        count = 2
+        tilt = 10
+        [[lights]]
+        direction = [0, 1, 0]
+        color = [1, 0, 0]
+        [output]
+        path = "a.png"
+        bits = 16
+        window = 2.0
+        level = 1
+        colormap = "bone"
+        [turntable]
+        frames = 12
+        fps = 6
+        path = "spin.apng"
+    "#;
+
+    fn parse_cli(argv: &[&str]) -> (Cli, ArgMatches) {
+        let m = Cli::command()
+            .try_get_matches_from(argv)
+            .expect("arguments parse");
+        (Cli::from_arg_matches(&m).expect("arguments convert"), m)
+    }
+
+    fn merged_render(scene: &str, flags: &[&str]) -> RenderArgs {
+        let mut argv = vec!["fvr", "render", "--scene", "s.toml"];
+        argv.extend(flags);
+        let (cli, m) = parse_cli(&argv);
+        let Some(Command::Render(mut args)) = cli.command else {
+            panic!("not a render")
+        };
+        let sub = m.subcommand_matches("render").expect("render matches");
+        let scene = SceneFile::parse(scene, "s.toml", Path::new("/s")).expect("scene parses");
+        apply_scene_to_render(&mut args, &scene, &|id| given_on_command_line(sub, id));
+        *args
+    }
+
+    #[test]
+    fn scene_fills_every_render_setting() {
+        let a = merged_render(FULL_SCENE, &[]);
+        assert_eq!(a.volume.as_deref(), Some("/s/v.raw"));
+        assert_eq!(a.input.raw_dims, Some([4, 5, 6]));
+        assert_eq!(a.input.raw_type, SampleType::U16);
+        assert_eq!(a.input.raw_endian, Endian::Big);
+        assert_eq!(a.input.background, Some(-1024.0));
+        assert_eq!(a.resample, Some(96));
+        assert_eq!(a.dir, Some([1.0, 0.5, -0.25]));
+        assert_eq!(a.up, [0.0, 1.0, 0.0]);
+        assert_eq!(a.size, Some((64, 32)));
+        assert_eq!(a.spectrum.filter, FilterKind::Cubic);
+        assert_eq!(a.spectrum.oversample, 2);
+        assert_eq!(a.spectrum.precision, Precision::F32);
+        assert_eq!(a.spectrum.kb_design, KbDesign::Sigma(1.5));
+        assert_eq!(a.ambient, Some([0.1; 3]));
+        assert_eq!(a.depth_cue, "linear:1,0.3");
+        assert_eq!(a.cue_harmonics, 6);
+        assert!(a.no_cue_correction);
+        assert_eq!(a.light_ring, Some((2, 10.0)));
+        assert_eq!(
+            a.lights,
+            vec![Light {
+                towards: [0.0, 1.0, 0.0],
+                color: [1.0, 0.0, 0.0]
+            }]
+        );
+        assert_eq!(a.out.as_deref(), Some(Path::new("/s/a.png")));
+        assert_eq!(a.png.bits, Bits::Sixteen);
+        assert_eq!((a.png.window, a.png.level), (Some(2.0), Some(1.0)));
+        assert_eq!(a.png.colormap, Colormap::Bone);
+        // An empty scene leaves the flags' defaults.
+        let d = merged_render("", &["v.nrrd", "--dir", "0,1,0", "--out", "o.png"]);
+        assert_eq!(d.spectrum.filter, FilterKind::Kb4);
+        assert_eq!(d.up, DEFAULT_UP);
+        assert_eq!(d.depth_cue, "none");
+        assert!(!d.no_cue_correction && d.lights.is_empty() && d.light_ring.is_none());
+    }
+
+    #[test]
+    fn each_flag_overrides_its_scene_key() {
+        type Check = fn(&RenderArgs) -> bool;
+        let cases: &[(&[&str], Check)] = &[
+            (&["other.nrrd"], |a| {
+                a.volume.as_deref() == Some("other.nrrd") && a.input.raw_dims.is_none()
+            }),
+            (&["--raw-dims", "7,8,9"], |a| {
+                a.input.raw_dims == Some([7, 8, 9])
+            }),
+            (&["--raw-type", "f32"], |a| {
+                a.input.raw_type == SampleType::F32
+            }),
+            (&["--raw-endian", "little"], |a| {
+                a.input.raw_endian == Endian::Little
+            }),
+            (&["--background", "0"], |a| a.input.background == Some(0.0)),
+            (&["--resample", "64"], |a| a.resample == Some(64)),
+            (&["--dir", "0,0,1"], |a| a.dir == Some([0.0, 0.0, 1.0])),
+            (&["--up", "1,0,0"], |a| a.up == [1.0, 0.0, 0.0]),
+            (&["--size", "8"], |a| a.size == Some((8, 8))),
+            (&["--filter", "kb3"], |a| {
+                a.spectrum.filter == FilterKind::Kb3
+            }),
+            (&["--oversample", "1"], |a| a.spectrum.oversample == 1),
+            (&["--precision", "f16"], |a| {
+                a.spectrum.precision == Precision::F16
+            }),
+            (&["--kb-design", "auto"], |a| {
+                a.spectrum.kb_design == KbDesign::Auto
+            }),
+            (&["--ambient", "0.5"], |a| a.ambient == Some([0.5; 3])),
+            (&["--depth-cue", "none"], |a| a.depth_cue == "none"),
+            (&["--cue-harmonics", "3"], |a| a.cue_harmonics == 3),
+            (&["--light", "1,0,0:0,0,1"], |a| {
+                a.lights
+                    == [Light {
+                        towards: [1.0, 0.0, 0.0],
+                        color: [0.0, 0.0, 1.0],
+                    }]
+            }),
+            (&["--light-ring", "3"], |a| a.light_ring == Some((3, 30.0))),
+            (&["--out", "x.nrrd"], |a| {
+                a.out.as_deref() == Some(Path::new("x.nrrd"))
+            }),
+            (&["--bits", "8"], |a| a.png.bits == Bits::Eight),
+            (&["--window", "4", "--level", "3"], |a| {
+                (a.png.window, a.png.level) == (Some(4.0), Some(3.0))
+            }),
+            (&["--percentiles", "1,99"], |a| {
+                a.png.percentiles == (1.0, 99.0) && a.png.window.is_none()
+            }),
+            (&["--colormap", "hot"], |a| a.png.colormap == Colormap::Hot),
+        ];
+        let scene_only = merged_render(FULL_SCENE, &[]);
+        for (flags, check) in cases {
+            assert!(!check(&scene_only), "{flags:?} matches the scene already");
+            assert!(check(&merged_render(FULL_SCENE, flags)), "{flags:?}");
+        }
+        // --no-cue-correction is a switch: the scene turns it on, the flag
+        // cannot turn it off, and an unset scene key leaves it to the flag.
+        let on = "[shading]\ncue_correction = true\n";
+        assert!(merged_render(on, &["--no-cue-correction"]).no_cue_correction);
+        assert!(!merged_render(on, &[]).no_cue_correction);
+    }
+
+    #[test]
+    fn turntable_takes_scene_values_and_flags_win() {
+        let run = |flags: &[&str]| {
+            let mut argv = vec!["fvr", "turntable", "--scene", "s.toml"];
+            argv.extend(flags);
+            let (cli, m) = parse_cli(&argv);
+            let Some(Command::Turntable(mut args)) = cli.command else {
+                panic!("not a turntable")
+            };
+            let sub = m.subcommand_matches("turntable").expect("matches");
+            let scene = SceneFile::parse(FULL_SCENE, "s.toml", Path::new("/s")).expect("parses");
+            apply_scene_to_turntable(&mut args, &scene, &|id| given_on_command_line(sub, id));
+            args
+        };
+        let a = run(&[]);
+        assert_eq!((a.frames, a.fps), (12, 6));
+        assert_eq!(a.out, PathBuf::from("/s/spin.apng"));
+        assert_eq!(a.dir, [1.0, 0.5, -0.25]);
+        assert_eq!(a.spectrum.filter, FilterKind::Cubic);
+        let b = run(&[
+            "--frames", "3", "--fps", "30", "--out", "t.apng", "--dir", "0,1,0",
+        ]);
+        assert_eq!((b.frames, b.fps), (3, 30));
+        assert_eq!(b.out, PathBuf::from("t.apng"));
+        assert_eq!(b.dir, [0.0, 1.0, 0.0]);
+    }
+
+    #[test]
+    fn default_scene_is_a_valid_scene() {
+        let scene = SceneFile::parse(DEFAULT_SCENE, "default", Path::new("")).expect("parses");
+        assert!(scene.volume.spec.is_some() && scene.camera.dir.is_some());
+        assert_eq!(scene.output.path, Some(PathBuf::from("fvr-default.png")));
+    }
 }
