@@ -9,7 +9,7 @@ use std::hint::black_box;
 use criterion::{criterion_group, criterion_main, Criterion};
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
-use fvr_host::adaptive::AdaptiveMarks;
+use fvr_host::adaptive::{AdaptiveMarks, AdaptiveSettings};
 use fvr_host::phantom::{sample, GaussianMixture};
 use fvr_host::pipeline::{OwnedSpectrum, ViewRenderer};
 use half::f16;
@@ -19,7 +19,7 @@ fn benches(c: &mut Criterion) {
     let volume = sample(&GaussianMixture::random(1, n, 8), [n; 3]);
     let filter = Filter::new(FilterKind::Kb3, 2).unwrap();
     let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
-    let marks = AdaptiveMarks::build(&spec, 40.0, &[FilterKind::Nearest], None).unwrap();
+    let marks = AdaptiveMarks::build(&spec, &AdaptiveSettings::new(40.0)).unwrap();
     let view = View::along([1.0, 0.3, 0.2]);
     let mut renderer = ViewRenderer::<f32>::new(spec.n(), filter);
     let mut out = vec![0.0f32; n * n];

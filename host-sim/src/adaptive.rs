@@ -7,11 +7,11 @@ use fvr_core::adaptive::{
     extract_slice_adaptive, mark, marks_words, response_difference, threshold_for, AdaptiveLevel,
     AdaptiveStats, Marks, MAX_LEVELS,
 };
-use fvr_core::dht::Twiddles;
+use fvr_core::dht::{dht_3d, dht_3d_scratch_len, Twiddles};
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::View;
 use fvr_core::real::{Real, Sample};
-use fvr_core::render::{aux_len, check_image, finish_projection, placement};
+use fvr_core::render::{aux_len, check_image, finish_projection, placement, signed_index};
 
 /// The cheaper filters tried, cheapest first, as the user names them.
 pub fn parse_chain(s: &str) -> Result<Vec<FilterKind>, String> {
@@ -40,6 +40,245 @@ pub fn parse_tolerance(s: &str) -> Result<f64, String> {
     }
 }
 
+/// How the magnitude threshold is derived from the tolerance.
+///
+/// Both keep the 3D error energy of the substitution (eq. 15) within
+/// `10^(−dB/10)` of the volume's energy; they differ in how tightly they
+/// measure it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Bound {
+    /// Eq. 16 as printed: `h_d² · Σ_{|F|<τ}|F|²` with `h_d` the largest
+    /// response difference anywhere in the volume's extent. Cheap (one pass
+    /// over a histogram) and loose: it charges every weak sample the
+    /// worst-case difference, which occurs only at the extent's corners.
+    Paper,
+    /// The error field of eq. 15 itself, `f₂·(g·h₂ − h₁)`, computed by one 3D
+    /// inverse transform of the weak samples per candidate `τ`, and its
+    /// energy summed over the whole grid. Exact for the substitution of the
+    /// weak set, so the largest `τ` it accepts is the largest the 3D energy
+    /// criterion allows; it costs about `log₂(bins)` 3D transforms once per
+    /// volume.
+    Exact,
+}
+
+impl Bound {
+    /// Parse `paper` or `exact`.
+    pub fn from_name(s: &str) -> Result<Self, String> {
+        match s.trim() {
+            "paper" => Ok(Self::Paper),
+            "exact" => Ok(Self::Exact),
+            other => Err(format!(
+                "unknown adaptive bound `{other}`: use `exact` (the error field of eq. 15) or \
+                 `paper` (eq. 16 with the worst-case response difference)"
+            )),
+        }
+    }
+
+    /// The name `from_name` accepts.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Paper => "paper",
+            Self::Exact => "exact",
+        }
+    }
+}
+
+/// The spectrum and grid the exact bound works on: the stored samples in
+/// f32 and the large filter's response per signed grid index.
+struct ErrorModel {
+    n: usize,
+    values: Vec<f32>,
+    large_response: Vec<f64>,
+    /// `Σ (f·h₁)²` over the grid: the energy the tolerance is relative to,
+    /// in the same (unnormalized) units as the error energies.
+    reference: f64,
+    work: Vec<f32>,
+    scratch: Vec<f32>,
+    twiddles: Vec<f32>,
+}
+
+impl ErrorModel {
+    fn new<S: Sample>(spec: &OwnedSpectrum<S>) -> Result<Self, String> {
+        let n = spec.n();
+        let view = spec.view();
+        let large = spec.filter();
+        let values: Vec<f32> = (0..n * n * n).map(|i| view.value(i) as f32).collect();
+        let large_response = Self::responses(&large, n);
+        let mut model = Self {
+            n,
+            values,
+            large_response,
+            reference: 0.0,
+            work: vec![0.0; n * n * n],
+            scratch: vec![0.0; dht_3d_scratch_len([n; 3])],
+            twiddles: vec![0.0; Twiddles::<f32>::buffer_len(n)],
+        };
+        let ones = model.large_response.clone();
+        model.reference =
+            model.field_energy(f64::INFINITY, |x| ones[x[0]] * ones[x[1]] * ones[x[2]])?;
+        Ok(model)
+    }
+
+    /// `ĥ(x/n)` for each grid index `x` in natural order (signed position).
+    fn responses(filter: &Filter, n: usize) -> Vec<f64> {
+        (0..n)
+            .map(|k| filter.response(signed_index(k, n) as f64 / n as f64))
+            .collect()
+    }
+
+    /// `Σ_x (f_τ(x)·weight(x))²`, `f_τ` the inverse transform of the
+    /// samples below `tau` (unnormalized: the transform is its own inverse
+    /// up to `n³`, and every energy here carries the same factor).
+    fn field_energy(
+        &mut self,
+        tau: f64,
+        weight: impl Fn([usize; 3]) -> f64,
+    ) -> Result<f64, String> {
+        let n = self.n;
+        let tau = tau as f32;
+        for (w, &v) in self.work.iter_mut().zip(&self.values) {
+            *w = if v.abs() < tau { v } else { 0.0 };
+        }
+        let tw = Twiddles::new(&mut self.twiddles, n).map_err(|e| e.to_string())?;
+        dht_3d::<f32, f32>(&mut self.work, [n; 3], &mut self.scratch, &tw)
+            .map_err(|e| e.to_string())?;
+        let mut energy = 0.0f64;
+        for z in 0..n {
+            for y in 0..n {
+                let row = &self.work[(z * n + y) * n..][..n];
+                let mut line = 0.0f64;
+                for (x, &f) in row.iter().enumerate() {
+                    let e = f as f64 * weight([x, y, z]);
+                    line += e * e;
+                }
+                energy += line;
+            }
+        }
+        Ok(energy)
+    }
+
+    /// The largest candidate threshold whose error energy for the pair
+    /// (large, `small` with gain `gain`) stays within `budget` of the
+    /// reference, and the relative energy it was verified at. Candidates are
+    /// ⅛-octave steps `2^(b/8)`; the search starts at `start` (the paper's
+    /// threshold, usually 1–2 octaves below the answer), gallops by whole
+    /// octaves until it brackets the answer, then bisects, about 6
+    /// transforms in all. It returns only thresholds it evaluated.
+    fn threshold(
+        &mut self,
+        small: &Filter,
+        gain: f64,
+        budget: f64,
+        start: f64,
+    ) -> Result<(f64, f64), String> {
+        let hs = Self::responses(small, self.n);
+        let hl = self.large_response.clone();
+        let weight =
+            |x: [usize; 3]| gain * hs[x[0]] * hs[x[1]] * hs[x[2]] - hl[x[0]] * hl[x[1]] * hl[x[2]];
+        let hi_mag = self
+            .values
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs() as f64));
+        if hi_mag == 0.0 || self.reference <= 0.0 {
+            return Ok((0.0, 0.0));
+        }
+        let tau_of = |b: i64| 2f64.powf(b as f64 / 8.0);
+        // Above `top` every sample is weak: no larger threshold changes the set.
+        let top = (hi_mag.log2() * 8.0).ceil() as i64 + 1;
+        let allowed = budget * self.reference;
+        let mut probe = |b: i64| -> Result<Option<f64>, String> {
+            let e = self.field_energy(tau_of(b), weight)?;
+            Ok((e <= allowed).then_some(e / self.reference))
+        };
+        let first = if start > 0.0 {
+            ((start.log2() * 8.0).round() as i64).min(top)
+        } else {
+            top - 8
+        };
+        // Invariant: `good` is accepted (`None` is the empty set, always
+        // accepted), `bad` is not (`top + 1` stands for "no limit found").
+        let (mut good, mut bad): ((i64, Option<f64>), i64);
+        match probe(first)? {
+            Some(r) => {
+                good = (first, Some(r));
+                bad = top + 1;
+                let mut step = 8;
+                while good.0 < top {
+                    let b = (good.0 + step).min(top);
+                    match probe(b)? {
+                        Some(r) => good = (b, Some(r)),
+                        None => {
+                            bad = b;
+                            break;
+                        }
+                    }
+                    step *= 2;
+                }
+            }
+            None => {
+                bad = first;
+                let mut step = 8;
+                loop {
+                    let b = first - step;
+                    if b < first - 8 * 64 {
+                        // 64 octaves below the paper's threshold: nothing fits.
+                        good = (b, None);
+                        break;
+                    }
+                    match probe(b)? {
+                        Some(r) => {
+                            good = (b, Some(r));
+                            break;
+                        }
+                        None => bad = b,
+                    }
+                    step *= 2;
+                }
+            }
+        }
+        while bad - good.0 > 1 && good.1.is_some() {
+            let mid = good.0 + (bad - good.0) / 2;
+            match probe(mid)? {
+                Some(r) => good = (mid, Some(r)),
+                None => bad = mid,
+            }
+        }
+        Ok(match good.1 {
+            Some(r) => (tau_of(good.0), r),
+            None => (0.0, 0.0),
+        })
+    }
+}
+
+/// What the user asked of adaptive filtering.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AdaptiveSettings {
+    /// Tolerance in dB: the substitution's error energy stays
+    /// `10^(−dB/10)` below the volume's.
+    pub tolerance_db: f64,
+    /// The cheaper filters, cheapest first ([`parse_chain`]).
+    pub chain: Vec<FilterKind>,
+    /// With [`Bound::Paper`], an `h_d` to use instead of the filter pair's
+    /// own (the paper used 0.3; a smaller value than the pair's voids the
+    /// bound).
+    pub h_d: Option<f64>,
+    /// How the thresholds are derived.
+    pub bound: Bound,
+}
+
+impl AdaptiveSettings {
+    /// `tolerance_db` with the 1³ filter and the exact bound: the defaults
+    /// of `fvr render --adaptive`.
+    pub fn new(tolerance_db: f64) -> Self {
+        Self {
+            tolerance_db,
+            chain: vec![FilterKind::Nearest],
+            h_d: None,
+            bound: Bound::Exact,
+        }
+    }
+}
+
 /// One cheaper filter with its marks.
 #[derive(Clone, Debug)]
 pub struct Level {
@@ -55,6 +294,9 @@ pub struct Level {
     pub marked: usize,
     /// DC gain correction `ĥ_large(0)/ĥ_small(0)`.
     pub gain: f64,
+    /// With [`Bound::Exact`]: the 3D error energy of this level's
+    /// substitution relative to the volume's, as verified for `threshold`.
+    pub error_ratio: Option<f64>,
 }
 
 /// Marks for adaptive filtering of one spectrum.
@@ -62,29 +304,41 @@ pub struct Level {
 pub struct AdaptiveMarks {
     /// The tolerance asked for, dB.
     pub tolerance_db: f64,
+    /// How the thresholds were derived.
+    pub bound: Bound,
     /// The cheaper filters, cheapest first.
     pub levels: Vec<Level>,
     n: usize,
 }
 
 impl AdaptiveMarks {
-    /// Mark `spec` for a tolerance of `tolerance_db` with the cheaper
-    /// filters `chain` (cheapest first), with `h_d` from
-    /// [`response_difference`] unless `h_d_override` sets it (the paper
-    /// used 0.3; a smaller `h_d` than the filters' own voids the bound). The energy budget
-    /// `10^(−dB/10)` is split evenly in amplitude between the levels, so
-    /// their errors, added, stay within it.
+    /// Mark `spec` as `settings` ask: for each cheaper filter of the chain
+    /// (cheapest first), the largest magnitude threshold that `settings.bound`
+    /// accepts. The energy budget `10^(−dB/10)` is split evenly in amplitude
+    /// between the levels, so their errors, added, stay within it.
     ///
     /// # Errors
-    /// A tolerance that is not a positive number, a chain too long, or a
-    /// filter whose response vanishes inside the volume.
+    /// A tolerance that is not a positive number, a chain too long or with a
+    /// filter no cheaper than the spectrum's, `h_d` given with the exact
+    /// bound, or a filter whose response vanishes inside the volume.
     pub fn build<S: Sample>(
         spec: &OwnedSpectrum<S>,
-        tolerance_db: f64,
-        chain: &[FilterKind],
-        h_d_override: Option<f64>,
+        settings: &AdaptiveSettings,
     ) -> Result<Self, String> {
+        let AdaptiveSettings {
+            tolerance_db,
+            ref chain,
+            h_d: h_d_override,
+            bound,
+        } = *settings;
         parse_tolerance(&tolerance_db.to_string())?;
+        if bound == Bound::Exact && h_d_override.is_some() {
+            return Err(
+                "--adaptive-hd sets the h_d of the paper's bound; the exact bound measures the \
+                 error field instead: use --adaptive-bound paper with it"
+                    .into(),
+            );
+        }
         if chain.is_empty() || chain.len() > MAX_LEVELS {
             return Err(format!(
                 "an adaptive chain names 1 to {MAX_LEVELS} cheaper filters"
@@ -98,7 +352,11 @@ impl AdaptiveMarks {
         let radius = large.width().div_ceil(2);
         let mut line = vec![false; n];
         let mut levels = Vec::with_capacity(chain.len());
-        for &kind in chain {
+        let mut model = match bound {
+            Bound::Exact => Some(ErrorModel::new(spec)?),
+            Bound::Paper => None,
+        };
+        for &kind in chain.iter() {
             let small = Filter::new(kind, large.oversample()).map_err(|e| e.to_string())?;
             if small.width() >= large.width() {
                 return Err(format!(
@@ -113,7 +371,15 @@ impl AdaptiveMarks {
                 None => response_difference(&large, &small, view.dims(), n)
                     .map_err(|e| e.to_string())?,
             };
-            let threshold = threshold_for(total, |i| view.value(i), h_d, budget);
+            let gain = large.response(0.0) / small.response(0.0);
+            let (threshold, error_ratio) = match model.as_mut() {
+                Some(model) => {
+                    let start = threshold_for(total, |i| view.value(i), h_d, budget);
+                    let (tau, ratio) = model.threshold(&small, gain, budget, start)?;
+                    (tau, Some(ratio))
+                }
+                None => (threshold_for(total, |i| view.value(i), h_d, budget), None),
+            };
             let mut words = vec![0u32; marks_words(n)];
             let marked = mark(
                 n,
@@ -130,11 +396,13 @@ impl AdaptiveMarks {
                 threshold,
                 words,
                 marked,
-                gain: large.response(0.0) / small.response(0.0),
+                gain,
+                error_ratio,
             });
         }
         Ok(Self {
             tolerance_db,
+            bound,
             levels,
             n,
         })
@@ -258,7 +526,8 @@ fn median_ms(runs: usize, mut f: impl FnMut()) -> f64 {
 }
 
 /// Measure a Table 1 row for `volume`: `filter` (at its oversampling)
-/// against `chain` at `tolerance_db`, view along `view`, `runs` timed runs.
+/// against adaptive filtering as `settings` ask, view along `view`, `runs`
+/// timed runs.
 ///
 /// # Errors
 /// As [`AdaptiveMarks::build`] and the renderers.
@@ -266,8 +535,7 @@ pub fn table1_row(
     name: &str,
     volume: &crate::volume::Volume,
     filter: Filter,
-    chain: &[FilterKind],
-    tolerance_db: f64,
+    settings: &AdaptiveSettings,
     view: &View,
     runs: usize,
 ) -> Result<Table1Row, String> {
@@ -276,7 +544,7 @@ pub fn table1_row(
     let n = spec.n();
     let side = n / filter.oversample() as usize;
     let any = crate::pipeline::AnySpectrum::F16(spec.clone());
-    let marks = AdaptiveMarks::build(&spec, tolerance_db, chain, None)?;
+    let marks = AdaptiveMarks::build(&spec, settings)?;
     let full = any.render(view, side, side).map_err(|e| e.to_string())?;
     let (image, stats) = marks
         .render::<half::f16, f32>(&spec, view, side, side)

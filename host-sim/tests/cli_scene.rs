@@ -170,6 +170,8 @@ fn adaptive_and_preview_options_report_and_refuse_conflicts() {
         "\"snr_vs_full_db\"",
         "\"levels\"",
         "\"marks_bytes\"",
+        "\"bound\": \"exact\"",
+        "\"error_field_db\"",
     ] {
         assert!(json.contains(key), "{key} not in {json}");
     }
@@ -209,6 +211,21 @@ fn adaptive_and_preview_options_report_and_refuse_conflicts() {
             vec!["plain X-ray views"],
         ),
         (vec!["--preview-level", "9"], vec!["progressive levels"]),
+        (
+            vec!["--adaptive", "40", "--adaptive-bound", "tight"],
+            vec!["unknown adaptive bound", "tight"],
+        ),
+        (
+            vec![
+                "--adaptive",
+                "40",
+                "--adaptive-bound",
+                "exact",
+                "--adaptive-hd",
+                "0.3",
+            ],
+            vec!["--adaptive-bound paper"],
+        ),
     ];
     for (extra, needles) in cases {
         let mut a = base.to_vec();

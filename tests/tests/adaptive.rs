@@ -4,14 +4,23 @@
 use fvr_core::adaptive::{mark, marks_words, threshold_for, Marks};
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
-use fvr_host::adaptive::{parse_chain, parse_tolerance, AdaptiveMarks};
+use fvr_host::adaptive::{parse_chain, parse_tolerance, AdaptiveMarks, AdaptiveSettings, Bound};
 use fvr_host::phantom::{sample, GaussianMixture, SheppLogan};
 use fvr_host::pipeline::{AnySpectrum, OwnedSpectrum};
 use fvr_host::reference::snr_db;
 use half::f16;
 
+/// Adaptive settings with the 1³ filter and the given bound.
+fn nearest(tolerance_db: f64, bound: Bound) -> AdaptiveSettings {
+    AdaptiveSettings {
+        bound,
+        ..AdaptiveSettings::new(tolerance_db)
+    }
+}
+
 /// The guarantee: the adaptive image is never further from the full-filter
-/// image than the tolerance, over volumes, views, filters and tolerances.
+/// image than the tolerance, over volumes, views, filters, tolerances and
+/// both bounds.
 #[test]
 fn adaptive_images_stay_within_the_requested_tolerance() {
     let n = 64;
@@ -35,30 +44,126 @@ fn adaptive_images_stay_within_the_requested_tolerance() {
         View::along([0.0, 1.0, 0.0]),
         View::along([1.0, 1.0, 1.0]),
     ];
-    let mut substituted = 0u64;
+    let mut substituted = [0u64; 2];
     for (name, volume) in &volumes {
         for kind in [FilterKind::Kb4, FilterKind::Kb6] {
             let filter = Filter::new(kind, 2).unwrap();
             let spec = OwnedSpectrum::<f16>::prepare::<f32>(volume, filter).unwrap();
             let any = AnySpectrum::F16(spec.clone());
-            for view in &views {
-                let full = any.render(view, n, n).unwrap();
+            let fulls: Vec<Vec<f64>> = views.iter().map(|v| any.render(v, n, n).unwrap()).collect();
+            for (b, bound) in [Bound::Paper, Bound::Exact].into_iter().enumerate() {
                 for tol in [30.0, 40.0, 50.0, 60.0] {
-                    let marks =
-                        AdaptiveMarks::build(&spec, tol, &[FilterKind::Nearest], None).unwrap();
-                    let (image, stats) = marks.render::<f16, f32>(&spec, view, n, n).unwrap();
-                    substituted += stats.per_filter[1];
-                    let snr = snr_db(&full, &image);
-                    assert!(
-                        snr >= tol,
-                        "{name} {kind:?} {view:?} tolerance {tol}: {snr:.1} dB"
-                    );
+                    let marks = AdaptiveMarks::build(&spec, &nearest(tol, bound)).unwrap();
+                    for (view, full) in views.iter().zip(&fulls) {
+                        let (image, stats) = marks.render::<f16, f32>(&spec, view, n, n).unwrap();
+                        substituted[b] += stats.per_filter[1];
+                        let snr = snr_db(full, &image);
+                        assert!(
+                            snr >= tol,
+                            "{name} {kind:?} {bound:?} {view:?} tolerance {tol}: {snr:.1} dB"
+                        );
+                    }
                 }
             }
         }
     }
-    // The sweep must exercise the substitution, not only the full filter.
-    assert!(substituted > 100_000, "{substituted}");
+    // The sweep must exercise the substitution, not only the full filter,
+    // and the exact bound must substitute more than the paper's.
+    assert!(substituted[0] > 100_000, "{substituted:?}");
+    assert!(substituted[1] > substituted[0], "{substituted:?}");
+}
+
+/// The exact bound accepts the largest threshold the 3D criterion allows:
+/// its verified error energy is within budget, it is never below the
+/// paper's threshold when the paper's h_d covers the whole grid, and the
+/// error energy it reports is what a direct evaluation of eq. 15 gives.
+#[test]
+fn exact_bound_is_within_budget_and_no_tighter_than_the_papers() {
+    let n = 32;
+    let volume = sample(&GaussianMixture::random(5, n, 8), [n; 3]);
+    let filter = Filter::new(FilterKind::Kb4, 2).unwrap();
+    let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+    for tol in [30.0, 45.0, 60.0] {
+        let exact = AdaptiveMarks::build(&spec, &nearest(tol, Bound::Exact)).unwrap();
+        let paper = AdaptiveMarks::build(&spec, &nearest(tol, Bound::Paper)).unwrap();
+        let (e, p) = (&exact.levels[0], &paper.levels[0]);
+        let ratio = e.error_ratio.unwrap();
+        assert!(ratio <= 10f64.powf(-tol / 10.0), "{tol}: {ratio}");
+        assert!(paper.levels[0].error_ratio.is_none());
+        assert!(
+            e.threshold >= p.threshold,
+            "{tol}: {} < {}",
+            e.threshold,
+            p.threshold
+        );
+        assert!(e.marked >= p.marked);
+    }
+}
+
+/// The error energy the exact bound verifies is eq. 15 evaluated the slow
+/// way. A 16³ spectrum keeps the naive transform (O(N²), N = 4096) cheap.
+#[test]
+fn exact_bound_energy_matches_a_direct_evaluation() {
+    let n = 8;
+    let volume = sample(&GaussianMixture::random(6, n, 4), [n; 3]);
+    let spec =
+        OwnedSpectrum::<f16>::prepare::<f32>(&volume, Filter::new(FilterKind::Kb4, 2).unwrap())
+            .unwrap();
+    let mut checked = 0;
+    for tol in [20.0, 30.0, 40.0] {
+        let exact = AdaptiveMarks::build(&spec, &nearest(tol, Bound::Exact)).unwrap();
+        let level = &exact.levels[0];
+        let ratio = level.error_ratio.unwrap();
+        if level.threshold == 0.0 {
+            continue;
+        }
+        // f32 transforms against f64 sums: relative agreement to ~1e-5 of
+        // the energy (f32 ε·log₂N on amplitudes, squared, with margin).
+        let direct = direct_error_ratio(&spec, level.threshold, level.gain);
+        assert!(
+            (direct - ratio).abs() <= 1e-4 * ratio,
+            "{tol}: direct {direct} against {ratio}"
+        );
+        checked += 1;
+    }
+    assert!(checked >= 2, "{checked}");
+}
+
+/// Eq. 15 evaluated the slow way in f64: the naive inverse 3D transform of
+/// the samples below `tau`, times `g·ĥ₂ − ĥ₁`, against the whole volume
+/// times `ĥ₁`.
+fn direct_error_ratio(spec: &OwnedSpectrum<f16>, tau: f64, gain: f64) -> f64 {
+    let n = spec.n();
+    let view = spec.view();
+    let all: Vec<f64> = (0..n * n * n).map(|i| view.value(i)).collect();
+    let weak: Vec<f64> = all
+        .iter()
+        .map(|&v| {
+            if (v as f32).abs() < tau as f32 {
+                v
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let f_all = fvr_host::reference::naive_dht_3d(&all, [n; 3]);
+    let f_weak = fvr_host::reference::naive_dht_3d(&weak, [n; 3]);
+    let small = Filter::new(FilterKind::Nearest, 2).unwrap();
+    let large = spec.filter();
+    let pos = |k: usize| fvr_core::render::signed_index(k, n) as f64 / n as f64;
+    let (mut err, mut reference) = (0.0, 0.0);
+    for z in 0..n {
+        for y in 0..n {
+            for x in 0..n {
+                let hl = large.response(pos(x)) * large.response(pos(y)) * large.response(pos(z));
+                let hs = small.response(pos(x)) * small.response(pos(y)) * small.response(pos(z));
+                let i = x + n * (y + n * z);
+                err += (f_weak[i] * (gain * hs - hl)).powi(2);
+                reference += (f_all[i] * hl).powi(2);
+            }
+        }
+    }
+    err / reference
 }
 
 /// The conservative marking of the paper: marked iff the sample and all
@@ -142,7 +247,11 @@ fn statistics_add_up_and_report_no_effect() {
     let filter = Filter::new(FilterKind::Kb4, 2).unwrap();
     let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
     let view = View::along([1.0, 0.4, 0.1]);
-    let marks = AdaptiveMarks::build(&spec, 40.0, &parse_chain("nearest").unwrap(), None).unwrap();
+    let settings = AdaptiveSettings {
+        chain: parse_chain("nearest").unwrap(),
+        ..AdaptiveSettings::new(40.0)
+    };
+    let marks = AdaptiveMarks::build(&spec, &settings).unwrap();
     let (_, stats) = marks.render::<f16, f32>(&spec, &view, n, n).unwrap();
     assert_eq!(stats.per_filter.iter().sum::<u64>(), stats.samples);
     assert_eq!(stats.full_taps, stats.samples * 64);
@@ -150,10 +259,17 @@ fn statistics_add_up_and_report_no_effect() {
     assert!(stats.taps < stats.full_taps);
     assert_eq!(marks.bytes(), 64 * 64 * 64 / 8);
 
-    let tight = AdaptiveMarks::build(&spec, 400.0, &[FilterKind::Nearest], None).unwrap();
+    let tight = AdaptiveMarks::build(&spec, &nearest(400.0, Bound::Exact)).unwrap();
     let (_, s) = tight.render::<f16, f32>(&spec, &view, n, n).unwrap();
     assert!(tight.effect(&s).unwrap().contains("no effect"));
-    let loose = AdaptiveMarks::build(&spec, 1e-9, &[FilterKind::Nearest], Some(1e-9)).unwrap();
+    let loose = AdaptiveMarks::build(
+        &spec,
+        &AdaptiveSettings {
+            h_d: Some(1e-9),
+            ..nearest(1e-9, Bound::Paper)
+        },
+    )
+    .unwrap();
     let (_, s) = loose.render::<f16, f32>(&spec, &view, n, n).unwrap();
     assert!(loose.effect(&s).unwrap().contains("so loose"), "{:?}", s);
 }
@@ -171,7 +287,22 @@ fn bad_tolerances_and_chains_are_refused() {
     let spec =
         OwnedSpectrum::<f16>::prepare::<f32>(&volume, Filter::new(FilterKind::Kb3, 2).unwrap())
             .unwrap();
-    let err = AdaptiveMarks::build(&spec, 40.0, &[FilterKind::Kb4], None).unwrap_err();
+    let kb4 = AdaptiveSettings {
+        chain: vec![FilterKind::Kb4],
+        ..AdaptiveSettings::new(40.0)
+    };
+    let err = AdaptiveMarks::build(&spec, &kb4).unwrap_err();
     assert!(err.contains("not cheaper"), "{err}");
-    assert!(AdaptiveMarks::build(&spec, 40.0, &[FilterKind::Nearest], Some(-1.0)).is_err());
+    let negative = AdaptiveSettings {
+        h_d: Some(-1.0),
+        ..nearest(40.0, Bound::Paper)
+    };
+    assert!(AdaptiveMarks::build(&spec, &negative).is_err());
+    let conflicting = AdaptiveSettings {
+        h_d: Some(0.3),
+        ..nearest(40.0, Bound::Exact)
+    };
+    let err = AdaptiveMarks::build(&spec, &conflicting).unwrap_err();
+    assert!(err.contains("--adaptive-bound paper"), "{err}");
+    assert!(Bound::from_name("tight").unwrap_err().contains("tight"));
 }

@@ -9,7 +9,7 @@ use clap::{ArgMatches, Args, CommandFactory, FromArgMatches, Parser, Subcommand}
 use fvr_core::filter::FilterKind;
 use fvr_core::geometry::{View, DEFAULT_UP};
 use fvr_core::scene::{Light, Scene, MAX_LIGHTS};
-use fvr_host::adaptive::{parse_chain, parse_tolerance};
+use fvr_host::adaptive::{parse_chain, parse_tolerance, AdaptiveSettings, Bound};
 use fvr_host::datasets::DATASETS_HELP;
 use fvr_host::formats::FORMATS_HELP;
 use fvr_host::nrrd::{read_nrrd, Endian, SampleType};
@@ -125,6 +125,9 @@ enum Command {
         /// Tolerance in dB.
         #[arg(long, default_value_t = 40.0, value_parser = parse_tolerance)]
         tolerance: f64,
+        /// How the tolerance becomes a threshold (see `render --adaptive-bound`).
+        #[arg(long, default_value = "exact", value_parser = Bound::from_name)]
+        bound: Bound,
         /// Large filter (the spectrum's).
         #[arg(long, value_parser = parse_filter, default_value = "kb3")]
         filter: FilterKind,
@@ -215,10 +218,18 @@ struct RenderArgs {
     #[arg(long, default_value = "nearest")]
     adaptive_chain: String,
     /// Use this response difference h_d in eq. 16 instead of the one computed
-    /// for the filter pair (the paper used 0.3). A smaller value than the
-    /// filters' own voids the guarantee; --stats then shows the SNR reached.
+    /// for the filter pair (the paper used 0.3); implies --adaptive-bound
+    /// paper. A smaller value than the filters' own voids the guarantee;
+    /// --stats then shows the SNR reached.
     #[arg(long, value_name = "H")]
     adaptive_hd: Option<f64>,
+    /// How --adaptive turns decibels into a magnitude threshold: `exact`
+    /// measures the error field of eq. 15 (one 3D inverse transform per
+    /// candidate threshold, about 8, once per volume); `paper` uses eq. 16
+    /// with the worst-case response difference h_d (instant, but loose).
+    /// Default: `exact`, or `paper` when --adaptive-hd is given.
+    #[arg(long, value_name = "BOUND", value_parser = Bound::from_name)]
+    adaptive_bound: Option<Bound>,
     /// Progressive preview level: 0 full resolution; L renders the image at
     /// 1/2^L of the size from the central 1/4^L of the slice (4^L times fewer
     /// interpolations). Plain X-ray views only. (`--level` is the PNG
@@ -478,11 +489,12 @@ fn main() -> ExitCode {
         Some(Command::Accuracy { sizes }) => accuracy(&sizes),
         Some(Command::AdaptiveTable {
             tolerance,
+            bound,
             filter,
             oversample,
             volumes,
             runs,
-        }) => adaptive_table(tolerance, filter, oversample, &volumes, runs),
+        }) => adaptive_table(tolerance, bound, filter, oversample, &volumes, runs),
         Some(Command::Precision(args)) => fvr_host::precision_cli::run(&args),
     };
     match result {
@@ -526,6 +538,7 @@ fn default_scene() -> Result<(), String> {
         adaptive: None,
         adaptive_chain: "nearest".into(),
         adaptive_hd: None,
+        adaptive_bound: None,
         preview_level: 0,
         exact: false,
         input: InputArgs::default(),
@@ -802,15 +815,16 @@ fn render(args: &RenderArgs) -> Result<(), String> {
             ph,
         )
     } else if let Some(tolerance) = args.adaptive {
-        let report = adaptive_render(
-            &spectra.density,
-            &view,
-            w,
-            h,
-            tolerance,
-            &parse_chain(&args.adaptive_chain)?,
-            args.adaptive_hd,
-        )?;
+        let settings = AdaptiveSettings {
+            tolerance_db: tolerance,
+            chain: parse_chain(&args.adaptive_chain)?,
+            h_d: args.adaptive_hd,
+            bound: args.adaptive_bound.unwrap_or(match args.adaptive_hd {
+                Some(_) => Bound::Paper,
+                None => Bound::Exact,
+            }),
+        };
+        let report = adaptive_render(&spectra.density, &view, w, h, &settings)?;
         let data = report.image.iter().map(|v| v * scene.ambient[0]).collect();
         adaptive_report = Some(report);
         (
@@ -1211,6 +1225,12 @@ impl AdaptiveReport {
                 l.marked,
                 l.words.len() * 32
             );
+            if let Some(r) = l.error_ratio {
+                println!(
+                    "  error field   {:.1} dB below the volume (exact bound, eq. 15)",
+                    -10.0 * r.log10()
+                );
+            }
         }
         println!(
             "  marks         {} bytes (1 bit per voxel per level), built in {:.1} ms",
@@ -1231,21 +1251,23 @@ impl AdaptiveReport {
             .enumerate()
             .map(|(i, l)| {
                 format!(
-                    "{{\"filter\": {}, \"h_d\": {}, \"threshold\": {}, \"marked\": {}, \"samples\": {}}}",
+                    "{{\"filter\": {}, \"h_d\": {}, \"threshold\": {}, \"marked\": {}, \"samples\": {}, \"error_field_db\": {}}}",
                     json_str(l.filter.kind().name()),
                     json_num(l.h_d),
                     json_num(l.threshold),
                     l.marked,
-                    s.per_filter[i + 1]
+                    s.per_filter[i + 1],
+                    l.error_ratio.map_or("null".into(), |r| json_num(-10.0 * r.log10()))
                 )
             })
             .collect();
         format!(
-            "{{\"tolerance_db\": {}, \"taps\": {}, \"full_taps\": {}, \"taps_ratio\": {}, \
+            "{{\"tolerance_db\": {}, \"bound\": {}, \"taps\": {}, \"full_taps\": {}, \"taps_ratio\": {}, \
              \"samples\": {}, \"full_filter_samples\": {}, \"levels\": [{}], \"marks_bytes\": {}, \
              \"mark_ms\": {}, \"view_ms\": {}, \"full_view_ms\": {}, \"snr_vs_full_db\": {}, \
              \"note\": {}}}",
             json_num(self.marks.tolerance_db),
+            json_str(self.marks.bound.name()),
             s.taps,
             s.full_taps,
             json_num(s.taps as f64 / s.full_taps.max(1) as f64),
@@ -1269,9 +1291,7 @@ fn adaptive_render(
     view: &View,
     w: usize,
     h: usize,
-    tolerance: f64,
-    chain: &[FilterKind],
-    h_d: Option<f64>,
+    settings: &AdaptiveSettings,
 ) -> Result<AdaptiveReport, String> {
     fn go<S: fvr_core::real::Sample, T: fvr_core::real::Real>(
         any: &AnySpectrum,
@@ -1279,12 +1299,10 @@ fn adaptive_render(
         view: &View,
         w: usize,
         h: usize,
-        tolerance: f64,
-        chain: &[FilterKind],
-        h_d: Option<f64>,
+        settings: &AdaptiveSettings,
     ) -> Result<AdaptiveReport, String> {
         let t0 = Instant::now();
-        let marks = fvr_host::adaptive::AdaptiveMarks::build(spec, tolerance, chain, h_d)?;
+        let marks = fvr_host::adaptive::AdaptiveMarks::build(spec, settings)?;
         let mark_time = t0.elapsed();
         let t1 = Instant::now();
         let (image, stats) = marks
@@ -1305,14 +1323,15 @@ fn adaptive_render(
         })
     }
     match spec {
-        AnySpectrum::F16(s) => go::<_, f32>(spec, s, view, w, h, tolerance, chain, h_d),
-        AnySpectrum::F32(s) => go::<_, f32>(spec, s, view, w, h, tolerance, chain, h_d),
-        AnySpectrum::F64(s) => go::<_, f64>(spec, s, view, w, h, tolerance, chain, h_d),
+        AnySpectrum::F16(s) => go::<_, f32>(spec, s, view, w, h, settings),
+        AnySpectrum::F32(s) => go::<_, f32>(spec, s, view, w, h, settings),
+        AnySpectrum::F64(s) => go::<_, f64>(spec, s, view, w, h, settings),
     }
 }
 
 fn adaptive_table(
     tolerance: f64,
+    bound: Bound,
     kind: FilterKind,
     oversample: u32,
     volumes: &[String],
@@ -1327,12 +1346,15 @@ fn adaptive_table(
             volume.subtract_background(-1024.0)?;
             volume = volume.resample_isotropic(128)?;
         }
+        let settings = AdaptiveSettings {
+            bound,
+            ..AdaptiveSettings::new(tolerance)
+        };
         rows.push(fvr_host::adaptive::table1_row(
             name,
             &volume,
             filter,
-            &[FilterKind::Nearest],
-            tolerance,
+            &settings,
             &view,
             runs.max(1),
         )?);
