@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use clap::{Args, Parser, Subcommand};
 use fvr_core::filter::FilterKind;
-use fvr_core::geometry::{View, DEFAULT_UP};
+use fvr_core::geometry::{Sampling, View, DEFAULT_UP};
 use fvr_core::scene::{Light, Scene, MAX_LIGHTS};
 use fvr_host::adaptive::{parse_chain, parse_tolerance};
 use fvr_host::datasets::DATASETS_HELP;
@@ -14,9 +14,9 @@ use fvr_host::formats::FORMATS_HELP;
 use fvr_host::nrrd::{read_nrrd, Endian, SampleType};
 use fvr_host::output::{write_apng, write_png, Bits, Colormap, Style, Window};
 use fvr_host::pipeline::{choose_filter, AnySpectrum, KbDesign, Precision};
-use fvr_host::reference::{exact_projection, max_abs_error, snr_db};
+use fvr_host::reference::{exact_projection_sampled, max_abs_error, snr_db};
 use fvr_host::scene::{load_volume_with_progress, phantom_by_name, RawLayout, PHANTOM_HELP};
-use fvr_host::scene_reference::exact_scene_projection;
+use fvr_host::scene_reference::exact_scene_projection_sampled;
 use fvr_host::shaded::{
     light_ring, negative_cue_share, parse_depth_cue, parse_light, parse_light_ring, parse_rgb,
     SceneRenderer, SceneSpectra, DEFAULT_PROFILE_HARMONICS, DEPTH_CUE_HELP,
@@ -41,6 +41,17 @@ GEOMETRY CONTRACT
   p = c + (col - W/2) r + (H/2 - row) u, and its value is the line integral
   of the band-limited interpolant of the voxels along p + t d, in voxel units.
   A zero d or u0, or u0 parallel to d, is an error.
+
+PHYSICAL UNITS (fvr render)
+  By default `fvr render` uses the volume's voxel spacing D (mm, from the
+  file; 1,1,1 when it gives none) and a pixel size P (--pixel-size, mm):
+  voxel (i,j,k) sits at (i Dx, j Dy, k Dz), the centre is C = (n/2) D, pixel
+  (col,row) sits at C + (col - W/2) P r + (H/2 - row) P u with r, u, d unit
+  vectors in mm, and its value is the line integral in mm (mm x volume
+  units). This is exact in the frequency domain: the slice is taken at index
+  frequencies k r_a D_a/P and scaled by Dx Dy Dz/P^2. --ignore-spacing gives
+  the voxel-unit contract above. Depth cues and lights need cubic voxels
+  imaged at their own size (--resample N makes them so).
 
 EXIT STATUS
   0  success (also for --help and --version)
@@ -126,10 +137,20 @@ struct RenderArgs {
     /// Up hint X,Y,Z.
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,1")]
     up: [f64; 3],
-    /// Image size W or WxH in pixels of one voxel; at most the padded grid.
+    /// Image size W or WxH in pixels (of --pixel-size mm, or of one voxel
+    /// with --ignore-spacing); at most the padded grid.
     /// Default: the padded grid divided by the oversampling.
     #[arg(long, value_parser = parse_size)]
     size: Option<(usize, usize)>,
+    /// Pixel size in mm. Default: the smallest voxel spacing, or, if the
+    /// volume's longest physical side would not fit the default image at
+    /// that size, the size that fits it (longest side / default width).
+    #[arg(long, value_name = "MM", conflicts_with = "ignore_spacing")]
+    pixel_size: Option<f64>,
+    /// Render in voxel units, as if the voxels were 1 mm cubes, ignoring the
+    /// volume's spacing (the behaviour before spacing was used).
+    #[arg(long)]
+    ignore_spacing: bool,
     #[command(flatten)]
     spectrum: SpectrumArgs,
     /// Depth cue: none, linear:FRONT,BACK, sine:FRONT,BACK, profile:W0,W1,...,
@@ -169,8 +190,9 @@ struct RenderArgs {
     #[arg(long)]
     stats: bool,
     /// Resample to cubic voxels with N samples along the longest physical
-    /// side (trilinear) before rendering: for anisotropic data such as CT
-    /// (0.957 x 0.957 x 1.5 mm), which is otherwise rendered in voxel units.
+    /// side (trilinear) before rendering. X-ray views of anisotropic data
+    /// such as CT (0.957 x 0.957 x 1.5 mm) are exact without it; depth cues
+    /// and lights need it.
     #[arg(long, value_name = "N")]
     resample: Option<usize>,
     /// Print the statistics as one JSON object instead (implies --stats).
@@ -449,6 +471,8 @@ fn default_scene() -> Result<(), String> {
         dir: [1.0, 0.45, -0.3],
         up: DEFAULT_UP,
         size: None,
+        pixel_size: None,
+        ignore_spacing: false,
         spectrum: SpectrumArgs::default(),
         depth_cue: "none".into(),
         cue_harmonics: DEFAULT_PROFILE_HARMONICS,
@@ -534,10 +558,19 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         );
     }
     let n = spectra.density.n();
-    let (w, h) = args.size.unwrap_or((
-        n / args.spectrum.oversample as usize,
-        n / args.spectrum.oversample as usize,
-    ));
+    let default_side = n / args.spectrum.oversample as usize;
+    let (w, h) = args.size.unwrap_or((default_side, default_side));
+    let sampling = render_sampling(&volume, args, default_side)?;
+    let longest_mm = volume_extent(&volume, &sampling);
+    let period_mm = n as f64 * sampling.pixel_size();
+    if longest_mm > period_mm {
+        eprintln!(
+            "fvr: warning: the volume's longest side ({longest_mm:.1} mm) exceeds the image \
+             grid's period ({n} pixels of {} mm = {period_mm:.1} mm): views across it wrap \
+             around. Use a larger --pixel-size or --oversample 2.",
+            sampling.pixel_size()
+        );
+    }
     let plain_view = scene.channels() == 1 && !scene.has_partner_terms();
     if (args.preview_level > 0 || args.adaptive.is_some()) && !plain_view {
         return Err(
@@ -549,13 +582,21 @@ fn render(args: &RenderArgs) -> Result<(), String> {
     if args.preview_level > 0 && args.adaptive.is_some() {
         return Err("--preview-level and --adaptive cannot be combined: choose one".into());
     }
+    if args.adaptive.is_some() && sampling != Sampling::UNIT {
+        return Err(format!(
+            "--adaptive renders in voxel units only, and this render uses {} mm voxels and \
+             {} mm pixels: add --ignore-spacing",
+            fmt_spacing(sampling.spacing()),
+            sampling.pixel_size()
+        ));
+    }
     let mut adaptive_report = None;
     let t2 = Instant::now();
     let (image, w, h) = if args.preview_level > 0 {
         let (pw, ph) = fvr_core::progressive::preview_size(w, h, args.preview_level);
         let data = spectra
             .density
-            .render_level(&view, pw, ph, args.preview_level)
+            .render_level_sampled(&view, &sampling, pw, ph, args.preview_level)
             .map_err(|e| e.to_string())?;
         (
             fvr_host::shaded::Image {
@@ -590,9 +631,7 @@ fn render(args: &RenderArgs) -> Result<(), String> {
             h,
         )
     } else {
-        let image = spectra
-            .render(&scene, &view, w, h)
-            .map_err(|e| e.to_string())?;
+        let image = spectra.render_sampled(&scene, &view, &sampling, w, h)?;
         (image, w, h)
     };
     let t_view = adaptive_report
@@ -614,6 +653,24 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         println!(
             "  volume        {}x{}x{} ({})",
             d[0], d[1], d[2], args.volume
+        );
+        let [dx, dy, dz] = volume.spacing;
+        println!(
+            "  spacing       {dx} x {dy} x {dz} mm{}",
+            if args.ignore_spacing {
+                " (ignored: --ignore-spacing, voxel units)"
+            } else {
+                ""
+            }
+        );
+        println!(
+            "  pixel size    {} {}",
+            sampling.pixel_size(),
+            if args.ignore_spacing {
+                "voxel"
+            } else {
+                "mm (values in mm x volume units)"
+            }
         );
         println!(
             "  spectrum      {n}^3 {} = {} bytes ({} bytes/voxel)",
@@ -673,6 +730,9 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         let mut fields = vec![
             ("volume", json_str(&args.volume)),
             ("dims", format!("{:?}", volume.dims)),
+            ("spacing_mm", format!("{:?}", volume.spacing)),
+            ("pixel_size", json_num(sampling.pixel_size())),
+            ("ignore_spacing", args.ignore_spacing.to_string()),
             ("image", format!("[{w}, {h}, {}]", image.channels)),
             ("spectrum_side", n.to_string()),
             ("precision", json_str(args.spectrum.precision.name())),
@@ -705,17 +765,32 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         let plain = scene.channels() == 1 && !scene.has_partner_terms();
         match phantom_by_name(&args.volume) {
             Some(Ok(p)) if plain => {
-                let exact = exact_projection(p.phantom.as_ref(), volume.dims, &view, w, h)
-                    .map_err(|e| e.to_string())?;
+                let exact = exact_projection_sampled(
+                    p.phantom.as_ref(),
+                    volume.dims,
+                    &view,
+                    &sampling,
+                    w,
+                    h,
+                )
+                .map_err(|e| e.to_string())?;
                 let ambient = scene.ambient[0];
                 let exact: Vec<f64> = exact.iter().map(|v| v * ambient).collect();
                 println!("  SNR vs exact  {:.2} dB", snr_db(&exact, &image.data));
             }
             Some(Ok(p)) => match p.phantom.as_gaussian_mixture() {
                 Some(mixture) => {
-                    let exact =
-                        exact_scene_projection(mixture, volume.dims, &scene, &view, w, h, 0.05)
-                            .map_err(|e| e.to_string())?;
+                    let exact = exact_scene_projection_sampled(
+                        mixture,
+                        volume.dims,
+                        &sampling,
+                        &scene,
+                        &view,
+                        w,
+                        h,
+                        0.05,
+                    )
+                    .map_err(|e| e.to_string())?;
                     println!("  SNR vs exact  {:.2} dB", snr_db(&exact.data, &image.data));
                 }
                 None => println!(
@@ -726,6 +801,44 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// The voxel spacing and pixel size of a render: the volume's spacing, or
+/// 1 mm with `--ignore-spacing`; `--pixel-size`, or by default the smallest
+/// spacing, raised if need be so that the longest physical side fits
+/// `default_side` pixels (the default image).
+fn render_sampling(
+    volume: &fvr_host::volume::Volume,
+    args: &RenderArgs,
+    default_side: usize,
+) -> Result<Sampling, String> {
+    if args.ignore_spacing {
+        return Ok(Sampling::UNIT);
+    }
+    let spacing = volume.spacing;
+    let pixel_size = match args.pixel_size {
+        Some(p) => p,
+        None => {
+            let finest = spacing.iter().copied().fold(f64::INFINITY, f64::min);
+            let longest = (0..3)
+                .map(|a| volume.dims[a] as f64 * spacing[a])
+                .fold(0.0, f64::max);
+            finest.max(longest / default_side.max(1) as f64)
+        }
+    };
+    Sampling::new(spacing, pixel_size).map_err(|e| format!("--pixel-size: {e}"))
+}
+
+/// The longest physical side of `volume` in mm under `sampling`.
+fn volume_extent(volume: &fvr_host::volume::Volume, sampling: &Sampling) -> f64 {
+    let s = sampling.spacing();
+    (0..3)
+        .map(|a| volume.dims[a] as f64 * s[a])
+        .fold(0.0, f64::max)
+}
+
+fn fmt_spacing(s: [f64; 3]) -> String {
+    format!("{} x {} x {}", s[0], s[1], s[2])
 }
 
 /// The scene from the command line: cue, ambient, lights.
