@@ -145,7 +145,12 @@ struct RenderArgs {
     /// Pixel size in mm. Default: the smallest voxel spacing, or, if the
     /// volume's longest physical side would not fit the default image at
     /// that size, the size that fits it (longest side / default width).
-    #[arg(long, value_name = "MM", conflicts_with = "ignore_spacing")]
+    #[arg(
+        long,
+        value_name = "MM",
+        conflicts_with = "ignore_spacing",
+        allow_hyphen_values = true
+    )]
     pixel_size: Option<f64>,
     /// Render in voxel units, as if the voxels were 1 mm cubes, ignoring the
     /// volume's spacing (the behaviour before spacing was used).
