@@ -109,7 +109,7 @@ impl Sampling {
             q.is_finite() && q > 0.0
         });
         let gain = sampling.gain();
-        if !ratios_ok || !(gain.is_finite() && gain > 0.0) {
+        if !(ratios_ok && gain.is_finite() && gain > 0.0) {
             return Err(Error::SamplingOutOfRange {
                 spacing,
                 pixel_size,
