@@ -216,3 +216,26 @@ fn bad_pixel_size_is_an_error() {
     args.extend(["--pixel-size", "1", "--ignore-spacing"]);
     assert_error(&fvr(&args, &dir), &["--ignore-spacing"]);
 }
+
+/// `fvr turntable` takes the same units: the spacing by default,
+/// `--pixel-size` checked, `--ignore-spacing` for voxel units.
+#[test]
+fn turntable_uses_the_spacing_too() {
+    let dir = temp_dir("spacing-turntable");
+    write_volume(&dir.join("v.nrrd"), Some(SPACING));
+    let base = ["turntable", "v.nrrd", "--frames", "2", "--size", "32"];
+    for extra in [
+        &[][..],
+        &["--ignore-spacing"][..],
+        &["--pixel-size", "1.6"][..],
+    ] {
+        let mut args = base.to_vec();
+        args.extend(extra);
+        args.extend(["--out", "s.apng"]);
+        ok_stdout(&fvr(&args, &dir));
+        assert!(dir.join("s.apng").exists());
+    }
+    let mut args = base.to_vec();
+    args.extend(["--pixel-size", "0", "--out", "t.apng"]);
+    assert_error(&fvr(&args, &dir), &["pixel size"]);
+}

@@ -42,8 +42,8 @@ GEOMETRY CONTRACT
   of the band-limited interpolant of the voxels along p + t d, in voxel units.
   A zero d or u0, or u0 parallel to d, is an error.
 
-PHYSICAL UNITS (fvr render)
-  By default `fvr render` uses the volume's voxel spacing D (mm, from the
+PHYSICAL UNITS (fvr render, fvr turntable)
+  By default fvr uses the volume's voxel spacing D (mm, from the
   file; 1,1,1 when it gives none) and a pixel size P (--pixel-size, mm):
   voxel (i,j,k) sits at (i Dx, j Dy, k Dz), the centre is C = (n/2) D, pixel
   (col,row) sits at C + (col - W/2) P r + (H/2 - row) P u with r, u, d unit
@@ -142,20 +142,8 @@ struct RenderArgs {
     /// Default: the padded grid divided by the oversampling.
     #[arg(long, value_parser = parse_size)]
     size: Option<(usize, usize)>,
-    /// Pixel size in mm. Default: the smallest voxel spacing, or, if the
-    /// volume's longest physical side would not fit the default image at
-    /// that size, the size that fits it (longest side / default width).
-    #[arg(
-        long,
-        value_name = "MM",
-        conflicts_with = "ignore_spacing",
-        allow_hyphen_values = true
-    )]
-    pixel_size: Option<f64>,
-    /// Render in voxel units, as if the voxels were 1 mm cubes, ignoring the
-    /// volume's spacing (the behaviour before spacing was used).
-    #[arg(long)]
-    ignore_spacing: bool,
+    #[command(flatten)]
+    units: UnitArgs,
     #[command(flatten)]
     spectrum: SpectrumArgs,
     /// Depth cue: none, linear:FRONT,BACK, sine:FRONT,BACK, profile:W0,W1,...,
@@ -283,10 +271,13 @@ struct TurntableArgs {
     /// Turntable axis and up hint X,Y,Z.
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,1")]
     up: [f64; 3],
-    /// Image size W or WxH in pixels of one voxel; at most the padded grid.
+    /// Image size W or WxH in pixels (of --pixel-size mm, or of one voxel
+    /// with --ignore-spacing); at most the padded grid.
     /// Default: the padded grid divided by the oversampling.
     #[arg(long, value_parser = parse_size)]
     size: Option<(usize, usize)>,
+    #[command(flatten)]
+    units: UnitArgs,
     #[command(flatten)]
     spectrum: SpectrumArgs,
     /// Output file: .apng or .png (an animated PNG either way).
@@ -296,6 +287,65 @@ struct TurntableArgs {
     png: PngArgs,
     #[command(flatten)]
     input: InputArgs,
+}
+
+/// Physical units (render and turntable).
+#[derive(Args, Clone, Copy, Default)]
+struct UnitArgs {
+    /// Pixel size in mm. Default: the smallest voxel spacing, or, if the
+    /// volume's longest physical side would not fit the default image at
+    /// that size, the size that fits it (longest side / default width).
+    #[arg(
+        long,
+        value_name = "MM",
+        conflicts_with = "ignore_spacing",
+        allow_hyphen_values = true
+    )]
+    pixel_size: Option<f64>,
+    /// Render in voxel units, as if the voxels were 1 mm cubes, ignoring the
+    /// volume's spacing (the behaviour before spacing was used).
+    #[arg(long)]
+    ignore_spacing: bool,
+}
+
+impl UnitArgs {
+    /// The voxel spacing and pixel size: the volume's spacing, or 1 mm
+    /// with `--ignore-spacing`; `--pixel-size`, or by default the smallest
+    /// spacing, raised if need be so that the longest physical side fits
+    /// `default_side` pixels (the default image). Warns when the longest
+    /// side exceeds the image grid's period `n·p`.
+    fn sampling(
+        &self,
+        volume: &fvr_host::volume::Volume,
+        n: usize,
+        default_side: usize,
+    ) -> Result<Sampling, String> {
+        if self.ignore_spacing {
+            return Ok(Sampling::UNIT);
+        }
+        let spacing = volume.spacing;
+        let longest = (0..3)
+            .map(|a| volume.dims[a] as f64 * spacing[a])
+            .fold(0.0, f64::max);
+        let pixel_size = match self.pixel_size {
+            Some(p) => p,
+            None => {
+                let finest = spacing.iter().copied().fold(f64::INFINITY, f64::min);
+                finest.max(longest / default_side.max(1) as f64)
+            }
+        };
+        let sampling =
+            Sampling::new(spacing, pixel_size).map_err(|e| format!("--pixel-size: {e}"))?;
+        let period = n as f64 * pixel_size;
+        if longest > period {
+            eprintln!(
+                "fvr: warning: the volume's longest side ({longest:.1} mm) exceeds the image \
+                 grid's period ({n} pixels of {pixel_size} mm = {period:.1} mm): views across \
+                 it wrap around. Use a larger --pixel-size or --oversample 2."
+            );
+        }
+        Ok(sampling)
+    }
 }
 
 /// How the spectrum is made (render and turntable).
@@ -476,8 +526,7 @@ fn default_scene() -> Result<(), String> {
         dir: [1.0, 0.45, -0.3],
         up: DEFAULT_UP,
         size: None,
-        pixel_size: None,
-        ignore_spacing: false,
+        units: UnitArgs::default(),
         spectrum: SpectrumArgs::default(),
         depth_cue: "none".into(),
         cue_harmonics: DEFAULT_PROFILE_HARMONICS,
@@ -565,17 +614,7 @@ fn render(args: &RenderArgs) -> Result<(), String> {
     let n = spectra.density.n();
     let default_side = n / args.spectrum.oversample as usize;
     let (w, h) = args.size.unwrap_or((default_side, default_side));
-    let sampling = render_sampling(&volume, args, default_side)?;
-    let longest_mm = volume_extent(&volume, &sampling);
-    let period_mm = n as f64 * sampling.pixel_size();
-    if longest_mm > period_mm {
-        eprintln!(
-            "fvr: warning: the volume's longest side ({longest_mm:.1} mm) exceeds the image \
-             grid's period ({n} pixels of {} mm = {period_mm:.1} mm): views across it wrap \
-             around. Use a larger --pixel-size or --oversample 2.",
-            sampling.pixel_size()
-        );
-    }
+    let sampling = args.units.sampling(&volume, n, default_side)?;
     let plain_view = scene.channels() == 1 && !scene.has_partner_terms();
     if (args.preview_level > 0 || args.adaptive.is_some()) && !plain_view {
         return Err(
@@ -662,7 +701,7 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         let [dx, dy, dz] = volume.spacing;
         println!(
             "  spacing       {dx} x {dy} x {dz} mm{}",
-            if args.ignore_spacing {
+            if args.units.ignore_spacing {
                 " (ignored: --ignore-spacing, voxel units)"
             } else {
                 ""
@@ -671,7 +710,7 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         println!(
             "  pixel size    {} {}",
             sampling.pixel_size(),
-            if args.ignore_spacing {
+            if args.units.ignore_spacing {
                 "voxel"
             } else {
                 "mm (values in mm x volume units)"
@@ -737,7 +776,7 @@ fn render(args: &RenderArgs) -> Result<(), String> {
             ("dims", format!("{:?}", volume.dims)),
             ("spacing_mm", format!("{:?}", volume.spacing)),
             ("pixel_size", json_num(sampling.pixel_size())),
-            ("ignore_spacing", args.ignore_spacing.to_string()),
+            ("ignore_spacing", args.units.ignore_spacing.to_string()),
             ("image", format!("[{w}, {h}, {}]", image.channels)),
             ("spectrum_side", n.to_string()),
             ("precision", json_str(args.spectrum.precision.name())),
@@ -806,40 +845,6 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         }
     }
     Ok(())
-}
-
-/// The voxel spacing and pixel size of a render: the volume's spacing, or
-/// 1 mm with `--ignore-spacing`; `--pixel-size`, or by default the smallest
-/// spacing, raised if need be so that the longest physical side fits
-/// `default_side` pixels (the default image).
-fn render_sampling(
-    volume: &fvr_host::volume::Volume,
-    args: &RenderArgs,
-    default_side: usize,
-) -> Result<Sampling, String> {
-    if args.ignore_spacing {
-        return Ok(Sampling::UNIT);
-    }
-    let spacing = volume.spacing;
-    let pixel_size = match args.pixel_size {
-        Some(p) => p,
-        None => {
-            let finest = spacing.iter().copied().fold(f64::INFINITY, f64::min);
-            let longest = (0..3)
-                .map(|a| volume.dims[a] as f64 * spacing[a])
-                .fold(0.0, f64::max);
-            finest.max(longest / default_side.max(1) as f64)
-        }
-    };
-    Sampling::new(spacing, pixel_size).map_err(|e| format!("--pixel-size: {e}"))
-}
-
-/// The longest physical side of `volume` in mm under `sampling`.
-fn volume_extent(volume: &fvr_host::volume::Volume, sampling: &Sampling) -> f64 {
-    let s = sampling.spacing();
-    (0..3)
-        .map(|a| volume.dims[a] as f64 * s[a])
-        .fold(0.0, f64::max)
 }
 
 fn fmt_spacing(s: [f64; 3]) -> String {
@@ -952,9 +957,10 @@ fn turntable(args: &TurntableArgs) -> Result<(), String> {
     let n = spec.n();
     let side = n / args.spectrum.oversample as usize;
     let (w, h) = args.size.unwrap_or((side, side));
+    let sampling = args.units.sampling(&volume, n, side)?;
     let bar = progress::count(views.len() as u64, "frames");
     let t2 = Instant::now();
-    let frames = turntable::render_views(&spec, &views, w, h, &bar);
+    let frames = turntable::render_views(&spec, &views, &sampling, w, h, &bar);
     let t_views = t2.elapsed();
     bar.finish_and_clear();
     let frames = frames.map_err(|e| e.to_string())?;
