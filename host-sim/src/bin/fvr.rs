@@ -760,9 +760,14 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         println!("  view          {:.2} ms", t_view.as_secs_f64() * 1e3);
         if args.preview_level > 0 {
             println!(
-                "  level         {} ({w}x{h} at pitch {} voxels, central 1/{} of the slice)",
+                "  level         {} ({w}x{h} at pitch {} {}, central 1/{} of the slice)",
                 args.preview_level,
-                1u64 << args.preview_level,
+                (1u64 << args.preview_level) as f64 * sampling.pixel_size(),
+                if sampling == Sampling::UNIT {
+                    "voxels"
+                } else {
+                    "mm"
+                },
                 1u64 << (2 * args.preview_level)
             );
         }
