@@ -153,6 +153,26 @@ pub enum Error {
         /// The line length (the spectrum's side).
         line: usize,
     },
+    /// A voxel spacing that is zero, negative, NaN or infinite.
+    InvalidSpacing {
+        /// The axis (0 = `i`, 1 = `j`, 2 = `k`).
+        axis: usize,
+        /// The spacing given (mm).
+        value: f64,
+    },
+    /// An image pixel size that is zero, negative, NaN or infinite.
+    InvalidPixelSize {
+        /// The pixel size given (mm).
+        value: f64,
+    },
+    /// Valid spacing and pixel size whose ratios or gain `Δx·Δy·Δz/p²`
+    /// overflow or underflow f64.
+    SamplingOutOfRange {
+        /// The spacing given (mm).
+        spacing: [f64; 3],
+        /// The pixel size given (mm).
+        pixel_size: f64,
+    },
     /// A storage format the target cannot store or prepare this way.
     UnsupportedFormat {
         /// Which format.
@@ -257,6 +277,24 @@ impl fmt::Display for Error {
             Error::BlockSizeMismatch { block, line } => write!(
                 f,
                 "block size {block} does not divide the spectrum's line of {line} values"
+            ),
+            Error::InvalidSpacing { axis, value } => write!(
+                f,
+                "voxel spacing {value} along axis {} is not allowed: spacings must be finite and positive (mm)",
+                ["i (x)", "j (y)", "k (z)"][axis.min(2)]
+            ),
+            Error::InvalidPixelSize { value } => write!(
+                f,
+                "pixel size {value} is not allowed: it must be finite and positive (mm)"
+            ),
+            Error::SamplingOutOfRange {
+                spacing,
+                pixel_size,
+            } => write!(
+                f,
+                "voxel spacing {} mm and pixel size {pixel_size} mm are too far apart: \
+                 their ratios or the gain spacing volume / pixel area leave the f64 range",
+                V3(spacing)
             ),
             Error::UnsupportedFormat { format, reason } => {
                 write!(f, "storage format {format} is not supported here: {reason}")

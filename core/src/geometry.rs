@@ -10,6 +10,24 @@
 //! - Its value is `∫ f(p + t·d) dt` in voxel units, `f` being the
 //!   band-limited interpolant of the samples.
 //! - A zero `d` or `u0`, or `u0` parallel to `d`, is an error naming both.
+//!
+//! # Physical units ([`Sampling`])
+//!
+//! With voxel spacing `Δ = (Δx, Δy, Δz)` and image pixel size `p` (both in
+//! mm), the same contract holds in physical space:
+//! - Voxel `(i, j, k)` sits at `(i·Δx, j·Δy, k·Δz)`; the rotation centre is
+//!   `C = (nx·Δx/2, ny·Δy/2, nz·Δz/2)`.
+//! - `d`, `r` and `u` are unit vectors in physical space (the frame above).
+//! - Pixel `(col, row)` sits at `P = C + (col − W/2)·p·r + (H/2 − row)·p·u`
+//!   (mm), and its value is `∫ f(P + t·d) dt` with `t` in mm: the image is
+//!   in mm × (volume units).
+//! - By the projection-slice theorem in physical frequencies, the slice
+//!   sample at 2D index `(kx, ky)` lies at the 3D index frequency
+//!   `kx·r' + ky·u'` with `r'_a = r_a·Δ_a/p` and `u'_a = u_a·Δ_a/p`
+//!   ([`SliceAxes`], no longer orthonormal), and the index-space image is
+//!   multiplied by `Δx·Δy·Δz/p²` ([`Sampling::gain`]).
+//! - [`Sampling::UNIT`] (1 mm voxels and pixels) is the voxel-unit contract
+//!   above, bit for bit.
 
 use crate::error::{Error, Result};
 
@@ -34,6 +52,133 @@ pub struct Frame {
     pub up: [f64; 3],
     /// Unit viewing direction.
     pub dir: [f64; 3],
+}
+
+/// The two step vectors of a slice in index-space frequency: the slice
+/// sample at 2D frequency index `(kx, ky)` is the spectrum at
+/// `kx·right + ky·up`. For voxel units they are the frame's orthonormal
+/// `r` and `u` ([`Frame::slice_axes`]); with a [`Sampling`] they are scaled
+/// per axis ([`Sampling::slice_axes`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SliceAxes {
+    /// Index-space step per unit of `kx`.
+    pub right: [f64; 3],
+    /// Index-space step per unit of `ky`.
+    pub up: [f64; 3],
+}
+
+/// Voxel spacing and image pixel size in mm (see the module docs): how an
+/// index-space spectrum is sliced and scaled for an image in physical units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sampling {
+    spacing: [f64; 3],
+    pixel_size: f64,
+}
+
+impl Sampling {
+    /// 1 mm voxels and 1 mm pixels: voxel units.
+    pub const UNIT: Sampling = Sampling {
+        spacing: [1.0; 3],
+        pixel_size: 1.0,
+    };
+
+    /// Voxels `spacing` mm apart along `i`, `j`, `k`, imaged at pixels
+    /// `pixel_size` mm apart.
+    ///
+    /// # Errors
+    /// [`Error::InvalidSpacing`] for a spacing that is zero, negative or not
+    /// finite (the first such axis), [`Error::InvalidPixelSize`] likewise
+    /// for the pixel size, and [`Error::SamplingOutOfRange`] when a ratio
+    /// `Δ_a/p` or the gain `Δx·Δy·Δz/p²` is not a finite positive number.
+    pub fn new(spacing: [f64; 3], pixel_size: f64) -> Result<Self> {
+        if let Some(axis) = spacing.iter().position(|&s| !(s.is_finite() && s > 0.0)) {
+            return Err(Error::InvalidSpacing {
+                axis,
+                value: spacing[axis],
+            });
+        }
+        if !(pixel_size.is_finite() && pixel_size > 0.0) {
+            return Err(Error::InvalidPixelSize { value: pixel_size });
+        }
+        let sampling = Self {
+            spacing,
+            pixel_size,
+        };
+        let ratios_ok = spacing.iter().all(|&s| {
+            let q = s / pixel_size;
+            q.is_finite() && q > 0.0
+        });
+        let gain = sampling.gain();
+        if !(ratios_ok && gain.is_finite() && gain > 0.0) {
+            return Err(Error::SamplingOutOfRange {
+                spacing,
+                pixel_size,
+            });
+        }
+        Ok(sampling)
+    }
+
+    /// Voxel spacing `Δ` in mm along `i`, `j`, `k`.
+    pub fn spacing(&self) -> [f64; 3] {
+        self.spacing
+    }
+
+    /// Image pixel size `p` in mm.
+    pub fn pixel_size(&self) -> f64 {
+        self.pixel_size
+    }
+
+    /// `Some(Δ)` when all three spacings equal the pixel size `Δ`: then the
+    /// slice axes are the frame's own and only the gain `Δ` differs from
+    /// voxel units.
+    pub fn uniform_pitch(&self) -> Option<f64> {
+        let p = self.pixel_size;
+        self.spacing.iter().all(|&s| s == p).then_some(p)
+    }
+
+    /// The slice's index-space step vectors for `frame`:
+    /// `r'_a = r_a·(Δ_a/p)`, `u'_a = u_a·(Δ_a/p)`. A ratio of exactly 1
+    /// leaves a component bit-identical.
+    pub fn slice_axes(&self, frame: &Frame) -> SliceAxes {
+        let ratio: [f64; 3] = core::array::from_fn(|a| self.spacing[a] / self.pixel_size);
+        SliceAxes {
+            right: core::array::from_fn(|a| frame.right[a] * ratio[a]),
+            up: core::array::from_fn(|a| frame.up[a] * ratio[a]),
+        }
+    }
+
+    /// The factor from the index-space image to the physical one:
+    /// `Δx·Δy·Δz/p²` (a line integral in mm over a pixel of `p²`, against
+    /// index-space frequencies of `1/(n·Δ_a)`). Exactly 1 for
+    /// [`Sampling::UNIT`].
+    pub fn gain(&self) -> f64 {
+        let [x, y, z] = self.spacing;
+        let p = self.pixel_size;
+        (x * y * z) / (p * p)
+    }
+
+    /// The rotation centre `C = (n/2)·Δ` in mm of a volume of `dims`.
+    pub fn center(&self, dims: [usize; 3]) -> [f64; 3] {
+        core::array::from_fn(|a| dims[a] as f64 / 2.0 * self.spacing[a])
+    }
+
+    /// Position in mm of pixel `(col, row)` of a `width × height` image of
+    /// a volume of `dims` seen in `frame` (see the module docs).
+    pub fn pixel_position(
+        &self,
+        frame: &Frame,
+        dims: [usize; 3],
+        width: usize,
+        height: usize,
+        col: f64,
+        row: f64,
+    ) -> [f64; 3] {
+        let c = self.center(dims);
+        let p = self.pixel_size;
+        let a = (col - width as f64 / 2.0) * p;
+        let b = (height as f64 / 2.0 - row) * p;
+        core::array::from_fn(|i| c[i] + a * frame.right[i] + b * frame.up[i])
+    }
 }
 
 impl View {
@@ -75,6 +220,14 @@ impl View {
 }
 
 impl Frame {
+    /// The slice axes in voxel units: `r` and `u` themselves.
+    pub fn slice_axes(&self) -> SliceAxes {
+        SliceAxes {
+            right: self.right,
+            up: self.up,
+        }
+    }
+
     /// Position of pixel `(col, row)` of a `width × height` image of a volume
     /// with centre `center` (see the module docs).
     pub fn pixel_position(

@@ -12,10 +12,10 @@
 use crate::dht::Twiddles;
 use crate::error::{require_len, Error, Result};
 use crate::filter::KernelTable;
-use crate::geometry::View;
+use crate::geometry::{Sampling, View};
 use crate::real::{Real, Sample};
 use crate::render::{
-    aux_len, check_image, extract_central_slice, finish_projection, placement_at_pitch,
+    aux_len, check_image, extract_central_slice_on, finish_projection, placement_on_axes,
 };
 use crate::spectrum::Spectrum;
 
@@ -50,6 +50,43 @@ pub fn render_level<S: Sample, T: Real>(
     aux: &mut [T],
     out: &mut [T],
 ) -> Result<()> {
+    render_level_sampled(
+        spec,
+        kernel,
+        view,
+        &Sampling::UNIT,
+        width,
+        height,
+        level,
+        tw,
+        grid,
+        aux,
+        out,
+    )
+}
+
+/// [`render_level`] in physical units ([`crate::render::render_sampled`]):
+/// pixels `2^level·p` mm apart. The slice axes are the full view's
+/// [`Sampling::slice_axes`] (level `L` samples the same plane `2^L` times
+/// more coarsely in frequency, and `m = n/2^L` makes `n/(m·2^L·p) = 1/p`),
+/// and the gain is `Δx·Δy·Δz/(2^L·p)²`. [`Sampling::UNIT`] gives
+/// [`render_level`]'s image bit for bit.
+///
+/// # Errors
+/// As [`render_level`].
+pub fn render_level_sampled<S: Sample, T: Real>(
+    spec: &Spectrum<'_, S>,
+    kernel: &KernelTable<T>,
+    view: &View,
+    sampling: &Sampling,
+    width: usize,
+    height: usize,
+    level: u32,
+    tw: &Twiddles<'_, T>,
+    grid: &mut [T],
+    aux: &mut [T],
+    out: &mut [T],
+) -> Result<()> {
     let n = spec.n();
     if level > max_level(n) {
         return Err(Error::TooMany {
@@ -58,7 +95,7 @@ pub fn render_level<S: Sample, T: Real>(
             capacity: max_level(n) as usize,
         });
     }
-    let frame = view.frame()?;
+    let axes = sampling.slice_axes(&view.frame()?);
     let m = n >> level;
     check_image(width, height, m)?;
     if kernel.filter() != spec.filter() {
@@ -68,9 +105,9 @@ pub fn render_level<S: Sample, T: Real>(
     require_len("auxiliary scratch", aux_len(m), aux.len())?;
     require_len("output image", width * height, out.len())?;
     let pitch = (1u64 << level) as f64;
-    extract_central_slice(spec, kernel, &frame, m, grid);
-    let place = placement_at_pitch(spec.dims(), &frame, width, height, pitch);
-    let gain = 1.0 / (spec.scale() * pitch * pitch);
+    extract_central_slice_on(spec, kernel, &axes, m, grid);
+    let place = placement_on_axes(spec.dims(), &axes, width, height, pitch);
+    let gain = sampling.gain() / (spec.scale() * pitch * pitch);
     finish_projection(
         &mut grid[..m * m],
         m,

@@ -13,12 +13,19 @@
 //! image sides) are applied exactly as a phase ramp on the slice:
 //! in Hartley form, shifting by `t` maps `H(k)` to
 //! `cos φ·H(k) + sin φ·H(−k)` with `φ = −2π k·t/n`.
+//!
+//! In physical units ([`Sampling`]: voxel spacing `Δ`, pixel size `p`, in
+//! mm) the slice is spanned by [`Sampling::slice_axes`] `r'_a = r_a·Δ_a/p`,
+//! `u'_a = u_a·Δ_a/p` instead, and the image is multiplied by
+//! `Δx·Δy·Δz/p²` ([`render_sampled`]). The extraction needs no change: the
+//! Nyquist-cube test is per index axis, the taps wrap modulo `n` as before,
+//! and `r'`, `u'` need not be orthonormal.
 
 use crate::dht::{dht_2d, neg_mod, Twiddles};
 use crate::error::{require_len, Error, Result};
 use crate::filter::{KernelTable, MAX_WIDTH};
 use crate::format::BlockLayout;
-use crate::geometry::{dot, Frame, View};
+use crate::geometry::{dot, Frame, Sampling, SliceAxes, View};
 use crate::real::{Real, Sample};
 use crate::spectrum::Spectrum;
 
@@ -52,9 +59,23 @@ pub fn placement_at_pitch(
     height: usize,
     pitch: f64,
 ) -> Placement {
+    placement_on_axes(dims, &frame.slice_axes(), width, height, pitch)
+}
+
+/// [`placement_at_pitch`] for slice axes `axes` (index units per pixel):
+/// with [`Sampling::slice_axes`], `δ·r' = Σ δ_a·Δ_a·r_a/p` is the physical
+/// offset `δ∘Δ` of the transform origin from the centre, in pixels of `p`
+/// mm, as the physical contract needs.
+pub fn placement_on_axes(
+    dims: [usize; 3],
+    axes: &SliceAxes,
+    width: usize,
+    height: usize,
+    pitch: f64,
+) -> Placement {
     let delta = dims.map(|d| (d % 2) as f64 * 0.5);
-    let a0 = -(width as f64) / 2.0 + dot(delta, frame.right) / pitch;
-    let b0 = height as f64 / 2.0 + dot(delta, frame.up) / pitch;
+    let a0 = -(width as f64) / 2.0 + dot(delta, axes.right) / pitch;
+    let b0 = height as f64 / 2.0 + dot(delta, axes.up) / pitch;
     let (col0, row0) = (libm::floor(a0), libm::floor(b0));
     Placement {
         col0: col0 as i64,
@@ -94,7 +115,40 @@ pub fn render<S: Sample, T: Real>(
     aux: &mut [T],
     out: &mut [T],
 ) -> Result<()> {
-    let frame = view.frame()?;
+    render_sampled(
+        spec,
+        kernel,
+        view,
+        &Sampling::UNIT,
+        width,
+        height,
+        tw,
+        grid,
+        aux,
+        out,
+    )
+}
+
+/// [`render`] in physical units: voxels `sampling.spacing()` mm apart,
+/// pixels `sampling.pixel_size()` mm apart, values `∫ f dt` in mm × volume
+/// units (the physical contract of [`crate::geometry`]).
+/// [`Sampling::UNIT`] gives [`render`]'s image bit for bit.
+///
+/// # Errors
+/// As [`render`].
+pub fn render_sampled<S: Sample, T: Real>(
+    spec: &Spectrum<'_, S>,
+    kernel: &KernelTable<T>,
+    view: &View,
+    sampling: &Sampling,
+    width: usize,
+    height: usize,
+    tw: &Twiddles<'_, T>,
+    grid: &mut [T],
+    aux: &mut [T],
+    out: &mut [T],
+) -> Result<()> {
+    let axes = sampling.slice_axes(&view.frame()?);
     let n = spec.n();
     check_image(width, height, n)?;
     if kernel.filter() != spec.filter() {
@@ -109,13 +163,13 @@ pub fn render<S: Sample, T: Real>(
             needed: n,
         });
     }
-    extract_slice(spec, kernel, &frame, &mut grid[..n * n]);
-    let place = placement(spec.dims(), &frame, width, height);
+    extract_central_slice_on(spec, kernel, &axes, n, &mut grid[..n * n]);
+    let place = placement_on_axes(spec.dims(), &axes, width, height, 1.0);
     finish_projection(
         &mut grid[..n * n],
         n,
         &place,
-        1.0 / spec.scale(),
+        sampling.gain() / spec.scale(),
         width,
         height,
         tw,
@@ -174,14 +228,28 @@ pub fn extract_central_slice<S: Sample, T: Real>(
     m: usize,
     grid: &mut [T],
 ) {
+    extract_central_slice_on(spec, kernel, &frame.slice_axes(), m, grid);
+}
+
+/// [`extract_central_slice`] on the plane spanned by `axes` (the slice
+/// sample at `(kx, ky)` is the spectrum at `kx·axes.right + ky·axes.up`,
+/// zero outside the Nyquist cube): the physical-units slice with
+/// [`Sampling::slice_axes`].
+pub fn extract_central_slice_on<S: Sample, T: Real>(
+    spec: &Spectrum<'_, S>,
+    kernel: &KernelTable<T>,
+    axes: &SliceAxes,
+    m: usize,
+    grid: &mut [T],
+) {
     let grid = &mut grid[..m * m];
     match kernel.filter().width() {
-        1 => extract_width::<1, S, T>(spec, kernel, frame, m, grid),
-        2 => extract_width::<2, S, T>(spec, kernel, frame, m, grid),
-        3 => extract_width::<3, S, T>(spec, kernel, frame, m, grid),
-        4 => extract_width::<4, S, T>(spec, kernel, frame, m, grid),
-        5 => extract_width::<5, S, T>(spec, kernel, frame, m, grid),
-        _ => extract_width::<MAX_WIDTH, S, T>(spec, kernel, frame, m, grid),
+        1 => extract_width::<1, S, T>(spec, kernel, axes, m, grid),
+        2 => extract_width::<2, S, T>(spec, kernel, axes, m, grid),
+        3 => extract_width::<3, S, T>(spec, kernel, axes, m, grid),
+        4 => extract_width::<4, S, T>(spec, kernel, axes, m, grid),
+        5 => extract_width::<5, S, T>(spec, kernel, axes, m, grid),
+        _ => extract_width::<MAX_WIDTH, S, T>(spec, kernel, axes, m, grid),
     }
 }
 
@@ -306,15 +374,15 @@ impl<'a> LineReads<'a> {
 fn extract_width<const W: usize, S: Sample, T: Real>(
     spec: &Spectrum<'_, S>,
     kernel: &KernelTable<T>,
-    frame: &Frame,
+    axes: &SliceAxes,
     m: usize,
     grid: &mut [T],
 ) {
     let n = spec.n();
     let nn = n * n;
     let reads = LineReads::of(spec);
-    let r = frame.right.map(T::from_f64);
-    let u = frame.up.map(T::from_f64);
+    let r = axes.right.map(T::from_f64);
+    let u = axes.up.map(T::from_f64);
     let nyquist = T::from_usize(n) * T::HALF;
     let mask = n - 1;
     for (iy, row) in grid.chunks_exact_mut(m).enumerate() {

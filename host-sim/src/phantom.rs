@@ -2,7 +2,9 @@
 //!
 //! Everything is in voxel units: voxel `(i, j, k)` sits at the point
 //! `(i, j, k)`, and the centre of a volume of dims `n` is `n / 2` per axis
-//! (real-valued). Each phantom gives its density at any point and the exact
+//! (real-valued). Sampled with a spacing `Δ` ([`sample_spaced`]), the same
+//! phantom is in mm instead: voxel `(i, j, k)` sits at `(i·Δx, j·Δy, k·Δz)`
+//! (the physical contract of `fvr_core::geometry`). Each phantom gives its density at any point and the exact
 //! integral of that density along any line, so renderers can be checked
 //! against references that carry no discretisation error of their own.
 
@@ -35,6 +37,35 @@ pub fn sample(phantom: &dyn Phantom, dims: [usize; 3]) -> Volume {
         }
     }
     volume
+}
+
+/// Sample a phantom given in mm at the voxel centres `(i·Δx, j·Δy, k·Δz)`
+/// into a [`Volume`] of spacing `spacing`. A spacing of 1 mm gives
+/// [`sample`]'s samples.
+///
+/// # Errors
+/// A spacing that is zero, negative or not finite.
+pub fn sample_spaced(
+    phantom: &dyn Phantom,
+    dims: [usize; 3],
+    spacing: [f64; 3],
+) -> Result<Volume, crate::volume::SpacingError> {
+    let mut volume = Volume::zeros(dims).with_spacing(spacing)?;
+    let mut idx = 0;
+    for k in 0..dims[2] {
+        for j in 0..dims[1] {
+            for i in 0..dims[0] {
+                let p = [
+                    i as f64 * spacing[0],
+                    j as f64 * spacing[1],
+                    k as f64 * spacing[2],
+                ];
+                volume.data[idx] = phantom.density(p) as f32;
+                idx += 1;
+            }
+        }
+    }
+    Ok(volume)
 }
 
 /// SplitMix64 (Steele, Lea & Flood 2014; Vigna's reference constants): a tiny,
@@ -208,13 +239,24 @@ impl GaussianMixture {
     /// As [`GaussianMixture::random`] with sigmas in
     /// `[1.5, max(1.5, sigma_fraction·n)]`.
     pub fn random_with(seed: u64, n: usize, count: usize, sigma_fraction: f64) -> Self {
-        let mut rng = SplitMix64::new(seed);
         let nf = n as f64;
+        Self::random_in(seed, nf, count, 1.5, (sigma_fraction * nf).max(1.5))
+    }
+
+    /// As [`GaussianMixture::random`] for a cube of side `side` (any unit,
+    /// e.g. mm) with sigmas uniform in `[sigma_lo, sigma_hi]`: centres in the
+    /// ball `|μ − c| ≤ 0.40·side − 4·σmax` around `c = side/2`. For a volume
+    /// of spacing `Δ`, `sigma_lo ≥ 1.5·max Δ` keeps every component at least
+    /// 1.5 samples wide along every axis, as [`GaussianMixture::random`] is.
+    /// `random_with(seed, n, count, f)` is
+    /// `random_in(seed, n, count, 1.5, max(1.5, f·n))`, draw for draw.
+    pub fn random_in(seed: u64, side: f64, count: usize, sigma_lo: f64, sigma_hi: f64) -> Self {
+        let mut rng = SplitMix64::new(seed);
+        let nf = side;
         let c = nf / 2.0;
-        let sigma_hi = (sigma_fraction * nf).max(1.5);
         let components = (0..count)
             .map(|_| {
-                let sigmas = [(); 3].map(|_| rng.uniform(1.5, sigma_hi));
+                let sigmas = [(); 3].map(|_| rng.uniform(sigma_lo, sigma_hi));
                 let rotation = quaternion_to_matrix(rng.in_unit_ball::<4>());
                 let amplitude = rng.uniform(0.3, 1.0);
                 let sigma_max = sigmas[0].max(sigmas[1]).max(sigmas[2]);

@@ -10,9 +10,9 @@ use std::str::FromStr;
 
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
-use fvr_core::geometry::View;
+use fvr_core::geometry::{Sampling, View};
 use fvr_core::real::{Real, Sample};
-use fvr_core::render::{aux_len, grid_len, render};
+use fvr_core::render::{aux_len, grid_len, render_sampled};
 use fvr_core::spectrum::{padded_size, prepare_scratch_len, DenseVolume, Spectrum};
 use half::f16;
 
@@ -198,11 +198,29 @@ impl<T: Real> ViewRenderer<T> {
         height: usize,
         out: &mut [T],
     ) -> Result<(), fvr_core::Error> {
+        self.render_sampled_into(spec, view, &Sampling::UNIT, width, height, out)
+    }
+
+    /// [`ViewRenderer::render_into`] in physical units
+    /// ([`fvr_core::render::render_sampled`]).
+    ///
+    /// # Errors
+    /// As [`fvr_core::render::render_sampled`].
+    pub fn render_sampled_into<S: Sample>(
+        &mut self,
+        spec: &OwnedSpectrum<S>,
+        view: &View,
+        sampling: &Sampling,
+        width: usize,
+        height: usize,
+        out: &mut [T],
+    ) -> Result<(), fvr_core::Error> {
         let tw = Twiddles::from_table(&self.tw, self.n)?;
-        render(
+        render_sampled(
             &spec.view(),
             &self.kernel,
             view,
+            sampling,
             width,
             height,
             &tw,
@@ -459,21 +477,37 @@ impl AnySpectrum {
         width: usize,
         height: usize,
     ) -> Result<Vec<f64>, fvr_core::Error> {
+        self.render_sampled(view, &Sampling::UNIT, width, height)
+    }
+
+    /// [`AnySpectrum::render`] in physical units: voxel spacing and pixel
+    /// size from `sampling`, values in mm × volume units.
+    ///
+    /// # Errors
+    /// As [`fvr_core::render::render_sampled`].
+    pub fn render_sampled(
+        &self,
+        view: &View,
+        sampling: &Sampling,
+        width: usize,
+        height: usize,
+    ) -> Result<Vec<f64>, fvr_core::Error> {
         fn go<S: Sample, T: Real>(
             s: &OwnedSpectrum<S>,
             view: &View,
+            sampling: &Sampling,
             w: usize,
             h: usize,
         ) -> Result<Vec<f64>, fvr_core::Error> {
             let mut r = ViewRenderer::<T>::new(s.n(), s.filter());
             let mut out = vec![T::ZERO; w * h];
-            r.render_into(s, view, w, h, &mut out)?;
+            r.render_sampled_into(s, view, sampling, w, h, &mut out)?;
             Ok(out.into_iter().map(T::to_f64).collect())
         }
         match self {
-            AnySpectrum::F16(s) => go::<_, f32>(s, view, width, height),
-            AnySpectrum::F32(s) => go::<_, f32>(s, view, width, height),
-            AnySpectrum::F64(s) => go::<_, f64>(s, view, width, height),
+            AnySpectrum::F16(s) => go::<_, f32>(s, view, sampling, width, height),
+            AnySpectrum::F32(s) => go::<_, f32>(s, view, sampling, width, height),
+            AnySpectrum::F64(s) => go::<_, f64>(s, view, sampling, width, height),
         }
     }
 
@@ -489,9 +523,26 @@ impl AnySpectrum {
         height: usize,
         level: u32,
     ) -> Result<Vec<f64>, fvr_core::Error> {
+        self.render_level_sampled(view, &Sampling::UNIT, width, height, level)
+    }
+
+    /// [`AnySpectrum::render_level`] in physical units: pixels
+    /// `2^level·sampling.pixel_size()` mm apart.
+    ///
+    /// # Errors
+    /// As [`fvr_core::progressive::render_level_sampled`].
+    pub fn render_level_sampled(
+        &self,
+        view: &View,
+        sampling: &Sampling,
+        width: usize,
+        height: usize,
+        level: u32,
+    ) -> Result<Vec<f64>, fvr_core::Error> {
         fn go<S: Sample, T: Real>(
             s: &OwnedSpectrum<S>,
             view: &View,
+            sampling: &Sampling,
             w: usize,
             h: usize,
             level: u32,
@@ -504,10 +555,11 @@ impl AnySpectrum {
             let mut grid = vec![T::ZERO; m * m];
             let mut aux = vec![T::ZERO; aux_len(m)];
             let mut out = vec![T::ZERO; w * h];
-            fvr_core::progressive::render_level(
+            fvr_core::progressive::render_level_sampled(
                 &s.view(),
                 &kernel,
                 view,
+                sampling,
                 w,
                 h,
                 level,
@@ -519,9 +571,9 @@ impl AnySpectrum {
             Ok(out.into_iter().map(T::to_f64).collect())
         }
         match self {
-            AnySpectrum::F16(s) => go::<_, f32>(s, view, width, height, level),
-            AnySpectrum::F32(s) => go::<_, f32>(s, view, width, height, level),
-            AnySpectrum::F64(s) => go::<_, f64>(s, view, width, height, level),
+            AnySpectrum::F16(s) => go::<_, f32>(s, view, sampling, width, height, level),
+            AnySpectrum::F32(s) => go::<_, f32>(s, view, sampling, width, height, level),
+            AnySpectrum::F64(s) => go::<_, f64>(s, view, sampling, width, height, level),
         }
     }
 }

@@ -11,7 +11,7 @@
 use std::f64::consts::PI;
 
 use fvr_core::dht::Twiddles;
-use fvr_core::geometry::{center, View};
+use fvr_core::geometry::{center, Sampling, View};
 use fvr_core::render::{check_image, finish_projection, placement, signed_index};
 use fvr_core::spectrum::padded_size;
 
@@ -121,12 +121,30 @@ pub fn exact_projection(
     width: usize,
     height: usize,
 ) -> Result<Vec<f64>, fvr_core::Error> {
+    exact_projection_sampled(phantom, dims, view, &Sampling::UNIT, width, height)
+}
+
+/// Exact X-ray image in physical units of a phantom given in mm, for a
+/// volume of `dims` sampled at `sampling.spacing()` and imaged at
+/// `sampling.pixel_size()` (the physical contract of `fvr_core::geometry`:
+/// pixel positions in mm around `C = (n/2)·Δ`, `∫ f dt` with `t` in mm).
+/// [`Sampling::UNIT`] gives [`exact_projection`].
+///
+/// # Errors
+/// Bad view vectors.
+pub fn exact_projection_sampled(
+    phantom: &dyn Phantom,
+    dims: [usize; 3],
+    view: &View,
+    sampling: &Sampling,
+    width: usize,
+    height: usize,
+) -> Result<Vec<f64>, fvr_core::Error> {
     let frame = view.frame()?;
-    let c = center(dims);
     let mut out = Vec::with_capacity(width * height);
     for row in 0..height {
         for col in 0..width {
-            let p = frame.pixel_position(c, width, height, col as f64, row as f64);
+            let p = sampling.pixel_position(&frame, dims, width, height, col as f64, row as f64);
             out.push(phantom.line_integral(p, frame.dir));
         }
     }

@@ -13,11 +13,13 @@
 //! # path = "head.nii.gz"        # a file, relative to this scene file
 //! # raw_dims = [256, 256, 108]  # raw_type = "u16", raw_endian = "little"
 //! # background = -1024          # resample = 128
+//! # ignore_spacing = false      # true: voxel units, as if the voxels were 1 mm cubes
 //!
 //! [camera]
 //! dir = [1, 0.45, -0.3]         # from the eye into the scene
 //! up = [0, 0, 1]
 //! size = 256                    # or [width, height]
+//! # pixel_size = 0.8            # mm; default: the smallest spacing
 //!
 //! [spectrum]
 //! filter = "kb4"                # oversample = 2, precision = "f16", kb_design = "auto"
@@ -88,6 +90,8 @@ pub struct VolumeSection {
     pub background: Option<f64>,
     /// Resample to cubic voxels with this many along the longest side.
     pub resample: Option<usize>,
+    /// Render in voxel units, ignoring the volume's spacing.
+    pub ignore_spacing: Option<bool>,
 }
 
 /// The `[camera]` table.
@@ -99,6 +103,8 @@ pub struct CameraSection {
     pub up: Option<[f64; 3]>,
     /// Image width and height in pixels.
     pub size: Option<(usize, usize)>,
+    /// Pixel size in mm.
+    pub pixel_size: Option<f64>,
 }
 
 /// The `[spectrum]` table.
@@ -195,8 +201,9 @@ const VOLUME_KEYS: &[&str] = &[
     "raw_endian",
     "background",
     "resample",
+    "ignore_spacing",
 ];
-const CAMERA_KEYS: &[&str] = &["dir", "up", "size"];
+const CAMERA_KEYS: &[&str] = &["dir", "up", "size", "pixel_size"];
 const SPECTRUM_KEYS: &[&str] = &["filter", "oversample", "precision", "kb_design"];
 const SHADING_KEYS: &[&str] = &["ambient", "depth_cue", "cue_harmonics", "cue_correction"];
 const LIGHT_RING_KEYS: &[&str] = &["count", "tilt"];
@@ -505,6 +512,14 @@ impl Checker<'_> {
                 None => {}
             }
         }
+        if scene.camera.pixel_size.is_some() && scene.volume.ignore_spacing == Some(true) {
+            self.bad(
+                "camera.pixel_size",
+                "conflicts with `volume.ignore_spacing = true` (voxel units have no mm): \
+                 remove one"
+                    .into(),
+            );
+        }
         scene.lights = self.lights(top);
         let ring = scene.light_ring.map_or(0, |r| r.0);
         let listed = scene.lights.as_ref().map_or(0, Vec::len);
@@ -567,6 +582,7 @@ impl Checker<'_> {
             raw_endian: self.parsed(t, p, "raw_endian", parse_endian),
             background: self.number(t, p, "background"),
             resample: self.integer(t, p, "resample", 2, 4096).map(|v| v as usize),
+            ignore_spacing: self.boolean(t, p, "ignore_spacing"),
         }
     }
 
@@ -604,6 +620,7 @@ impl Checker<'_> {
             dir: self.direction(t, p, "dir"),
             up: self.direction(t, p, "up"),
             size,
+            pixel_size: self.number(t, p, "pixel_size"),
         }
     }
 
@@ -793,10 +810,12 @@ mod tests {
             raw_endian = "big"
             background = -1024
             resample = 128
+            ignore_spacing = false
             [camera]
             dir = [1, 0.5, -0.25]
             up = [0, 0, 1]
             size = [64, 32]
+            pixel_size = 0.75
             [spectrum]
             filter = "cubic"
             oversample = 2
@@ -833,6 +852,8 @@ mod tests {
         assert_eq!(s.volume.resample, Some(128));
         assert_eq!(s.camera.dir, Some([1.0, 0.5, -0.25]));
         assert_eq!(s.camera.size, Some((64, 32)));
+        assert_eq!(s.camera.pixel_size, Some(0.75));
+        assert_eq!(s.volume.ignore_spacing, Some(false));
         assert_eq!(s.spectrum.filter, Some(FilterKind::Cubic));
         assert_eq!(s.spectrum.oversample, Some(2));
         assert_eq!(s.spectrum.precision, Some(Precision::F32));
@@ -915,6 +936,10 @@ mod tests {
             (
                 "[shading]\ncue_correction = 1",
                 "`shading.cue_correction` must be true or false",
+            ),
+            (
+                "[volume]\nignore_spacing = true\n[camera]\npixel_size = 0.5",
+                "`camera.pixel_size`: conflicts with `volume.ignore_spacing = true`",
             ),
             (
                 "[shading]\nambient = [1, \"a\", 0]",

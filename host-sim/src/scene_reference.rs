@@ -21,7 +21,7 @@ use crate::reference::trilinear;
 use crate::shaded::Image;
 use crate::volume::Volume;
 use fvr_core::dht::Twiddles;
-use fvr_core::geometry::{center, View};
+use fvr_core::geometry::{center, Sampling, View};
 use fvr_core::gradient::{gradient_scratch_len, partial_derivative};
 use fvr_core::scene::{CueTerms, Scene};
 use fvr_core::spectrum::DenseVolume;
@@ -146,20 +146,53 @@ pub fn exact_scene_projection(
     height: usize,
     step: f64,
 ) -> Result<Image, fvr_core::Error> {
+    exact_scene_projection_sampled(
+        mixture,
+        dims,
+        &Sampling::UNIT,
+        scene,
+        view,
+        width,
+        height,
+        step,
+    )
+}
+
+/// [`exact_scene_projection`] in physical units, for a mixture given in mm
+/// and a volume of `dims` sampled at `sampling.spacing()`: pixels at
+/// `sampling.pixel_position`, depth `t = d·(x − C)` in mm with the cue's `R`
+/// half the longest physical side `max_a n_a·Δ_a`, gradients per mm, and
+/// `∫ … dt` with `t` in mm. `step` is in mm. [`Sampling::UNIT`] gives
+/// [`exact_scene_projection`].
+///
+/// # Errors
+/// As [`exact_scene_projection`].
+pub fn exact_scene_projection_sampled(
+    mixture: &GaussianMixture,
+    dims: [usize; 3],
+    sampling: &Sampling,
+    scene: &Scene,
+    view: &View,
+    width: usize,
+    height: usize,
+    step: f64,
+) -> Result<Image, fvr_core::Error> {
     scene.validate()?;
     let frame = view.frame()?;
-    let c = center(dims);
-    let radius = dims.iter().copied().max().unwrap_or(1) as f64 / 2.0;
+    let spacing = sampling.spacing();
+    let sides: [f64; 3] = std::array::from_fn(|a| dims[a] as f64 * spacing[a]);
+    let radius = sides.iter().copied().fold(0.0, f64::max).max(spacing[0]) / 2.0;
     let terms = CueTerms::new(&scene.cue, radius)?;
     let channels = channel_terms(scene);
     let needs_gradient = scene.needs_gradient_spectrum();
-    let reach = 0.5 * dims.iter().map(|&d| (d * d) as f64).sum::<f64>().sqrt() + 2.0;
+    let reach = 0.5 * sides.iter().map(|&d| d * d).sum::<f64>().sqrt()
+        + 2.0 * spacing.iter().copied().fold(0.0, f64::max);
     let steps = 2 * (reach / step).ceil() as usize;
     let h = 2.0 * reach / steps as f64;
     let mut data = Vec::with_capacity(channels.len() * width * height);
     for row in 0..height {
         for col in 0..width {
-            let p = frame.pixel_position(c, width, height, col as f64, row as f64);
+            let p = sampling.pixel_position(&frame, dims, width, height, col as f64, row as f64);
             let rays: Vec<RayGaussian> = mixture
                 .components
                 .iter()

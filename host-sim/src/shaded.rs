@@ -5,7 +5,7 @@ use crate::pipeline::{AnySpectrum, OwnedSpectrum, PipelineError, Precision};
 use crate::volume::Volume;
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::{DerivativeTable, Filter, KernelTable};
-use fvr_core::geometry::View;
+use fvr_core::geometry::{Sampling, View};
 use fvr_core::gradient::{gradient_magnitude, gradient_scratch_len};
 use fvr_core::real::{Real, Sample};
 use fvr_core::render::aux_len;
@@ -92,6 +92,69 @@ impl SceneSpectra {
     /// Bytes of spectra held.
     pub fn bytes(&self) -> usize {
         self.density.bytes() + self.gradient.as_ref().map_or(0, AnySpectrum::bytes)
+    }
+
+    /// Render one view of `scene` in physical units (`fvr_core::geometry`'s
+    /// physical contract: voxel spacing and pixel size from `sampling`).
+    ///
+    /// - A plain X-ray scene (one channel, no cue, no light) renders any
+    ///   sampling ([`AnySpectrum::render_sampled`], times the ambient grey).
+    /// - A cued or lit scene needs a *uniform pitch*: the three spacings
+    ///   equal to the pixel size `Δ`. Then `t = Δ·t_index`, `R = Δ·R_index`
+    ///   (the cue weights are unchanged), `∇ = ∇_index/Δ` and `dt = Δ·dt_index`,
+    ///   so `I = ∫ w·[Δ·A·f + Σ ½D·(|∇f| − ∇f·L)]_index dt`: the voxel-unit
+    ///   render with the ambient colour scaled by `Δ`, exactly.
+    /// - Other samplings of cued or lit scenes are refused: the cue's ramp
+    ///   (`d∘Δ` in index space), the light moments (`L_a/Δ_a`) and `|∇f|`
+    ///   (per-axis `1/Δ_a`) are not carried through the core's scene path.
+    ///
+    /// [`Sampling::UNIT`] gives [`SceneSpectra::render`]'s image bit for bit.
+    ///
+    /// # Errors
+    /// As [`SceneSpectra::render`], and a refused sampling (the message
+    /// suggests `--resample` or `--ignore-spacing`).
+    pub fn render_sampled(
+        &self,
+        scene: &Scene,
+        view: &View,
+        sampling: &Sampling,
+        width: usize,
+        height: usize,
+    ) -> Result<Image, String> {
+        if *sampling == Sampling::UNIT {
+            return self
+                .render(scene, view, width, height)
+                .map_err(|e| e.to_string());
+        }
+        if let Some(pitch) = sampling.uniform_pitch() {
+            let scaled = Scene {
+                ambient: scene.ambient.map(|a| a * pitch),
+                ..scene.clone()
+            };
+            return self
+                .render(&scaled, view, width, height)
+                .map_err(|e| e.to_string());
+        }
+        if scene.channels() == 1 && !scene.has_partner_terms() {
+            let grey = scene.ambient[0];
+            let data = self
+                .density
+                .render_sampled(view, sampling, width, height)
+                .map_err(|e| e.to_string())?;
+            return Ok(Image {
+                channels: 1,
+                width,
+                height,
+                data: data.into_iter().map(|v| v * grey).collect(),
+            });
+        }
+        let [x, y, z] = sampling.spacing();
+        Err(format!(
+            "depth cueing and shading need cubic voxels imaged at their own size, but the voxels \
+             are {x} x {y} x {z} mm and the pixels {} mm: use --resample N (cubic voxels) or \
+             --ignore-spacing (voxel units), or render an X-ray view",
+            sampling.pixel_size()
+        ))
     }
 
     /// Render one view of `scene`; the image comes back in f64.

@@ -6,7 +6,7 @@
 
 use std::f64::consts::TAU;
 
-use fvr_core::geometry::View;
+use fvr_core::geometry::{Sampling, View};
 use fvr_core::real::{Real, Sample};
 use indicatif::ProgressBar;
 
@@ -53,14 +53,17 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// Render every view of `views` at `width × height`, advancing `progress`
-/// by one per frame. Frames come back in f64, row 0 at the top.
+/// Render every view of `views` at `width × height` in the physical units
+/// of `sampling` ([`fvr_core::render::render_sampled`]; `Sampling::UNIT`
+/// for voxel units), advancing `progress` by one per frame. Frames come
+/// back in f64, row 0 at the top.
 ///
 /// # Errors
 /// As [`fvr_core::render::render`] (an image larger than the grid, ...).
 pub fn render_views(
     spec: &AnySpectrum,
     views: &[View],
+    sampling: &Sampling,
     width: usize,
     height: usize,
     progress: &ProgressBar,
@@ -68,6 +71,7 @@ pub fn render_views(
     fn go<S: Sample, T: Real>(
         s: &OwnedSpectrum<S>,
         views: &[View],
+        sampling: &Sampling,
         w: usize,
         h: usize,
         progress: &ProgressBar,
@@ -76,15 +80,15 @@ pub fn render_views(
         let mut out = vec![T::ZERO; w * h];
         let mut frames = Vec::with_capacity(views.len());
         for view in views {
-            renderer.render_into(s, view, w, h, &mut out)?;
+            renderer.render_sampled_into(s, view, sampling, w, h, &mut out)?;
             frames.push(out.iter().map(|v| v.to_f64()).collect());
             progress.inc(1);
         }
         Ok(frames)
     }
     match spec {
-        AnySpectrum::F16(s) => go::<_, f32>(s, views, width, height, progress),
-        AnySpectrum::F32(s) => go::<_, f32>(s, views, width, height, progress),
-        AnySpectrum::F64(s) => go::<_, f64>(s, views, width, height, progress),
+        AnySpectrum::F16(s) => go::<_, f32>(s, views, sampling, width, height, progress),
+        AnySpectrum::F32(s) => go::<_, f32>(s, views, sampling, width, height, progress),
+        AnySpectrum::F64(s) => go::<_, f64>(s, views, sampling, width, height, progress),
     }
 }

@@ -114,6 +114,8 @@ fn turntable_options_match_render_options() {
         "raw-type",
         "raw-endian",
         "up",
+        "pixel-size",
+        "ignore-spacing",
     ];
     for name in shared {
         let r = render.iter().find(|(n, _)| n == name);

@@ -3,6 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use fvr_core::filter::{Filter, FilterKind};
+use fvr_core::geometry::Sampling;
 use fvr_host::output::{percentile_range, write_apng, write_png, Bits, Colormap, Style, Window};
 use fvr_host::phantom::{sample, GaussianMixture};
 use fvr_host::pipeline::{AnySpectrum, Precision};
@@ -239,7 +240,7 @@ fn turntable_frames_equal_single_renders_of_the_same_views() {
     for precision in [Precision::F16, Precision::F64] {
         let spec = AnySpectrum::prepare(&volume, filter, precision).unwrap();
         let bar = ProgressBar::hidden();
-        let frames = render_views(&spec, &views, 32, 24, &bar).unwrap();
+        let frames = render_views(&spec, &views, &Sampling::UNIT, 32, 24, &bar).unwrap();
         assert_eq!(bar.position(), 6);
         for (view, frame) in views.iter().zip(&frames) {
             assert_eq!(frame, &spec.render(view, 32, 24).unwrap(), "{precision}");

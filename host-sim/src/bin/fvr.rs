@@ -7,7 +7,7 @@ use std::time::Instant;
 use clap::parser::ValueSource;
 use clap::{ArgMatches, Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 use fvr_core::filter::FilterKind;
-use fvr_core::geometry::{View, DEFAULT_UP};
+use fvr_core::geometry::{Sampling, View, DEFAULT_UP};
 use fvr_core::scene::{Light, Scene, MAX_LIGHTS};
 use fvr_host::adaptive::{parse_chain, parse_tolerance, AdaptiveSettings, Bound};
 use fvr_host::datasets::DATASETS_HELP;
@@ -15,10 +15,10 @@ use fvr_host::formats::FORMATS_HELP;
 use fvr_host::nrrd::{read_nrrd, Endian, SampleType};
 use fvr_host::output::{write_apng, write_png, Bits, Colormap, Style, Window};
 use fvr_host::pipeline::{choose_filter, AnySpectrum, KbDesign, Precision};
-use fvr_host::reference::{exact_projection, max_abs_error, snr_db};
+use fvr_host::reference::{exact_projection_sampled, max_abs_error, snr_db};
 use fvr_host::scene::{load_volume_with_progress, phantom_by_name, RawLayout, PHANTOM_HELP};
 use fvr_host::scene_file::{parse_endian, SceneFile};
-use fvr_host::scene_reference::exact_scene_projection;
+use fvr_host::scene_reference::exact_scene_projection_sampled;
 use fvr_host::shaded::{
     light_ring, negative_cue_share, parse_depth_cue, parse_light, parse_light_ring, parse_rgb,
     SceneRenderer, SceneSpectra, DEFAULT_PROFILE_HARMONICS, DEPTH_CUE_HELP,
@@ -43,6 +43,17 @@ GEOMETRY CONTRACT
   p = c + (col - W/2) r + (H/2 - row) u, and its value is the line integral
   of the band-limited interpolant of the voxels along p + t d, in voxel units.
   A zero d or u0, or u0 parallel to d, is an error.
+
+PHYSICAL UNITS (fvr render, fvr turntable)
+  By default fvr uses the volume's voxel spacing D (mm, from the
+  file; 1,1,1 when it gives none) and a pixel size P (--pixel-size, mm):
+  voxel (i,j,k) sits at (i Dx, j Dy, k Dz), the centre is C = (n/2) D, pixel
+  (col,row) sits at C + (col - W/2) P r + (H/2 - row) P u with r, u, d unit
+  vectors in mm, and its value is the line integral in mm (mm x volume
+  units). This is exact in the frequency domain: the slice is taken at index
+  frequencies k r_a D_a/P and scaled by Dx Dy Dz/P^2. --ignore-spacing gives
+  the voxel-unit contract above. Depth cues and lights need cubic voxels
+  imaged at their own size (--resample N makes them so).
 
 EXIT STATUS
   0  success (also for --help and --version)
@@ -158,10 +169,13 @@ struct RenderArgs {
     /// Up hint X,Y,Z.
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,1")]
     up: [f64; 3],
-    /// Image size W or WxH in pixels of one voxel; at most the padded grid.
+    /// Image size W or WxH in pixels (of --pixel-size mm, or of one voxel
+    /// with --ignore-spacing); at most the padded grid.
     /// Default: the padded grid divided by the oversampling.
     #[arg(long, value_parser = parse_size)]
     size: Option<(usize, usize)>,
+    #[command(flatten)]
+    units: UnitArgs,
     #[command(flatten)]
     spectrum: SpectrumArgs,
     /// Depth cue: none, linear:FRONT,BACK, sine:FRONT,BACK, profile:W0,W1,...,
@@ -201,8 +215,9 @@ struct RenderArgs {
     #[arg(long)]
     stats: bool,
     /// Resample to cubic voxels with N samples along the longest physical
-    /// side (trilinear) before rendering: for anisotropic data such as CT
-    /// (0.957 x 0.957 x 1.5 mm), which is otherwise rendered in voxel units.
+    /// side (trilinear) before rendering. X-ray views of anisotropic data
+    /// such as CT (0.957 x 0.957 x 1.5 mm) are exact without it; depth cues
+    /// and lights need it.
     #[arg(long, value_name = "N")]
     resample: Option<usize>,
     /// Print the statistics as one JSON object instead (implies --stats).
@@ -300,10 +315,13 @@ struct TurntableArgs {
     /// Turntable axis and up hint X,Y,Z.
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,1")]
     up: [f64; 3],
-    /// Image size W or WxH in pixels of one voxel; at most the padded grid.
+    /// Image size W or WxH in pixels (of --pixel-size mm, or of one voxel
+    /// with --ignore-spacing); at most the padded grid.
     /// Default: the padded grid divided by the oversampling.
     #[arg(long, value_parser = parse_size)]
     size: Option<(usize, usize)>,
+    #[command(flatten)]
+    units: UnitArgs,
     #[command(flatten)]
     spectrum: SpectrumArgs,
     /// Output file: .apng or .png (an animated PNG either way).
@@ -317,6 +335,65 @@ struct TurntableArgs {
     png: PngArgs,
     #[command(flatten)]
     input: InputArgs,
+}
+
+/// Physical units (render and turntable).
+#[derive(Args, Clone, Copy, Default)]
+struct UnitArgs {
+    /// Pixel size in mm. Default: the smallest voxel spacing, or, if the
+    /// volume's longest physical side would not fit the default image at
+    /// that size, the size that fits it (longest side / default width).
+    #[arg(
+        long,
+        value_name = "MM",
+        conflicts_with = "ignore_spacing",
+        allow_hyphen_values = true
+    )]
+    pixel_size: Option<f64>,
+    /// Render in voxel units, as if the voxels were 1 mm cubes, ignoring the
+    /// volume's spacing (the behaviour before spacing was used).
+    #[arg(long)]
+    ignore_spacing: bool,
+}
+
+impl UnitArgs {
+    /// The voxel spacing and pixel size: the volume's spacing, or 1 mm
+    /// with `--ignore-spacing`; `--pixel-size`, or by default the smallest
+    /// spacing, raised if need be so that the longest physical side fits
+    /// `default_side` pixels (the default image). Warns when the longest
+    /// side exceeds the image grid's period `n·p`.
+    fn sampling(
+        &self,
+        volume: &fvr_host::volume::Volume,
+        n: usize,
+        default_side: usize,
+    ) -> Result<Sampling, String> {
+        if self.ignore_spacing {
+            return Ok(Sampling::UNIT);
+        }
+        let spacing = volume.spacing;
+        let longest = (0..3)
+            .map(|a| volume.dims[a] as f64 * spacing[a])
+            .fold(0.0, f64::max);
+        let pixel_size = match self.pixel_size {
+            Some(p) => p,
+            None => {
+                let finest = spacing.iter().copied().fold(f64::INFINITY, f64::min);
+                finest.max(longest / default_side.max(1) as f64)
+            }
+        };
+        let sampling =
+            Sampling::new(spacing, pixel_size).map_err(|e| format!("--pixel-size: {e}"))?;
+        let period = n as f64 * pixel_size;
+        if longest > period {
+            eprintln!(
+                "fvr: warning: the volume's longest side ({longest:.1} mm) exceeds the image \
+                 grid's period ({n} pixels of {pixel_size} mm = {period:.1} mm): views across \
+                 it wrap around. Use a larger --pixel-size or --oversample 2."
+            );
+        }
+        Ok(sampling)
+    }
 }
 
 /// How the spectrum is made (render and turntable).
@@ -517,6 +594,7 @@ fn default_scene() -> Result<(), String> {
         dir: None,
         up: DEFAULT_UP,
         size: None,
+        units: UnitArgs::default(),
         spectrum: SpectrumArgs::default(),
         depth_cue: "none".into(),
         cue_harmonics: DEFAULT_PROFILE_HARMONICS,
@@ -587,6 +665,27 @@ fn apply_scene_to_input(
     );
 }
 
+/// Fill the physical-unit settings from the scene. A command-line choice of
+/// either wins over the scene's other one, since the two conflict.
+fn apply_scene_to_units(units: &mut UnitArgs, scene: &SceneFile, given: &dyn Fn(&str) -> bool) {
+    if !given("ignore_spacing") {
+        fill(
+            given,
+            "pixel_size",
+            &mut units.pixel_size,
+            scene.camera.pixel_size.map(Some),
+        );
+    }
+    if !given("pixel_size") {
+        fill(
+            given,
+            "ignore_spacing",
+            &mut units.ignore_spacing,
+            scene.volume.ignore_spacing,
+        );
+    }
+}
+
 fn apply_scene_to_spectrum(
     spectrum: &mut SpectrumArgs,
     scene: &SceneFile,
@@ -628,6 +727,7 @@ fn apply_scene_to_render(args: &mut RenderArgs, scene: &SceneFile, given: &dyn F
     fill(given, "dir", &mut args.dir, c.dir.map(Some));
     fill(given, "up", &mut args.up, c.up);
     fill(given, "size", &mut args.size, c.size.map(Some));
+    apply_scene_to_units(&mut args.units, scene, given);
     apply_scene_to_spectrum(&mut args.spectrum, scene, given);
     let sh = &scene.shading;
     fill(
@@ -678,6 +778,7 @@ fn apply_scene_to_turntable(
     fill(given, "dir", &mut args.dir, c.dir);
     fill(given, "up", &mut args.up, c.up);
     fill(given, "size", &mut args.size, c.size.map(Some));
+    apply_scene_to_units(&mut args.units, scene, given);
     apply_scene_to_spectrum(&mut args.spectrum, scene, given);
     apply_scene_to_png(&mut args.png, scene, given);
     let t = &scene.turntable;
@@ -781,10 +882,9 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         );
     }
     let n = spectra.density.n();
-    let (w, h) = args.size.unwrap_or((
-        n / args.spectrum.oversample as usize,
-        n / args.spectrum.oversample as usize,
-    ));
+    let default_side = n / args.spectrum.oversample as usize;
+    let (w, h) = args.size.unwrap_or((default_side, default_side));
+    let sampling = args.units.sampling(&volume, n, default_side)?;
     let plain_view = scene.channels() == 1 && !scene.has_partner_terms();
     if (args.preview_level > 0 || args.adaptive.is_some()) && !plain_view {
         return Err(
@@ -796,13 +896,21 @@ fn render(args: &RenderArgs) -> Result<(), String> {
     if args.preview_level > 0 && args.adaptive.is_some() {
         return Err("--preview-level and --adaptive cannot be combined: choose one".into());
     }
+    if args.adaptive.is_some() && sampling != Sampling::UNIT {
+        return Err(format!(
+            "--adaptive renders in voxel units only, and this render uses {} mm voxels and \
+             {} mm pixels: add --ignore-spacing",
+            fmt_spacing(sampling.spacing()),
+            sampling.pixel_size()
+        ));
+    }
     let mut adaptive_report = None;
     let t2 = Instant::now();
     let (image, w, h) = if args.preview_level > 0 {
         let (pw, ph) = fvr_core::progressive::preview_size(w, h, args.preview_level);
         let data = spectra
             .density
-            .render_level(&view, pw, ph, args.preview_level)
+            .render_level_sampled(&view, &sampling, pw, ph, args.preview_level)
             .map_err(|e| e.to_string())?;
         (
             fvr_host::shaded::Image {
@@ -838,9 +946,7 @@ fn render(args: &RenderArgs) -> Result<(), String> {
             h,
         )
     } else {
-        let image = spectra
-            .render(&scene, &view, w, h)
-            .map_err(|e| e.to_string())?;
+        let image = spectra.render_sampled(&scene, &view, &sampling, w, h)?;
         (image, w, h)
     };
     let t_view = adaptive_report
@@ -862,6 +968,24 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         println!(
             "  volume        {}x{}x{} ({})",
             d[0], d[1], d[2], volume_spec
+        );
+        let [dx, dy, dz] = volume.spacing;
+        println!(
+            "  spacing       {dx} x {dy} x {dz} mm{}",
+            if args.units.ignore_spacing {
+                " (ignored: --ignore-spacing, voxel units)"
+            } else {
+                ""
+            }
+        );
+        println!(
+            "  pixel size    {} {}",
+            sampling.pixel_size(),
+            if args.units.ignore_spacing {
+                "voxel"
+            } else {
+                "mm (values in mm x volume units)"
+            }
         );
         println!(
             "  spectrum      {n}^3 {} = {} bytes ({} bytes/voxel)",
@@ -907,9 +1031,14 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         println!("  view          {:.2} ms", t_view.as_secs_f64() * 1e3);
         if args.preview_level > 0 {
             println!(
-                "  level         {} ({w}x{h} at pitch {} voxels, central 1/{} of the slice)",
+                "  level         {} ({w}x{h} at pitch {} {}, central 1/{} of the slice)",
                 args.preview_level,
-                1u64 << args.preview_level,
+                (1u64 << args.preview_level) as f64 * sampling.pixel_size(),
+                if sampling == Sampling::UNIT {
+                    "voxels"
+                } else {
+                    "mm"
+                },
                 1u64 << (2 * args.preview_level)
             );
         }
@@ -921,6 +1050,9 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         let mut fields = vec![
             ("volume", json_str(volume_spec)),
             ("dims", format!("{:?}", volume.dims)),
+            ("spacing_mm", format!("{:?}", volume.spacing)),
+            ("pixel_size", json_num(sampling.pixel_size())),
+            ("ignore_spacing", args.units.ignore_spacing.to_string()),
             ("image", format!("[{w}, {h}, {}]", image.channels)),
             ("spectrum_side", n.to_string()),
             ("precision", json_str(args.spectrum.precision.name())),
@@ -953,17 +1085,32 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         let plain = scene.channels() == 1 && !scene.has_partner_terms();
         match phantom_by_name(volume_spec) {
             Some(Ok(p)) if plain => {
-                let exact = exact_projection(p.phantom.as_ref(), volume.dims, &view, w, h)
-                    .map_err(|e| e.to_string())?;
+                let exact = exact_projection_sampled(
+                    p.phantom.as_ref(),
+                    volume.dims,
+                    &view,
+                    &sampling,
+                    w,
+                    h,
+                )
+                .map_err(|e| e.to_string())?;
                 let ambient = scene.ambient[0];
                 let exact: Vec<f64> = exact.iter().map(|v| v * ambient).collect();
                 println!("  SNR vs exact  {:.2} dB", snr_db(&exact, &image.data));
             }
             Some(Ok(p)) => match p.phantom.as_gaussian_mixture() {
                 Some(mixture) => {
-                    let exact =
-                        exact_scene_projection(mixture, volume.dims, &scene, &view, w, h, 0.05)
-                            .map_err(|e| e.to_string())?;
+                    let exact = exact_scene_projection_sampled(
+                        mixture,
+                        volume.dims,
+                        &sampling,
+                        &scene,
+                        &view,
+                        w,
+                        h,
+                        0.05,
+                    )
+                    .map_err(|e| e.to_string())?;
                     println!("  SNR vs exact  {:.2} dB", snr_db(&exact.data, &image.data));
                 }
                 None => println!(
@@ -974,6 +1121,10 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+fn fmt_spacing(s: [f64; 3]) -> String {
+    format!("{} x {} x {}", s[0], s[1], s[2])
 }
 
 /// The scene from the command line: cue, ambient, lights.
@@ -1081,9 +1232,10 @@ fn turntable(args: &TurntableArgs) -> Result<(), String> {
     let n = spec.n();
     let side = n / args.spectrum.oversample as usize;
     let (w, h) = args.size.unwrap_or((side, side));
+    let sampling = args.units.sampling(&volume, n, side)?;
     let bar = progress::count(views.len() as u64, "frames");
     let t2 = Instant::now();
-    let frames = turntable::render_views(&spec, &views, w, h, &bar);
+    let frames = turntable::render_views(&spec, &views, &sampling, w, h, &bar);
     let t_views = t2.elapsed();
     bar.finish_and_clear();
     let frames = frames.map_err(|e| e.to_string())?;
@@ -1381,6 +1533,7 @@ mod tests {
         dir = [1, 0.5, -0.25]
         up = [0, 1, 0]
         size = [64, 32]
+        pixel_size = 0.5
         [spectrum]
         filter = "cubic"
         oversample = 2
@@ -1441,6 +1594,8 @@ mod tests {
         assert_eq!(a.dir, Some([1.0, 0.5, -0.25]));
         assert_eq!(a.up, [0.0, 1.0, 0.0]);
         assert_eq!(a.size, Some((64, 32)));
+        assert_eq!(a.units.pixel_size, Some(0.5));
+        assert!(!a.units.ignore_spacing);
         assert_eq!(a.spectrum.filter, FilterKind::Cubic);
         assert_eq!(a.spectrum.oversample, 2);
         assert_eq!(a.spectrum.precision, Precision::F32);
@@ -1490,6 +1645,10 @@ mod tests {
             (&["--dir", "0,0,1"], |a| a.dir == Some([0.0, 0.0, 1.0])),
             (&["--up", "1,0,0"], |a| a.up == [1.0, 0.0, 0.0]),
             (&["--size", "8"], |a| a.size == Some((8, 8))),
+            (&["--pixel-size", "2"], |a| a.units.pixel_size == Some(2.0)),
+            (&["--ignore-spacing"], |a| {
+                a.units.ignore_spacing && a.units.pixel_size.is_none()
+            }),
             (&["--filter", "kb3"], |a| {
                 a.spectrum.filter == FilterKind::Kb3
             }),
