@@ -239,3 +239,62 @@ fn turntable_uses_the_spacing_too() {
     args.extend(["--pixel-size", "0", "--out", "t.apng"]);
     assert_error(&fvr(&args, &dir), &["pixel size"]);
 }
+
+/// `--adaptive` on cubic voxels imaged at their own size renders in mm (the
+/// voxel-unit image times Δ, within the tolerance of the full-filter render
+/// in mm); on anisotropic voxels it is refused with the ways out.
+#[test]
+fn adaptive_renders_cubic_voxels_in_mm_and_refuses_anisotropic_ones() {
+    let dir = temp_dir("spacing-adaptive");
+    let dims = [32, 32, 32];
+    write_volume_of(&dir.join("c.nrrd"), dims, Some([2.0; 3]));
+    let base = [
+        "render",
+        "c.nrrd",
+        "--dir",
+        "1,0.3,0.2",
+        "--oversample",
+        "2",
+    ];
+    let run = |extra: &[&str], out: &str| {
+        let mut args = base.to_vec();
+        args.extend(extra);
+        args.extend(["--out", out]);
+        ok_stdout(&fvr(&args, &dir));
+        let data: Vec<f64> = read_nrrd(&dir.join(out))
+            .unwrap()
+            .data
+            .iter()
+            .map(|&v| f64::from(v))
+            .collect();
+        data
+    };
+    let full = run(&[], "full.nrrd");
+    let adaptive = run(&["--adaptive", "40"], "adaptive.nrrd");
+    let voxel_units = run(&["--ignore-spacing"], "voxel.nrrd");
+    let snr = snr_db(&full, &adaptive);
+    assert!(snr >= 40.0, "{snr}");
+    // The mm image is the voxel-unit one times Δ = 2 (exactly: a power of two).
+    let doubled: Vec<f64> = voxel_units.iter().map(|v| 2.0 * v).collect();
+    assert_eq!(full, doubled);
+
+    write_volume(&dir.join("a.nrrd"), Some(SPACING));
+    assert_error(
+        &fvr(
+            &[
+                "render",
+                "a.nrrd",
+                "--dir",
+                "1,0.3,0.2",
+                "--oversample",
+                "2",
+                "--adaptive",
+                "40",
+                "--out",
+                "x.png",
+            ],
+            &dir,
+        ),
+        &["cubic voxels", "--resample", "--ignore-spacing"],
+    );
+}

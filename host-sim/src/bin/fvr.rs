@@ -896,10 +896,13 @@ fn render(args: &RenderArgs) -> Result<(), String> {
     if args.preview_level > 0 && args.adaptive.is_some() {
         return Err("--preview-level and --adaptive cannot be combined: choose one".into());
     }
-    if args.adaptive.is_some() && sampling != Sampling::UNIT {
+    // Cubic voxels imaged at their own size read the slice along the frame's
+    // own axes: only the gain ΔV/p² = Δ differs from voxel units.
+    if args.adaptive.is_some() && sampling.uniform_pitch().is_none() {
         return Err(format!(
-            "--adaptive renders in voxel units only, and this render uses {} mm voxels and \
-             {} mm pixels: add --ignore-spacing",
+            "--adaptive needs cubic voxels imaged at their own size (or voxel units), and this \
+             render uses {} mm voxels and {} mm pixels: add --resample N, drop --pixel-size, \
+             or add --ignore-spacing",
             fmt_spacing(sampling.spacing()),
             sampling.pixel_size()
         ));
@@ -933,7 +936,8 @@ fn render(args: &RenderArgs) -> Result<(), String> {
             }),
         };
         let report = adaptive_render(&spectra.density, &view, w, h, &settings)?;
-        let data = report.image.iter().map(|v| v * scene.ambient[0]).collect();
+        let gain = sampling.gain() * scene.ambient[0];
+        let data = report.image.iter().map(|v| v * gain).collect();
         adaptive_report = Some(report);
         (
             fvr_host::shaded::Image {
