@@ -661,3 +661,125 @@ fn background_becomes_zero_and_lower_values_clamp() {
     assert_eq!(v.data, vec![0.0, 0.0, 924.0, 2924.0]);
     assert!(v.subtract_background(f64::NAN).is_err());
 }
+
+/// Brute force: the sample of `v` (file order) at the world position `q`
+/// after mapping file axis `a` to world axis `world[a]`, reversed by `flip[a]`.
+fn at_world(v: &[f32], dims: [usize; 3], world: [usize; 3], flip: [bool; 3], q: [usize; 3]) -> f32 {
+    let p: [usize; 3] = std::array::from_fn(|a| {
+        let c = q[world[a]];
+        if flip[a] {
+            dims[a] - 1 - c
+        } else {
+            c
+        }
+    });
+    v[p[0] + dims[0] * (p[1] + dims[1] * p[2])]
+}
+
+fn check_reoriented(
+    vol: &Volume,
+    data: &[f32],
+    dims: [usize; 3],
+    spacing: [f64; 3],
+    world: [usize; 3],
+    flip: [bool; 3],
+) {
+    let mut want_dims = [0; 3];
+    let mut want_spacing = [0.0; 3];
+    for a in 0..3 {
+        want_dims[world[a]] = dims[a];
+        want_spacing[world[a]] = spacing[a];
+    }
+    assert_eq!((vol.dims, vol.spacing), (want_dims, want_spacing));
+    for z in 0..want_dims[2] {
+        for y in 0..want_dims[1] {
+            for x in 0..want_dims[0] {
+                assert_eq!(
+                    vol.data[x + want_dims[0] * (y + want_dims[1] * z)],
+                    at_world(data, dims, world, flip, [x, y, z]),
+                    "at {x},{y},{z}"
+                );
+            }
+        }
+    }
+}
+
+/// The sform wins over the qform and is followed to the closest RAS order:
+/// a file whose i runs to the left, j up and k forward (slightly oblique)
+/// comes out with x right, y anterior, z superior.
+#[test]
+fn nifti_sform_reorients_to_closest_ras() {
+    let (dims, spacing) = ([4, 3, 2], [2.0, 1.0, 3.0]);
+    let data = ramp(24);
+    let bytes = nifti_with_dims(dims, spacing, &data, |b| {
+        put_i16(b, offsets::SFORM_CODE, 2);
+        put_i16(b, offsets::QFORM_CODE, 1); // ignored: the sform wins
+        put_f32(b, offsets::QUATERN_B, 1.0); // a 180° qform that would flip y and z
+        let rows = [
+            [-2.0, 0.0, 0.1, 10.0],
+            [0.0, 0.05, 3.0, -4.0],
+            [0.1, 1.0, 0.0, 7.0],
+        ];
+        for (r, row) in rows.iter().enumerate() {
+            for (c, &v) in row.iter().enumerate() {
+                put_f32(b, offsets::SROW_X + 16 * r + 4 * c, v);
+            }
+        }
+    });
+    let vol = parse_nifti(&bytes).unwrap();
+    check_reoriented(&vol, &data, dims, spacing, [0, 2, 1], [true, false, false]);
+}
+
+/// Without an sform, the qform's quaternion and qfac give the order: 180°
+/// about z flips x and y, and qfac −1 flips z.
+#[test]
+fn nifti_qform_reorients_with_quaternion_and_qfac() {
+    let (dims, spacing) = ([4, 3, 2], [1.0, 1.0, 1.0]);
+    let data = ramp(24);
+    let bytes = nifti_with_dims(dims, spacing, &data, |b| {
+        put_i16(b, offsets::QFORM_CODE, 1);
+        put_f32(b, offsets::QUATERN_B + 8, 1.0); // quatern_d
+        put_f32(b, offsets::PIXDIM, -1.0); // qfac
+    });
+    let vol = parse_nifti(&bytes).unwrap();
+    check_reoriented(&vol, &data, dims, spacing, [0, 1, 2], [true, true, true]);
+    // Codes 0 keep the file's order, whatever the fields hold.
+    let kept = nifti_with_dims(dims, spacing, &data, |b| {
+        put_f32(b, offsets::QUATERN_B + 8, 1.0);
+        put_f32(b, offsets::SROW_X, -1.0);
+    });
+    let vol = parse_nifti(&kept).unwrap();
+    assert_eq!((vol.dims, &vol.data), (dims, &data));
+}
+
+#[test]
+fn nifti_bad_orientations_are_named() {
+    let data = ramp(24);
+    let zero_column = nifti_with_dims([4, 3, 2], [1.0; 3], &data, |b| {
+        put_i16(b, offsets::SFORM_CODE, 1);
+        put_f32(b, offsets::SROW_X, 1.0);
+        put_f32(b, offsets::SROW_X + 16 + 4, 1.0); // srow_y: j; nothing for k
+    });
+    expect_err(
+        parse_nifti(&zero_column),
+        &["srow_x", "sform", "zero or non-finite column"],
+    );
+    let not_unit = nifti_with_dims([4, 3, 2], [1.0; 3], &data, |b| {
+        put_i16(b, offsets::QFORM_CODE, 1);
+        for k in 0..3 {
+            put_f32(b, offsets::QUATERN_B + 4 * k, 0.9);
+        }
+    });
+    expect_err(parse_nifti(&not_unit), &["quatern_b", "unit quaternion"]);
+}
+
+fn nifti_with_dims(
+    dims: [usize; 3],
+    spacing: [f64; 3],
+    data: &[f32],
+    edit: impl FnOnce(&mut Vec<u8>),
+) -> Vec<u8> {
+    let mut bytes = encode_nifti_f32(dims, spacing, (1.0, 0.0), data, Endian::Little);
+    edit(&mut bytes);
+    bytes
+}

@@ -18,9 +18,16 @@
 //! - `vox_offset`: where the samples start (after the header extensions,
 //!   which are skipped).
 //!
-//! Not used: the qform/sform orientation. The volume is rendered in its
-//! index space (axis `i` of the file is the renderer's x), with the
-//! spacings; a flipped or rotated sform is not undone.
+//! - The orientation, from the sform (`sform_code > 0`), else the qform
+//!   (`qform_code > 0`, quaternion `quatern_b/c/d` and `qfac = pixdim[0]`):
+//!   the axes are permuted and flipped to the closest RAS order, as 3D
+//!   Slicer and nibabel's `as_closest_canonical` do. The renderer's x, y, z
+//!   then run to the subject's right, anterior and superior, so the default
+//!   up hint `+z` shows a head upright. Each file axis goes to the world axis
+//!   it runs closest to (greedily, largest direction cosine first). An
+//!   oblique rotation is not resampled: the remaining rotation (at most 45°
+//!   per axis) stays in the picture. With both codes 0 the index order is
+//!   kept (NIfTI-1 "method 1").
 
 use std::io::BufRead;
 use std::path::{Path, PathBuf};
@@ -71,6 +78,97 @@ pub struct NiftiLayout {
     pub vox_offset: u64,
     /// Whether the samples are in a separate `.img` file (magic `ni1`).
     pub pair: bool,
+    /// The permutation and flips to the closest RAS order.
+    pub to_ras: AxisMap,
+}
+
+/// A permutation and flips of the three axes: file axis `a` becomes axis
+/// `world[a]` of the result, reversed when `flip[a]`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct AxisMap {
+    /// The result's axis for each file axis.
+    pub world: [usize; 3],
+    /// Whether each file axis runs against its result axis.
+    pub flip: [bool; 3],
+    /// Which header field gave it: `"sform"`, `"qform"` or `"none"`.
+    pub source: &'static str,
+}
+
+impl AxisMap {
+    /// Keep the file's order.
+    pub const IDENTITY: Self = Self {
+        world: [0, 1, 2],
+        flip: [false; 3],
+        source: "none",
+    };
+
+    /// The closest axis order to a direction-cosine matrix `m` (`m[w][a]`:
+    /// world component `w` of file axis `a`), greedily by the largest
+    /// normalized cosine. `None` when a column is zero or not finite.
+    pub fn closest(m: [[f64; 3]; 3], source: &'static str) -> Option<Self> {
+        let mut cos = [[0.0f64; 3]; 3];
+        for a in 0..3 {
+            let norm = (0..3).map(|w| m[w][a] * m[w][a]).sum::<f64>().sqrt();
+            if !(norm.is_finite() && norm > 0.0) {
+                return None;
+            }
+            for w in 0..3 {
+                cos[w][a] = m[w][a] / norm;
+            }
+        }
+        let (mut world, mut flip) = ([usize::MAX; 3], [false; 3]);
+        let mut row_used = [false; 3];
+        for _ in 0..3 {
+            let mut best = (0usize, 0usize, -1.0f64);
+            for (w, row) in cos.iter().enumerate() {
+                for (a, &c) in row.iter().enumerate() {
+                    if !row_used[w] && world[a] == usize::MAX && c.abs() > best.2 {
+                        best = (w, a, c.abs());
+                    }
+                }
+            }
+            let (w, a, _) = best;
+            row_used[w] = true;
+            world[a] = w;
+            flip[a] = cos[w][a] < 0.0;
+        }
+        Some(Self {
+            world,
+            flip,
+            source,
+        })
+    }
+
+    /// Reorder `volume` (samples and spacing) by this map.
+    pub fn apply(&self, volume: &mut Volume) {
+        if self.world == [0, 1, 2] && self.flip == [false; 3] {
+            return;
+        }
+        let old = volume.dims;
+        let mut dims = [0usize; 3];
+        let mut spacing = [0.0f64; 3];
+        for a in 0..3 {
+            dims[self.world[a]] = old[a];
+            spacing[self.world[a]] = volume.spacing[a];
+        }
+        let mut data = Vec::with_capacity(volume.data.len());
+        let mut p = [0usize; 3];
+        for z in 0..dims[2] {
+            for y in 0..dims[1] {
+                for x in 0..dims[0] {
+                    let q = [x, y, z];
+                    for a in 0..3 {
+                        let c = q[self.world[a]];
+                        p[a] = if self.flip[a] { old[a] - 1 - c } else { c };
+                    }
+                    data.push(volume.data[p[0] + old[0] * (p[1] + old[1] * p[2])]);
+                }
+            }
+        }
+        volume.dims = dims;
+        volume.data = data;
+        volume.spacing = spacing;
+    }
 }
 
 /// Check the 348 header bytes and decode the fields a reader needs.
@@ -126,6 +224,7 @@ pub fn parse_header(bytes: &[u8]) -> Result<NiftiLayout, IoError> {
     let scaling = parse_scaling(h.scl_slope, h.scl_inter)?;
     let pair = &h.magic == MAGIC_PAIR;
     let vox_offset = parse_vox_offset(h.vox_offset, pair)?;
+    let to_ras = parse_orientation(&h)?;
     Ok(NiftiLayout {
         dims,
         ty,
@@ -134,7 +233,65 @@ pub fn parse_header(bytes: &[u8]) -> Result<NiftiLayout, IoError> {
         scaling,
         vox_offset,
         pair,
+        to_ras,
     })
+}
+
+/// The axis map from the sform, else the qform, else the identity.
+fn parse_orientation(h: &NiftiHeader) -> Result<AxisMap, IoError> {
+    if h.sform_code > 0 {
+        let rows = [h.srow_x, h.srow_y, h.srow_z];
+        let m: [[f64; 3]; 3] =
+            core::array::from_fn(|w| core::array::from_fn(|a| rows[w][a] as f64));
+        return AxisMap::closest(m, "sform").ok_or_else(|| {
+            format_error(
+                FORMAT,
+                "srow_x",
+                format!(
+                    "sform_code is {} but the sform's 3×3 part has a zero or non-finite column: \
+                     srow_x {:?}, srow_y {:?}, srow_z {:?}",
+                    h.sform_code, h.srow_x, h.srow_y, h.srow_z
+                ),
+            )
+        });
+    }
+    if h.qform_code > 0 {
+        let (b, c, d) = (h.quatern_b as f64, h.quatern_c as f64, h.quatern_d as f64);
+        let bcd = b * b + c * c + d * d;
+        // NIfTI-1 allows rounding to push b²+c²+d² a little above 1.
+        if !bcd.is_finite() || bcd > 1.0 + 1e-4 {
+            return Err(format_error(
+                FORMAT,
+                "quatern_b",
+                format!(
+                    "qform_code is {} but quatern_b/c/d = {b}, {c}, {d} is not a unit quaternion's \
+                     vector part (b²+c²+d² = {bcd})",
+                    h.qform_code
+                ),
+            ));
+        }
+        let a = (1.0 - bcd).max(0.0).sqrt();
+        let qfac = if h.pixdim[0] < 0.0 { -1.0 } else { 1.0 };
+        let m = [
+            [
+                a * a + b * b - c * c - d * d,
+                2.0 * (b * c - a * d),
+                qfac * 2.0 * (b * d + a * c),
+            ],
+            [
+                2.0 * (b * c + a * d),
+                a * a + c * c - b * b - d * d,
+                qfac * 2.0 * (c * d - a * b),
+            ],
+            [
+                2.0 * (b * d - a * c),
+                2.0 * (c * d + a * b),
+                qfac * (a * a + d * d - c * c - b * b),
+            ],
+        ];
+        return Ok(AxisMap::closest(m, "qform").unwrap_or(AxisMap::IDENTITY));
+    }
+    Ok(AxisMap::IDENTITY)
 }
 
 fn hex(bytes: &[u8]) -> String {
@@ -360,6 +517,7 @@ fn read_samples<R: BufRead>(
     if let Some((slope, inter)) = layout.scaling {
         apply_scaling(&mut volume, slope, inter)?;
     }
+    layout.to_ras.apply(&mut volume);
     Ok(volume)
 }
 
@@ -499,6 +657,14 @@ pub mod offsets {
     pub const SCL_INTER: usize = 116;
     /// `xyzt_units`, u8.
     pub const XYZT_UNITS: usize = 123;
+    /// `qform_code`, i16.
+    pub const QFORM_CODE: usize = 252;
+    /// `sform_code`, i16.
+    pub const SFORM_CODE: usize = 254;
+    /// `quatern_b`, `quatern_c`, `quatern_d`, f32 each.
+    pub const QUATERN_B: usize = 256;
+    /// `srow_x`, `srow_y`, `srow_z`, 4 f32 each.
+    pub const SROW_X: usize = 280;
     /// `magic`, 4 bytes.
     pub const MAGIC: usize = super::MAGIC_OFFSET;
 }
