@@ -12,7 +12,9 @@ use fvr_core::dht::Twiddles;
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::View;
 use fvr_core::real::{Real, Sample};
-use fvr_core::render::{aux_len, grid_len, render};
+use fvr_core::render::{
+    aux_len, check_image, extract_slice_rows, finish_projection, grid_len, placement, render,
+};
 use fvr_core::spectrum::{padded_size, prepare_scratch_len, DenseVolume, Spectrum};
 use half::f16;
 
@@ -170,6 +172,7 @@ pub struct ViewRenderer<T> {
     grid: Vec<T>,
     aux: Vec<T>,
     n: usize,
+    threads: usize,
 }
 
 impl<T: Real> ViewRenderer<T> {
@@ -183,10 +186,22 @@ impl<T: Real> ViewRenderer<T> {
             grid: vec![T::ZERO; grid_len(n)],
             aux: vec![T::ZERO; aux_len(n)],
             n,
+            threads: 0,
         }
     }
 
+    /// Extract the slice on `threads` threads (0, the default: one per
+    /// core). The image is the same bit for bit whatever the count.
+    pub fn with_threads(mut self, threads: usize) -> Self {
+        self.threads = threads;
+        self
+    }
+
     /// Render one view into `out` (`width × height`, row 0 at the top).
+    ///
+    /// The slice is extracted in blocks of rows on the renderer's threads
+    /// ([`fvr_core::render::extract_slice_rows`]; the core stays
+    /// single-threaded), then inverse-transformed on this one.
     ///
     /// # Errors
     /// As [`fvr_core::render::render`].
@@ -199,14 +214,63 @@ impl<T: Real> ViewRenderer<T> {
         out: &mut [T],
     ) -> Result<(), fvr_core::Error> {
         let tw = Twiddles::from_table(&self.tw, self.n)?;
-        render(
-            &spec.view(),
-            &self.kernel,
-            view,
+        let spec = spec.view();
+        let n = spec.n();
+        let threads = match self.threads {
+            0 => std::thread::available_parallelism().map_or(1, |t| t.get()),
+            t => t,
+        };
+        // Blocks of at least 16 rows: below that a thread costs more than it saves.
+        let blocks = threads.min(n / 16).max(1);
+        if blocks == 1 || self.grid.len() != grid_len(n) || self.kernel.filter() != spec.filter() {
+            return render(
+                &spec,
+                &self.kernel,
+                view,
+                width,
+                height,
+                &tw,
+                &mut self.grid,
+                &mut self.aux,
+                out,
+            );
+        }
+        let frame = view.frame()?;
+        check_image(width, height, n)?;
+        let rows_per_block = n.div_ceil(blocks);
+        let kernel = &self.kernel;
+        let spec_ref = &spec;
+        let frame_ref = &frame;
+        std::thread::scope(|scope| {
+            let workers: Vec<_> = self
+                .grid
+                .chunks_mut(rows_per_block * n)
+                .enumerate()
+                .map(|(block, rows)| {
+                    scope.spawn(move || {
+                        extract_slice_rows(
+                            spec_ref,
+                            kernel,
+                            frame_ref,
+                            block * rows_per_block,
+                            rows,
+                        )
+                    })
+                })
+                .collect();
+            workers
+                .into_iter()
+                .try_for_each(|w| w.join().expect("an extraction thread panicked"))
+        })?;
+        let place = placement(spec.dims(), &frame, width, height);
+        finish_projection(
+            &mut self.grid,
+            n,
+            &place,
+            1.0 / spec.scale(),
             width,
             height,
             &tw,
-            &mut self.grid,
             &mut self.aux,
             out,
         )
