@@ -390,12 +390,29 @@ fn hao_bracewell_2d<T: Real>(data: &mut [T], nx: usize, ny: usize) {
     }
 }
 
-/// Transpose an `n × n` array in place.
+/// Transpose an `n × n` array in place: row by row below `n = 128`, in
+/// tiles of 16 × 16 from there (a row-by-row transpose walks one side with
+/// a stride of `n` and misses the cache on every element once rows outgrow
+/// it; on a cacheless core the plain loop costs fewer instructions).
 fn transpose_square<T>(data: &mut [T], n: usize) {
-    for i in 1..n {
-        let (upper, lower) = data.split_at_mut(i * n);
-        for (j, below) in lower[..i].iter_mut().enumerate() {
-            core::mem::swap(below, &mut upper[j * n + i]);
+    const TILE: usize = 16;
+    if n < 128 || n % TILE != 0 {
+        for i in 1..n {
+            let (upper, lower) = data.split_at_mut(i * n);
+            for (j, below) in lower[..i].iter_mut().enumerate() {
+                core::mem::swap(below, &mut upper[j * n + i]);
+            }
+        }
+        return;
+    }
+    for bi in (0..n).step_by(TILE) {
+        for bj in (bi..n).step_by(TILE) {
+            for i in bi..bi + TILE {
+                let first = if bi == bj { i + 1 } else { bj };
+                for j in first..bj + TILE {
+                    data.swap(i * n + j, j * n + i);
+                }
+            }
         }
     }
 }
@@ -434,24 +451,43 @@ fn dht_columns<T: Real>(data: &mut [T], nx: usize, ny: usize, tw: &Twiddles<'_, 
                     let (c, s) = tw.cos_sin(k * stride);
                     let (x_low, x_high) = x.split_at_mut((m - k) * nx);
                     let (y_low, y_high) = y.split_at_mut((m - k) * nx);
-                    let rows = x_low[k * nx..(k + 1) * nx]
-                        .iter_mut()
-                        .zip(&mut x_high[..nx])
-                        .zip(&mut y_low[k * nx..(k + 1) * nx])
-                        .zip(&mut y_high[..nx]);
-                    for (((xk, xmk), yk), ymk) in rows {
-                        let t1 = c * *yk + s * *ymk;
-                        let t2 = s * *yk - c * *ymk;
-                        let (a, b) = (*xk, *xmk);
-                        *xk = a + t1;
-                        *yk = a - t1;
-                        *xmk = b + t2;
-                        *ymk = b - t2;
-                    }
+                    butterfly_rows_twiddled(
+                        &mut x_low[k * nx..(k + 1) * nx],
+                        &mut x_high[..nx],
+                        &mut y_low[k * nx..(k + 1) * nx],
+                        &mut y_high[..nx],
+                        c,
+                        s,
+                    );
                 }
             }
         }
         m *= 2;
+    }
+}
+
+/// The twiddled butterfly of [`dht_stages`] over whole rows: `xk`, `yk`
+/// hold index `k` and `xmk`, `ymk` index `m − k` of every column. Written
+/// over equal-length slices indexed in step, so that it vectorizes.
+#[inline(always)]
+fn butterfly_rows_twiddled<T: Real>(
+    xk: &mut [T],
+    xmk: &mut [T],
+    yk: &mut [T],
+    ymk: &mut [T],
+    c: T,
+    s: T,
+) {
+    let len = xk.len();
+    let (xmk, yk, ymk) = (&mut xmk[..len], &mut yk[..len], &mut ymk[..len]);
+    for i in 0..len {
+        let t1 = c * yk[i] + s * ymk[i];
+        let t2 = s * yk[i] - c * ymk[i];
+        let (a, b) = (xk[i], xmk[i]);
+        xk[i] = a + t1;
+        yk[i] = a - t1;
+        xmk[i] = b + t2;
+        ymk[i] = b - t2;
     }
 }
 
