@@ -596,16 +596,20 @@ pub fn finish_channel<T: Real>(
     apply_shift(grid, m, place.shift, aux);
     dht_2d(grid, m, m, &mut aux[..m], tw)?;
     let g = T::from_f64(gain / (m * m) as f64);
-    let mask = (m - 1) as i64;
+    // Grid indices modulo m (a power of two), in wrapping usize arithmetic:
+    // the same residues as the signed i64 ones, without 64-bit adds on a
+    // 32-bit core, and the row is sliced once.
+    let mask = m - 1;
+    let (row0, col0) = (place.row0 as usize, place.col0 as usize);
     for (row, line) in out
         .chunks_exact_mut(width * channels)
         .take(height)
         .enumerate()
     {
-        let gy = ((place.row0 - row as i64) & mask) as usize;
+        let gy = row0.wrapping_sub(row) & mask;
+        let grid_row = &grid[gy * m..(gy + 1) * m];
         for (col, o) in line.chunks_exact_mut(channels).enumerate() {
-            let gx = ((place.col0 + col as i64) & mask) as usize;
-            o[channel] = grid[gy * m + gx] * g;
+            o[channel] = grid_row[col0.wrapping_add(col) & mask] * g;
         }
     }
     Ok(())
