@@ -634,6 +634,75 @@ impl<T: Real> KernelTable<T> {
     }
 }
 
+/// The weights of all `W` taps of a sample at every phase `p = i/1024`,
+/// `i = 0 ..= 1024`, gathered from a [`KernelTable`]: row `i` holds
+/// `k(p + W/2 − 1 − m)` for `m = 0 … W−1`, each an entry of the kernel table
+/// itself (`|i + (W−2)·512 − 1024·m|`), so no value is rounded anew.
+///
+/// [`PhaseTable::taps`] finds a sample's first tap and phase with one
+/// floor and interpolates its `W` weights between two adjacent rows, where
+/// [`KernelTable::taps_fixed`] looks each weight up on its own. This is the
+/// per-axis setup of every slice sample (3 per pixel), so it matters.
+///
+/// # Accuracy
+/// As [`KernelTable`]: the same entries, linearly interpolated at the same
+/// fractions (to the rounding of the fraction, `ε·1024·|q|` in index units).
+#[derive(Clone, Debug)]
+pub(crate) struct PhaseTable<T, const W: usize> {
+    rows: [[T; W]; TABLE_RESOLUTION + 1],
+}
+
+impl<T: Real, const W: usize> PhaseTable<T, W> {
+    /// An all-zero table, to be [`PhaseTable::fill`]ed in place (the table
+    /// is up to 24 KiB in f32: built where it stays, it is not copied).
+    pub(crate) fn zeroed() -> Self {
+        Self {
+            rows: [[T::ZERO; W]; TABLE_RESOLUTION + 1],
+        }
+    }
+
+    /// Gather the rows from `kernel`, whose width must be `W`.
+    ///
+    /// # Errors
+    /// A kernel of another width ([`Error::LengthMismatch`]).
+    pub(crate) fn fill(&mut self, kernel: &KernelTable<T>) -> Result<()> {
+        let width = kernel.filter().width();
+        if width != W {
+            return Err(crate::error::mismatch("phase table width", width, W));
+        }
+        let values = &kernel.samples.values;
+        let centre = (W as i64 - 2) * (TABLE_RESOLUTION as i64 / 2);
+        for (i, row) in self.rows.iter_mut().enumerate() {
+            for (m, w) in row.iter_mut().enumerate() {
+                let index = (i as i64 + centre - (m * TABLE_RESOLUTION) as i64).unsigned_abs();
+                // |index| ≤ W·512 < the table's length; 0 beyond, like `lerp`.
+                *w = values.get(index as usize).copied().unwrap_or(T::ZERO);
+            }
+        }
+        Ok(())
+    }
+
+    /// Taps of a sample at fractional index `q`: the first tap's index
+    /// `j0 = ⌊q − W/2⌋ + 1` and the weights `k(q − j0 − m)`. With `Y = 1024·q − 512·W` and `F = ⌊Y⌋`, `j0 = ⌊F/1024⌋ + 1`
+    /// and the phase row is `F mod 1024`, interpolated by `Y − F`.
+    #[inline(always)]
+    pub(crate) fn taps(&self, q: T) -> (i64, [T; W]) {
+        let y = q * T::from_usize(TABLE_RESOLUTION) - T::from_usize(W * TABLE_RESOLUTION / 2);
+        // ⌊y⌋ by truncation and one correction below zero; slice points lie
+        // inside the Nyquist cube, so |y| ≤ 512·n is far inside the i32 range.
+        let t = y.trunc_i32();
+        let floor = t - (T::from_i32(t) > y) as i32;
+        let f = y - T::from_i32(floor);
+        let row = (floor & (TABLE_RESOLUTION as i32 - 1)) as usize;
+        let (p0, p1) = (&self.rows[row], &self.rows[row + 1]);
+        let weights = core::array::from_fn(|m| p0[m] + f * (p1[m] - p0[m]));
+        (
+            ((floor >> TABLE_RESOLUTION.trailing_zeros()) + 1) as i64,
+            weights,
+        )
+    }
+}
+
 /// The kernel derivative `k'` tabulated like [`KernelTable`] (odd: the table
 /// holds `k'(|t|)` and [`DerivativeTable::eval`] restores the sign). Built
 /// only for scenes that need `∇H` (linear depth cueing, paper eq. 5).

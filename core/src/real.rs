@@ -12,6 +12,8 @@ use half::f16;
 /// Arithmetic type of a pipeline: `f32` or `f64`.
 pub trait Real:
     Copy
+    + Send
+    + Sync
     + Default
     + Debug
     + PartialOrd
@@ -52,8 +54,20 @@ pub trait Real:
     fn floor_i64(self) -> i64;
     /// Integer part of a non-negative value, saturating.
     fn trunc_usize(self) -> usize;
+    /// Integer part (toward zero), saturating at the i32 range, NaN to 0:
+    /// one hardware conversion on a Cortex-M4F.
+    fn trunc_i32(self) -> i32;
     /// `2^e`, exact for `e` in `[-149, 127]` (f32) or `[-1074, 1023]` (f64).
     fn exp2i(e: i32) -> Self;
+    /// A stored *finite* sample as its value times `2^−e`, `e` being
+    /// [`Real::raw_exponent`]`::<S>()`: the cheapest exact widening (for f16
+    /// into f32, the bits moved into place without the rebias
+    /// multiplication of [`f16_bits_to_f32`]). Hot loops fold `2^e` into a
+    /// weight once instead of paying for it per sample. Not meaningful for
+    /// infinities and NaNs (spectra hold neither: [`crate::spectrum`]).
+    fn load_raw<S: Sample>(s: S) -> Self;
+    /// The power of two `e` that turns [`Real::load_raw`] into the value.
+    fn raw_exponent<S: Sample>() -> i32;
 }
 
 impl Real for f32 {
@@ -108,8 +122,20 @@ impl Real for f32 {
         self as usize
     }
     #[inline(always)]
+    fn trunc_i32(self) -> i32 {
+        self as i32
+    }
+    #[inline(always)]
     fn exp2i(e: i32) -> Self {
         libm::scalbnf(1.0, e)
+    }
+    #[inline(always)]
+    fn load_raw<S: Sample>(s: S) -> Self {
+        s.to_f32_raw()
+    }
+    #[inline(always)]
+    fn raw_exponent<S: Sample>() -> i32 {
+        S::RAW_EXPONENT_F32
     }
 }
 
@@ -155,8 +181,20 @@ impl Real for f64 {
         self as usize
     }
     #[inline(always)]
+    fn trunc_i32(self) -> i32 {
+        self as i32
+    }
+    #[inline(always)]
     fn exp2i(e: i32) -> Self {
         libm::scalbn(1.0, e)
+    }
+    #[inline(always)]
+    fn load_raw<S: Sample>(s: S) -> Self {
+        s.to_f64()
+    }
+    #[inline(always)]
+    fn raw_exponent<S: Sample>() -> i32 {
+        0
     }
 }
 
@@ -165,7 +203,7 @@ impl Real for f64 {
 /// Besides the IEEE types here, [`crate::format`] has bfloat16, 16-bit and
 /// 8-bit minifloats of any exponent width, and the Q15/Q7 mantissas of block
 /// floating point.
-pub trait Sample: Copy + Default + Debug + PartialEq {
+pub trait Sample: Copy + Default + Debug + PartialEq + Send + Sync {
     /// Short name, e.g. `"f16"`.
     const NAME: &'static str;
     /// Largest finite value.
@@ -182,6 +220,15 @@ pub trait Sample: Copy + Default + Debug + PartialEq {
     /// ([`crate::format::BlockLayout`]). Without block exponents they are
     /// fixed-point numbers.
     const BLOCK_MANTISSA: bool = false;
+    /// `e` of [`Sample::to_f32_raw`]: 0 unless the format has a cheaper
+    /// scaled widening.
+    const RAW_EXPONENT_F32: i32 = 0;
+    /// A finite value as an f32 times `2^−RAW_EXPONENT_F32`, exactly (see
+    /// [`Real::load_raw`]); by default [`Sample::to_f32`].
+    #[inline(always)]
+    fn to_f32_raw(self) -> f32 {
+        self.to_f32()
+    }
     /// Round an f32 to this format, to nearest even.
     fn from_f32(v: f32) -> Self;
     /// Round an f64 to this format, to nearest even (one rounding).
@@ -221,11 +268,28 @@ pub fn f16_bits_to_f32(bits: u16) -> f32 {
     f32::from_bits(value.to_bits() | ((bits as u32 & 0x8000) << 16))
 }
 
+/// The finite binary16 `bits` as binary32 times `2^−112`, exactly: the
+/// rebias of [`f16_bits_to_f32`] without its multiplication by `2^112` and
+/// without its infinity/NaN branch. The sign-extending read puts copies of
+/// the sign in bits 28–31 after the shift; clearing bits 28–30 leaves the
+/// sign in bit 31 over the 15 magnitude bits. Three integer instructions
+/// on a Cortex-M4F; exponent-all-ones patterns come out finite and wrong,
+/// which is why it is only for data known to be finite.
+#[inline(always)]
+pub fn f16_bits_to_f32_raw(bits: u16) -> f32 {
+    f32::from_bits((((bits as i16 as i32) << 13) as u32) & 0x8FFF_FFFF)
+}
+
 impl Sample for f16 {
     const NAME: &'static str = "f16";
     const BITS: u32 = 16;
     const SCALE_LOG2: i32 = 14;
     const MAX_FINITE: f64 = 65504.0;
+    const RAW_EXPONENT_F32: i32 = 112;
+    #[inline(always)]
+    fn to_f32_raw(self) -> f32 {
+        f16_bits_to_f32_raw(self.to_bits())
+    }
     #[inline(always)]
     fn from_f32(v: f32) -> Self {
         f16::from_f32(v)

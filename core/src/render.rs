@@ -23,7 +23,7 @@
 
 use crate::dht::{dht_2d, neg_mod, Twiddles};
 use crate::error::{require_len, Error, Result};
-use crate::filter::{KernelTable, MAX_WIDTH};
+use crate::filter::{KernelTable, PhaseTable, MAX_WIDTH};
 use crate::format::BlockLayout;
 use crate::geometry::{dot, Frame, Sampling, SliceAxes, View};
 use crate::real::{Real, Sample};
@@ -242,14 +242,56 @@ pub fn extract_central_slice_on<S: Sample, T: Real>(
     m: usize,
     grid: &mut [T],
 ) {
-    let grid = &mut grid[..m * m];
+    extract_rows(spec, kernel, axes, m, 0, &mut grid[..m * m]);
+}
+
+/// Rows `first_row ..` of the `n × n` slice on `axes` ([`Frame::slice_axes`]
+/// in voxel units, [`Sampling::slice_axes`] in physical units), as many as
+/// `rows` holds (`rows.len()` a multiple of `n`): the unit of work of a
+/// caller that spreads the extraction over threads. Every value equals the
+/// one [`extract_central_slice_on`] computes, bit for bit, whatever the
+/// split.
+///
+/// # Errors
+/// `rows.len()` not a multiple of `n`, or rows beyond the grid
+/// ([`Error::LengthMismatch`]).
+pub fn extract_slice_rows<S: Sample, T: Real>(
+    spec: &Spectrum<'_, S>,
+    kernel: &KernelTable<T>,
+    axes: &SliceAxes,
+    first_row: usize,
+    rows: &mut [T],
+) -> Result<()> {
+    let n = spec.n();
+    let count = rows.len() / n;
+    if count * n != rows.len() || first_row + count > n {
+        return Err(Error::LengthMismatch {
+            what: "slice rows (a whole number of rows within the grid)",
+            expected: (n - first_row.min(n)) * n,
+            got: rows.len(),
+        });
+    }
+    extract_rows(spec, kernel, axes, n, first_row, rows);
+    Ok(())
+}
+
+/// Rows `first_row ..` (as many as `grid` holds) of the central `m × m`
+/// slice, by filter width.
+fn extract_rows<S: Sample, T: Real>(
+    spec: &Spectrum<'_, S>,
+    kernel: &KernelTable<T>,
+    axes: &SliceAxes,
+    m: usize,
+    first_row: usize,
+    grid: &mut [T],
+) {
     match kernel.filter().width() {
-        1 => extract_width::<1, S, T>(spec, kernel, axes, m, grid),
-        2 => extract_width::<2, S, T>(spec, kernel, axes, m, grid),
-        3 => extract_width::<3, S, T>(spec, kernel, axes, m, grid),
-        4 => extract_width::<4, S, T>(spec, kernel, axes, m, grid),
-        5 => extract_width::<5, S, T>(spec, kernel, axes, m, grid),
-        _ => extract_width::<MAX_WIDTH, S, T>(spec, kernel, axes, m, grid),
+        1 => extract_width::<1, S, T>(spec, kernel, axes, m, first_row, grid),
+        2 => extract_width::<2, S, T>(spec, kernel, axes, m, first_row, grid),
+        3 => extract_width::<3, S, T>(spec, kernel, axes, m, first_row, grid),
+        4 => extract_width::<4, S, T>(spec, kernel, axes, m, first_row, grid),
+        5 => extract_width::<5, S, T>(spec, kernel, axes, m, first_row, grid),
+        _ => extract_width::<MAX_WIDTH, S, T>(spec, kernel, axes, m, first_row, grid),
     }
 }
 
@@ -366,58 +408,207 @@ impl<'a> LineReads<'a> {
     }
 }
 
-/// [`extract_slice`] for filter width `W`. The inner loop reads the `W`
-/// x-taps of a line as one contiguous run when they do not wrap around the
-/// cube (all but the outermost slice samples), with the loops unrolled;
-/// sums are taken in the same order as the general path, so results are
-/// bit-identical to it.
+/// [`extract_rows`] for filter width `W`: the phase-table path for plain
+/// and per-line-exponent spectra, the general one for the rest. Not
+/// inlined, so that only one width's phase table is on the stack.
+#[inline(never)]
 fn extract_width<const W: usize, S: Sample, T: Real>(
     spec: &Spectrum<'_, S>,
     kernel: &KernelTable<T>,
     axes: &SliceAxes,
     m: usize,
+    first_row: usize,
+    grid: &mut [T],
+) {
+    let geometry = SliceRows {
+        right: axes.right.map(T::from_f64),
+        up: axes.up.map(T::from_f64),
+        m,
+        first_row,
+    };
+    let mut phases = PhaseTable::<T, W>::zeroed();
+    match (phases.fill(kernel), LineReads::of(spec)) {
+        (Ok(()), LineReads::Plain) => {
+            extract_lines::<W, false, S, T>(spec, &phases, &geometry, &[], grid)
+        }
+        (Ok(()), LineReads::LineExponents(e)) => {
+            extract_lines::<W, true, S, T>(spec, &phases, &geometry, e, grid)
+        }
+        _ => extract_general::<W, S, T>(spec, kernel, &geometry, grid),
+    }
+}
+
+/// Which rows of the slice to fill, and its axes in index units.
+struct SliceRows<T> {
+    right: [T; 3],
+    up: [T; 3],
+    m: usize,
+    first_row: usize,
+}
+
+impl<T: Real> SliceRows<T> {
+    /// Calls `pixel(slot, q)` for every slice point of the rows inside
+    /// the spectrum's Nyquist cube, with `q = kx·r + ky·u` (`ky·u` once per
+    /// row), and zeroes the points outside. The cube `|q_a| ≤ n/2` cuts each
+    /// row to one interval of `kx`, found once per row
+    /// ([`SliceRows::row_interval`]).
+    #[inline(always)]
+    fn for_each(&self, n: usize, grid: &mut [T], mut pixel: impl FnMut(&mut T, [T; 3])) {
+        let m = self.m;
+        for (row_offset, row) in grid.chunks_exact_mut(m).enumerate() {
+            let ky = T::from_i32(signed_index(self.first_row + row_offset, m) as i32);
+            let kyu = self.up.map(|c| ky * c);
+            let (low, high) = self.row_interval(n, kyu);
+            for (ix, g) in row.iter_mut().enumerate() {
+                let k = signed_index(ix, m) as i32;
+                if k < low || k > high {
+                    *g = T::ZERO;
+                    continue;
+                }
+                let kx = T::from_i32(k);
+                pixel(g, core::array::from_fn(|a| kx * self.right[a] + kyu[a]));
+            }
+        }
+    }
+
+    /// The integers `kx` in `[low, high]` for which `|kx·r_a + c_a| ≤ n/2` on
+    /// every axis (`c = ky·u`): the intersection of three intervals, each
+    /// `(±n/2 − c_a)/r_a`, rounded inwards. Points within rounding of the
+    /// cube's faces may fall on either side; their interpolated value is
+    /// next to nothing there (the band-limited spectrum ends at the faces).
+    fn row_interval(&self, n: usize, c: [T; 3]) -> (i32, i32) {
+        let half = T::from_usize(n) * T::HALF;
+        let (mut low, mut high) = (-T::from_usize(n), T::from_usize(n));
+        for a in 0..3 {
+            let (r, c) = (self.right[a], c[a]);
+            if r == T::ZERO {
+                if c > half || -c > half {
+                    return (1, 0);
+                }
+                continue;
+            }
+            let (t1, t2) = ((-half - c) / r, (half - c) / r);
+            let (t_low, t_high) = if t1 < t2 { (t1, t2) } else { (t2, t1) };
+            if t_low > low {
+                low = t_low;
+            }
+            if t_high < high {
+                high = t_high;
+            }
+        }
+        (-((-low).floor_i64() as i32), high.floor_i64() as i32)
+    }
+}
+
+/// The extraction's hot loop: per slice point, three phase-table lookups
+/// for the weights, then `W²` x-lines of `W` taps, each line one
+/// contiguous run with one bounds check unless its taps wrap around the
+/// cube. The `W` x-weights carry the `2^e` of [`Real::load_raw`], so a tap
+/// costs a load, its raw widening, a multiplication and an addition; the
+/// products are the same numbers as with the full widening (a power of two
+/// moved between factors is exact). `LINE_EXP`: multiply each line's sum
+/// by its block exponent's power of two (`exponents`, one per x-line).
+fn extract_lines<const W: usize, const LINE_EXP: bool, S: Sample, T: Real>(
+    spec: &Spectrum<'_, S>,
+    phases: &PhaseTable<T, W>,
+    geometry: &SliceRows<T>,
+    exponents: &[i8],
+    grid: &mut [T],
+) {
+    let n = spec.n();
+    let nn = n * n;
+    let mask = n - 1;
+    let data = spec.data();
+    let raw_gain = T::exp2i(T::raw_exponent::<S>());
+    let line_sum = |line: usize, acc_x: T| {
+        if LINE_EXP {
+            let e = exponents.get(line / n).copied().unwrap_or(0);
+            acc_x * T::exp2i(e as i32)
+        } else {
+            acc_x
+        }
+    };
+    geometry.for_each(n, grid, |g, q| {
+        let (jx, wx) = phases.taps(q[0]);
+        let (jy, wy) = phases.taps(q[1]);
+        let (jz, wz) = phases.taps(q[2]);
+        let wx = wx.map(|w| w * raw_gain);
+        let lines: [usize; W] = core::array::from_fn(|b| ((jy + b as i64) as usize & mask) * n);
+        let planes: [usize; W] = core::array::from_fn(|c| ((jz + c as i64) as usize & mask) * nn);
+        let x0 = jx as usize & mask;
+        let mut acc = T::ZERO;
+        if x0 + W <= n {
+            for c in 0..W {
+                let mut acc_y = T::ZERO;
+                for b in 0..W {
+                    let start = planes[c] + lines[b] + x0;
+                    let acc_x = match data.get(start..start + W) {
+                        Some(run) => {
+                            let mut sum = T::ZERO;
+                            for t in 0..W {
+                                sum += wx[t] * T::load_raw(run[t]);
+                            }
+                            sum
+                        }
+                        None => T::ZERO,
+                    };
+                    acc_y += wy[b] * line_sum(start, acc_x);
+                }
+                acc += wz[c] * acc_y;
+            }
+        } else {
+            let xs: [usize; W] = core::array::from_fn(|t| (jx + t as i64) as usize & mask);
+            for c in 0..W {
+                let mut acc_y = T::ZERO;
+                for b in 0..W {
+                    let line = planes[c] + lines[b];
+                    let mut acc_x = T::ZERO;
+                    for t in 0..W {
+                        let v = data.get(line + xs[t]).copied().unwrap_or_default();
+                        acc_x += wx[t] * T::load_raw(v);
+                    }
+                    acc_y += wy[b] * line_sum(line, acc_x);
+                }
+                acc += wz[c] * acc_y;
+            }
+        }
+        *g = acc;
+    });
+}
+
+/// The extraction for any storage (e.g. bricked block exponents): taps
+/// through [`LineReads::sum`], weights from the kernel table.
+fn extract_general<const W: usize, S: Sample, T: Real>(
+    spec: &Spectrum<'_, S>,
+    kernel: &KernelTable<T>,
+    geometry: &SliceRows<T>,
     grid: &mut [T],
 ) {
     let n = spec.n();
     let nn = n * n;
     let reads = LineReads::of(spec);
-    let r = axes.right.map(T::from_f64);
-    let u = axes.up.map(T::from_f64);
-    let nyquist = T::from_usize(n) * T::HALF;
     let mask = n - 1;
-    for (iy, row) in grid.chunks_exact_mut(m).enumerate() {
-        let ky = T::from_i32(signed_index(iy, m) as i32);
-        for (ix, g) in row.iter_mut().enumerate() {
-            let kx = T::from_i32(signed_index(ix, m) as i32);
-            let q: [T; 3] = core::array::from_fn(|a| kx * r[a] + ky * u[a]);
-            if q.iter().any(|&c| c > nyquist || -c > nyquist) {
-                *g = T::ZERO;
-                continue;
+    geometry.for_each(n, grid, |g, q| {
+        let (mut wx, mut wy, mut wz) = ([T::ZERO; W], [T::ZERO; W], [T::ZERO; W]);
+        let jx = kernel.taps_fixed(q[0], &mut wx);
+        let jy = kernel.taps_fixed(q[1], &mut wy);
+        let jz = kernel.taps_fixed(q[2], &mut wz);
+        let x0 = jx as usize & mask;
+        let contiguous = reads.contiguous::<W>(x0, n);
+        let xs: [usize; W] = core::array::from_fn(|t| (jx + t as i64) as usize & mask);
+        let mut acc = T::ZERO;
+        for (c, wzc) in wz.iter().enumerate() {
+            let z = ((jz + c as i64) as usize & mask) * nn;
+            let mut acc_y = T::ZERO;
+            for (b, wyb) in wy.iter().enumerate() {
+                let line = z + ((jy + b as i64) as usize & mask) * n;
+                let acc_x = reads.sum(spec, line, x0, contiguous, &xs, &wx);
+                acc_y += *wyb * acc_x;
             }
-            let (mut wx, mut wy, mut wz) = ([T::ZERO; W], [T::ZERO; W], [T::ZERO; W]);
-            let jx = kernel.taps_fixed(q[0], &mut wx);
-            let jy = kernel.taps_fixed(q[1], &mut wy);
-            let jz = kernel.taps_fixed(q[2], &mut wz);
-            let x0 = jx as usize & mask;
-            let contiguous = reads.contiguous::<W>(x0, n);
-            let mut xs = [0usize; W];
-            for (t, x) in xs.iter_mut().enumerate() {
-                *x = (jx + t as i64) as usize & mask;
-            }
-            let mut acc = T::ZERO;
-            for (c, wzc) in wz.iter().enumerate() {
-                let z = ((jz + c as i64) as usize & mask) * nn;
-                let mut acc_y = T::ZERO;
-                for (b, wyb) in wy.iter().enumerate() {
-                    let line = z + ((jy + b as i64) as usize & mask) * n;
-                    let acc_x = reads.sum(spec, line, x0, contiguous, &xs, &wx);
-                    acc_y += *wyb * acc_x;
-                }
-                acc += *wzc * acc_y;
-            }
-            *g = acc;
+            acc += *wzc * acc_y;
         }
-    }
+        *g = acc;
+    });
 }
 
 /// Turn a filled `m × m` slice into the image: sub-pixel shift, 2D inverse
@@ -475,16 +666,20 @@ pub fn finish_channel<T: Real>(
     apply_shift(grid, m, place.shift, aux);
     dht_2d(grid, m, m, &mut aux[..m], tw)?;
     let g = T::from_f64(gain / (m * m) as f64);
-    let mask = (m - 1) as i64;
+    // Grid indices modulo m (a power of two), in wrapping usize arithmetic:
+    // the same residues as the signed i64 ones, without 64-bit adds on a
+    // 32-bit core, and the row is sliced once.
+    let mask = m - 1;
+    let (row0, col0) = (place.row0 as usize, place.col0 as usize);
     for (row, line) in out
         .chunks_exact_mut(width * channels)
         .take(height)
         .enumerate()
     {
-        let gy = ((place.row0 - row as i64) & mask) as usize;
+        let gy = row0.wrapping_sub(row) & mask;
+        let grid_row = &grid[gy * m..(gy + 1) * m];
         for (col, o) in line.chunks_exact_mut(channels).enumerate() {
-            let gx = ((place.col0 + col as i64) & mask) as usize;
-            o[channel] = grid[gy * m + gx] * g;
+            o[channel] = grid_row[col0.wrapping_add(col) & mask] * g;
         }
     }
     Ok(())

@@ -232,6 +232,12 @@ impl<'a, S: Sample> Spectrum<'a, S> {
     /// # Errors
     /// `n` not a power of two, `data.len() != n³`, dims that do not fit, or
     /// a scale that is not a positive finite number.
+    ///
+    /// `data` is not scanned (this runs once per view on the host): it must
+    /// hold finite values, as [`Spectrum::prepare`] guarantees. Data from
+    /// elsewhere goes through [`Spectrum::check_finite`] once; the
+    /// extraction's widening ([`Real::load_raw`]) turns an infinity or NaN
+    /// into a finite wrong value.
     pub fn from_parts(
         data: &'a [S],
         n: usize,
@@ -322,6 +328,23 @@ impl<'a, S: Sample> Spectrum<'a, S> {
                 }
                 acc
             }
+        }
+    }
+
+    /// `Ok` if every stored coefficient is finite: the check for spectra
+    /// rebuilt by [`Spectrum::from_parts`] from data that did not come
+    /// straight from [`Spectrum::prepare`] (O(n³); once per load, not per
+    /// view).
+    ///
+    /// # Errors
+    /// [`Error::NonFiniteTableEntry`] naming the first bad coefficient.
+    pub fn check_finite(&self) -> Result<()> {
+        match self.data.iter().position(|v| !v.is_finite()) {
+            None => Ok(()),
+            Some(index) => Err(Error::NonFiniteTableEntry {
+                what: "spectrum coefficient",
+                index,
+            }),
         }
     }
 

@@ -12,7 +12,10 @@ use fvr_core::dht::Twiddles;
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::{Sampling, View};
 use fvr_core::real::{Real, Sample};
-use fvr_core::render::{aux_len, grid_len, render_sampled};
+use fvr_core::render::{
+    aux_len, check_image, extract_slice_rows, finish_projection, grid_len, placement_on_axes,
+    render_sampled,
+};
 use fvr_core::spectrum::{padded_size, prepare_scratch_len, DenseVolume, Spectrum};
 use half::f16;
 
@@ -170,6 +173,7 @@ pub struct ViewRenderer<T> {
     grid: Vec<T>,
     aux: Vec<T>,
     n: usize,
+    threads: usize,
 }
 
 impl<T: Real> ViewRenderer<T> {
@@ -183,10 +187,22 @@ impl<T: Real> ViewRenderer<T> {
             grid: vec![T::ZERO; grid_len(n)],
             aux: vec![T::ZERO; aux_len(n)],
             n,
+            threads: 0,
         }
     }
 
+    /// Extract the slice on `threads` threads (0, the default: one per
+    /// core). The image is the same bit for bit whatever the count.
+    pub fn with_threads(mut self, threads: usize) -> Self {
+        self.threads = threads;
+        self
+    }
+
     /// Render one view into `out` (`width × height`, row 0 at the top).
+    ///
+    /// The slice is extracted in blocks of rows on the renderer's threads
+    /// ([`fvr_core::render::extract_slice_rows`]; the core stays
+    /// single-threaded), then inverse-transformed on this one.
     ///
     /// # Errors
     /// As [`fvr_core::render::render`].
@@ -216,15 +232,58 @@ impl<T: Real> ViewRenderer<T> {
         out: &mut [T],
     ) -> Result<(), fvr_core::Error> {
         let tw = Twiddles::from_table(&self.tw, self.n)?;
-        render_sampled(
-            &spec.view(),
-            &self.kernel,
-            view,
-            sampling,
+        let spec = spec.view();
+        let n = spec.n();
+        let threads = match self.threads {
+            0 => std::thread::available_parallelism().map_or(1, |t| t.get()),
+            t => t,
+        };
+        // Blocks of at least 16 rows: below that a thread costs more than it saves.
+        let blocks = threads.min(n / 16).max(1);
+        if blocks == 1 || self.grid.len() != grid_len(n) || self.kernel.filter() != spec.filter() {
+            return render_sampled(
+                &spec,
+                &self.kernel,
+                view,
+                sampling,
+                width,
+                height,
+                &tw,
+                &mut self.grid,
+                &mut self.aux,
+                out,
+            );
+        }
+        let axes = sampling.slice_axes(&view.frame()?);
+        check_image(width, height, n)?;
+        let rows_per_block = n.div_ceil(blocks);
+        let kernel = &self.kernel;
+        let spec_ref = &spec;
+        let axes_ref = &axes;
+        std::thread::scope(|scope| {
+            let workers: Vec<_> = self
+                .grid
+                .chunks_mut(rows_per_block * n)
+                .enumerate()
+                .map(|(block, rows)| {
+                    scope.spawn(move || {
+                        extract_slice_rows(spec_ref, kernel, axes_ref, block * rows_per_block, rows)
+                    })
+                })
+                .collect();
+            workers
+                .into_iter()
+                .try_for_each(|w| w.join().expect("an extraction thread panicked"))
+        })?;
+        let place = placement_on_axes(spec.dims(), &axes, width, height, 1.0);
+        finish_projection(
+            &mut self.grid,
+            n,
+            &place,
+            sampling.gain() / spec.scale(),
             width,
             height,
             &tw,
-            &mut self.grid,
             &mut self.aux,
             out,
         )

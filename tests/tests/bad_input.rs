@@ -127,3 +127,25 @@ fn ill_conditioned_premultiplication_is_flagged() {
     let spec = AnySpectrum::prepare(&volume, filter, Precision::F16).unwrap();
     assert!(spec.storage_snr_estimate_db(sum) > 70.0);
 }
+
+#[test]
+fn check_finite_names_the_first_nan_or_infinite_coefficient() {
+    let filter = Filter::new(FilterKind::Kb3, 1).unwrap();
+    let mut data = vec![f16::from_f32(0.25); 8 * 8 * 8];
+    // A spectrum rebuilt from parts is not scanned per view...
+    let spec = Spectrum::from_parts(&data, 8, 1.0, filter, [8, 8, 8]).unwrap();
+    assert!(spec.check_finite().is_ok());
+    // ...so data from elsewhere is checked once: the first bad index is named.
+    data[77] = f16::NAN;
+    data[300] = f16::INFINITY;
+    let spec = Spectrum::from_parts(&data, 8, 1.0, filter, [8, 8, 8]).unwrap();
+    let err = spec.check_finite().unwrap_err();
+    assert!(
+        matches!(err, Error::NonFiniteTableEntry { index: 77, .. }),
+        "{err:?}"
+    );
+    assert!(
+        err.to_string().contains("spectrum coefficient entry 77"),
+        "{err}"
+    );
+}

@@ -86,6 +86,37 @@ fn fast_f16_widening_is_bit_identical_to_half_for_every_pattern() {
 }
 
 #[test]
+fn raw_f16_widening_times_two_pow_112_is_the_value_for_every_finite_pattern() {
+    // The hot loops fold 2^112 into a weight; (w·2^112)·raw must equal
+    // w·value bit for bit, which holds when raw·2^112 is the value exactly.
+    let two_pow_112 = f32::exp2i(112);
+    assert_eq!(<f32 as Real>::raw_exponent::<f16>(), 112);
+    for bits in (0..0x7C00u16).chain(0x8000..0xFC00u16) {
+        let raw = fvr_core::real::f16_bits_to_f32_raw(bits);
+        let value = f16::from_bits(bits).to_f32();
+        assert_eq!(
+            (raw * two_pow_112).to_bits(),
+            value.to_bits(),
+            "{bits:#06x}"
+        );
+        assert_eq!(
+            <f32 as Real>::load_raw(f16::from_bits(bits)).to_bits(),
+            raw.to_bits()
+        );
+        for w in [0.3f32, -1.7e-3, 0.999_999_9] {
+            assert_eq!(
+                ((w * two_pow_112) * raw).to_bits(),
+                (w * value).to_bits(),
+                "{bits:#06x} {w}"
+            );
+        }
+    }
+    // Formats without a raw form widen as usual, with exponent 0.
+    assert_eq!(<f32 as Real>::raw_exponent::<f32>(), 0);
+    assert_eq!(<f64 as Real>::raw_exponent::<f16>(), 0);
+}
+
+#[test]
 fn f32_floor_i64_equals_libm_floor_on_a_dense_sweep_and_the_edges() {
     let check = |x: f32| {
         assert_eq!(
