@@ -12,6 +12,7 @@ use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::View;
 use fvr_core::real::{Real, Sample};
 use fvr_core::render::{aux_len, check_image, finish_projection, placement};
+use fvr_core::spectrum::Spectrum;
 
 /// The cheaper filters tried, cheapest first, as the user names them.
 pub fn parse_chain(s: &str) -> Result<Vec<FilterKind>, String> {
@@ -84,15 +85,28 @@ impl AdaptiveMarks {
         chain: &[FilterKind],
         h_d_override: Option<f64>,
     ) -> Result<Self, String> {
+        Self::build_for(&spec.view(), tolerance_db, chain, h_d_override)
+    }
+
+    /// [`AdaptiveMarks::build`] for any core spectrum (every storage
+    /// format, block exponents included).
+    ///
+    /// # Errors
+    /// As [`AdaptiveMarks::build`].
+    pub fn build_for<S: Sample>(
+        view: &Spectrum<'_, S>,
+        tolerance_db: f64,
+        chain: &[FilterKind],
+        h_d_override: Option<f64>,
+    ) -> Result<Self, String> {
         parse_tolerance(&tolerance_db.to_string())?;
         if chain.is_empty() || chain.len() > MAX_LEVELS {
             return Err(format!(
                 "an adaptive chain names 1 to {MAX_LEVELS} cheaper filters"
             ));
         }
-        let view = spec.view();
-        let n = spec.n();
-        let large = spec.filter();
+        let n = view.n();
+        let large = *view.filter();
         let total = n * n * n;
         let budget = 10f64.powf(-tolerance_db / 10.0) / (chain.len() * chain.len()) as f64;
         let radius = large.width().div_ceil(2);

@@ -19,5 +19,6 @@ pub mod reference;
 pub mod scene;
 pub mod scene_reference;
 pub mod shaded;
+pub mod trade;
 pub mod turntable;
 pub mod volume;
