@@ -38,7 +38,7 @@ use crate::pipeline::{choose_filter, KbDesign};
 use crate::plot::{Canvas, Overlay, Point, Scatter};
 use crate::precision::{parse_format, StoredSpectrum};
 use crate::reference::snr_db;
-use crate::scene::{DEFAULT_SEED, GAUSSIAN_COUNT};
+use crate::scene::{BLOB_COUNT, BLOB_SIGMA_FRACTION, DEFAULT_SEED, GAUSSIAN_COUNT};
 use crate::volume::Volume;
 
 /// Largest volume side without `--large`.
@@ -77,7 +77,12 @@ pub struct TradeArgs {
     /// preview 2^L times smaller from the central 1/4^L of the slice.
     #[arg(long, default_value = "0,1,2")]
     pub levels: String,
-    /// Sides of the Gaussian-mixture phantom (16 to 256; 512 with --large).
+    /// The Gaussian-mixture phantom: `gaussians` (8 Gaussians, sigma 1.5 to
+    /// 0.12 N voxels) or `blobs` (24 smaller ones, sigma 1.5 to 0.05 N:
+    /// more detail, so filters and previews differ more).
+    #[arg(long, default_value = "gaussians")]
+    pub phantom: String,
+    /// Sides of the phantom (16 to 256; 512 with --large).
     #[arg(long, default_value = "64,128")]
     pub sizes: String,
     /// Allow sides up to 512 (a 512³ f16 spectrum at oversampling 2 holds 2 GiB).
@@ -211,9 +216,41 @@ impl Setting {
     }
 }
 
+/// The phantoms `fvr trade` measures on: Gaussian mixtures, whose line
+/// integrals are exact.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TradePhantom {
+    /// `gaussians@N`: 8 Gaussians, σ from 1.5 to 0.12·N voxels.
+    Gaussians,
+    /// `blobs@N`: 24 Gaussians, σ from 1.5 to 0.05·N voxels.
+    Blobs,
+}
+
+impl TradePhantom {
+    /// The phantom's name, as in `fvr render`.
+    pub fn name(self) -> &'static str {
+        match self {
+            TradePhantom::Gaussians => "gaussians",
+            TradePhantom::Blobs => "blobs",
+        }
+    }
+
+    /// The mixture at side `n`, with the default seed.
+    pub fn mixture(self, n: usize) -> GaussianMixture {
+        match self {
+            TradePhantom::Gaussians => GaussianMixture::random(DEFAULT_SEED, n, GAUSSIAN_COUNT),
+            TradePhantom::Blobs => {
+                GaussianMixture::random_with(DEFAULT_SEED, n, BLOB_COUNT, BLOB_SIGMA_FRACTION)
+            }
+        }
+    }
+}
+
 /// A validated sweep: every axis non-empty and every value usable.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sweep {
+    /// The phantom.
+    pub phantom: TradePhantom,
     /// Phantom sides.
     pub sizes: Vec<usize>,
     /// Filters.
@@ -396,7 +433,18 @@ impl Sweep {
                 return Err(format!("--adaptive {db} {why}"));
             }
         }
+        let phantom = match args.phantom.as_str() {
+            "gaussians" => TradePhantom::Gaussians,
+            "blobs" => TradePhantom::Blobs,
+            other => {
+                return Err(format!(
+                    "--phantom `{other}`: expected gaussians or blobs (Gaussian mixtures, whose \
+                     line integrals are exact)"
+                ))
+            }
+        };
         Ok(Self {
+            phantom,
             sizes,
             filters,
             oversamples,
@@ -653,9 +701,14 @@ struct Subject {
 }
 
 impl Subject {
-    fn new(size: usize, views: usize, levels: &[u32]) -> Result<Self, String> {
+    fn new(
+        phantom: TradePhantom,
+        size: usize,
+        views: usize,
+        levels: &[u32],
+    ) -> Result<Self, String> {
         let dims = [size; 3];
-        let phantom = GaussianMixture::random(DEFAULT_SEED, size, GAUSSIAN_COUNT);
+        let phantom = phantom.mixture(size);
         let volume = sample(&phantom, dims);
         let views: Vec<View> = view_directions(views)
             .into_iter()
@@ -931,7 +984,7 @@ pub fn measure(sweep: &Sweep, mut progress: impl FnMut(&Row)) -> Result<Vec<Row>
     let settings = sweep.settings();
     let mut rows = Vec::with_capacity(settings.len());
     for &size in &sweep.sizes {
-        let subject = Subject::new(size, sweep.views, &sweep.levels)?;
+        let subject = Subject::new(sweep.phantom, size, sweep.views, &sweep.levels)?;
         let mine: Vec<Setting> = settings
             .iter()
             .copied()
@@ -1095,7 +1148,7 @@ pub fn summary(rows: &[Row], sweep: &Sweep, command: &str) -> String {
     let _ = write!(
         s,
         "Made by `{command}` on {} ({threads} hardware threads), {} points.\n\n\
-         - Phantom: `gaussians@N` (8 random Gaussians, seed {DEFAULT_SEED}), {} view \
+         - Phantom: `{}@N` ({}, seed {DEFAULT_SEED}), {} view \
          directions (golden-angle azimuths, elevations from 40° to −30°).\n\
          - Time per view: the median of {} views × {} repeats, wall clock, one thread, \
          buffers allocated beforehand. It is noisy (other processes share the machine): \
@@ -1107,10 +1160,16 @@ pub fn summary(rows: &[Row], sweep: &Sweep, command: &str) -> String {
          - Adaptive points use nearest as the cheaper filter, at oversampling 2 and level 0 only.\n\n",
         cpu_model().unwrap_or_else(|| "an unknown CPU".into()),
         rows.len(),
+        sweep.phantom.name(),
+        match sweep.phantom {
+            TradePhantom::Gaussians => "8 random Gaussians, σ from 1.5 to 0.12·N voxels",
+            TradePhantom::Blobs => "24 random Gaussians, σ from 1.5 to 0.05·N voxels",
+        },
         sweep.views,
         sweep.views,
         sweep.repeats,
     );
+    s.push_str(&levels_table(rows, sweep));
     for &size in &sweep.sizes {
         let mut front: Vec<&Row> = rows
             .iter()
@@ -1150,6 +1209,48 @@ pub fn summary(rows: &[Row], sweep: &Sweep, command: &str) -> String {
             None => s.push_str("\nNo full-resolution point reached 50 dB.\n\n"),
         }
     }
+    s
+}
+
+/// Each size and level: its fastest point at ≥ 50 dB, and its most
+/// accurate point, so every level's time and dB can be read off.
+fn levels_table(rows: &[Row], sweep: &Sweep) -> String {
+    let mut s = String::from(
+        "## Each level: fastest at ≥ 50 dB, and most accurate\n\n\
+         | size | level | image | fastest at ≥ 50 dB | ms/view | dB | most accurate | ms/view | dB |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
+    );
+    for &size in &sweep.sizes {
+        for &level in &sweep.levels {
+            let mine: Vec<&Row> = rows
+                .iter()
+                .filter(|r| r.setting.size == size && r.setting.level == level)
+                .collect();
+            let Some(first) = mine.first() else { continue };
+            let fast = mine
+                .iter()
+                .filter(|r| r.snr_db >= 50.0)
+                .min_by(|a, b| a.ms_per_view.total_cmp(&b.ms_per_view));
+            let best = mine.iter().max_by(|a, b| a.snr_db.total_cmp(&b.snr_db));
+            let cells = |r: Option<&&Row>| match r {
+                Some(r) => format!(
+                    "{} | {:.3} | {:.1}",
+                    r.setting.describe(),
+                    r.ms_per_view,
+                    r.snr_db
+                ),
+                None => "none | — | —".into(),
+            };
+            let _ = writeln!(
+                s,
+                "| {size}³ | {level} | {}² | {} | {} |",
+                first.setting.image_side(),
+                cells(fast),
+                cells(best)
+            );
+        }
+    }
+    s.push('\n');
     s
 }
 

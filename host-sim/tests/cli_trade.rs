@@ -137,7 +137,7 @@ fn a_sweep_beyond_memory_is_refused_before_any_work() {
 #[test]
 fn conflicting_and_bad_options_are_named_before_any_work() {
     let dir = temp_dir("trade-bad");
-    let cases: [(&[&str], &[&str]); 11] = [
+    let cases: [(&[&str], &[&str]); 12] = [
         (
             &["--adaptive", "40", "--oversample", "1"],
             &["--adaptive 40 needs --oversample 2"],
@@ -167,6 +167,10 @@ fn conflicting_and_bad_options_are_named_before_any_work() {
         ),
         (&["--views", "0"], &["--views 0", "at least 1"]),
         (&["--memory-limit", "lots"], &["--memory-limit `lots`"]),
+        (
+            &["--phantom", "shepp-logan"],
+            &["--phantom `shepp-logan`", "gaussians or blobs"],
+        ),
     ];
     for (args, needles) in cases {
         let mut all = vec!["trade", "--out-dir", "out"];
