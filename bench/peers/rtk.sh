@@ -24,6 +24,11 @@
 # `fvr trade` gives the frequency path's time for every filter and format
 # at each size, but with a noisier wall clock (see docs/trade/README.md).
 #
+# RTK's time depends on the view: rays along an axis or in the detector
+# plane walk memory differently. The views here are oblique (25° tilt), as in
+# `fvr trade`. Check that the printed image sum / volume sum is about 1: the
+# detector then sees the whole volume.
+#
 # This is a manual benchmark: it is not part of scripts/test-all.sh.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
