@@ -12,6 +12,7 @@ use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::View;
 use fvr_core::real::{Real, Sample};
 use fvr_core::render::{aux_len, check_image, finish_projection, placement, signed_index};
+use fvr_core::spectrum::Spectrum;
 
 /// The cheaper filters tried, cheapest first, as the user names them.
 pub fn parse_chain(s: &str) -> Result<Vec<FilterKind>, String> {
@@ -98,10 +99,9 @@ struct ErrorModel {
 }
 
 impl ErrorModel {
-    fn new<S: Sample>(spec: &OwnedSpectrum<S>) -> Result<Self, String> {
-        let n = spec.n();
-        let view = spec.view();
-        let large = spec.filter();
+    fn new<S: Sample>(view: &Spectrum<'_, S>) -> Result<Self, String> {
+        let n = view.n();
+        let large = *view.filter();
         let values: Vec<f32> = (0..n * n * n).map(|i| view.value(i) as f32).collect();
         let large_response = Self::responses(&large, n);
         let mut model = Self {
@@ -325,6 +325,18 @@ impl AdaptiveMarks {
         spec: &OwnedSpectrum<S>,
         settings: &AdaptiveSettings,
     ) -> Result<Self, String> {
+        Self::build_for(&spec.view(), settings)
+    }
+
+    /// [`AdaptiveMarks::build`] for any core spectrum (every storage
+    /// format, block exponents included).
+    ///
+    /// # Errors
+    /// As [`AdaptiveMarks::build`].
+    pub fn build_for<S: Sample>(
+        view: &Spectrum<'_, S>,
+        settings: &AdaptiveSettings,
+    ) -> Result<Self, String> {
         let AdaptiveSettings {
             tolerance_db,
             ref chain,
@@ -344,16 +356,15 @@ impl AdaptiveMarks {
                 "an adaptive chain names 1 to {MAX_LEVELS} cheaper filters"
             ));
         }
-        let view = spec.view();
-        let n = spec.n();
-        let large = spec.filter();
+        let n = view.n();
+        let large = *view.filter();
         let total = n * n * n;
         let budget = 10f64.powf(-tolerance_db / 10.0) / (chain.len() * chain.len()) as f64;
         let radius = large.width().div_ceil(2);
         let mut line = vec![false; n];
         let mut levels = Vec::with_capacity(chain.len());
         let mut model = match bound {
-            Bound::Exact => Some(ErrorModel::new(spec)?),
+            Bound::Exact => Some(ErrorModel::new(view)?),
             Bound::Paper => None,
         };
         for &kind in chain.iter() {

@@ -21,5 +21,6 @@ pub mod scene_file;
 pub mod scene_reference;
 pub mod shaded;
 pub mod teapot;
+pub mod trade;
 pub mod turntable;
 pub mod volume;

@@ -1,5 +1,6 @@
 //! A small raster scatter plot written as PNG: SNR against bytes per voxel
-//! for the precision study. Text uses a built-in 3×5 pixel font (upper-case
+//! for the precision study, and SNR against time per view with Pareto
+//! fronts for the speed–accuracy trade. Text uses a built-in 3×5 pixel font (upper-case
 //! letters, digits and a few signs), drawn at twice its size.
 
 use std::fs::File;
@@ -210,9 +211,25 @@ pub struct Scatter<'a> {
     pub points: &'a [Point],
 }
 
+/// Extras drawn over a [`Scatter`].
+#[derive(Default)]
+pub struct Overlay<'a> {
+    /// Pareto fronts: a label and the front's points in data units, sorted
+    /// by x. Each is drawn as a staircase (the best y reached by that x),
+    /// its points ringed, and the label left of its first point.
+    pub fronts: &'a [(String, Vec<(f64, f64)>)],
+    /// Marker side in pixels per point (odd; default 7 where missing).
+    pub marker_sizes: &'a [i64],
+}
+
 impl Scatter<'_> {
     /// Draw on a new `width × height` canvas.
     pub fn draw(&self, width: usize, height: usize) -> Canvas {
+        self.draw_with(width, height, &Overlay::default())
+    }
+
+    /// Draw on a new `width × height` canvas, with `overlay` on top.
+    pub fn draw_with(&self, width: usize, height: usize, overlay: &Overlay<'_>) -> Canvas {
         let mut c = Canvas::new(width, height);
         let black = [0, 0, 0];
         let grey = [200, 200, 200];
@@ -286,10 +303,41 @@ impl Scatter<'_> {
             c.text(right - 134, ly, name, 2, black);
         }
         // Points, clamped to the plot area.
-        for p in self.points {
+        for (i, p) in self.points.iter().enumerate() {
             let (x, y) = (px(p.x), py(p.y.clamp(y0, y1)));
             let col = self.series.get(p.series).map_or(black, |s| s.1);
-            c.rect(x - 3, y - 3, 7, 7, col);
+            let side = overlay.marker_sizes.get(i).copied().unwrap_or(7);
+            c.rect(x - side / 2, y - side / 2, side, side, col);
+        }
+        for (label, front) in overlay.fronts {
+            let at = |&(x, y): &(f64, f64)| (px(x), py(y.clamp(y0, y1)));
+            for pair in front.windows(2) {
+                let (a, b) = (at(&pair[0]), at(&pair[1]));
+                c.line(a, (b.0, a.1), black, 0);
+                c.line((b.0, a.1), b, black, 0);
+            }
+            for p in front {
+                let (x, y) = at(p);
+                let corners = [
+                    (x - 6, y - 6),
+                    (x + 6, y - 6),
+                    (x + 6, y + 6),
+                    (x - 6, y + 6),
+                ];
+                for k in 0..4 {
+                    c.line(corners[k], corners[(k + 1) % 4], black, 0);
+                }
+            }
+            if let Some(first) = front.first() {
+                let (x, y) = at(first);
+                c.text(
+                    x - 10 - Canvas::text_width(label, 2),
+                    y - 5,
+                    label,
+                    2,
+                    black,
+                );
+            }
         }
         c
     }

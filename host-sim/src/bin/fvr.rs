@@ -128,6 +128,12 @@ enum Command {
     /// against the f64 pipeline and exact line integrals, with bytes per
     /// voxel; writes a Markdown table, a CSV and a PNG plot.
     Precision(fvr_host::precision_cli::PrecisionArgs),
+    /// The speed-accuracy map: time per view, SNR against exact line
+    /// integrals and memory held over filter, oversampling, storage format,
+    /// adaptive tolerance, progressive level and volume size, on the
+    /// Gaussian-mixture phantom; writes trade.csv, trade.png (dB against ms,
+    /// Pareto fronts) and trade.md (the settings on each front).
+    Trade(fvr_host::trade::TradeArgs),
     /// The paper's Table 1 measured here: filter taps and time per view with
     /// and without adaptive filtering, and the spatial-domain ray caster, on
     /// the CT head (resampled to 128 along its longest side), a 256³ volume
@@ -573,6 +579,7 @@ fn main() -> ExitCode {
             runs,
         }) => adaptive_table(tolerance, bound, filter, oversample, &volumes, runs),
         Some(Command::Precision(args)) => fvr_host::precision_cli::run(&args),
+        Some(Command::Trade(args)) => fvr_host::trade::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
