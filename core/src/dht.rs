@@ -104,7 +104,7 @@ impl<'a, T: Real> Twiddles<'a, T> {
         }
     }
 
-    fn check(&self, n: usize) -> Result<()> {
+    pub(crate) fn check(&self, n: usize) -> Result<()> {
         require_pow2("transform length", n)?;
         if n > self.len {
             return Err(Error::TwiddlesTooShort {

@@ -101,9 +101,11 @@ pub fn render_level_sampled<S: Sample, T: Real>(
     if kernel.filter() != spec.filter() {
         return Err(Error::FilterMismatch);
     }
-    require_len("preview slice grid", m * m, grid.len())?;
+    require_len("slice grid", m * m, grid.len())?;
     require_len("auxiliary scratch", aux_len(m), aux.len())?;
     require_len("output image", width * height, out.len())?;
+    // Checked before the extraction, which is the bulk of the work.
+    tw.check(m)?;
     let pitch = (1u64 << level) as f64;
     extract_central_slice_on(spec, kernel, &axes, m, grid);
     let place = placement_on_axes(spec.dims(), &axes, width, height, pitch);

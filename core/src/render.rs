@@ -148,33 +148,8 @@ pub fn render_sampled<S: Sample, T: Real>(
     aux: &mut [T],
     out: &mut [T],
 ) -> Result<()> {
-    let axes = sampling.slice_axes(&view.frame()?);
-    let n = spec.n();
-    check_image(width, height, n)?;
-    if kernel.filter() != spec.filter() {
-        return Err(Error::FilterMismatch);
-    }
-    require_len("slice grid", grid_len(n), grid.len())?;
-    require_len("auxiliary scratch", aux_len(n), aux.len())?;
-    require_len("output image", width * height, out.len())?;
-    if n > tw.len() {
-        return Err(Error::TwiddlesTooShort {
-            table_len: tw.len(),
-            needed: n,
-        });
-    }
-    extract_central_slice_on(spec, kernel, &axes, n, &mut grid[..n * n]);
-    let place = placement_on_axes(spec.dims(), &axes, width, height, 1.0);
-    finish_projection(
-        &mut grid[..n * n],
-        n,
-        &place,
-        sampling.gain() / spec.scale(),
-        width,
-        height,
-        tw,
-        aux,
-        out,
+    crate::progressive::render_level_sampled(
+        spec, kernel, view, sampling, width, height, 0, tw, grid, aux, out,
     )
 }
 
