@@ -1,7 +1,7 @@
 //! The `fvr` program end to end: outputs, and clear errors on bad input.
 
 mod common;
-use common::{assert_error, fvr, temp_dir};
+use common::{assert_error, assert_ok, fvr, temp_dir};
 
 use fvr_host::nrrd::{encode_nrrd, Encoding, Endian, SampleType};
 
@@ -10,11 +10,7 @@ fn no_arguments_renders_the_default_scene_and_says_where() {
     let dir = temp_dir("default");
     let out = fvr(&[], &dir);
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     assert!(stdout.contains("wrote fvr-default.png"), "{stdout}");
     let png = std::fs::read(dir.join("fvr-default.png")).unwrap();
     assert_eq!(&png[1..4], b"PNG");
@@ -39,11 +35,7 @@ fn render_to_nrrd_and_compare_precisions() {
             ],
             &dir,
         );
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        assert_ok(&out);
     }
     let out = fvr(&["compare", "f64.nrrd", "f16.nrrd"], &dir);
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -224,11 +216,7 @@ fn precision_study_writes_markdown_csv_and_png_with_no_non_finite_pixel() {
         ],
         &dir,
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let csv = std::fs::read_to_string(dir.join("out/precision.csv")).unwrap();
     let lines: Vec<&str> = csv.lines().collect();
     assert!(lines[0].starts_with("volume,size,grid,format,arithmetic,bytes_per_voxel"));
@@ -278,11 +266,7 @@ fn precision_extremes_table_reports_every_case() {
         &["precision", "--extremes", "8", "--formats", "f16,q15-line"],
         &dir,
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let md = String::from_utf8_lossy(&out.stdout);
     for case in [
         "constant 1",

@@ -2,7 +2,7 @@
 //! clear errors on bad scene values.
 
 mod common;
-use common::{assert_error, fvr, temp_dir};
+use common::{assert_error, assert_ok, fvr, temp_dir};
 
 use fvr_host::nrrd::read_nrrd;
 
@@ -25,11 +25,7 @@ fn lit_and_cued_render_writes_rgb_nrrd_and_reports_memory() {
     ]);
     let out = fvr(&args, &dir);
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     assert!(stdout.contains("RGB"), "{stdout}");
     assert!(stdout.contains("second spectrum"), "{stdout}");
     let image = read_nrrd(&dir.join("lit.nrrd")).unwrap();
@@ -74,11 +70,7 @@ fn light_ring_and_profile_cue_render_png() {
         "ring.png",
     ]);
     let out = fvr(&args, &dir);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let decoder = png::Decoder::new(std::io::BufReader::new(
         std::fs::File::open(dir.join("ring.png")).unwrap(),
     ));
@@ -156,11 +148,7 @@ fn adaptive_and_preview_options_report_and_refuse_conflicts() {
     args.extend(["--adaptive", "40", "--stats-json", "--out", "a.nrrd"]);
     let out = fvr(&args, &dir);
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let json = stdout
         .lines()
         .find(|l| l.starts_with('{'))
@@ -186,11 +174,7 @@ fn adaptive_and_preview_options_report_and_refuse_conflicts() {
     let mut preview = base.to_vec();
     preview.extend(["--preview-level", "1", "--out", "p.nrrd"]);
     let out = fvr(&preview, &dir);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     // 32³ at oversampling 2: a 32² image by default, 16² at level 1.
     assert_eq!(read_nrrd(&dir.join("p.nrrd")).unwrap().dims, [16, 16, 1]);
 

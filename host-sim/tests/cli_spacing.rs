@@ -3,7 +3,7 @@
 //! on anisotropic voxels.
 
 mod common;
-use common::{assert_error, fvr, temp_dir};
+use common::{assert_error, assert_ok, fvr, temp_dir};
 
 use std::path::Path;
 
@@ -45,15 +45,6 @@ fn write_volume_of(path: &Path, dims: [usize; 3], spacing: Option<[f64; 3]>) {
     std::fs::write(path, bytes).unwrap();
 }
 
-fn ok_stdout(out: &std::process::Output) -> String {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
 /// By default the spacing from the file is used, with the smallest spacing
 /// as pixel size: the image matches the exact line integrals in mm at the
 /// kb4/f16 floor (50 dB), and `--stats` reports both.
@@ -61,7 +52,7 @@ fn ok_stdout(out: &std::process::Output) -> String {
 fn render_uses_the_files_spacing_and_matches_exact_in_mm() {
     let dir = temp_dir("spacing-default");
     write_volume(&dir.join("v.nrrd"), Some(SPACING));
-    let stdout = ok_stdout(&fvr(
+    let stdout = assert_ok(&fvr(
         &[
             "render",
             "v.nrrd",
@@ -88,7 +79,7 @@ fn render_uses_the_files_spacing_and_matches_exact_in_mm() {
     assert!(snr >= 50.0, "{snr:.2} dB");
 
     // A coarser --pixel-size halves the pixel count across the same extent.
-    ok_stdout(&fvr(
+    assert_ok(&fvr(
         &[
             "render",
             "v.nrrd",
@@ -118,7 +109,7 @@ fn render_uses_the_files_spacing_and_matches_exact_in_mm() {
 fn default_pixel_size_fits_the_longest_side() {
     let dir = temp_dir("spacing-fit");
     write_volume_of(&dir.join("v.nrrd"), [64, 63, 35], Some(SPACING));
-    let stdout = ok_stdout(&fvr(
+    let stdout = assert_ok(&fvr(
         &[
             "render", "v.nrrd", "--dir", "0,1,0", "--out", "a.nrrd", "--stats",
         ],
@@ -138,7 +129,7 @@ fn default_pixel_size_fits_the_longest_side() {
         ],
         &dir,
     );
-    ok_stdout(&out);
+    assert_ok(&out);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("wrap"), "{err}");
 }
@@ -156,13 +147,13 @@ fn ignore_spacing_is_the_voxel_unit_render() {
     ] {
         let mut args = vec!["render", input, "--dir", "1,0.3,0.2", "--out", out];
         args.extend(extra);
-        ok_stdout(&fvr(&args, &dir));
+        assert_ok(&fvr(&args, &dir));
     }
     let a = std::fs::read(dir.join("ignored.nrrd")).unwrap();
     let b = std::fs::read(dir.join("plain-out.nrrd")).unwrap();
     assert_eq!(a, b);
     let spaced = {
-        ok_stdout(&fvr(
+        assert_ok(&fvr(
             &[
                 "render",
                 "spaced.nrrd",
@@ -198,7 +189,7 @@ fn cued_or_lit_anisotropic_renders_are_refused_until_resampled() {
         let mut args = base.to_vec();
         args.extend(extra);
         args.extend(["--resample", "48"]);
-        ok_stdout(&fvr(&args, &dir));
+        assert_ok(&fvr(&args, &dir));
     }
 }
 
@@ -232,7 +223,7 @@ fn turntable_uses_the_spacing_too() {
         let mut args = base.to_vec();
         args.extend(extra);
         args.extend(["--out", "s.apng"]);
-        ok_stdout(&fvr(&args, &dir));
+        assert_ok(&fvr(&args, &dir));
         assert!(dir.join("s.apng").exists());
     }
     let mut args = base.to_vec();
@@ -260,7 +251,7 @@ fn adaptive_renders_cubic_voxels_in_mm_and_refuses_anisotropic_ones() {
         let mut args = base.to_vec();
         args.extend(extra);
         args.extend(["--out", out]);
-        ok_stdout(&fvr(&args, &dir));
+        assert_ok(&fvr(&args, &dir));
         let data: Vec<f64> = read_nrrd(&dir.join(out))
             .unwrap()
             .data

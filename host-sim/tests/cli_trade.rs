@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{assert_error, fvr, temp_dir};
+use common::{assert_error, assert_ok, fvr, temp_dir};
 
 /// The header `fvr trade` writes, as documented in docs/trade/README.md.
 const HEADER: &str = "size,grid,filter,oversample,format,adaptive_db,level,image_side,views,\
@@ -37,11 +37,7 @@ fn tiny_sweep_writes_csv_png_and_summary_with_one_row_per_point() {
         ],
         &dir,
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let csv = std::fs::read_to_string(dir.join("out/trade.csv")).unwrap();
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines[0], HEADER);

@@ -4,7 +4,7 @@
 //! file and the key.
 
 mod common;
-use common::{assert_error, fvr, temp_dir};
+use common::{assert_error, assert_ok, fvr, temp_dir};
 
 const SCENE: &str = r#"
 [volume]
@@ -49,25 +49,16 @@ const EQUIVALENT_FLAGS: [&str; 18] = [
     "-1,-0.5,0.4:0.5",
 ];
 
-fn ok(out: &std::process::Output) -> String {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
 #[test]
 fn scene_and_equivalent_flags_write_identical_nrrd_bytes() {
     let dir = temp_dir("scenefile-same");
     std::fs::create_dir_all(dir.join("scenes/out")).unwrap();
     std::fs::write(dir.join("scenes/lit.toml"), SCENE).unwrap();
     // Run from elsewhere: the output lands next to the scene file.
-    ok(&fvr(&["render", "--scene", "scenes/lit.toml"], &dir));
+    assert_ok(&fvr(&["render", "--scene", "scenes/lit.toml"], &dir));
     let mut flags = EQUIVALENT_FLAGS.to_vec();
     flags.extend(["--out", "flags.nrrd"]);
-    ok(&fvr(&flags, &dir));
+    assert_ok(&fvr(&flags, &dir));
     let from_scene = std::fs::read(dir.join("scenes/out/scene.nrrd")).unwrap();
     let from_flags = std::fs::read(dir.join("flags.nrrd")).unwrap();
     assert!(from_scene.len() > 24 * 20 * 3 * 4);
@@ -81,7 +72,7 @@ fn flags_override_the_scene() {
     std::fs::write(dir.join("lit.toml"), SCENE).unwrap();
     // Size, output (relative to the working directory) and lights replaced:
     // one grey light makes an RGB image with equal channels.
-    let stdout = ok(&fvr(
+    let stdout = assert_ok(&fvr(
         &[
             "render",
             "--scene",
@@ -101,7 +92,7 @@ fn flags_override_the_scene() {
     assert!(image.data.chunks(3).all(|p| p[0] == p[1] && p[1] == p[2]));
     assert!(image.data.iter().any(|&v| v > 0.0));
     // The volume on the command line replaces the scene's.
-    let stdout = ok(&fvr(
+    let stdout = assert_ok(&fvr(
         &["render", "sphere@16", "--scene", "lit.toml", "--stats"],
         &dir,
     ));
@@ -165,7 +156,7 @@ fn turntable_reads_the_scene() {
     )
     .unwrap();
     let out = fvr(&["turntable", "--scene", "spin.toml"], &dir);
-    let stdout = ok(&out);
+    let stdout = assert_ok(&out);
     assert!(stdout.contains("(3 frames, 12x12, 5 fps)"), "{stdout}");
     assert!(String::from_utf8_lossy(&out.stderr).contains("does not use the scene's [shading]"));
     assert!(dir.join("spin.apng").is_file());
@@ -229,7 +220,7 @@ fn example_scenes_parse_and_render() {
                 &dir,
             )
         };
-        let stdout = ok(&out);
+        let stdout = assert_ok(&out);
         assert!(stdout.contains("wrote"), "{name}: {stdout}");
         rendered += 1;
     }
@@ -251,7 +242,7 @@ fn teapot_names_are_checked() {
     }
     let mut args = vec!["render", "teapot@24"];
     args.extend(base);
-    assert!(ok(&fvr(&args, &dir)).contains("wrote t.png (32x32 grey)"));
+    assert!(assert_ok(&fvr(&args, &dir)).contains("wrote t.png (32x32 grey)"));
 }
 
 #[test]
@@ -269,7 +260,7 @@ fn turntable_stats_json_is_one_object_with_views_per_second() {
         ],
         &dir,
     );
-    let stdout = ok(&out);
+    let stdout = assert_ok(&out);
     let json = stdout
         .lines()
         .find(|l| l.starts_with('{'))

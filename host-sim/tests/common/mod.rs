@@ -29,3 +29,13 @@ pub fn assert_error(out: &Output, needles: &[&str]) {
         assert!(err.contains(n), "`{n}` not in: {err}");
     }
 }
+
+/// Exit status 0; returns stdout. Panics with stderr otherwise.
+pub fn assert_ok(out: &Output) -> String {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
