@@ -639,14 +639,17 @@ impl<T: Real> KernelTable<T> {
 /// `k(p + W/2 − 1 − m)` for `m = 0 … W−1`, each an entry of the kernel table
 /// itself (`|i + (W−2)·512 − 1024·m|`), so no value is rounded anew.
 ///
-/// [`PhaseTable::taps`] finds a sample's first tap and phase with one
-/// floor and interpolates its `W` weights between two adjacent rows, where
+/// [`PhaseTable::taps_fixed_point`] finds a sample's first tap and phase
+/// from its position in fixed point ([`PhaseTable::fixed_position`]: one
+/// floor, or along a slice row one integer step) and interpolates its `W`
+/// weights between two adjacent rows, where
 /// [`KernelTable::taps_fixed`] looks each weight up on its own. This is the
 /// per-axis setup of every slice sample (3 per pixel), so it matters.
 ///
 /// # Accuracy
 /// As [`KernelTable`]: the same entries, linearly interpolated at the same
-/// fractions (to the rounding of the fraction, `ε·1024·|q|` in index units).
+/// fractions (to the rounding of the fraction: `ε·1024·|q|` in index units
+/// for the position, `2^−42` for the fixed point).
 #[derive(Clone, Debug)]
 pub(crate) struct PhaseTable<T, const W: usize> {
     rows: [[T; W]; TABLE_RESOLUTION + 1],
@@ -682,26 +685,51 @@ impl<T: Real, const W: usize> PhaseTable<T, W> {
         Ok(())
     }
 
-    /// Taps of a sample at fractional index `q`: the first tap's index
-    /// `j0 = ⌊q − W/2⌋ + 1` and the weights `k(q − j0 − m)`. With `Y = 1024·q − 512·W` and `F = ⌊Y⌋`, `j0 = ⌊F/1024⌋ + 1`
-    /// and the phase row is `F mod 1024`, interpolated by `Y − F`.
+    /// The position `Y = 1024·q − 512·W` of a sample at `q` in 32.32 fixed
+    /// point, `⌊Y·2^32⌋`: the first tap is `j0 = ⌊q − W/2⌋ + 1 = ⌊F/1024⌋ + 1`
+    /// and the phase row `F mod 1024` for `F = ⌊Y⌋`, found by one truncation
+    /// and one correction below zero (slice points lie inside the Nyquist
+    /// cube, so `|Y| ≤ 512·(n + W)` is far inside the i32 range); the fraction is `Y − F`
+    /// (exact in `T`) times `2^32`, truncated. Rows of the slice start from
+    /// this and add [`PhaseTable::fixed_step`] per pixel.
     #[inline(always)]
-    pub(crate) fn taps(&self, q: T) -> (i64, [T; W]) {
+    pub(crate) fn fixed_position(q: T) -> i64 {
         let y = q * T::from_usize(TABLE_RESOLUTION) - T::from_usize(W * TABLE_RESOLUTION / 2);
-        // ⌊y⌋ by truncation and one correction below zero; slice points lie
-        // inside the Nyquist cube, so |y| ≤ 512·n is far inside the i32 range.
         let t = y.trunc_i32();
         let floor = t - (T::from_i32(t) > y) as i32;
-        let f = y - T::from_i32(floor);
+        let fraction = (y - T::from_i32(floor)) * T::from_f64(FIXED_ONE);
+        // < 2^32 (a fraction below 1 times a power of two); the bound keeps
+        // 64- and 32-bit `usize` alike should it ever not be.
+        let fraction = fraction.trunc_usize().min(u32::MAX as usize);
+        ((floor as i64) << 32) + fraction as i64
+    }
+
+    /// The step of [`PhaseTable::fixed_position`] for a unit step of `q`
+    /// along `r`: `1024·r·2^32`, rounded to nearest. Over a row of `m`
+    /// pixels its rounding (≤ 2^−33 of a phase step a pixel) moves a sample
+    /// by at most `m·2^−43` index units, far below `T`'s own rounding of
+    /// `q` in f32 (`2^−24·|q|`).
+    pub(crate) fn fixed_step(r: T) -> i64 {
+        (r * T::from_f64(FIXED_ONE * TABLE_RESOLUTION as f64) + T::HALF).floor_i64()
+    }
+
+    /// Taps of the sample at fixed-point position `y`
+    /// ([`PhaseTable::fixed_position`]): the first tap's index `j0` and the
+    /// weights `k(q − j0 − m)`, `m = 0 … W−1`, interpolated between phase
+    /// rows `F mod 1024` and the next by the 32-bit fraction.
+    #[inline(always)]
+    pub(crate) fn taps_fixed_point(&self, y: i64) -> (i32, [T; W]) {
+        let floor = (y >> 32) as i32;
+        let f = T::from_usize(y as u32 as usize) * T::from_f64(1.0 / FIXED_ONE);
         let row = (floor & (TABLE_RESOLUTION as i32 - 1)) as usize;
         let (p0, p1) = (&self.rows[row], &self.rows[row + 1]);
         let weights = core::array::from_fn(|m| p0[m] + f * (p1[m] - p0[m]));
-        (
-            ((floor >> TABLE_RESOLUTION.trailing_zeros()) + 1) as i64,
-            weights,
-        )
+        ((floor >> TABLE_RESOLUTION.trailing_zeros()) + 1, weights)
     }
 }
+
+/// One in the 32.32 fixed point of [`PhaseTable::fixed_position`].
+const FIXED_ONE: f64 = 4_294_967_296.0;
 
 /// The kernel derivative `k'` tabulated like [`KernelTable`] (odd: the table
 /// holds `k'(|t|)` and [`DerivativeTable::eval`] restores the sign). Built

@@ -471,6 +471,57 @@ impl<T: Real> SliceRows<T> {
         }
     }
 
+    /// Calls `pixel(slot, y)` for every slice point of the rows inside the
+    /// Nyquist cube, with `y` its per-axis phase-table positions in fixed
+    /// point ([`PhaseTable::fixed_position`]), and zeroes the points
+    /// outside. One point of a row's interval is placed from
+    /// `q = kx·r + ky·u` in `T` as in [`SliceRows::for_each`]; along the row
+    /// `q` advances by `r`, so each next `y` is the last plus
+    /// [`PhaseTable::fixed_step`]`(r)`: two integer additions an axis
+    /// instead of a product, a sum and a floor in floating point.
+    #[inline(always)]
+    fn for_each_fixed<const W: usize>(
+        &self,
+        n: usize,
+        grid: &mut [T],
+        mut pixel: impl FnMut(&mut T, [i64; 3]),
+    ) {
+        let m = self.m;
+        let step = self.right.map(PhaseTable::<T, W>::fixed_step);
+        // Signed frequencies of a row: −⌊m/2⌋ … ⌈m/2⌉ − 1 (`signed_index`).
+        let (k_min, k_max) = (-((m / 2) as i32), ((m - 1) / 2) as i32);
+        let mask = m.wrapping_sub(1);
+        for (row_offset, row) in grid.chunks_exact_mut(m).enumerate() {
+            row.fill(T::ZERO);
+            let ky = T::from_i32(signed_index(self.first_row + row_offset, m) as i32);
+            let kyu = self.up.map(|c| ky * c);
+            let (low, high) = self.row_interval(n, kyu);
+            let (low, high) = (low.max(k_min), high.min(k_max));
+            if low > high {
+                continue;
+            }
+            // The row is anchored at `kx = 0` (or the nearest point of its
+            // interval), where `q = ky·u` is as exact as `T` makes it: the
+            // low frequencies, which carry most of the energy, then get
+            // the least rounding (the steps are exact multiples of `r`).
+            let anchor = 0.clamp(low, high);
+            let kx = T::from_i32(anchor);
+            let mut y: [i64; 3] = core::array::from_fn(|a| {
+                PhaseTable::<T, W>::fixed_position(kx * self.right[a] + kyu[a])
+                    + (low - anchor) as i64 * step[a]
+            });
+            for k in low..=high {
+                // `m` is a power of two: `k mod m` by a mask.
+                if let Some(g) = row.get_mut(k as usize & mask) {
+                    pixel(g, y);
+                }
+                for a in 0..3 {
+                    y[a] += step[a];
+                }
+            }
+        }
+    }
+
     /// The integers `kx` in `[low, high]` for which `|kx·r_a + c_a| ≤ n/2` on
     /// every axis (`c = ky·u`): the intersection of three intervals, each
     /// `(±n/2 − c_a)/r_a`, rounded inwards. Points within rounding of the
@@ -528,13 +579,13 @@ fn extract_lines<const W: usize, const LINE_EXP: bool, S: Sample, T: Real>(
             acc_x
         }
     };
-    geometry.for_each(n, grid, |g, q| {
-        let (jx, wx) = phases.taps(q[0]);
-        let (jy, wy) = phases.taps(q[1]);
-        let (jz, wz) = phases.taps(q[2]);
+    geometry.for_each_fixed::<W>(n, grid, |g, y| {
+        let (jx, wx) = phases.taps_fixed_point(y[0]);
+        let (jy, wy) = phases.taps_fixed_point(y[1]);
+        let (jz, wz) = phases.taps_fixed_point(y[2]);
         let wx = wx.map(|w| w * raw_gain);
-        let lines: [usize; W] = core::array::from_fn(|b| ((jy + b as i64) as usize & mask) * n);
-        let planes: [usize; W] = core::array::from_fn(|c| ((jz + c as i64) as usize & mask) * nn);
+        let lines: [usize; W] = core::array::from_fn(|b| ((jy + b as i32) as usize & mask) * n);
+        let planes: [usize; W] = core::array::from_fn(|c| ((jz + c as i32) as usize & mask) * nn);
         let x0 = jx as usize & mask;
         let mut acc = T::ZERO;
         if x0 + W <= n {
@@ -557,7 +608,7 @@ fn extract_lines<const W: usize, const LINE_EXP: bool, S: Sample, T: Real>(
                 acc += wz[c] * acc_y;
             }
         } else {
-            let xs: [usize; W] = core::array::from_fn(|t| (jx + t as i64) as usize & mask);
+            let xs: [usize; W] = core::array::from_fn(|t| (jx + t as i32) as usize & mask);
             for c in 0..W {
                 let mut acc_y = T::ZERO;
                 for b in 0..W {
