@@ -673,16 +673,42 @@ impl<T: Real, const W: usize> PhaseTable<T, W> {
         if width != W {
             return Err(crate::error::mismatch("phase table width", width, W));
         }
-        let values = &kernel.samples.values;
+        self.gather(&kernel.samples, false);
+        Ok(())
+    }
+
+    /// Gather the rows of the kernel derivative `k'` from `derivative`
+    /// (odd: an entry at a negative argument is the negated entry at its
+    /// absolute value, as [`DerivativeTable::eval`]), whose width must be
+    /// `W`. Its rows pair with a [`PhaseTable::fill`]ed one at the same
+    /// positions: the same taps, the derivative weights.
+    ///
+    /// # Errors
+    /// A table of another width ([`Error::LengthMismatch`]).
+    pub(crate) fn fill_derivative(&mut self, derivative: &DerivativeTable<T>) -> Result<()> {
+        let width = derivative.filter().width();
+        if width != W {
+            return Err(crate::error::mismatch("phase table width", width, W));
+        }
+        self.gather(&derivative.samples, true);
+        Ok(())
+    }
+
+    /// Row `i`, weight `m`: the entry at `i + (W−2)·512 − 1024·m`.
+    fn gather(&mut self, samples: &Samples<T>, odd: bool) {
+        let values = &samples.values;
         let centre = (W as i64 - 2) * (TABLE_RESOLUTION as i64 / 2);
         for (i, row) in self.rows.iter_mut().enumerate() {
             for (m, w) in row.iter_mut().enumerate() {
-                let index = (i as i64 + centre - (m * TABLE_RESOLUTION) as i64).unsigned_abs();
+                let signed = i as i64 + centre - (m * TABLE_RESOLUTION) as i64;
                 // |index| ≤ W·512 < the table's length; 0 beyond, like `lerp`.
-                *w = values.get(index as usize).copied().unwrap_or(T::ZERO);
+                let v = values
+                    .get(signed.unsigned_abs() as usize)
+                    .copied()
+                    .unwrap_or(T::ZERO);
+                *w = if odd && signed < 0 { -v } else { v };
             }
         }
-        Ok(())
     }
 
     /// The position `Y = 1024·q − 512·W` of a sample at `q` in 32.32 fixed

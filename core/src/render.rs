@@ -376,6 +376,78 @@ impl<'a> LineReads<'a> {
         }
     }
 
+    /// [`LineReads::sum`] with raw widening ([`Real::load_raw`]): the
+    /// weights must carry the `2^e` of [`Real::raw_exponent`]. Plain and
+    /// per-line-exponent reads only (never [`LineReads::General`], whose
+    /// per-tap exponents this does not apply).
+    #[inline(always)]
+    pub(crate) fn sum_raw<const W: usize, S: Sample, T: Real>(
+        self,
+        spec: &Spectrum<'_, S>,
+        line: usize,
+        x0: usize,
+        contiguous: bool,
+        xs: &[usize; W],
+        weights: &[T; W],
+    ) -> T {
+        let mut sum = T::ZERO;
+        match Self::run::<W, S>(spec, line, x0, contiguous) {
+            Some(run) => {
+                for t in 0..W {
+                    sum += weights[t] * T::load_raw(run[t]);
+                }
+            }
+            None => {
+                let data = spec.data();
+                for t in 0..W {
+                    let v = data.get(line + xs[t]).copied().unwrap_or_default();
+                    sum += weights[t] * T::load_raw(v);
+                }
+            }
+        }
+        match self.line_scale::<S, T>(spec, line) {
+            Some(scale) => sum * scale,
+            None => sum,
+        }
+    }
+
+    /// [`LineReads::sum2`] with raw widening, as [`LineReads::sum_raw`]
+    /// (both weight sets carry the `2^e`).
+    #[inline(always)]
+    pub(crate) fn sum2_raw<const W: usize, S: Sample, T: Real>(
+        self,
+        spec: &Spectrum<'_, S>,
+        line: usize,
+        x0: usize,
+        contiguous: bool,
+        xs: &[usize; W],
+        first: &[T; W],
+        second: &[T; W],
+    ) -> (T, T) {
+        let (mut a, mut b) = (T::ZERO, T::ZERO);
+        match Self::run::<W, S>(spec, line, x0, contiguous) {
+            Some(run) => {
+                for t in 0..W {
+                    let v = T::load_raw(run[t]);
+                    a += first[t] * v;
+                    b += second[t] * v;
+                }
+            }
+            None => {
+                let data = spec.data();
+                for t in 0..W {
+                    let v = T::load_raw(data.get(line + xs[t]).copied().unwrap_or_default());
+                    a += first[t] * v;
+                    b += second[t] * v;
+                }
+            }
+        }
+        match self.line_scale::<S, T>(spec, line) {
+            Some(scale) => (a * scale, b * scale),
+            None => (a, b),
+        }
+    }
+
     /// Two weighted sums over the same taps, each coefficient read once
     /// (the value and a derivative of [`LineReads::sum`]).
     #[inline(always)]
