@@ -336,9 +336,18 @@ impl<'a> LineReads<'a> {
         if !contiguous {
             return None;
         }
-        spec.data()
-            .get(line + x0..line + x0 + W)
-            .and_then(|s| <&[S; W]>::try_from(s).ok())
+        let start = line + x0;
+        // As in `extract_lines`: for W ≤ 4 the tail's first chunk (no
+        // overflow test of `start + W`).
+        if W <= 4 {
+            spec.data()
+                .get(start..)
+                .and_then(|rest| rest.first_chunk::<W>())
+        } else {
+            spec.data()
+                .get(start..start + W)
+                .and_then(|s| <&[S; W]>::try_from(s).ok())
+        }
     }
 
     /// The block exponent's power of two for `line`, if lines carry one.
