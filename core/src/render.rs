@@ -665,8 +665,14 @@ fn extract_lines<const W: usize, const LINE_EXP: bool, S: Sample, T: Real>(
         let (jy, wy) = phases.taps_fixed_point(y[1]);
         let (jz, wz) = phases.taps_fixed_point(y[2]);
         let wx = wx.map(|w| w * raw_gain);
-        let lines: [usize; W] = core::array::from_fn(|b| ((jy + b as i32) as usize & mask) * n);
-        let planes: [usize; W] = core::array::from_fn(|c| ((jz + c as i32) as usize & mask) * nn);
+        // `((j + b) mod n)·n` as `(j·n + b·n) mod n²`, in wrapping usize:
+        // the offsets of the taps' lines and planes with one product an axis.
+        let (y0, z0) = (
+            (jy as usize).wrapping_mul(n),
+            (jz as usize).wrapping_mul(nn),
+        );
+        let lines: [usize; W] = core::array::from_fn(|b| y0.wrapping_add(b * n) & (nn - n));
+        let planes: [usize; W] = core::array::from_fn(|c| z0.wrapping_add(c * nn) & (nn * n - nn));
         let x0 = jx as usize & mask;
         let mut acc = T::ZERO;
         if x0 + W <= n {
