@@ -635,9 +635,10 @@ impl<T: Real> KernelTable<T> {
 }
 
 /// The weights of all `W` taps of a sample at every phase `p = i/1024`,
-/// `i = 0 ..= 1024`, gathered from a [`KernelTable`]: row `i` holds
+/// `i = 0 … 1023`, gathered from a [`KernelTable`]: row `i` holds
 /// `k(p + W/2 − 1 − m)` for `m = 0 … W−1`, each an entry of the kernel table
-/// itself (`|i + (W−2)·512 − 1024·m|`), so no value is rounded anew.
+/// itself (`|i + (W−2)·512 − 1024·m|`), so no value is rounded anew, and
+/// the differences to the next row's (`i + 1 = 1024` included).
 ///
 /// [`PhaseTable::taps_fixed_point`] finds a sample's first tap and phase
 /// from its position in fixed point ([`PhaseTable::fixed_position`]: one
@@ -652,15 +653,18 @@ impl<T: Real> KernelTable<T> {
 /// for the position, `2^−42` for the fixed point).
 #[derive(Clone, Debug)]
 pub(crate) struct PhaseTable<T, const W: usize> {
-    rows: [[T; W]; TABLE_RESOLUTION + 1],
+    /// Row `i`: the weights at phase `i/1024` and their differences to
+    /// row `i + 1` (the same `p1 − p0` the interpolation would compute),
+    /// so that a weight is one multiply-add.
+    rows: [[[T; W]; 2]; TABLE_RESOLUTION],
 }
 
 impl<T: Real, const W: usize> PhaseTable<T, W> {
     /// An all-zero table, to be [`PhaseTable::fill`]ed in place (the table
-    /// is up to 24 KiB in f32: built where it stays, it is not copied).
+    /// is up to 48 KiB in f32: built where it stays, it is not copied).
     pub(crate) fn zeroed() -> Self {
         Self {
-            rows: [[T::ZERO; W]; TABLE_RESOLUTION + 1],
+            rows: [[[T::ZERO; W]; 2]; TABLE_RESOLUTION],
         }
     }
 
@@ -698,15 +702,24 @@ impl<T: Real, const W: usize> PhaseTable<T, W> {
     fn gather(&mut self, samples: &Samples<T>, odd: bool) {
         let values = &samples.values;
         let centre = (W as i64 - 2) * (TABLE_RESOLUTION as i64 / 2);
-        for (i, row) in self.rows.iter_mut().enumerate() {
-            for (m, w) in row.iter_mut().enumerate() {
-                let signed = i as i64 + centre - (m * TABLE_RESOLUTION) as i64;
-                // |index| ≤ W·512 < the table's length; 0 beyond, like `lerp`.
-                let v = values
-                    .get(signed.unsigned_abs() as usize)
-                    .copied()
-                    .unwrap_or(T::ZERO);
-                *w = if odd && signed < 0 { -v } else { v };
+        let entry = |i: usize, m: usize| {
+            let signed = i as i64 + centre - (m * TABLE_RESOLUTION) as i64;
+            // |index| ≤ W·512 < the table's length; 0 beyond, like `lerp`.
+            let v = values
+                .get(signed.unsigned_abs() as usize)
+                .copied()
+                .unwrap_or(T::ZERO);
+            if odd && signed < 0 {
+                -v
+            } else {
+                v
+            }
+        };
+        for (i, [weights, differences]) in self.rows.iter_mut().enumerate() {
+            for m in 0..W {
+                let (w0, w1) = (entry(i, m), entry(i + 1, m));
+                weights[m] = w0;
+                differences[m] = w1 - w0;
             }
         }
     }
@@ -748,8 +761,8 @@ impl<T: Real, const W: usize> PhaseTable<T, W> {
         let floor = (y >> 32) as i32;
         let f = T::from_usize(y as u32 as usize) * T::from_f64(1.0 / FIXED_ONE);
         let row = (floor & (TABLE_RESOLUTION as i32 - 1)) as usize;
-        let (p0, p1) = (&self.rows[row], &self.rows[row + 1]);
-        let weights = core::array::from_fn(|m| p0[m] + f * (p1[m] - p0[m]));
+        let [p0, dp] = &self.rows[row];
+        let weights = core::array::from_fn(|m| p0[m] + f * dp[m]);
         ((floor >> TABLE_RESOLUTION.trailing_zeros()) + 1, weights)
     }
 }
