@@ -635,29 +635,36 @@ impl<T: Real> KernelTable<T> {
 }
 
 /// The weights of all `W` taps of a sample at every phase `p = i/1024`,
-/// `i = 0 ..= 1024`, gathered from a [`KernelTable`]: row `i` holds
+/// `i = 0 … 1023`, gathered from a [`KernelTable`]: row `i` holds
 /// `k(p + W/2 − 1 − m)` for `m = 0 … W−1`, each an entry of the kernel table
-/// itself (`|i + (W−2)·512 − 1024·m|`), so no value is rounded anew.
+/// itself (`|i + (W−2)·512 − 1024·m|`), so no value is rounded anew, and
+/// the differences to the next row's (`i + 1 = 1024` included).
 ///
-/// [`PhaseTable::taps`] finds a sample's first tap and phase with one
-/// floor and interpolates its `W` weights between two adjacent rows, where
+/// [`PhaseTable::taps_fixed_point`] finds a sample's first tap and phase
+/// from its position in fixed point ([`PhaseTable::fixed_position`]: one
+/// floor, or along a slice row one integer step) and interpolates its `W`
+/// weights between two adjacent rows, where
 /// [`KernelTable::taps_fixed`] looks each weight up on its own. This is the
 /// per-axis setup of every slice sample (3 per pixel), so it matters.
 ///
 /// # Accuracy
 /// As [`KernelTable`]: the same entries, linearly interpolated at the same
-/// fractions (to the rounding of the fraction, `ε·1024·|q|` in index units).
+/// fractions (to the rounding of the fraction: `ε·1024·|q|` in index units
+/// for the position, `2^−42` for the fixed point).
 #[derive(Clone, Debug)]
 pub(crate) struct PhaseTable<T, const W: usize> {
-    rows: [[T; W]; TABLE_RESOLUTION + 1],
+    /// Row `i`: the weights at phase `i/1024` and their differences to
+    /// row `i + 1` (the same `p1 − p0` the interpolation would compute),
+    /// so that a weight is one multiply-add.
+    rows: [[[T; W]; 2]; TABLE_RESOLUTION],
 }
 
 impl<T: Real, const W: usize> PhaseTable<T, W> {
     /// An all-zero table, to be [`PhaseTable::fill`]ed in place (the table
-    /// is up to 24 KiB in f32: built where it stays, it is not copied).
+    /// is up to 48 KiB in f32: built where it stays, it is not copied).
     pub(crate) fn zeroed() -> Self {
         Self {
-            rows: [[T::ZERO; W]; TABLE_RESOLUTION + 1],
+            rows: [[[T::ZERO; W]; 2]; TABLE_RESOLUTION],
         }
     }
 
@@ -670,38 +677,98 @@ impl<T: Real, const W: usize> PhaseTable<T, W> {
         if width != W {
             return Err(crate::error::mismatch("phase table width", width, W));
         }
-        let values = &kernel.samples.values;
-        let centre = (W as i64 - 2) * (TABLE_RESOLUTION as i64 / 2);
-        for (i, row) in self.rows.iter_mut().enumerate() {
-            for (m, w) in row.iter_mut().enumerate() {
-                let index = (i as i64 + centre - (m * TABLE_RESOLUTION) as i64).unsigned_abs();
-                // |index| ≤ W·512 < the table's length; 0 beyond, like `lerp`.
-                *w = values.get(index as usize).copied().unwrap_or(T::ZERO);
-            }
-        }
+        self.gather(&kernel.samples, false);
         Ok(())
     }
 
-    /// Taps of a sample at fractional index `q`: the first tap's index
-    /// `j0 = ⌊q − W/2⌋ + 1` and the weights `k(q − j0 − m)`. With `Y = 1024·q − 512·W` and `F = ⌊Y⌋`, `j0 = ⌊F/1024⌋ + 1`
-    /// and the phase row is `F mod 1024`, interpolated by `Y − F`.
+    /// Gather the rows of the kernel derivative `k'` from `derivative`
+    /// (odd: an entry at a negative argument is the negated entry at its
+    /// absolute value, as [`DerivativeTable::eval`]), whose width must be
+    /// `W`. Its rows pair with a [`PhaseTable::fill`]ed one at the same
+    /// positions: the same taps, the derivative weights.
+    ///
+    /// # Errors
+    /// A table of another width ([`Error::LengthMismatch`]).
+    pub(crate) fn fill_derivative(&mut self, derivative: &DerivativeTable<T>) -> Result<()> {
+        let width = derivative.filter().width();
+        if width != W {
+            return Err(crate::error::mismatch("phase table width", width, W));
+        }
+        self.gather(&derivative.samples, true);
+        Ok(())
+    }
+
+    /// Row `i`, weight `m`: the entry at `i + (W−2)·512 − 1024·m`.
+    fn gather(&mut self, samples: &Samples<T>, odd: bool) {
+        let values = &samples.values;
+        let centre = (W as i64 - 2) * (TABLE_RESOLUTION as i64 / 2);
+        let entry = |i: usize, m: usize| {
+            let signed = i as i64 + centre - (m * TABLE_RESOLUTION) as i64;
+            // |index| ≤ W·512 < the table's length; 0 beyond, like `lerp`.
+            let v = values
+                .get(signed.unsigned_abs() as usize)
+                .copied()
+                .unwrap_or(T::ZERO);
+            if odd && signed < 0 {
+                -v
+            } else {
+                v
+            }
+        };
+        for (i, [weights, differences]) in self.rows.iter_mut().enumerate() {
+            for m in 0..W {
+                let (w0, w1) = (entry(i, m), entry(i + 1, m));
+                weights[m] = w0;
+                differences[m] = w1 - w0;
+            }
+        }
+    }
+
+    /// The position `Y = 1024·q − 512·W` of a sample at `q` in 32.32 fixed
+    /// point, `⌊Y·2^32⌋`: the first tap is `j0 = ⌊q − W/2⌋ + 1 = ⌊F/1024⌋ + 1`
+    /// and the phase row `F mod 1024` for `F = ⌊Y⌋`, found by one truncation
+    /// and one correction below zero (slice points lie inside the Nyquist
+    /// cube, so `|Y| ≤ 512·(n + W)` is far inside the i32 range); the fraction is `Y − F`
+    /// (exact in `T`) times `2^32`, truncated. Rows of the slice start from
+    /// this and add [`PhaseTable::fixed_step`] per pixel.
     #[inline(always)]
-    pub(crate) fn taps(&self, q: T) -> (i64, [T; W]) {
+    pub(crate) fn fixed_position(q: T) -> i64 {
         let y = q * T::from_usize(TABLE_RESOLUTION) - T::from_usize(W * TABLE_RESOLUTION / 2);
-        // ⌊y⌋ by truncation and one correction below zero; slice points lie
-        // inside the Nyquist cube, so |y| ≤ 512·n is far inside the i32 range.
         let t = y.trunc_i32();
         let floor = t - (T::from_i32(t) > y) as i32;
-        let f = y - T::from_i32(floor);
+        let fraction = (y - T::from_i32(floor)) * T::from_f64(FIXED_ONE);
+        // < 2^32 (a fraction below 1 times a power of two); the bound keeps
+        // 64- and 32-bit `usize` alike should it ever not be.
+        let fraction = fraction.trunc_usize().min(u32::MAX as usize);
+        ((floor as i64) << 32) + fraction as i64
+    }
+
+    /// The step of [`PhaseTable::fixed_position`] for a unit step of `q`
+    /// along `r`: `1024·r·2^32`, rounded to nearest. Over a row of `m`
+    /// pixels its rounding (≤ 2^−33 of a phase step a pixel) moves a sample
+    /// by at most `m·2^−43` index units, far below `T`'s own rounding of
+    /// `q` in f32 (`2^−24·|q|`).
+    pub(crate) fn fixed_step(r: T) -> i64 {
+        (r * T::from_f64(FIXED_ONE * TABLE_RESOLUTION as f64) + T::HALF).floor_i64()
+    }
+
+    /// Taps of the sample at fixed-point position `y`
+    /// ([`PhaseTable::fixed_position`]): the first tap's index `j0` and the
+    /// weights `k(q − j0 − m)`, `m = 0 … W−1`, interpolated between phase
+    /// rows `F mod 1024` and the next by the 32-bit fraction.
+    #[inline(always)]
+    pub(crate) fn taps_fixed_point(&self, y: i64) -> (i32, [T; W]) {
+        let floor = (y >> 32) as i32;
+        let f = T::from_usize(y as u32 as usize) * T::from_f64(1.0 / FIXED_ONE);
         let row = (floor & (TABLE_RESOLUTION as i32 - 1)) as usize;
-        let (p0, p1) = (&self.rows[row], &self.rows[row + 1]);
-        let weights = core::array::from_fn(|m| p0[m] + f * (p1[m] - p0[m]));
-        (
-            ((floor >> TABLE_RESOLUTION.trailing_zeros()) + 1) as i64,
-            weights,
-        )
+        let [p0, dp] = &self.rows[row];
+        let weights = core::array::from_fn(|m| p0[m] + f * dp[m]);
+        ((floor >> TABLE_RESOLUTION.trailing_zeros()) + 1, weights)
     }
 }
+
+/// One in the 32.32 fixed point of [`PhaseTable::fixed_position`].
+const FIXED_ONE: f64 = 4_294_967_296.0;
 
 /// The kernel derivative `k'` tabulated like [`KernelTable`] (odd: the table
 /// holds `k'(|t|)` and [`DerivativeTable::eval`] restores the sign). Built

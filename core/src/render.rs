@@ -311,9 +311,18 @@ impl<'a> LineReads<'a> {
         if !contiguous {
             return None;
         }
-        spec.data()
-            .get(line + x0..line + x0 + W)
-            .and_then(|s| <&[S; W]>::try_from(s).ok())
+        let start = line + x0;
+        // As in `extract_lines`: for W ≤ 4 the tail's first chunk (no
+        // overflow test of `start + W`).
+        if W <= 4 {
+            spec.data()
+                .get(start..)
+                .and_then(|rest| rest.first_chunk::<W>())
+        } else {
+            spec.data()
+                .get(start..start + W)
+                .and_then(|s| <&[S; W]>::try_from(s).ok())
+        }
     }
 
     /// The block exponent's power of two for `line`, if lines carry one.
@@ -348,6 +357,78 @@ impl<'a> LineReads<'a> {
         match self.line_scale::<S, T>(spec, line) {
             Some(scale) => sum * scale,
             None => sum,
+        }
+    }
+
+    /// [`LineReads::sum`] with raw widening ([`Real::load_raw`]): the
+    /// weights must carry the `2^e` of [`Real::raw_exponent`]. Plain and
+    /// per-line-exponent reads only (never [`LineReads::General`], whose
+    /// per-tap exponents this does not apply).
+    #[inline(always)]
+    pub(crate) fn sum_raw<const W: usize, S: Sample, T: Real>(
+        self,
+        spec: &Spectrum<'_, S>,
+        line: usize,
+        x0: usize,
+        contiguous: bool,
+        xs: &[usize; W],
+        weights: &[T; W],
+    ) -> T {
+        let mut sum = T::ZERO;
+        match Self::run::<W, S>(spec, line, x0, contiguous) {
+            Some(run) => {
+                for t in 0..W {
+                    sum += weights[t] * T::load_raw(run[t]);
+                }
+            }
+            None => {
+                let data = spec.data();
+                for t in 0..W {
+                    let v = data.get(line + xs[t]).copied().unwrap_or_default();
+                    sum += weights[t] * T::load_raw(v);
+                }
+            }
+        }
+        match self.line_scale::<S, T>(spec, line) {
+            Some(scale) => sum * scale,
+            None => sum,
+        }
+    }
+
+    /// [`LineReads::sum2`] with raw widening, as [`LineReads::sum_raw`]
+    /// (both weight sets carry the `2^e`).
+    #[inline(always)]
+    pub(crate) fn sum2_raw<const W: usize, S: Sample, T: Real>(
+        self,
+        spec: &Spectrum<'_, S>,
+        line: usize,
+        x0: usize,
+        contiguous: bool,
+        xs: &[usize; W],
+        first: &[T; W],
+        second: &[T; W],
+    ) -> (T, T) {
+        let (mut a, mut b) = (T::ZERO, T::ZERO);
+        match Self::run::<W, S>(spec, line, x0, contiguous) {
+            Some(run) => {
+                for t in 0..W {
+                    let v = T::load_raw(run[t]);
+                    a += first[t] * v;
+                    b += second[t] * v;
+                }
+            }
+            None => {
+                let data = spec.data();
+                for t in 0..W {
+                    let v = T::load_raw(data.get(line + xs[t]).copied().unwrap_or_default());
+                    a += first[t] * v;
+                    b += second[t] * v;
+                }
+            }
+        }
+        match self.line_scale::<S, T>(spec, line) {
+            Some(scale) => (a * scale, b * scale),
+            None => (a, b),
         }
     }
 
@@ -446,6 +527,57 @@ impl<T: Real> SliceRows<T> {
         }
     }
 
+    /// Calls `pixel(slot, y)` for every slice point of the rows inside the
+    /// Nyquist cube, with `y` its per-axis phase-table positions in fixed
+    /// point ([`PhaseTable::fixed_position`]), and zeroes the points
+    /// outside. One point of a row's interval is placed from
+    /// `q = kx·r + ky·u` in `T` as in [`SliceRows::for_each`]; along the row
+    /// `q` advances by `r`, so each next `y` is the last plus
+    /// [`PhaseTable::fixed_step`]`(r)`: two integer additions an axis
+    /// instead of a product, a sum and a floor in floating point.
+    #[inline(always)]
+    fn for_each_fixed<const W: usize>(
+        &self,
+        n: usize,
+        grid: &mut [T],
+        mut pixel: impl FnMut(&mut T, [i64; 3]),
+    ) {
+        let m = self.m;
+        let step = self.right.map(PhaseTable::<T, W>::fixed_step);
+        // Signed frequencies of a row: −⌊m/2⌋ … ⌈m/2⌉ − 1 (`signed_index`).
+        let (k_min, k_max) = (-((m / 2) as i32), ((m - 1) / 2) as i32);
+        let mask = m.wrapping_sub(1);
+        for (row_offset, row) in grid.chunks_exact_mut(m).enumerate() {
+            row.fill(T::ZERO);
+            let ky = T::from_i32(signed_index(self.first_row + row_offset, m) as i32);
+            let kyu = self.up.map(|c| ky * c);
+            let (low, high) = self.row_interval(n, kyu);
+            let (low, high) = (low.max(k_min), high.min(k_max));
+            if low > high {
+                continue;
+            }
+            // The row is anchored at `kx = 0` (or the nearest point of its
+            // interval), where `q = ky·u` is as exact as `T` makes it: the
+            // low frequencies, which carry most of the energy, then get
+            // the least rounding (the steps are exact multiples of `r`).
+            let anchor = 0.clamp(low, high);
+            let kx = T::from_i32(anchor);
+            let mut y: [i64; 3] = core::array::from_fn(|a| {
+                PhaseTable::<T, W>::fixed_position(kx * self.right[a] + kyu[a])
+                    + (low - anchor) as i64 * step[a]
+            });
+            for k in low..=high {
+                // `m` is a power of two: `k mod m` by a mask.
+                if let Some(g) = row.get_mut(k as usize & mask) {
+                    pixel(g, y);
+                }
+                for a in 0..3 {
+                    y[a] += step[a];
+                }
+            }
+        }
+    }
+
     /// The integers `kx` in `[low, high]` for which `|kx·r_a + c_a| ≤ n/2` on
     /// every axis (`c = ky·u`): the intersection of three intervals, each
     /// `(±n/2 − c_a)/r_a`, rounded inwards. Points within rounding of the
@@ -503,13 +635,19 @@ fn extract_lines<const W: usize, const LINE_EXP: bool, S: Sample, T: Real>(
             acc_x
         }
     };
-    geometry.for_each(n, grid, |g, q| {
-        let (jx, wx) = phases.taps(q[0]);
-        let (jy, wy) = phases.taps(q[1]);
-        let (jz, wz) = phases.taps(q[2]);
+    geometry.for_each_fixed::<W>(n, grid, |g, y| {
+        let (jx, wx) = phases.taps_fixed_point(y[0]);
+        let (jy, wy) = phases.taps_fixed_point(y[1]);
+        let (jz, wz) = phases.taps_fixed_point(y[2]);
         let wx = wx.map(|w| w * raw_gain);
-        let lines: [usize; W] = core::array::from_fn(|b| ((jy + b as i64) as usize & mask) * n);
-        let planes: [usize; W] = core::array::from_fn(|c| ((jz + c as i64) as usize & mask) * nn);
+        // `((j + b) mod n)·n` as `(j·n + b·n) mod n²`, in wrapping usize:
+        // the offsets of the taps' lines and planes with one product an axis.
+        let (y0, z0) = (
+            (jy as usize).wrapping_mul(n),
+            (jz as usize).wrapping_mul(nn),
+        );
+        let lines: [usize; W] = core::array::from_fn(|b| y0.wrapping_add(b * n) & (nn - n));
+        let planes: [usize; W] = core::array::from_fn(|c| z0.wrapping_add(c * nn) & (nn * n - nn));
         let x0 = jx as usize & mask;
         let mut acc = T::ZERO;
         if x0 + W <= n {
@@ -517,7 +655,18 @@ fn extract_lines<const W: usize, const LINE_EXP: bool, S: Sample, T: Real>(
                 let mut acc_y = T::ZERO;
                 for b in 0..W {
                     let start = planes[c] + lines[b] + x0;
-                    let acc_x = match data.get(start..start + W) {
+                    // The run of W taps from `start`. For W ≤ 4, as the tail
+                    // from `start` and its first chunk: two length tests and
+                    // no overflow test of `start + W` (plain kb3 −32 k, kb4
+                    // −55 k instructions on the M4F); kb6's loop compiles
+                    // worse that way (+690 k), so it keeps the range.
+                    let run = if W <= 4 {
+                        data.get(start..).and_then(|rest| rest.first_chunk::<W>())
+                    } else {
+                        data.get(start..start + W)
+                            .and_then(|s| <&[S; W]>::try_from(s).ok())
+                    };
+                    let acc_x = match run {
                         Some(run) => {
                             let mut sum = T::ZERO;
                             for t in 0..W {
@@ -532,7 +681,7 @@ fn extract_lines<const W: usize, const LINE_EXP: bool, S: Sample, T: Real>(
                 acc += wz[c] * acc_y;
             }
         } else {
-            let xs: [usize; W] = core::array::from_fn(|t| (jx + t as i64) as usize & mask);
+            let xs: [usize; W] = core::array::from_fn(|t| (jx + t as i32) as usize & mask);
             for c in 0..W {
                 let mut acc_y = T::ZERO;
                 for b in 0..W {

@@ -37,7 +37,7 @@
 
 use crate::dht::{neg_mod, Twiddles};
 use crate::error::{require_len, Error, Result};
-use crate::filter::{DerivativeTable, KernelTable, MAX_WIDTH};
+use crate::filter::{DerivativeTable, KernelTable, PhaseTable, MAX_WIDTH};
 use crate::geometry::View;
 use crate::real::{Real, Sample};
 use crate::render::LineReads;
@@ -115,6 +115,14 @@ struct Axis<T, const W: usize> {
     index: [usize; W],
 }
 
+/// One pass over the `n × n` slice for filter width `W`. Plain and
+/// per-line-exponent spectra take their weights from phase tables
+/// ([`PhaseTable`], an odd one for `k'`) and widen raw, with the `2^e` of
+/// [`Real::load_raw`] folded into the x-weights (exact: a power of two moved
+/// between the factors of each product), as the plain extraction does;
+/// other storage reads through the kernel tables and [`LineReads::sum`].
+/// Not inlined, so that only one width's tables are on the stack.
+#[inline(never)]
 fn run_pass_width<const W: usize, S: Sample, T: Real, const MODE: u8>(
     spec: &Spectrum<'_, S>,
     tables: &Tables<'_, T>,
@@ -122,11 +130,78 @@ fn run_pass_width<const W: usize, S: Sample, T: Real, const MODE: u8>(
     fields: &mut [T],
     targets: &[Target<T>],
 ) {
+    let reads = LineReads::of(spec);
+    if !matches!(reads, LineReads::General) {
+        let mut phases = PhaseTable::<T, W>::zeroed();
+        let filled = phases.fill(tables.kernel).is_ok();
+        let slopes = match (MODE == mode::VALUE_GRADIENT, tables.derivative) {
+            (true, Some(d)) => {
+                let mut slopes = PhaseTable::<T, W>::zeroed();
+                slopes.fill_derivative(d).ok().map(|()| slopes)
+            }
+            _ => None,
+        };
+        if filled && (MODE != mode::VALUE_GRADIENT || slopes.is_some()) {
+            let raw_gain = T::exp2i(T::raw_exponent::<S>());
+            let mask = spec.n() - 1;
+            for_each_point::<W, S, T, MODE, true>(spec, reads, geo, fields, targets, |q| {
+                let mut axes: [Axis<T, W>; 3] = core::array::from_fn(|a| {
+                    let y = PhaseTable::<T, W>::fixed_position(q[a]);
+                    let (j0, weights) = phases.taps_fixed_point(y);
+                    let derivative = match &slopes {
+                        Some(table) => table.taps_fixed_point(y).1,
+                        None => [T::ZERO; W],
+                    };
+                    Axis {
+                        weights,
+                        derivative,
+                        first: j0 as usize & mask,
+                        index: core::array::from_fn(|t| (j0 + t as i32) as usize & mask),
+                    }
+                });
+                axes[0].weights = axes[0].weights.map(|w| w * raw_gain);
+                axes[0].derivative = axes[0].derivative.map(|w| w * raw_gain);
+                axes
+            });
+            return;
+        }
+    }
+    let mask = spec.n() - 1;
+    for_each_point::<W, S, T, MODE, false>(spec, reads, geo, fields, targets, |q| {
+        core::array::from_fn(|a| {
+            let mut weights = [T::ZERO; W];
+            let j0 = tables.kernel.taps_fixed(q[a], &mut weights);
+            let mut derivative = [T::ZERO; W];
+            if MODE == mode::VALUE_GRADIENT {
+                if let Some(table) = tables.derivative {
+                    table.taps_fixed(q[a], &mut derivative);
+                }
+            }
+            Axis {
+                weights,
+                derivative,
+                first: j0 as usize & mask,
+                index: core::array::from_fn(|t| (j0 + t as i64) as usize & mask),
+            }
+        })
+    });
+}
+
+/// The pass's loop over the slice points inside the Nyquist cube: `taps`
+/// gives the per-axis taps of a point `q`, `RAW` says whether their
+/// x-weights carry the `2^e` of raw widening.
+#[inline(always)]
+fn for_each_point<const W: usize, S: Sample, T: Real, const MODE: u8, const RAW: bool>(
+    spec: &Spectrum<'_, S>,
+    reads: LineReads<'_>,
+    geo: &PassGeometry<T>,
+    fields: &mut [T],
+    targets: &[Target<T>],
+    taps: impl Fn([T; 3]) -> [Axis<T, W>; 3],
+) {
     let n = spec.n();
     let nn = n * n;
-    let mask = n - 1;
     let nyquist = T::from_usize(n) * T::HALF;
-    let reads = LineReads::of(spec);
     for iy in 0..n {
         let ky = T::from_i32(signed_index(iy, n) as i32);
         for ix in 0..n {
@@ -136,26 +211,11 @@ fn run_pass_width<const W: usize, S: Sample, T: Real, const MODE: u8>(
             if q.iter().any(|&c| c > nyquist || -c > nyquist) {
                 continue;
             }
-            let axes: [Axis<T, W>; 3] = core::array::from_fn(|a| {
-                let mut weights = [T::ZERO; W];
-                let j0 = tables.kernel.taps_fixed(q[a], &mut weights);
-                let mut derivative = [T::ZERO; W];
-                if MODE == mode::VALUE_GRADIENT {
-                    if let Some(table) = tables.derivative {
-                        table.taps_fixed(q[a], &mut derivative);
-                    }
-                }
-                Axis {
-                    weights,
-                    derivative,
-                    first: j0 as usize & mask,
-                    index: core::array::from_fn(|t| (j0 + t as i64) as usize & mask),
-                }
-            });
+            let axes = taps(q);
             let (r0, r1) = match MODE {
-                mode::VALUE_GRADIENT => value_gradient(spec, reads, &axes, geo.dir),
-                mode::VALUE_MIRROR => value_mirror(spec, reads, &axes),
-                _ => (value(spec, reads, &axes), T::ZERO),
+                mode::VALUE_GRADIENT => value_gradient::<W, RAW, S, T>(spec, reads, &axes, geo.dir),
+                mode::VALUE_MIRROR => value_mirror::<W, RAW, S, T>(spec, reads, &axes),
+                _ => (value::<W, RAW, S, T>(spec, reads, &axes), T::ZERO),
             };
             let i = iy * n + ix;
             for t in targets {
@@ -165,8 +225,26 @@ fn run_pass_width<const W: usize, S: Sample, T: Real, const MODE: u8>(
     }
 }
 
+/// One x-line's weighted sum, raw or fully widened ([`LineReads::sum_raw`],
+/// [`LineReads::sum`]).
 #[inline(always)]
-fn value<const W: usize, S: Sample, T: Real>(
+fn line_sum<const W: usize, const RAW: bool, S: Sample, T: Real>(
+    spec: &Spectrum<'_, S>,
+    reads: LineReads<'_>,
+    line: usize,
+    x: (usize, bool, &[usize; W]),
+    weights: &[T; W],
+) -> T {
+    let (first, contiguous, index) = x;
+    if RAW {
+        reads.sum_raw(spec, line, first, contiguous, index, weights)
+    } else {
+        reads.sum(spec, line, first, contiguous, index, weights)
+    }
+}
+
+#[inline(always)]
+fn value<const W: usize, const RAW: bool, S: Sample, T: Real>(
     spec: &Spectrum<'_, S>,
     reads: LineReads<'_>,
     axes: &[Axis<T, W>; 3],
@@ -180,8 +258,14 @@ fn value<const W: usize, S: Sample, T: Real>(
         let mut acc_y = T::ZERO;
         for b in 0..W {
             let line = plane + y.index[b] * n;
-            acc_y +=
-                y.weights[b] * reads.sum(spec, line, x.first, contiguous, &x.index, &x.weights);
+            acc_y += y.weights[b]
+                * line_sum::<W, RAW, S, T>(
+                    spec,
+                    reads,
+                    line,
+                    (x.first, contiguous, &x.index),
+                    &x.weights,
+                );
         }
         acc += z.weights[c] * acc_y;
     }
@@ -191,7 +275,7 @@ fn value<const W: usize, S: Sample, T: Real>(
 /// `X(p)` and `(d·∇X)(p)` from one neighbourhood: the separable gradient
 /// `∂_x = k'⊗k⊗k`, `∂_y = k⊗k'⊗k`, `∂_z = k⊗k⊗k'`.
 #[inline(always)]
-fn value_gradient<const W: usize, S: Sample, T: Real>(
+fn value_gradient<const W: usize, const RAW: bool, S: Sample, T: Real>(
     spec: &Spectrum<'_, S>,
     reads: LineReads<'_>,
     axes: &[Axis<T, W>; 3],
@@ -206,15 +290,27 @@ fn value_gradient<const W: usize, S: Sample, T: Real>(
         let (mut v_y, mut gx_y, mut gy_y) = (T::ZERO, T::ZERO, T::ZERO);
         for b in 0..W {
             let line = plane + y.index[b] * n;
-            let (v_x, gx_x) = reads.sum2(
-                spec,
-                line,
-                x.first,
-                contiguous,
-                &x.index,
-                &x.weights,
-                &x.derivative,
-            );
+            let (v_x, gx_x) = if RAW {
+                reads.sum2_raw(
+                    spec,
+                    line,
+                    x.first,
+                    contiguous,
+                    &x.index,
+                    &x.weights,
+                    &x.derivative,
+                )
+            } else {
+                reads.sum2(
+                    spec,
+                    line,
+                    x.first,
+                    contiguous,
+                    &x.index,
+                    &x.weights,
+                    &x.derivative,
+                )
+            };
             v_y += y.weights[b] * v_x;
             gx_y += y.weights[b] * gx_x;
             gy_y += y.derivative[b] * v_x;
@@ -227,7 +323,7 @@ fn value_gradient<const W: usize, S: Sample, T: Real>(
 
 /// `X(p)` and `X(−p)`: the same weights on the taps `j` and `−j`.
 #[inline(always)]
-fn value_mirror<const W: usize, S: Sample, T: Real>(
+fn value_mirror<const W: usize, const RAW: bool, S: Sample, T: Real>(
     spec: &Spectrum<'_, S>,
     reads: LineReads<'_>,
     axes: &[Axis<T, W>; 3],
@@ -255,14 +351,20 @@ fn value_mirror<const W: usize, S: Sample, T: Real>(
         for b in 0..W {
             let yi = y.index[b];
             let (line, line_m) = (plane + yi * n, plane_m + ((n - yi) & mask) * n);
-            d_y += y.weights[b] * reads.sum(spec, line, x.first, contiguous, &x.index, &x.weights);
-            m_y += y.weights[b]
-                * reads.sum(
+            d_y += y.weights[b]
+                * line_sum::<W, RAW, S, T>(
                     spec,
+                    reads,
+                    line,
+                    (x.first, contiguous, &x.index),
+                    &x.weights,
+                );
+            m_y += y.weights[b]
+                * line_sum::<W, RAW, S, T>(
+                    spec,
+                    reads,
                     line_m,
-                    mirror_first,
-                    mirror_contiguous,
-                    &mirror_index,
+                    (mirror_first, mirror_contiguous, &mirror_index),
                     &mirror_weights,
                 );
         }
