@@ -5,6 +5,7 @@ pub mod accuracy;
 pub mod adaptive;
 pub mod datasets;
 pub mod formats;
+pub mod growth;
 pub mod image;
 pub mod nrrd;
 pub mod output;

@@ -175,3 +175,50 @@ fn conflicting_and_bad_options_are_named_before_any_work() {
         assert!(!dir.join("out").exists(), "{args:?} started work");
     }
 }
+
+/// `fvr growth` writes its CSV, Markdown and plot for a tiny run, and
+/// refuses sizes it cannot do before any work.
+#[test]
+fn growth_writes_csv_markdown_and_plot_and_refuses_bad_sizes() {
+    let dir = temp_dir("growth");
+    let out = fvr(
+        &[
+            "growth",
+            "--sizes",
+            "16,32",
+            "--runs",
+            "1",
+            "--out-dir",
+            "g",
+        ],
+        &dir,
+    );
+    let stdout = assert_ok(&out);
+    assert!(stdout.contains("| 32³ |"), "{stdout}");
+    let csv = std::fs::read_to_string(dir.join("g/growth.csv")).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines[0], "n,frequency_ms,raycast_ms,ratio");
+    assert_eq!(lines.len(), 3, "{csv}");
+    for line in &lines[1..] {
+        let ms: Vec<f64> = line
+            .split(',')
+            .skip(1)
+            .map(|v| v.parse().unwrap())
+            .collect();
+        assert!(ms.iter().all(|v| v.is_finite() && *v > 0.0), "{line}");
+    }
+    let png = std::fs::read(dir.join("g/growth.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+    for (args, needle) in [
+        (&["growth", "--sizes", "256,512"][..], "512 needs --large"),
+        (&["growth", "--sizes", "100,128"][..], "power of two"),
+        (&["growth", "--sizes", "64"][..], "at least two"),
+        (
+            &["growth", "--sizes", "32,64", "--runs", "0"][..],
+            "at least 1",
+        ),
+    ] {
+        assert_error(&fvr(args, &dir), &[needle]);
+    }
+    assert!(!dir.join("growth").exists());
+}

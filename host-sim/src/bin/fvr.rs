@@ -134,6 +134,25 @@ enum Command {
     /// Gaussian-mixture phantom; writes trade.csv, trade.png (dB against ms,
     /// Pareto fronts) and trade.md (the settings on each front).
     Trade(fvr_host::trade::TradeArgs),
+    /// How the time per view grows with the volume's side: the kb3 f16
+    /// frequency-domain view against the f32 ray caster (both on all cores),
+    /// medians of RUNS views per size; writes growth.csv, growth.md and a
+    /// log-log growth.png, and prints the Markdown (with the growth per
+    /// doubling against the n² log n ratio).
+    Growth {
+        /// Volume sides: powers of two from 16 to 256 (512 with --large).
+        #[arg(long, value_delimiter = ',', default_values_t = [64usize, 128, 256])]
+        sizes: Vec<usize>,
+        /// Timed views per size and method (after one warm-up view).
+        #[arg(long, default_value_t = 15)]
+        runs: usize,
+        /// Allow 512 (a 256 MiB spectrum and a 512 MiB volume).
+        #[arg(long)]
+        large: bool,
+        /// Where to write the files.
+        #[arg(long, default_value = "growth")]
+        out_dir: PathBuf,
+    },
     /// The paper's Table 1 measured here: filter taps and time per view with
     /// and without adaptive filtering, and the spatial-domain ray caster, on
     /// the CT head (resampled to 128 along its longest side), a 256³ volume
@@ -580,6 +599,18 @@ fn main() -> ExitCode {
         }) => adaptive_table(tolerance, bound, filter, oversample, &volumes, runs),
         Some(Command::Precision(args)) => fvr_host::precision_cli::run(&args),
         Some(Command::Trade(args)) => fvr_host::trade::run(&args),
+        Some(Command::Growth {
+            sizes,
+            runs,
+            large,
+            out_dir,
+        }) => fvr_host::growth::run(&sizes, runs, large, &out_dir, |r| {
+            eprintln!(
+                "fvr: {}³: {:.3} ms against {:.2} ms",
+                r.n, r.frequency_ms, r.raycast_ms
+            )
+        })
+        .map(|md| print!("{md}")),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
