@@ -291,64 +291,20 @@ fn bad_inputs_and_options_exit_2_with_the_file_and_field() {
         &dir,
     );
     assert_error(&out, &["junk.vol", "unknown volume format", "--raw-dims"]);
-    let out = fvr(
-        &[
-            "render",
-            "gaussians@16",
-            "--dir",
-            "1,0,0",
-            "--out",
-            "x.png",
-            "--window",
-            "10",
-        ],
-        &dir,
-    );
-    assert_error(&out, &["--level"]);
-    let out = fvr(
-        &[
-            "render",
-            "gaussians@16",
-            "--dir",
-            "1,0,0",
-            "--out",
-            "x.png",
-            "--window",
-            "0",
-            "--level",
-            "1",
-        ],
-        &dir,
-    );
-    assert_error(&out, &["--window 0", "positive"]);
-    let out = fvr(
-        &[
-            "render",
-            "gaussians@16",
-            "--dir",
-            "1,0,0",
-            "--out",
-            "x.png",
-            "--bits",
-            "12",
-        ],
-        &dir,
-    );
-    assert_error(&out, &["8 or 16"]);
-    let out = fvr(
-        &[
-            "render",
-            "gaussians@16",
-            "--dir",
-            "1,0,0",
-            "--out",
-            "x.png",
-            "--percentiles",
-            "90,10",
-        ],
-        &dir,
-    );
-    assert_error(&out, &["LOW < HIGH"]);
+    let png_cases: [(&[&str], &[&str]); 4] = [
+        (&["--window", "10"], &["--level"]),
+        (
+            &["--window", "0", "--level", "1"],
+            &["--window 0", "positive"],
+        ),
+        (&["--bits", "12"], &["8 or 16"]),
+        (&["--percentiles", "90,10"], &["LOW < HIGH"]),
+    ];
+    for (extra, needles) in png_cases {
+        let mut args = vec!["render", "gaussians@16", "--dir", "1,0,0", "--out", "x.png"];
+        args.extend_from_slice(extra);
+        assert_error(&fvr(&args, &dir), needles);
+    }
 }
 
 #[test]

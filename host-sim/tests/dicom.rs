@@ -189,17 +189,7 @@ fn fuzz_regression_declared_lengths_beyond_the_file_are_refused() {
         "{e}"
     );
     // The same for pixel data whose length is patched to nearly 4 GiB.
-    let orientation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
-    let mut bytes = encode_ct_slice(
-        "1",
-        1,
-        [2, 2],
-        [1.0, 1.0],
-        [0.0; 3],
-        orientation,
-        0.0,
-        &[1, 2, 3, 4],
-    );
+    let mut bytes = tiny_slice(0.0);
     let at = bytes
         .windows(4)
         .rposition(|w| w == [0xE0, 0x7F, 0x10, 0x00])
@@ -218,17 +208,7 @@ fn fuzz_regression_bits_stored_out_of_range_is_an_error_not_a_panic() {
     let e = parse_slice(found).unwrap_err().to_string();
     assert!(e.contains("Bits"), "{e}");
     // BitsStored 0 and 33 in an otherwise valid slice.
-    let orientation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
-    let good = encode_ct_slice(
-        "1",
-        1,
-        [2, 2],
-        [1.0, 1.0],
-        [0.0; 3],
-        orientation,
-        -5.0,
-        &[1, 2, 3, 4],
-    );
+    let good = tiny_slice(-5.0);
     assert_eq!(
         parse_slice(&good).unwrap().pixels,
         vec![-4.0, -3.0, -2.0, -1.0]
@@ -254,17 +234,7 @@ fn fuzz_regression_bits_stored_out_of_range_is_an_error_not_a_panic() {
 /// of memory on such inputs).
 #[test]
 fn sizes_beyond_the_pixel_data_are_refused_before_decoding() {
-    let orientation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
-    let good = encode_ct_slice(
-        "1",
-        1,
-        [2, 2],
-        [1.0, 1.0],
-        [0.0; 3],
-        orientation,
-        0.0,
-        &[1, 2, 3, 4],
-    );
+    let good = tiny_slice(0.0);
     // (0028,0010) Rows, US, length 2.
     let at = good
         .windows(8)
@@ -280,4 +250,19 @@ fn sizes_beyond_the_pixel_data_are_refused_before_decoding() {
     bytes[at + 8..at + 10].copy_from_slice(&0u16.to_le_bytes());
     let e = parse_slice(&bytes).unwrap_err().to_string();
     assert!(e.contains("`Rows`: is 0"), "{e}");
+}
+
+/// A valid 2×2 axial CT slice of pixels 1..=4 with `intercept`.
+fn tiny_slice(intercept: f64) -> Vec<u8> {
+    let orientation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    encode_ct_slice(
+        "1",
+        1,
+        [2, 2],
+        [1.0, 1.0],
+        [0.0; 3],
+        orientation,
+        intercept,
+        &[1, 2, 3, 4],
+    )
 }
