@@ -509,12 +509,7 @@ pub fn render_scene<S: Sample, T: Real>(
     require_len("scene fields", fields_len(scene, n), fields.len())?;
     require_len("auxiliary scratch", aux_len(n), aux.len())?;
     require_len("output image", channels * width * height, out.len())?;
-    if n > tw.len() {
-        return Err(Error::TwiddlesTooShort {
-            table_len: tw.len(),
-            needed: n,
-        });
-    }
+    tw.check(n)?;
     if plan.slope != 0.0 {
         match derivative {
             None => return Err(Error::NoKernelDerivative),
