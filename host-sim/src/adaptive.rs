@@ -3,6 +3,7 @@
 //! wherever the marks allow, with statistics.
 
 use crate::pipeline::OwnedSpectrum;
+use crate::timing::median_ms;
 use fvr_core::adaptive::{
     extract_slice_adaptive, mark, marks_words, response_difference, threshold_for, AdaptiveLevel,
     AdaptiveStats, Marks, MAX_LEVELS,
@@ -526,18 +527,6 @@ pub struct Table1Row {
     pub mark_ms: f64,
 }
 
-fn median_ms(runs: usize, mut f: impl FnMut()) -> f64 {
-    let mut times: Vec<f64> = (0..runs)
-        .map(|_| {
-            let t = std::time::Instant::now();
-            f();
-            t.elapsed().as_secs_f64() * 1e3
-        })
-        .collect();
-    times.sort_by(f64::total_cmp);
-    times[times.len() / 2]
-}
-
 /// Measure a Table 1 row for `volume`: `filter` (at its oversampling)
 /// against adaptive filtering as `settings` ask, view along `view`, `runs`
 /// timed runs.
@@ -565,15 +554,18 @@ pub fn table1_row(
         .render::<half::f16, f32>(&spec, view, side, side)
         .map_err(|e| e.to_string())?;
     let full_ms = median_ms(runs, || {
-        let _ = any.render(view, side, side);
-    });
+        any.render(view, side, side)
+            .map(drop)
+            .map_err(|e| e.to_string())
+    })?;
     let adaptive_ms = median_ms(runs, || {
-        let _ = marks.render::<half::f16, f32>(&spec, view, side, side);
-    });
+        marks
+            .render::<half::f16, f32>(&spec, view, side, side)
+            .map(drop)
+            .map_err(|e| e.to_string())
+    })?;
     let caster = crate::raycast::RayCaster::new(volume);
-    let spatial_ms = median_ms(runs, || {
-        let _ = caster.project(view, side, side, 1.0, 0);
-    });
+    let spatial_ms = median_ms(runs, || caster.project(view, side, side, 1.0, 0).map(drop))?;
     Ok(Table1Row {
         name: name.to_string(),
         dims: volume.dims,

@@ -9,7 +9,6 @@
 //! after one warm-up view; preprocessing is not timed.
 
 use std::path::Path;
-use std::time::Instant;
 
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
@@ -19,6 +18,7 @@ use crate::phantom::{sample, GaussianMixture};
 use crate::pipeline::{OwnedSpectrum, ViewRenderer};
 use crate::plot::{Canvas, Rgb};
 use crate::raycast::RayCaster;
+use crate::timing::median_ms;
 
 /// Time per view at one size.
 #[derive(Clone, Debug, PartialEq)]
@@ -55,18 +55,6 @@ pub fn check_sizes(sizes: &[usize], large: bool) -> Result<(), String> {
     Ok(())
 }
 
-fn median_ms(runs: usize, mut f: impl FnMut() -> Result<(), String>) -> Result<f64, String> {
-    f()?;
-    let mut times = Vec::with_capacity(runs);
-    for _ in 0..runs {
-        let t = Instant::now();
-        f()?;
-        times.push(t.elapsed().as_secs_f64() * 1e3);
-    }
-    times.sort_by(f64::total_cmp);
-    Ok(times[times.len() / 2])
-}
-
 /// Measure every size in `sizes` (checked by [`check_sizes`]) with `runs`
 /// timed views each, calling `progress` after each size.
 ///
@@ -91,14 +79,18 @@ pub fn measure(
             OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).map_err(|e| e.to_string())?;
         let mut renderer = ViewRenderer::<f32>::new(spec.n(), filter);
         let mut out = vec![0.0f32; n * n];
-        let frequency_ms = median_ms(runs, || {
+        let mut frequency_view = || {
             renderer
                 .render_into(&spec, &view, n, n, &mut out)
                 .map_err(|e| e.to_string())
-        })?;
+        };
+        frequency_view()?;
+        let frequency_ms = median_ms(runs, frequency_view)?;
         drop(spec);
         let caster = RayCaster::new(&volume);
-        let raycast_ms = median_ms(runs, || caster.project(&view, n, n, 1.0, 0).map(|_| ()))?;
+        let raycast_view = || caster.project(&view, n, n, 1.0, 0).map(drop);
+        raycast_view()?;
+        let raycast_ms = median_ms(runs, raycast_view)?;
         let row = GrowthRow {
             n,
             frequency_ms,

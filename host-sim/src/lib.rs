@@ -22,6 +22,7 @@ pub mod scene_file;
 pub mod scene_reference;
 pub mod shaded;
 pub mod teapot;
+pub mod timing;
 pub mod trade;
 pub mod turntable;
 pub mod volume;
