@@ -27,7 +27,7 @@ use crate::filter::{KernelTable, PhaseTable, MAX_WIDTH};
 use crate::format::BlockLayout;
 use crate::geometry::{dot, Frame, Sampling, SliceAxes, View};
 use crate::real::{Real, Sample};
-use crate::spectrum::Spectrum;
+use crate::spectrum::{CubeSide, Spectrum};
 
 /// Where a `W × H` image sits on the `m × m` projection grid.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -104,8 +104,8 @@ pub const fn aux_len(m: usize) -> usize {
 /// # Errors
 /// Bad view vectors, an image side of 0 or above `n`, short buffers, or a
 /// kernel for another filter than the spectrum was premultiplied for.
-pub fn render<S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+pub fn render<S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
     view: &View,
     width: usize,
@@ -136,8 +136,8 @@ pub fn render<S: Sample, T: Real>(
 ///
 /// # Errors
 /// As [`render`].
-pub fn render_sampled<S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+pub fn render_sampled<S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
     view: &View,
     sampling: &Sampling,
@@ -184,8 +184,8 @@ pub fn signed_index(k: usize, m: usize) -> i64 {
 /// Fill the `n × n` slice `grid` (`kx` fastest, natural DHT order) by
 /// interpolating the spectrum with `kernel` on the plane spanned by the
 /// frame's right and up vectors.
-pub fn extract_slice<S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+pub fn extract_slice<S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
     frame: &Frame,
     grid: &mut [T],
@@ -196,8 +196,8 @@ pub fn extract_slice<S: Sample, T: Real>(
 /// [`extract_slice`] restricted to the central `m × m` frequencies
 /// (`m ≤ n`, a power of two): the slice of a preview at pitch `n/m`
 /// ([`crate::progressive`]). `grid` holds `m²` values, `kx` fastest.
-pub fn extract_central_slice<S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+pub fn extract_central_slice<S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
     frame: &Frame,
     m: usize,
@@ -210,8 +210,8 @@ pub fn extract_central_slice<S: Sample, T: Real>(
 /// sample at `(kx, ky)` is the spectrum at `kx·axes.right + ky·axes.up`,
 /// zero outside the Nyquist cube): the physical-units slice with
 /// [`Sampling::slice_axes`].
-pub fn extract_central_slice_on<S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+pub fn extract_central_slice_on<S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
     axes: &SliceAxes,
     m: usize,
@@ -230,8 +230,8 @@ pub fn extract_central_slice_on<S: Sample, T: Real>(
 /// # Errors
 /// `rows.len()` not a multiple of `n`, or rows beyond the grid
 /// ([`Error::LengthMismatch`]).
-pub fn extract_slice_rows<S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+pub fn extract_slice_rows<S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
     axes: &SliceAxes,
     first_row: usize,
@@ -252,8 +252,8 @@ pub fn extract_slice_rows<S: Sample, T: Real>(
 
 /// Rows `first_row ..` (as many as `grid` holds) of the central `m × m`
 /// slice, by filter width.
-fn extract_rows<S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+fn extract_rows<S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
     axes: &SliceAxes,
     m: usize,
@@ -261,12 +261,12 @@ fn extract_rows<S: Sample, T: Real>(
     grid: &mut [T],
 ) {
     match kernel.filter().width() {
-        1 => extract_width::<1, S, T>(spec, kernel, axes, m, first_row, grid),
-        2 => extract_width::<2, S, T>(spec, kernel, axes, m, first_row, grid),
-        3 => extract_width::<3, S, T>(spec, kernel, axes, m, first_row, grid),
-        4 => extract_width::<4, S, T>(spec, kernel, axes, m, first_row, grid),
-        5 => extract_width::<5, S, T>(spec, kernel, axes, m, first_row, grid),
-        _ => extract_width::<MAX_WIDTH, S, T>(spec, kernel, axes, m, first_row, grid),
+        1 => extract_width::<1, S, Z, T>(spec, kernel, axes, m, first_row, grid),
+        2 => extract_width::<2, S, Z, T>(spec, kernel, axes, m, first_row, grid),
+        3 => extract_width::<3, S, Z, T>(spec, kernel, axes, m, first_row, grid),
+        4 => extract_width::<4, S, Z, T>(spec, kernel, axes, m, first_row, grid),
+        5 => extract_width::<5, S, Z, T>(spec, kernel, axes, m, first_row, grid),
+        _ => extract_width::<MAX_WIDTH, S, Z, T>(spec, kernel, axes, m, first_row, grid),
     }
 }
 
@@ -283,7 +283,7 @@ pub(crate) enum LineReads<'a> {
 
 impl<'a> LineReads<'a> {
     /// The reads for `spec`.
-    pub(crate) fn of<S: Sample>(spec: &Spectrum<'a, S>) -> Self {
+    pub(crate) fn of<S: Sample, Z: CubeSide>(spec: &Spectrum<'a, S, Z>) -> Self {
         match spec.blocks() {
             Some(b) if S::BLOCK_MANTISSA => match b.layout() {
                 BlockLayout::Line => LineReads::LineExponents(b.exponents()),
@@ -302,8 +302,8 @@ impl<'a> LineReads<'a> {
     /// The `W` coefficients from `line + x0` as one run, when `contiguous`
     /// (one bounds check for the run).
     #[inline(always)]
-    fn run<'s, const W: usize, S: Sample>(
-        spec: &Spectrum<'s, S>,
+    fn run<'s, const W: usize, S: Sample, Z: CubeSide>(
+        spec: &Spectrum<'s, S, Z>,
         line: usize,
         x0: usize,
         contiguous: bool,
@@ -327,7 +327,11 @@ impl<'a> LineReads<'a> {
 
     /// The block exponent's power of two for `line`, if lines carry one.
     #[inline(always)]
-    fn line_scale<S: Sample, T: Real>(self, spec: &Spectrum<'_, S>, line: usize) -> Option<T> {
+    fn line_scale<S: Sample, Z: CubeSide, T: Real>(
+        self,
+        spec: &Spectrum<'_, S, Z>,
+        line: usize,
+    ) -> Option<T> {
         match self {
             LineReads::LineExponents(e) => Some(T::exp2i(e[line / spec.n()] as i32)),
             _ => None,
@@ -338,23 +342,23 @@ impl<'a> LineReads<'a> {
     /// contiguous run from `x0` when `contiguous`, else through
     /// [`Spectrum::line_taps`] at the wrapped indices `xs`.
     #[inline(always)]
-    pub(crate) fn sum<const W: usize, S: Sample, T: Real>(
+    pub(crate) fn sum<const W: usize, S: Sample, Z: CubeSide, T: Real>(
         self,
-        spec: &Spectrum<'_, S>,
+        spec: &Spectrum<'_, S, Z>,
         line: usize,
         x0: usize,
         contiguous: bool,
         xs: &[usize; W],
         weights: &[T; W],
     ) -> T {
-        let Some(run) = Self::run::<W, S>(spec, line, x0, contiguous) else {
+        let Some(run) = Self::run::<W, S, Z>(spec, line, x0, contiguous) else {
             return spec.line_taps(line, xs, weights);
         };
         let mut sum = T::ZERO;
         for (wt, v) in weights.iter().zip(run) {
             sum += *wt * T::load(*v);
         }
-        match self.line_scale::<S, T>(spec, line) {
+        match self.line_scale::<S, Z, T>(spec, line) {
             Some(scale) => sum * scale,
             None => sum,
         }
@@ -365,9 +369,9 @@ impl<'a> LineReads<'a> {
     /// per-line-exponent reads only (never [`LineReads::General`], whose
     /// per-tap exponents this does not apply).
     #[inline(always)]
-    pub(crate) fn sum_raw<const W: usize, S: Sample, T: Real>(
+    pub(crate) fn sum_raw<const W: usize, S: Sample, Z: CubeSide, T: Real>(
         self,
-        spec: &Spectrum<'_, S>,
+        spec: &Spectrum<'_, S, Z>,
         line: usize,
         x0: usize,
         contiguous: bool,
@@ -375,7 +379,7 @@ impl<'a> LineReads<'a> {
         weights: &[T; W],
     ) -> T {
         let mut sum = T::ZERO;
-        match Self::run::<W, S>(spec, line, x0, contiguous) {
+        match Self::run::<W, S, Z>(spec, line, x0, contiguous) {
             Some(run) => {
                 for t in 0..W {
                     sum += weights[t] * T::load_raw(run[t]);
@@ -389,7 +393,7 @@ impl<'a> LineReads<'a> {
                 }
             }
         }
-        match self.line_scale::<S, T>(spec, line) {
+        match self.line_scale::<S, Z, T>(spec, line) {
             Some(scale) => sum * scale,
             None => sum,
         }
@@ -398,9 +402,9 @@ impl<'a> LineReads<'a> {
     /// [`LineReads::sum2`] with raw widening, as [`LineReads::sum_raw`]
     /// (both weight sets carry the `2^e`).
     #[inline(always)]
-    pub(crate) fn sum2_raw<const W: usize, S: Sample, T: Real>(
+    pub(crate) fn sum2_raw<const W: usize, S: Sample, Z: CubeSide, T: Real>(
         self,
-        spec: &Spectrum<'_, S>,
+        spec: &Spectrum<'_, S, Z>,
         line: usize,
         x0: usize,
         contiguous: bool,
@@ -409,7 +413,7 @@ impl<'a> LineReads<'a> {
         second: &[T; W],
     ) -> (T, T) {
         let (mut a, mut b) = (T::ZERO, T::ZERO);
-        match Self::run::<W, S>(spec, line, x0, contiguous) {
+        match Self::run::<W, S, Z>(spec, line, x0, contiguous) {
             Some(run) => {
                 for t in 0..W {
                     let v = T::load_raw(run[t]);
@@ -426,7 +430,7 @@ impl<'a> LineReads<'a> {
                 }
             }
         }
-        match self.line_scale::<S, T>(spec, line) {
+        match self.line_scale::<S, Z, T>(spec, line) {
             Some(scale) => (a * scale, b * scale),
             None => (a, b),
         }
@@ -435,9 +439,9 @@ impl<'a> LineReads<'a> {
     /// Two weighted sums over the same taps, each coefficient read once
     /// (the value and a derivative of [`LineReads::sum`]).
     #[inline(always)]
-    pub(crate) fn sum2<const W: usize, S: Sample, T: Real>(
+    pub(crate) fn sum2<const W: usize, S: Sample, Z: CubeSide, T: Real>(
         self,
-        spec: &Spectrum<'_, S>,
+        spec: &Spectrum<'_, S, Z>,
         line: usize,
         x0: usize,
         contiguous: bool,
@@ -445,7 +449,7 @@ impl<'a> LineReads<'a> {
         first: &[T; W],
         second: &[T; W],
     ) -> (T, T) {
-        let Some(run) = Self::run::<W, S>(spec, line, x0, contiguous) else {
+        let Some(run) = Self::run::<W, S, Z>(spec, line, x0, contiguous) else {
             return (
                 spec.line_taps(line, xs, first),
                 spec.line_taps(line, xs, second),
@@ -457,7 +461,7 @@ impl<'a> LineReads<'a> {
             a += first[t] * v;
             b += second[t] * v;
         }
-        match self.line_scale::<S, T>(spec, line) {
+        match self.line_scale::<S, Z, T>(spec, line) {
             Some(scale) => (a * scale, b * scale),
             None => (a, b),
         }
@@ -468,8 +472,8 @@ impl<'a> LineReads<'a> {
 /// and per-line-exponent spectra, the general one for the rest. Not
 /// inlined, so that only one width's phase table is on the stack.
 #[inline(never)]
-fn extract_width<const W: usize, S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+fn extract_width<const W: usize, S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
     axes: &SliceAxes,
     m: usize,
@@ -485,12 +489,12 @@ fn extract_width<const W: usize, S: Sample, T: Real>(
     let mut phases = PhaseTable::<T, W>::zeroed();
     match (phases.fill(kernel), LineReads::of(spec)) {
         (Ok(()), LineReads::Plain) => {
-            extract_lines::<W, false, S, T>(spec, &phases, &geometry, &[], grid)
+            extract_lines::<W, false, S, Z, T>(spec, &phases, &geometry, &[], grid)
         }
         (Ok(()), LineReads::LineExponents(e)) => {
-            extract_lines::<W, true, S, T>(spec, &phases, &geometry, e, grid)
+            extract_lines::<W, true, S, Z, T>(spec, &phases, &geometry, e, grid)
         }
-        _ => extract_general::<W, S, T>(spec, kernel, &geometry, grid),
+        _ => extract_general::<W, S, Z, T>(spec, kernel, &geometry, grid),
     }
 }
 
@@ -615,8 +619,8 @@ impl<T: Real> SliceRows<T> {
 /// products are the same numbers as with the full widening (a power of two
 /// moved between factors is exact). `LINE_EXP`: multiply each line's sum
 /// by its block exponent's power of two (`exponents`, one per x-line).
-fn extract_lines<const W: usize, const LINE_EXP: bool, S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+fn extract_lines<const W: usize, const LINE_EXP: bool, S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     phases: &PhaseTable<T, W>,
     geometry: &SliceRows<T>,
     exponents: &[i8],
@@ -625,7 +629,13 @@ fn extract_lines<const W: usize, const LINE_EXP: bool, S: Sample, T: Real>(
     let n = spec.n();
     let nn = n * n;
     let mask = n - 1;
-    let data = spec.data();
+    // Exactly `n³` (as `Spectrum` guarantees): with a compile-time side
+    // ([`CubeSide`]) the compiler then proves every masked tap index in
+    // range and drops the bounds tests.
+    let Some(data) = spec.data().get(..nn * n) else {
+        grid.fill(T::ZERO);
+        return;
+    };
     let raw_gain = T::exp2i(T::raw_exponent::<S>());
     let line_sum = |line: usize, acc_x: T| {
         if LINE_EXP {
@@ -702,8 +712,8 @@ fn extract_lines<const W: usize, const LINE_EXP: bool, S: Sample, T: Real>(
 
 /// The extraction for any storage (e.g. bricked block exponents): taps
 /// through [`LineReads::sum`], weights from the kernel table.
-fn extract_general<const W: usize, S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+fn extract_general<const W: usize, S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
     geometry: &SliceRows<T>,
     grid: &mut [T],
