@@ -900,8 +900,16 @@ pub fn finish_channel<T: Real>(
     {
         let gy = row0.wrapping_sub(row) & mask;
         let grid_row = &grid[gy * m..(gy + 1) * m];
-        for (col, o) in line.chunks_exact_mut(channels).enumerate() {
-            o[channel] = grid_row[col0.wrapping_add(col) & mask] * g;
+        if channels == 1 {
+            // One channel (plain and cued frames): a plain loop over the
+            // row, without the per-pixel chunking of interleaved ones.
+            for (col, o) in line.iter_mut().enumerate() {
+                *o = grid_row[col0.wrapping_add(col) & mask] * g;
+            }
+        } else {
+            for (col, o) in line.chunks_exact_mut(channels).enumerate() {
+                o[channel] = grid_row[col0.wrapping_add(col) & mask] * g;
+            }
         }
     }
     Ok(())
