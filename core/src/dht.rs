@@ -420,6 +420,13 @@ fn transpose_square<T>(data: &mut [T], n: usize) {
 /// The radix-2 DHT of [`dht_unchecked`] along `y` for all `nx` columns at
 /// once: rows take the place of elements, so every butterfly is a loop
 /// over `nx` contiguous values with one twiddle pair.
+///
+/// Stages go two at a time (radix 2²): the stages of half-lengths `m` and
+/// `2m` touch the rows `k, m−k, m+k, 2m−k` and those `2m` further on
+/// together, eight rows closed under both stages, so each value is loaded
+/// and stored once per two stages. The butterflies and their operands are
+/// those of [`dht_stages`], in the same order, so the result is the same to
+/// the bit; a single radix-2 stage finishes odd `log₂ny`.
 fn dht_columns<T: Real>(data: &mut [T], nx: usize, ny: usize, tw: &Twiddles<'_, T>) {
     if ny <= 1 {
         return;
@@ -439,30 +446,159 @@ fn dht_columns<T: Real>(data: &mut [T], nx: usize, ny: usize, tw: &Twiddles<'_, 
         }
     }
     let mut m = 1;
-    while m < ny {
-        let stride = tw.len / (2 * m);
-        for block in data.chunks_exact_mut(2 * m * nx) {
-            let (x, y) = block.split_at_mut(m * nx);
-            butterfly_rows(&mut x[..nx], &mut y[..nx]);
+    while 4 * m <= ny {
+        let stride1 = tw.len / (2 * m);
+        let stride2 = tw.len / (4 * m);
+        for block in data.chunks_exact_mut(4 * m * nx) {
+            let [r0, r1, r2, r3] = rows_mut(block, nx, [0, m, 2 * m, 3 * m]);
+            radix4_rows_plain(r0, r1, r2, r3);
             if m >= 2 {
                 let h = m / 2;
-                butterfly_rows(&mut x[h * nx..(h + 1) * nx], &mut y[h * nx..(h + 1) * nx]);
+                let [r0, r1, r2, r3] = rows_mut(block, nx, [h, 3 * h, 5 * h, 7 * h]);
+                let (c, s) = tw.cos_sin(h * stride2);
+                radix4_rows_half(r0, r1, r2, r3, c, s);
                 for k in 1..h {
-                    let (c, s) = tw.cos_sin(k * stride);
-                    let (x_low, x_high) = x.split_at_mut((m - k) * nx);
-                    let (y_low, y_high) = y.split_at_mut((m - k) * nx);
-                    butterfly_rows_twiddled(
-                        &mut x_low[k * nx..(k + 1) * nx],
-                        &mut x_high[..nx],
-                        &mut y_low[k * nx..(k + 1) * nx],
-                        &mut y_high[..nx],
-                        c,
-                        s,
+                    let rows = rows_mut(
+                        block,
+                        nx,
+                        [
+                            k,
+                            m - k,
+                            m + k,
+                            2 * m - k,
+                            2 * m + k,
+                            3 * m - k,
+                            3 * m + k,
+                            4 * m - k,
+                        ],
                     );
+                    let first = tw.cos_sin(k * stride1);
+                    let second = [tw.cos_sin(k * stride2), tw.cos_sin((m - k) * stride2)];
+                    radix4_rows_twiddled(rows, first, second);
                 }
             }
         }
-        m *= 2;
+        m *= 4;
+    }
+    if m < ny {
+        radix2_columns_stage(data, nx, m, tw);
+    }
+}
+
+/// One radix-2 stage of half-length `m` of [`dht_columns`].
+fn radix2_columns_stage<T: Real>(data: &mut [T], nx: usize, m: usize, tw: &Twiddles<'_, T>) {
+    let stride = tw.len / (2 * m);
+    for block in data.chunks_exact_mut(2 * m * nx) {
+        let (x, y) = block.split_at_mut(m * nx);
+        butterfly_rows(&mut x[..nx], &mut y[..nx]);
+        if m >= 2 {
+            let h = m / 2;
+            butterfly_rows(&mut x[h * nx..(h + 1) * nx], &mut y[h * nx..(h + 1) * nx]);
+            for k in 1..h {
+                let (c, s) = tw.cos_sin(k * stride);
+                let (x_low, x_high) = x.split_at_mut((m - k) * nx);
+                let (y_low, y_high) = y.split_at_mut((m - k) * nx);
+                butterfly_rows_twiddled(
+                    &mut x_low[k * nx..(k + 1) * nx],
+                    &mut x_high[..nx],
+                    &mut y_low[k * nx..(k + 1) * nx],
+                    &mut y_high[..nx],
+                    c,
+                    s,
+                );
+            }
+        }
+    }
+}
+
+/// Rows `idx[0] < idx[1] < …` (each `nx` long) of `block`, borrowed apart.
+#[inline(always)]
+fn rows_mut<T, const K: usize>(block: &mut [T], nx: usize, idx: [usize; K]) -> [&mut [T]; K] {
+    let mut rest = block;
+    let mut next = 0;
+    core::array::from_fn(|j| {
+        let (_, tail) = core::mem::take(&mut rest).split_at_mut((idx[j] - next) * nx);
+        let (row, tail) = tail.split_at_mut(nx);
+        rest = tail;
+        next = idx[j] + 1;
+        row
+    })
+}
+
+/// The twiddled butterfly of [`dht_stages`] on one set of operands:
+/// `(x[k], x[m−k], y[k], y[m−k])` in, the same four out.
+#[inline(always)]
+fn twiddled<T: Real>(xk: T, xmk: T, yk: T, ymk: T, c: T, s: T) -> [T; 4] {
+    let t1 = c * yk + s * ymk;
+    let t2 = s * yk - c * ymk;
+    [xk + t1, xmk + t2, xk - t1, xmk - t2]
+}
+
+/// Radix-2² on rows `0, m, 2m, 3m` of a block: both stages untwiddled
+/// (`k = 0` of each, and the middle `k = m` of the second).
+#[inline(always)]
+fn radix4_rows_plain<T: Real>(r0: &mut [T], r1: &mut [T], r2: &mut [T], r3: &mut [T]) {
+    let len = r0.len();
+    let (r1, r2, r3) = (&mut r1[..len], &mut r2[..len], &mut r3[..len]);
+    for i in 0..len {
+        let (a, b) = (r0[i] + r1[i], r0[i] - r1[i]);
+        let (c, d) = (r2[i] + r3[i], r2[i] - r3[i]);
+        r0[i] = a + c;
+        r2[i] = a - c;
+        r1[i] = b + d;
+        r3[i] = b - d;
+    }
+}
+
+/// Radix-2² on rows `h, 3h, 5h, 7h` (`h = m/2`): the middle butterflies of
+/// the first stage, then the twiddled one of the second at `k = h`.
+#[inline(always)]
+fn radix4_rows_half<T: Real>(r0: &mut [T], r1: &mut [T], r2: &mut [T], r3: &mut [T], c: T, s: T) {
+    let len = r0.len();
+    let (r1, r2, r3) = (&mut r1[..len], &mut r2[..len], &mut r3[..len]);
+    for i in 0..len {
+        let (a, b) = (r0[i] + r1[i], r0[i] - r1[i]);
+        let (y, ym) = (r2[i] + r3[i], r2[i] - r3[i]);
+        let [xk, xmk, yk, ymk] = twiddled(a, b, y, ym, c, s);
+        r0[i] = xk;
+        r1[i] = xmk;
+        r2[i] = yk;
+        r3[i] = ymk;
+    }
+}
+
+/// Radix-2² on the rows `k, m−k, m+k, 2m−k, 2m+k, 3m−k, 3m+k, 4m−k`
+/// (`0 < k < m/2`): the first stage's twiddled butterflies at `k` in both
+/// halves (`first`), then the second's at `k` and `m − k` (`second`).
+#[inline(always)]
+fn radix4_rows_twiddled<T: Real>(rows: [&mut [T]; 8], first: (T, T), second: [(T, T); 2]) {
+    let [r0, r1, r2, r3, r4, r5, r6, r7] = rows;
+    let len = r0.len();
+    let (r1, r2, r3) = (&mut r1[..len], &mut r2[..len], &mut r3[..len]);
+    let (r4, r5, r6, r7) = (
+        &mut r4[..len],
+        &mut r5[..len],
+        &mut r6[..len],
+        &mut r7[..len],
+    );
+    let (c1, s1) = first;
+    let [(c2, s2), (c3, s3)] = second;
+    for i in 0..len {
+        // First stage, half-length m: blocks [0, 2m) and [2m, 4m).
+        let [a0, a1, a2, a3] = twiddled(r0[i], r1[i], r2[i], r3[i], c1, s1);
+        let [b0, b1, b2, b3] = twiddled(r4[i], r5[i], r6[i], r7[i], c1, s1);
+        // Second stage, half-length 2m: k pairs rows k, 2m−k with 2m+k,
+        // 4m−k; m−k pairs rows m−k, m+k with 3m−k, 3m+k.
+        let [k0, k1, k2, k3] = twiddled(a0, a3, b0, b3, c2, s2);
+        let [j0, j1, j2, j3] = twiddled(a1, a2, b1, b2, c3, s3);
+        r0[i] = k0;
+        r3[i] = k1;
+        r4[i] = k2;
+        r7[i] = k3;
+        r1[i] = j0;
+        r2[i] = j1;
+        r5[i] = j2;
+        r6[i] = j3;
     }
 }
 
@@ -481,13 +617,7 @@ fn butterfly_rows_twiddled<T: Real>(
     let len = xk.len();
     let (xmk, yk, ymk) = (&mut xmk[..len], &mut yk[..len], &mut ymk[..len]);
     for i in 0..len {
-        let t1 = c * yk[i] + s * ymk[i];
-        let t2 = s * yk[i] - c * ymk[i];
-        let (a, b) = (xk[i], xmk[i]);
-        xk[i] = a + t1;
-        yk[i] = a - t1;
-        xmk[i] = b + t2;
-        ymk[i] = b - t2;
+        [xk[i], xmk[i], yk[i], ymk[i]] = twiddled(xk[i], xmk[i], yk[i], ymk[i], c, s);
     }
 }
 
