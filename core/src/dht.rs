@@ -375,19 +375,36 @@ pub fn dht_2d_lines<T: Real>(
 }
 
 /// `H(u,v) = ½[T(u,v) + T(−u,v) + T(u,−v) − T(−u,−v)]` in place.
+///
+/// Where `u ≡ −u` (`u = 0`, `nx/2`) or `v ≡ −v` the bracket is `2·T(u,v)`
+/// exactly, so those rows and columns stay as they are. Every other group
+/// of four points shares `S = ½[T(u,v) + T(−u,v) + T(u,−v) + T(−u,−v)]`,
+/// and each point's value is `S` minus the point diagonally opposite
+/// (`H(u,v) = S − T(−u,−v)`, …): 8 operations instead of 16. Rows `v` and
+/// `ny − v` go together, with `u` and `nx − u` walked from both ends.
 fn hao_bracewell_2d<T: Real>(data: &mut [T], nx: usize, ny: usize) {
-    for v in 0..=ny / 2 {
-        let vm = neg_mod(v, ny);
-        for u in 0..=nx / 2 {
-            let um = neg_mod(u, nx);
-            let idx = [u + nx * v, um + nx * v, u + nx * vm, um + nx * vm];
-            let [a, b, c, d] = idx.map(|i| data[i]);
-            data[idx[0]] = T::HALF * (a + b + c - d);
-            data[idx[1]] = T::HALF * (b + a + d - c);
-            data[idx[2]] = T::HALF * (c + d + a - b);
-            data[idx[3]] = T::HALF * (d + c + b - a);
+    if nx <= 2 || ny <= 2 {
+        return;
+    }
+    let h = nx / 2;
+    for v in 1..ny / 2 {
+        let (top, bottom) = data.split_at_mut((ny - v) * nx);
+        let (lo_v, hi_v) = split_row(&mut top[v * nx..(v + 1) * nx], h);
+        let (lo_m, hi_m) = split_row(&mut bottom[..nx], h);
+        let pairs = lo_v.iter_mut().zip(hi_v.iter_mut().rev());
+        let pairs_m = lo_m.iter_mut().zip(hi_m.iter_mut().rev());
+        for ((a, b), (c, d)) in pairs.zip(pairs_m) {
+            let s = T::HALF * ((*a + *b) + (*c + *d));
+            (*a, *b, *c, *d) = (s - *d, s - *c, s - *b, s - *a);
         }
     }
+}
+
+/// Columns `1..h` and `h+1..2h` of a row of `2h`.
+#[inline(always)]
+fn split_row<T>(row: &mut [T], h: usize) -> (&mut [T], &mut [T]) {
+    let (lo, hi) = row.split_at_mut(h);
+    (&mut lo[1..], &mut hi[1..])
 }
 
 /// Transpose an `n × n` array in place: row by row below `n = 128`, in
