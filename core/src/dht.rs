@@ -391,11 +391,13 @@ fn hao_bracewell_2d<T: Real>(data: &mut [T], nx: usize, ny: usize) {
         let (top, bottom) = data.split_at_mut((ny - v) * nx);
         let (lo_v, hi_v) = split_row(&mut top[v * nx..(v + 1) * nx], h);
         let (lo_m, hi_m) = split_row(&mut bottom[..nx], h);
-        let pairs = lo_v.iter_mut().zip(hi_v.iter_mut().rev());
-        let pairs_m = lo_m.iter_mut().zip(hi_m.iter_mut().rev());
-        for ((a, b), (c, d)) in pairs.zip(pairs_m) {
-            let s = T::HALF * ((*a + *b) + (*c + *d));
-            (*a, *b, *c, *d) = (s - *d, s - *c, s - *b, s - *a);
+        let len = lo_v.len();
+        let (hi_v, lo_m, hi_m) = (&mut hi_v[..len], &mut lo_m[..len], &mut hi_m[..len]);
+        for j in 0..len {
+            let r = len - 1 - j;
+            let (a, b, c, d) = (lo_v[j], hi_v[r], lo_m[j], hi_m[r]);
+            let s = T::HALF * ((a + b) + (c + d));
+            (lo_v[j], hi_v[r], lo_m[j], hi_m[r]) = (s - d, s - c, s - b, s - a);
         }
     }
 }
