@@ -326,16 +326,26 @@ pub fn dht_2d<T: Real>(
     tw.check(ny)?;
     check_len("2D array", nx * ny, data.len())?;
     require_len("column scratch", ny, column.len())?;
-    if nx == ny {
+    if nx == ny && nx < TILED_TRANSPOSE_FROM {
+        // The first transpose also bit-reverses both indices: rows come out
+        // in the order the column pass wants, and its output columns in
+        // the bit-reversed row order the second pass wants after a plain
+        // transpose, so no pass reorders rows on its own.
+        transpose_square_bit_reversed(data, nx);
+        dht_columns_bit_reversed(data, nx, ny, tw);
+        transpose_square(data, nx);
+    } else if nx == ny {
         transpose_square(data, nx);
         dht_columns(data, nx, ny, tw);
         transpose_square(data, nx);
+        bit_reverse_rows(data, nx, ny);
     } else {
         for row in data.chunks_exact_mut(nx) {
             dht_unchecked(row, tw);
         }
+        bit_reverse_rows(data, nx, ny);
     }
-    dht_columns(data, nx, ny, tw);
+    dht_columns_bit_reversed(data, nx, ny, tw);
     hao_bracewell_2d(data, nx, ny);
     Ok(())
 }
@@ -409,19 +419,17 @@ fn split_row<T>(row: &mut [T], h: usize) -> (&mut [T], &mut [T]) {
     (&mut lo[1..], &mut hi[1..])
 }
 
+/// Side from which [`transpose_square`] works in tiles.
+const TILED_TRANSPOSE_FROM: usize = 128;
+
 /// Transpose an `n × n` array in place: row by row below `n = 128`, in
 /// tiles of 16 × 16 from there (a row-by-row transpose walks one side with
 /// a stride of `n` and misses the cache on every element once rows outgrow
 /// it; on a cacheless core the plain loop costs fewer instructions).
 fn transpose_square<T>(data: &mut [T], n: usize) {
     const TILE: usize = 16;
-    if n < 128 || n % TILE != 0 {
-        for i in 1..n {
-            let (upper, lower) = data.split_at_mut(i * n);
-            for (j, below) in lower[..i].iter_mut().enumerate() {
-                core::mem::swap(below, &mut upper[j * n + i]);
-            }
-        }
+    if n < TILED_TRANSPOSE_FROM || n % TILE != 0 {
+        swap_across_diagonal(data, n, |i| i);
         return;
     }
     for bi in (0..n).step_by(TILE) {
@@ -436,21 +444,36 @@ fn transpose_square<T>(data: &mut [T], n: usize) {
     }
 }
 
-/// The radix-2 DHT of [`dht_unchecked`] along `y` for all `nx` columns at
-/// once: rows take the place of elements, so every butterfly is a loop
-/// over `nx` contiguous values with one twiddle pair.
-///
-/// Stages go two at a time (radix 2²): the stages of half-lengths `m` and
-/// `2m` touch the rows `k, m−k, m+k, 2m−k` and those `2m` further on
-/// together, eight rows closed under both stages, so each value is loaded
-/// and stored once per two stages. The butterflies and their operands are
-/// those of [`dht_stages`], in the same order, so the result is the same to
-/// the bit; a single radix-2 stage finishes odd `log₂ny`.
-fn dht_columns<T: Real>(data: &mut [T], nx: usize, ny: usize, tw: &Twiddles<'_, T>) {
-    if ny <= 1 {
+/// `data[r][c] ← data[rev c][rev r]` in place for an `n × n` array
+/// (`n` a power of two, `rev` reversing `log₂n` bits): a transpose that
+/// also bit-reverses the order of the rows and of the columns.
+fn transpose_square_bit_reversed<T>(data: &mut [T], n: usize) {
+    if n <= 1 {
         return;
     }
-    // Bit-reverse the order of the rows.
+    let shift = usize::BITS - n.trailing_zeros();
+    swap_across_diagonal(data, n, |i| i.reverse_bits() >> shift);
+}
+
+/// Swap `data[r·n + p(s)]` with `data[s·n + p(r)]` for all `s < r < n`,
+/// `p` a permutation of `0..n` (an involution of the array: the identity
+/// gives the transpose).
+#[inline(always)]
+fn swap_across_diagonal<T, P: Fn(usize) -> usize>(data: &mut [T], n: usize, p: P) {
+    for r in 1..n {
+        let (above, below) = data.split_at_mut(r * n);
+        let row = &mut below[..n];
+        let column = above[p(r) % n..].iter_mut().step_by(n);
+        for (s, a) in column.enumerate() {
+            if let Some(b) = row.get_mut(p(s)) {
+                core::mem::swap(a, b);
+            }
+        }
+    }
+}
+
+/// Put the rows of an `nx × ny` array in bit-reversed order.
+fn bit_reverse_rows<T>(data: &mut [T], nx: usize, ny: usize) {
     let mut j = 0usize;
     for i in 1..ny {
         let mut bit = ny >> 1;
@@ -464,6 +487,26 @@ fn dht_columns<T: Real>(data: &mut [T], nx: usize, ny: usize, tw: &Twiddles<'_, 
             head[i * nx..(i + 1) * nx].swap_with_slice(&mut tail[..nx]);
         }
     }
+}
+
+/// [`bit_reverse_rows`] then [`dht_columns_bit_reversed`].
+fn dht_columns<T: Real>(data: &mut [T], nx: usize, ny: usize, tw: &Twiddles<'_, T>) {
+    bit_reverse_rows(data, nx, ny);
+    dht_columns_bit_reversed(data, nx, ny, tw);
+}
+
+/// The radix-2 DHT of [`dht_unchecked`] along `y` for all `nx` columns at
+/// once, on rows already in bit-reversed order: rows take the place of
+/// elements, so every butterfly is a loop over `nx` contiguous values with
+/// one twiddle pair.
+///
+/// Stages go two at a time (radix 2²): the stages of half-lengths `m` and
+/// `2m` touch the rows `k, m−k, m+k, 2m−k` and those `2m` further on
+/// together, eight rows closed under both stages, so each value is loaded
+/// and stored once per two stages. The butterflies and their operands are
+/// those of [`dht_stages`], in the same order, so the result is the same to
+/// the bit; a single radix-2 stage finishes odd `log₂ny`.
+fn dht_columns_bit_reversed<T: Real>(data: &mut [T], nx: usize, ny: usize, tw: &Twiddles<'_, T>) {
     let mut m = 1;
     while 4 * m <= ny {
         let stride1 = tw.len / (2 * m);
