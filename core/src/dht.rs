@@ -326,26 +326,29 @@ pub fn dht_2d<T: Real>(
     tw.check(ny)?;
     check_len("2D array", nx * ny, data.len())?;
     require_len("column scratch", ny, column.len())?;
-    if nx == ny && nx < TILED_TRANSPOSE_FROM {
+    if nx == ny && (4..TILED_TRANSPOSE_FROM).contains(&nx) {
         // The first transpose also bit-reverses both indices: rows come out
         // in the order the column pass wants, and its output columns in
         // the bit-reversed row order the second pass wants after a plain
-        // transpose, so no pass reorders rows on its own.
-        transpose_square_bit_reversed(data, nx);
-        dht_columns_bit_reversed(data, nx, ny, tw);
-        transpose_square(data, nx);
-    } else if nx == ny {
-        transpose_square(data, nx);
-        dht_columns(data, nx, ny, tw);
-        transpose_square(data, nx);
-        bit_reverse_rows(data, nx, ny);
+        // transpose, so no pass reorders rows on its own. Each transpose
+        // also does the first two (untwiddled) stages of the pass after it.
+        let shift = usize::BITS - nx.trailing_zeros();
+        transpose_square_radix4(data, nx, |i| i.reverse_bits() >> shift);
+        dht_columns_stages(data, nx, ny, 4, tw);
+        transpose_square_radix4(data, nx, |i| i);
+        dht_columns_stages(data, nx, ny, 4, tw);
     } else {
-        for row in data.chunks_exact_mut(nx) {
-            dht_unchecked(row, tw);
+        if nx == ny {
+            transpose_square(data, nx);
+            dht_columns(data, nx, ny, tw);
+            transpose_square(data, nx);
+        } else {
+            for row in data.chunks_exact_mut(nx) {
+                dht_unchecked(row, tw);
+            }
         }
-        bit_reverse_rows(data, nx, ny);
+        dht_columns(data, nx, ny, tw);
     }
-    dht_columns_bit_reversed(data, nx, ny, tw);
     hao_bracewell_2d(data, nx, ny);
     Ok(())
 }
@@ -444,15 +447,47 @@ fn transpose_square<T>(data: &mut [T], n: usize) {
     }
 }
 
-/// `data[r][c] ← data[rev c][rev r]` in place for an `n × n` array
-/// (`n` a power of two, `rev` reversing `log₂n` bits): a transpose that
-/// also bit-reverses the order of the rows and of the columns.
-fn transpose_square_bit_reversed<T>(data: &mut [T], n: usize) {
-    if n <= 1 {
-        return;
+/// `data[r][c] ← data[p(c)][p(r)]` in place for an `n × n` array (`n` a
+/// multiple of 4, `p` an involution of `0..n` with `p(4t + j) = p(4t) +
+/// p(j)` for `j < 4`), then the first two (untwiddled) stages of
+/// [`dht_columns_stages`] on every group of four rows `4t .. 4t+3`.
+///
+/// With `p` the identity the permutation is the transpose; with `p` the
+/// reversal of `log₂n` bits it also puts rows and columns in bit-reversed
+/// order. The groups of four rows are closed under the permutation in
+/// 4 × 4 tiles, so each value is loaded and stored once for both.
+fn transpose_square_radix4<T: Real, P: Fn(usize) -> usize>(data: &mut [T], n: usize, p: P) {
+    const B: usize = 4;
+    let q: [usize; B] = core::array::from_fn(&p);
+    for rt in 0..n / B {
+        let (above, below) = data.split_at_mut(B * rt * n);
+        let band = &mut below[..B * n];
+        let pr = p(B * rt);
+        // The tile on the diagonal: its column j becomes its row j.
+        let tile: [[T; B]; B] =
+            core::array::from_fn(|i| core::array::from_fn(|j| band[i * n + pr + q[j]]));
+        for (j, column) in tile.iter().enumerate() {
+            for (i, v) in radix4_plain(*column).into_iter().enumerate() {
+                band[i * n + pr + q[j]] = v;
+            }
+        }
+        for (st, other) in above.chunks_exact_mut(B * n).enumerate() {
+            let ps = p(B * st);
+            let mine: [[T; B]; B] =
+                core::array::from_fn(|i| core::array::from_fn(|j| band[i * n + ps + q[j]]));
+            for j in 0..B {
+                let theirs: [T; B] = core::array::from_fn(|i| other[j * n + pr + q[i]]);
+                for (i, v) in radix4_plain(theirs).into_iter().enumerate() {
+                    band[i * n + ps + q[j]] = v;
+                }
+            }
+            for (i, row) in mine.iter().enumerate() {
+                for (j, v) in radix4_plain(*row).into_iter().enumerate() {
+                    other[j * n + pr + q[i]] = v;
+                }
+            }
+        }
     }
-    let shift = usize::BITS - n.trailing_zeros();
-    swap_across_diagonal(data, n, |i| i.reverse_bits() >> shift);
 }
 
 /// Swap `data[r·n + p(s)]` with `data[s·n + p(r)]` for all `s < r < n`,
@@ -510,16 +545,17 @@ fn bit_reverse_rows<T>(data: &mut [T], nx: usize, ny: usize) {
     }
 }
 
-/// [`bit_reverse_rows`] then [`dht_columns_bit_reversed`].
+/// [`bit_reverse_rows`] then all of [`dht_columns_stages`].
 fn dht_columns<T: Real>(data: &mut [T], nx: usize, ny: usize, tw: &Twiddles<'_, T>) {
     bit_reverse_rows(data, nx, ny);
-    dht_columns_bit_reversed(data, nx, ny, tw);
+    dht_columns_stages(data, nx, ny, 1, tw);
 }
 
 /// The radix-2 DHT of [`dht_unchecked`] along `y` for all `nx` columns at
-/// once, on rows already in bit-reversed order: rows take the place of
-/// elements, so every butterfly is a loop over `nx` contiguous values with
-/// one twiddle pair.
+/// once, from the stage of half-length `m` on (rows already in bit-reversed
+/// order, the stages below `m` done): rows take the place of elements, so
+/// every butterfly is a loop over `nx` contiguous values with one twiddle
+/// pair.
 ///
 /// Stages go two at a time (radix 2²): the stages of half-lengths `m` and
 /// `2m` touch the rows `k, m−k, m+k, 2m−k` and those `2m` further on
@@ -527,8 +563,13 @@ fn dht_columns<T: Real>(data: &mut [T], nx: usize, ny: usize, tw: &Twiddles<'_, 
 /// and stored once per two stages. The butterflies and their operands are
 /// those of [`dht_stages`], in the same order, so the result is the same to
 /// the bit; a single radix-2 stage finishes odd `log₂ny`.
-fn dht_columns_bit_reversed<T: Real>(data: &mut [T], nx: usize, ny: usize, tw: &Twiddles<'_, T>) {
-    let mut m = 1;
+fn dht_columns_stages<T: Real>(
+    data: &mut [T],
+    nx: usize,
+    ny: usize,
+    mut m: usize,
+    tw: &Twiddles<'_, T>,
+) {
     while 4 * m <= ny {
         let stride1 = tw.len / (2 * m);
         let stride2 = tw.len / (4 * m);
@@ -624,13 +665,17 @@ fn radix4_rows_plain<T: Real>(r0: &mut [T], r1: &mut [T], r2: &mut [T], r3: &mut
     let len = r0.len();
     let (r1, r2, r3) = (&mut r1[..len], &mut r2[..len], &mut r3[..len]);
     for i in 0..len {
-        let (a, b) = (r0[i] + r1[i], r0[i] - r1[i]);
-        let (c, d) = (r2[i] + r3[i], r2[i] - r3[i]);
-        r0[i] = a + c;
-        r2[i] = a - c;
-        r1[i] = b + d;
-        r3[i] = b - d;
+        [r0[i], r1[i], r2[i], r3[i]] = radix4_plain([r0[i], r1[i], r2[i], r3[i]]);
     }
+}
+
+/// Both untwiddled stages on four values in bit-reversed order: the pairs
+/// `(0, 1)` and `(2, 3)`, then `(0, 2)` and `(1, 3)`.
+#[inline(always)]
+fn radix4_plain<T: Real>([r0, r1, r2, r3]: [T; 4]) -> [T; 4] {
+    let (a, b) = (r0 + r1, r0 - r1);
+    let (c, d) = (r2 + r3, r2 - r3);
+    [a + c, b + d, a - c, b - d]
 }
 
 /// Radix-2² on rows `h, 3h, 5h, 7h` (`h = m/2`): the middle butterflies of
