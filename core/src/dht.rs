@@ -335,7 +335,7 @@ pub fn dht_2d<T: Real>(
         let shift = usize::BITS - nx.trailing_zeros();
         transpose_square_radix4(data, nx, |i| i.reverse_bits() >> shift);
         dht_columns_stages(data, nx, ny, 4, tw);
-        transpose_square_radix4(data, nx, |i| i);
+        transpose_square_plain_radix4(data, nx);
         dht_columns_stages(data, nx, ny, 4, tw);
     } else {
         if nx == ny {
@@ -488,6 +488,57 @@ fn transpose_square_radix4<T: Real, P: Fn(usize) -> usize>(data: &mut [T], n: us
             }
         }
     }
+}
+
+/// [`transpose_square_radix4`] for the identity (the plain transpose),
+/// written over row segments of four, which the M4F addresses with
+/// immediate offsets from one pointer per segment.
+fn transpose_square_plain_radix4<T: Real>(data: &mut [T], n: usize) {
+    const B: usize = 4;
+    for rt in 0..n / B {
+        let (above, below) = data.split_at_mut(B * rt * n);
+        let band = &mut below[..B * n];
+        let c = B * rt;
+        let tile: [[T; B]; B] = core::array::from_fn(|i| *segment(band, i * n + c));
+        for (j, column) in tile.iter().enumerate() {
+            for (i, v) in radix4_plain(*column).into_iter().enumerate() {
+                segment(band, i * n + c)[j] = v;
+            }
+        }
+        for (st, other) in above.chunks_exact_mut(B * n).enumerate() {
+            let cs = B * st;
+            let [b0, b1, b2, b3] = rows_mut(band, n, [0, 1, 2, 3]);
+            let mine = [b0, b1, b2, b3].map(|row| segment(row, cs));
+            let [o0, o1, o2, o3] = rows_mut(other, n, [0, 1, 2, 3]);
+            let theirs = [o0, o1, o2, o3].map(|row| segment(row, c));
+            let saved: [[T; B]; B] = core::array::from_fn(|i| *mine[i]);
+            for (j, row) in theirs.iter().enumerate() {
+                for (i, v) in radix4_plain(**row).into_iter().enumerate() {
+                    mine[i][j] = v;
+                }
+            }
+            for (i, row) in saved.iter().enumerate() {
+                for (j, v) in radix4_plain(*row).into_iter().enumerate() {
+                    theirs[j][i] = v;
+                }
+            }
+        }
+    }
+}
+
+/// The four values of `row` from `start` on, as an array.
+#[inline(always)]
+fn segment<T>(row: &mut [T], start: usize) -> &mut [T; 4] {
+    let (_, tail) = row.split_at_mut(start);
+    match tail.first_chunk_mut::<4>() {
+        Some(s) => s,
+        None => segment_out_of_range(),
+    }
+}
+
+#[cold]
+fn segment_out_of_range() -> ! {
+    panic!("segment past the end of its row")
 }
 
 /// Swap `data[r·n + p(s)]` with `data[s·n + p(r)]` for all `s < r < n`,
