@@ -332,8 +332,7 @@ pub fn dht_2d<T: Real>(
         // the bit-reversed row order the second pass wants after a plain
         // transpose, so no pass reorders rows on its own. Each transpose
         // also does the first two (untwiddled) stages of the pass after it.
-        let shift = usize::BITS - nx.trailing_zeros();
-        transpose_square_radix4(data, nx, |i| i.reverse_bits() >> shift);
+        transpose_square_bit_reversed_radix4(data, nx);
         dht_columns_stages(data, nx, ny, 4, tw);
         transpose_square_plain_radix4(data, nx);
         dht_columns_stages(data, nx, ny, 4, tw);
@@ -447,51 +446,70 @@ fn transpose_square<T>(data: &mut [T], n: usize) {
     }
 }
 
-/// `data[r][c] ← data[p(c)][p(r)]` in place for an `n × n` array (`n` a
-/// multiple of 4, `p` an involution of `0..n` with `p(4t + j) = p(4t) +
-/// p(j)` for `j < 4`), then the first two (untwiddled) stages of
-/// [`dht_columns_stages`] on every group of four rows `4t .. 4t+3`.
+/// `data[r][c] ← data[rev c][rev r]` in place for an `n × n` array (`n` a
+/// power of two, at least 4, `rev` reversing `log₂n` bits), then the first
+/// two (untwiddled) stages of [`dht_columns_stages`] on every group of
+/// four rows `4t .. 4t+3`.
 ///
-/// With `p` the identity the permutation is the transpose; with `p` the
-/// reversal of `log₂n` bits it also puts rows and columns in bit-reversed
-/// order. The groups of four rows are closed under the permutation in
-/// 4 × 4 tiles, so each value is loaded and stored once for both.
-fn transpose_square_radix4<T: Real, P: Fn(usize) -> usize>(data: &mut [T], n: usize, p: P) {
+/// The permutation is a transpose that also puts rows and columns in
+/// bit-reversed order. The groups of four rows are closed under it in
+/// 4 × 4 tiles (`rev(4t + j) = rev(4t) + rev(j)` for `j < 4`), so each
+/// value is loaded and stored once for both. Since `rev(4t) < n/4` and
+/// `rev(j)` is a whole number of quarters, a tile's values sit at one
+/// index of sixteen quarter rows, and one bounds check covers them all.
+fn transpose_square_bit_reversed_radix4<T: Real>(data: &mut [T], n: usize) {
     const B: usize = 4;
-    let q: [usize; B] = core::array::from_fn(&p);
+    // Quarter holding column rev(4t) + rev(j): rev(j) = QUARTER_OF[j]·n/4.
+    const QUARTER_OF: [usize; B] = [0, 2, 1, 3];
+    let quarter = n / B;
+    let shift = usize::BITS - quarter.trailing_zeros();
+    let rev4 = |t: usize| t.reverse_bits().checked_shr(shift).unwrap_or(0);
     for rt in 0..n / B {
         let (above, below) = data.split_at_mut(B * rt * n);
-        let band = &mut below[..B * n];
-        let pr = p(B * rt);
-        // The tile on the diagonal: its column j becomes its row j.
+        let band = quarters(&mut below[..B * n], n);
+        let pr = rev4(rt);
+        if pr >= quarter {
+            return;
+        }
         let tile: [[T; B]; B] =
-            core::array::from_fn(|i| core::array::from_fn(|j| band[i * n + pr + q[j]]));
+            core::array::from_fn(|i| core::array::from_fn(|j| band[i][QUARTER_OF[j]][pr]));
         for (j, column) in tile.iter().enumerate() {
             for (i, v) in radix4_plain(*column).into_iter().enumerate() {
-                band[i * n + pr + q[j]] = v;
+                band[i][QUARTER_OF[j]][pr] = v;
             }
         }
         for (st, other) in above.chunks_exact_mut(B * n).enumerate() {
-            let ps = p(B * st);
-            let mine: [[T; B]; B] =
-                core::array::from_fn(|i| core::array::from_fn(|j| band[i * n + ps + q[j]]));
+            let ps = rev4(st);
+            if ps >= quarter {
+                return;
+            }
+            let other = quarters(other, n);
+            let saved: [[T; B]; B] =
+                core::array::from_fn(|i| core::array::from_fn(|j| band[i][QUARTER_OF[j]][ps]));
             for j in 0..B {
-                let theirs: [T; B] = core::array::from_fn(|i| other[j * n + pr + q[i]]);
+                let theirs: [T; B] = core::array::from_fn(|i| other[j][QUARTER_OF[i]][pr]);
                 for (i, v) in radix4_plain(theirs).into_iter().enumerate() {
-                    band[i * n + ps + q[j]] = v;
+                    band[i][QUARTER_OF[j]][ps] = v;
                 }
             }
-            for (i, row) in mine.iter().enumerate() {
+            for (i, row) in saved.iter().enumerate() {
                 for (j, v) in radix4_plain(*row).into_iter().enumerate() {
-                    other[j * n + pr + q[i]] = v;
+                    other[j][QUARTER_OF[i]][pr] = v;
                 }
             }
         }
     }
 }
 
-/// [`transpose_square_radix4`] for the identity (the plain transpose),
-/// written over row segments of four, which the M4F addresses with
+/// Four rows of `n` as four quarter rows each.
+#[inline(always)]
+fn quarters<T>(rows: &mut [T], n: usize) -> [[&mut [T]; 4]; 4] {
+    rows_mut(rows, n, [0, 1, 2, 3]).map(|row| rows_mut(row, n / 4, [0, 1, 2, 3]))
+}
+
+/// [`transpose_square_bit_reversed_radix4`] without the bit reversal: the
+/// plain transpose, then the two untwiddled stages on every group of four
+/// rows. Written over row segments of four, which the M4F addresses with
 /// immediate offsets from one pointer per segment.
 fn transpose_square_plain_radix4<T: Real>(data: &mut [T], n: usize) {
     const B: usize = 4;
