@@ -403,15 +403,53 @@ fn hao_bracewell_2d<T: Real>(data: &mut [T], nx: usize, ny: usize) {
         let (top, bottom) = data.split_at_mut((ny - v) * nx);
         let (lo_v, hi_v) = split_row(&mut top[v * nx..(v + 1) * nx], h);
         let (lo_m, hi_m) = split_row(&mut bottom[..nx], h);
-        let len = lo_v.len();
-        let (hi_v, lo_m, hi_m) = (&mut hi_v[..len], &mut lo_m[..len], &mut hi_m[..len]);
-        for j in 0..len {
-            let r = len - 1 - j;
-            let (a, b, c, d) = (lo_v[j], hi_v[r], lo_m[j], hi_m[r]);
-            let s = T::HALF * ((a + b) + (c + d));
-            (lo_v[j], hi_v[r], lo_m[j], hi_m[r]) = (s - d, s - c, s - b, s - a);
+        // Four groups at a time: `u` ascending in chunks of `lo_*`, `nx − u`
+        // descending in the chunks of `hi_*` counted from its end.
+        let (lo_v, lo_v_rest) = lo_v.as_chunks_mut::<4>();
+        let (hi_v_rest, hi_v) = hi_v.as_rchunks_mut::<4>();
+        let (lo_m, lo_m_rest) = lo_m.as_chunks_mut::<4>();
+        let (hi_m_rest, hi_m) = hi_m.as_rchunks_mut::<4>();
+        let chunks = lo_v.len();
+        let (hi_v, lo_m, hi_m) = (
+            &mut hi_v[..chunks],
+            &mut lo_m[..chunks],
+            &mut hi_m[..chunks],
+        );
+        for j in 0..chunks {
+            let r = chunks - 1 - j;
+            for k in 0..4 {
+                hao_bracewell_group(
+                    &mut lo_v[j][k],
+                    &mut hi_v[r][3 - k],
+                    &mut lo_m[j][k],
+                    &mut hi_m[r][3 - k],
+                );
+            }
+        }
+        let rest = lo_v_rest.len();
+        let (hi_v_rest, lo_m_rest, hi_m_rest) = (
+            &mut hi_v_rest[..rest],
+            &mut lo_m_rest[..rest],
+            &mut hi_m_rest[..rest],
+        );
+        for j in 0..rest {
+            let r = rest - 1 - j;
+            hao_bracewell_group(
+                &mut lo_v_rest[j],
+                &mut hi_v_rest[r],
+                &mut lo_m_rest[j],
+                &mut hi_m_rest[r],
+            );
         }
     }
+}
+
+/// The correction on one group: `a, b, c, d` at `(u, v)`, `(−u, v)`,
+/// `(u, −v)`, `(−u, −v)`.
+#[inline(always)]
+fn hao_bracewell_group<T: Real>(a: &mut T, b: &mut T, c: &mut T, d: &mut T) {
+    let s = T::HALF * ((*a + *b) + (*c + *d));
+    (*a, *b, *c, *d) = (s - *d, s - *c, s - *b, s - *a);
 }
 
 /// Columns `1..h` and `h+1..2h` of a row of `2h`.
