@@ -769,11 +769,7 @@ fn twiddled<T: Real>(xk: T, xmk: T, yk: T, ymk: T, c: T, s: T) -> [T; 4] {
 /// (`k = 0` of each, and the middle `k = m` of the second).
 #[inline(always)]
 fn radix4_rows_plain<T: Real>(r0: &mut [T], r1: &mut [T], r2: &mut [T], r3: &mut [T]) {
-    let len = r0.len();
-    let (r1, r2, r3) = (&mut r1[..len], &mut r2[..len], &mut r3[..len]);
-    for i in 0..len {
-        [r0[i], r1[i], r2[i], r3[i]] = radix4_plain([r0[i], r1[i], r2[i], r3[i]]);
-    }
+    for_each_column([r0, r1, r2, r3], radix4_plain);
 }
 
 /// Both untwiddled stages on four values in bit-reversed order: the pairs
@@ -789,17 +785,11 @@ fn radix4_plain<T: Real>([r0, r1, r2, r3]: [T; 4]) -> [T; 4] {
 /// the first stage, then the twiddled one of the second at `k = h`.
 #[inline(always)]
 fn radix4_rows_half<T: Real>(r0: &mut [T], r1: &mut [T], r2: &mut [T], r3: &mut [T], c: T, s: T) {
-    let len = r0.len();
-    let (r1, r2, r3) = (&mut r1[..len], &mut r2[..len], &mut r3[..len]);
-    for i in 0..len {
-        let (a, b) = (r0[i] + r1[i], r0[i] - r1[i]);
-        let (y, ym) = (r2[i] + r3[i], r2[i] - r3[i]);
-        let [xk, xmk, yk, ymk] = twiddled(a, b, y, ym, c, s);
-        r0[i] = xk;
-        r1[i] = xmk;
-        r2[i] = yk;
-        r3[i] = ymk;
-    }
+    for_each_column([r0, r1, r2, r3], |[r0, r1, r2, r3]| {
+        let (a, b) = (r0 + r1, r0 - r1);
+        let (y, ym) = (r2 + r3, r2 - r3);
+        twiddled(a, b, y, ym, c, s)
+    });
 }
 
 /// Radix-2² on the rows `k, m−k, m+k, 2m−k, 2m+k, 3m−k, 3m+k, 4m−k`
@@ -807,39 +797,50 @@ fn radix4_rows_half<T: Real>(r0: &mut [T], r1: &mut [T], r2: &mut [T], r3: &mut 
 /// halves (`first`), then the second's at `k` and `m − k` (`second`).
 #[inline(always)]
 fn radix4_rows_twiddled<T: Real>(rows: [&mut [T]; 8], first: (T, T), second: [(T, T); 2]) {
-    let [r0, r1, r2, r3, r4, r5, r6, r7] = rows;
-    let len = r0.len();
-    let (r1, r2, r3) = (&mut r1[..len], &mut r2[..len], &mut r3[..len]);
-    let (r4, r5, r6, r7) = (
-        &mut r4[..len],
-        &mut r5[..len],
-        &mut r6[..len],
-        &mut r7[..len],
-    );
     let (c1, s1) = first;
     let [(c2, s2), (c3, s3)] = second;
-    for i in 0..len {
+    for_each_column(rows, |[r0, r1, r2, r3, r4, r5, r6, r7]| {
         // First stage, half-length m: blocks [0, 2m) and [2m, 4m).
-        let [a0, a1, a2, a3] = twiddled(r0[i], r1[i], r2[i], r3[i], c1, s1);
-        let [b0, b1, b2, b3] = twiddled(r4[i], r5[i], r6[i], r7[i], c1, s1);
+        let [a0, a1, a2, a3] = twiddled(r0, r1, r2, r3, c1, s1);
+        let [b0, b1, b2, b3] = twiddled(r4, r5, r6, r7, c1, s1);
         // Second stage, half-length 2m: k pairs rows k, 2m−k with 2m+k,
         // 4m−k; m−k pairs rows m−k, m+k with 3m−k, 3m+k.
         let [k0, k1, k2, k3] = twiddled(a0, a3, b0, b3, c2, s2);
         let [j0, j1, j2, j3] = twiddled(a1, a2, b1, b2, c3, s3);
-        r0[i] = k0;
-        r3[i] = k1;
-        r4[i] = k2;
-        r7[i] = k3;
-        r1[i] = j0;
-        r2[i] = j1;
-        r5[i] = j2;
-        r6[i] = j3;
+        [k0, j0, j1, k1, k2, j2, j3, k3]
+    });
+}
+
+/// Apply `f` to every column of `R` equal-length rows: the values of the
+/// column in, its new values out. Runs over chunks of four columns
+/// (`[T; 4]`), which the M4F addresses with immediate offsets from one
+/// pointer per row, then over the rest.
+#[inline(always)]
+fn for_each_column<T: Copy, const R: usize>(
+    rows: [&mut [T]; R],
+    mut f: impl FnMut([T; R]) -> [T; R],
+) {
+    let len = rows.iter().map(|r| r.len()).min().unwrap_or(0);
+    let mut split = rows.map(|r| r[..len].as_chunks_mut::<4>());
+    let chunks = len / 4;
+    for c in 0..chunks {
+        for k in 0..4 {
+            let out = f(core::array::from_fn(|r| split[r].0[c][k]));
+            for (row, v) in split.iter_mut().zip(out) {
+                row.0[c][k] = v;
+            }
+        }
+    }
+    for k in 0..len % 4 {
+        let out = f(core::array::from_fn(|r| split[r].1[k]));
+        for (row, v) in split.iter_mut().zip(out) {
+            row.1[k] = v;
+        }
     }
 }
 
 /// The twiddled butterfly of [`dht_stages`] over whole rows: `xk`, `yk`
-/// hold index `k` and `xmk`, `ymk` index `m − k` of every column. Written
-/// over equal-length slices indexed in step, so that it vectorizes.
+/// hold index `k` and `xmk`, `ymk` index `m − k` of every column.
 #[inline(always)]
 fn butterfly_rows_twiddled<T: Real>(
     xk: &mut [T],
@@ -849,19 +850,15 @@ fn butterfly_rows_twiddled<T: Real>(
     c: T,
     s: T,
 ) {
-    let len = xk.len();
-    let (xmk, yk, ymk) = (&mut xmk[..len], &mut yk[..len], &mut ymk[..len]);
-    for i in 0..len {
-        [xk[i], xmk[i], yk[i], ymk[i]] = twiddled(xk[i], xmk[i], yk[i], ymk[i], c, s);
-    }
+    for_each_column([xk, xmk, yk, ymk], |[xk, xmk, yk, ymk]| {
+        twiddled(xk, xmk, yk, ymk, c, s)
+    });
 }
 
 /// [`butterfly_pair`] over two rows.
 #[inline(always)]
 fn butterfly_rows<T: Real>(x: &mut [T], y: &mut [T]) {
-    for (a, b) in x.iter_mut().zip(y.iter_mut()) {
-        butterfly_pair(a, b);
-    }
+    for_each_column([x, y], |[a, b]| [a + b, a - b]);
 }
 
 /// Inverse of [`dht_2d`]: the same transform divided by `nx·ny`.
