@@ -403,45 +403,59 @@ fn hao_bracewell_2d<T: Real>(data: &mut [T], nx: usize, ny: usize) {
         let (top, bottom) = data.split_at_mut((ny - v) * nx);
         let (lo_v, hi_v) = split_row(&mut top[v * nx..(v + 1) * nx], h);
         let (lo_m, hi_m) = split_row(&mut bottom[..nx], h);
-        // Four groups at a time: `u` ascending in chunks of `lo_*`, `nx − u`
-        // descending in the chunks of `hi_*` counted from its end.
-        let (lo_v, lo_v_rest) = lo_v.as_chunks_mut::<4>();
-        let (hi_v_rest, hi_v) = hi_v.as_rchunks_mut::<4>();
-        let (lo_m, lo_m_rest) = lo_m.as_chunks_mut::<4>();
-        let (hi_m_rest, hi_m) = hi_m.as_rchunks_mut::<4>();
-        let chunks = lo_v.len();
-        let (hi_v, lo_m, hi_m) = (
-            &mut hi_v[..chunks],
-            &mut lo_m[..chunks],
-            &mut hi_m[..chunks],
-        );
-        for j in 0..chunks {
-            let r = chunks - 1 - j;
+        // Four groups at a time: `u` ascending in chunks from the front of
+        // `lo_*`, `nx − u` descending in chunks from the back of `hi_*`.
+        let mut streams = [lo_v, hi_v, lo_m, hi_m];
+        for _ in 0..streams[0].len() / 4 {
+            let [lo_v, hi_v, lo_m, hi_m] = &mut streams;
+            let (lo_v, hi_v) = (take_first4(lo_v), take_last4(hi_v));
+            let (lo_m, hi_m) = (take_first4(lo_m), take_last4(hi_m));
             for k in 0..4 {
                 hao_bracewell_group(
-                    &mut lo_v[j][k],
-                    &mut hi_v[r][3 - k],
-                    &mut lo_m[j][k],
-                    &mut hi_m[r][3 - k],
+                    &mut lo_v[k],
+                    &mut hi_v[3 - k],
+                    &mut lo_m[k],
+                    &mut hi_m[3 - k],
                 );
             }
         }
-        let rest = lo_v_rest.len();
-        let (hi_v_rest, lo_m_rest, hi_m_rest) = (
-            &mut hi_v_rest[..rest],
-            &mut lo_m_rest[..rest],
-            &mut hi_m_rest[..rest],
-        );
+        let [lo_v, hi_v, lo_m, hi_m] = streams;
+        let rest = lo_v.len();
+        let (hi_v, lo_m, hi_m) = (&mut hi_v[..rest], &mut lo_m[..rest], &mut hi_m[..rest]);
         for j in 0..rest {
             let r = rest - 1 - j;
-            hao_bracewell_group(
-                &mut lo_v_rest[j],
-                &mut hi_v_rest[r],
-                &mut lo_m_rest[j],
-                &mut hi_m_rest[r],
-            );
+            hao_bracewell_group(&mut lo_v[j], &mut hi_v[r], &mut lo_m[j], &mut hi_m[r]);
         }
     }
+}
+
+/// The first four values of `*s`, which then starts after them.
+#[inline(always)]
+fn take_first4<'a, T>(s: &mut &'a mut [T]) -> &'a mut [T; 4] {
+    match core::mem::take(s).split_first_chunk_mut::<4>() {
+        Some((chunk, tail)) => {
+            *s = tail;
+            chunk
+        }
+        None => chunk_out_of_range(),
+    }
+}
+
+/// The last four values of `*s`, which then ends before them.
+#[inline(always)]
+fn take_last4<'a, T>(s: &mut &'a mut [T]) -> &'a mut [T; 4] {
+    match core::mem::take(s).split_last_chunk_mut::<4>() {
+        Some((head, chunk)) => {
+            *s = head;
+            chunk
+        }
+        None => chunk_out_of_range(),
+    }
+}
+
+#[cold]
+fn chunk_out_of_range() -> ! {
+    panic!("chunk of four past the end of its slice")
 }
 
 /// The correction on one group: `a, b, c, d` at `(u, v)`, `(−u, v)`,
@@ -588,13 +602,8 @@ fn segment<T>(row: &mut [T], start: usize) -> &mut [T; 4] {
     let (_, tail) = row.split_at_mut(start);
     match tail.first_chunk_mut::<4>() {
         Some(s) => s,
-        None => segment_out_of_range(),
+        None => chunk_out_of_range(),
     }
-}
-
-#[cold]
-fn segment_out_of_range() -> ! {
-    panic!("segment past the end of its row")
 }
 
 /// Swap `data[r·n + p(s)]` with `data[s·n + p(r)]` for all `s < r < n`,
@@ -821,20 +830,20 @@ fn for_each_column<T: Copy, const R: usize>(
     mut f: impl FnMut([T; R]) -> [T; R],
 ) {
     let len = rows.iter().map(|r| r.len()).min().unwrap_or(0);
-    let mut split = rows.map(|r| r[..len].as_chunks_mut::<4>());
-    let chunks = len / 4;
-    for c in 0..chunks {
+    let mut rest = rows.map(|r| &mut r[..len]);
+    for _ in 0..len / 4 {
+        let mut chunks = rest.each_mut().map(take_first4);
         for k in 0..4 {
-            let out = f(core::array::from_fn(|r| split[r].0[c][k]));
-            for (row, v) in split.iter_mut().zip(out) {
-                row.0[c][k] = v;
+            let out = f(core::array::from_fn(|r| chunks[r][k]));
+            for (chunk, v) in chunks.iter_mut().zip(out) {
+                chunk[k] = v;
             }
         }
     }
     for k in 0..len % 4 {
-        let out = f(core::array::from_fn(|r| split[r].1[k]));
-        for (row, v) in split.iter_mut().zip(out) {
-            row.1[k] = v;
+        let out = f(core::array::from_fn(|r| rest[r][k]));
+        for (row, v) in rest.iter_mut().zip(out) {
+            row[k] = v;
         }
     }
 }
