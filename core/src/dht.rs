@@ -332,9 +332,15 @@ pub fn dht_2d<T: Real>(
         // the bit-reversed row order the second pass wants after a plain
         // transpose, so no pass reorders rows on its own. Each transpose
         // also does the first two (untwiddled) stages of the pass after it.
-        transpose_square_bit_reversed_radix4(data, nx);
+        match nx {
+            64 => transpose_square_bit_reversed_radix4::<T, 64>(data, nx),
+            _ => transpose_square_bit_reversed_radix4::<T, 0>(data, nx),
+        }
         dht_columns_stages(data, nx, ny, 4, tw);
-        transpose_square_plain_radix4(data, nx);
+        match nx {
+            64 => transpose_square_plain_radix4::<T, 64>(data, nx),
+            _ => transpose_square_plain_radix4::<T, 0>(data, nx),
+        }
         dht_columns_stages(data, nx, ny, 4, tw);
     } else {
         if nx == ny {
@@ -509,8 +515,9 @@ fn transpose_square<T>(data: &mut [T], n: usize) {
 /// value is loaded and stored once for both. Since `rev(4t) < n/4` and
 /// `rev(j)` is a whole number of quarters, a tile's values sit at one
 /// index of sixteen quarter rows, and one bounds check covers them all.
-fn transpose_square_bit_reversed_radix4<T: Real>(data: &mut [T], n: usize) {
+fn transpose_square_bit_reversed_radix4<T: Real, const N: usize>(data: &mut [T], n: usize) {
     const B: usize = 4;
+    let n = if N == 0 { n } else { N };
     // Quarter holding column rev(4t) + rev(j): rev(j) = QUARTER_OF[j]·n/4.
     const QUARTER_OF: [usize; B] = [0, 2, 1, 3];
     let quarter = n / B;
@@ -563,8 +570,9 @@ fn quarters<T>(rows: &mut [T], n: usize) -> [[&mut [T]; 4]; 4] {
 /// plain transpose, then the two untwiddled stages on every group of four
 /// rows. Written over row segments of four, which the M4F addresses with
 /// immediate offsets from one pointer per segment.
-fn transpose_square_plain_radix4<T: Real>(data: &mut [T], n: usize) {
+fn transpose_square_plain_radix4<T: Real, const N: usize>(data: &mut [T], n: usize) {
     const B: usize = 4;
+    let n = if N == 0 { n } else { N };
     for rt in 0..n / B {
         let (above, below) = data.split_at_mut(B * rt * n);
         let band = &mut below[..B * n];
