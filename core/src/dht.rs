@@ -327,21 +327,10 @@ pub fn dht_2d<T: Real>(
     check_len("2D array", nx * ny, data.len())?;
     require_len("column scratch", ny, column.len())?;
     if nx == ny && (4..TILED_TRANSPOSE_FROM).contains(&nx) {
-        // The first transpose also bit-reverses both indices: rows come out
-        // in the order the column pass wants, and its output columns in
-        // the bit-reversed row order the second pass wants after a plain
-        // transpose, so no pass reorders rows on its own. Each transpose
-        // also does the first two (untwiddled) stages of the pass after it.
         match nx {
-            64 => transpose_square_bit_reversed_radix4::<T, 64>(data, nx),
-            _ => transpose_square_bit_reversed_radix4::<T, 0>(data, nx),
+            64 => dht_2d_square::<T, 64>(data, nx, tw),
+            _ => dht_2d_square::<T, 0>(data, nx, tw),
         }
-        dht_columns_stages(data, nx, ny, 4, tw);
-        match nx {
-            64 => transpose_square_plain_radix4::<T, 64>(data, nx),
-            _ => transpose_square_plain_radix4::<T, 0>(data, nx),
-        }
-        dht_columns_stages(data, nx, ny, 4, tw);
     } else {
         if nx == ny {
             transpose_square(data, nx);
@@ -353,9 +342,27 @@ pub fn dht_2d<T: Real>(
             }
         }
         dht_columns(data, nx, ny, tw);
+        hao_bracewell_2d::<T, 0>(data, nx, ny);
     }
-    hao_bracewell_2d(data, nx, ny);
     Ok(())
+}
+
+/// The square path of [`dht_2d`] for `4 ≤ n < 128`, with the side fixed
+/// at compile time when `N ≠ 0` (then every offset within a tile or a
+/// chunk is an immediate on the M4F).
+///
+/// The first transpose also bit-reverses both indices: rows come out in
+/// the order the column pass wants, and its output columns in the
+/// bit-reversed row order the second pass wants after a plain transpose,
+/// so no pass reorders rows on its own. Each transpose also does the first
+/// two (untwiddled) stages of the pass after it.
+fn dht_2d_square<T: Real, const N: usize>(data: &mut [T], n: usize, tw: &Twiddles<'_, T>) {
+    let n = if N == 0 { n } else { N };
+    transpose_square_bit_reversed_radix4::<T, N>(data, n);
+    dht_columns_stages::<T, N>(data, n, n, 4, tw);
+    transpose_square_plain_radix4::<T, N>(data, n);
+    dht_columns_stages::<T, N>(data, n, n, 4, tw);
+    hao_bracewell_2d::<T, N>(data, n, n);
 }
 
 /// [`dht_2d`] line by line: each row transformed in place, then each
@@ -388,7 +395,7 @@ pub fn dht_2d_lines<T: Real>(
             data[x + nx * y] = *c;
         }
     }
-    hao_bracewell_2d(data, nx, ny);
+    hao_bracewell_2d::<T, 0>(data, nx, ny);
     Ok(())
 }
 
@@ -400,7 +407,8 @@ pub fn dht_2d_lines<T: Real>(
 /// and each point's value is `S` minus the point diagonally opposite
 /// (`H(u,v) = S − T(−u,−v)`, …): 8 operations instead of 16. Rows `v` and
 /// `ny − v` go together, with `u` and `nx − u` walked from both ends.
-fn hao_bracewell_2d<T: Real>(data: &mut [T], nx: usize, ny: usize) {
+fn hao_bracewell_2d<T: Real, const NX: usize>(data: &mut [T], nx: usize, ny: usize) {
+    let nx = if NX == 0 { nx } else { NX };
     if nx <= 2 || ny <= 2 {
         return;
     }
@@ -672,7 +680,7 @@ fn bit_reverse_rows<T>(data: &mut [T], nx: usize, ny: usize) {
 /// [`bit_reverse_rows`] then all of [`dht_columns_stages`].
 fn dht_columns<T: Real>(data: &mut [T], nx: usize, ny: usize, tw: &Twiddles<'_, T>) {
     bit_reverse_rows(data, nx, ny);
-    dht_columns_stages(data, nx, ny, 1, tw);
+    dht_columns_stages::<T, 0>(data, nx, ny, 1, tw);
 }
 
 /// The radix-2 DHT of [`dht_unchecked`] along `y` for all `nx` columns at
@@ -687,13 +695,14 @@ fn dht_columns<T: Real>(data: &mut [T], nx: usize, ny: usize, tw: &Twiddles<'_, 
 /// and stored once per two stages. The butterflies and their operands are
 /// those of [`dht_stages`], in the same order, so the result is the same to
 /// the bit; a single radix-2 stage finishes odd `log₂ny`.
-fn dht_columns_stages<T: Real>(
+fn dht_columns_stages<T: Real, const NX: usize>(
     data: &mut [T],
     nx: usize,
     ny: usize,
     mut m: usize,
     tw: &Twiddles<'_, T>,
 ) {
+    let nx = if NX == 0 { nx } else { NX };
     while 4 * m <= ny {
         let stride1 = tw.len / (2 * m);
         let stride2 = tw.len / (4 * m);
