@@ -677,10 +677,17 @@ fn bit_reverse_rows<T>(data: &mut [T], nx: usize, ny: usize) {
     }
 }
 
-/// [`bit_reverse_rows`] then all of [`dht_columns_stages`].
+/// [`bit_reverse_rows`] then every stage of the column transform, one
+/// radix-2 stage at a time: the path for large and non-square arrays on
+/// cached hosts, where the four-row butterfly loops vectorize and the
+/// radix-2² kernels (eight rows, six twiddles) run out of SIMD registers.
 fn dht_columns<T: Real>(data: &mut [T], nx: usize, ny: usize, tw: &Twiddles<'_, T>) {
     bit_reverse_rows(data, nx, ny);
-    dht_columns_stages::<T, 0>(data, nx, ny, 1, tw);
+    let mut m = 1;
+    while m < ny {
+        radix2_columns_stage(data, nx, m, tw);
+        m *= 2;
+    }
 }
 
 /// The radix-2 DHT of [`dht_unchecked`] along `y` for all `nx` columns at
@@ -866,7 +873,8 @@ fn for_each_column<T: Copy, const R: usize>(
 }
 
 /// The twiddled butterfly of [`dht_stages`] over whole rows: `xk`, `yk`
-/// hold index `k` and `xmk`, `ymk` index `m − k` of every column.
+/// hold index `k` and `xmk`, `ymk` index `m − k` of every column. Written
+/// over equal-length slices indexed in step, so that it vectorizes.
 #[inline(always)]
 fn butterfly_rows_twiddled<T: Real>(
     xk: &mut [T],
@@ -876,15 +884,19 @@ fn butterfly_rows_twiddled<T: Real>(
     c: T,
     s: T,
 ) {
-    for_each_column([xk, xmk, yk, ymk], |[xk, xmk, yk, ymk]| {
-        twiddled(xk, xmk, yk, ymk, c, s)
-    });
+    let len = xk.len();
+    let (xmk, yk, ymk) = (&mut xmk[..len], &mut yk[..len], &mut ymk[..len]);
+    for i in 0..len {
+        [xk[i], xmk[i], yk[i], ymk[i]] = twiddled(xk[i], xmk[i], yk[i], ymk[i], c, s);
+    }
 }
 
 /// [`butterfly_pair`] over two rows.
 #[inline(always)]
 fn butterfly_rows<T: Real>(x: &mut [T], y: &mut [T]) {
-    for_each_column([x, y], |[a, b]| [a + b, a - b]);
+    for (a, b) in x.iter_mut().zip(y.iter_mut()) {
+        butterfly_pair(a, b);
+    }
 }
 
 /// Inverse of [`dht_2d`]: the same transform divided by `nx·ny`.
