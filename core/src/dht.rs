@@ -327,10 +327,7 @@ pub fn dht_2d<T: Real>(
     check_len("2D array", nx * ny, data.len())?;
     require_len("column scratch", ny, column.len())?;
     if nx == ny && (4..TILED_TRANSPOSE_FROM).contains(&nx) {
-        match nx {
-            64 => dht_2d_square::<T, 64>(data, nx, tw),
-            _ => dht_2d_square::<T, 0>(data, nx, tw),
-        }
+        dht_2d_square(data, nx, tw);
     } else {
         if nx == ny {
             transpose_square(data, nx);
@@ -342,27 +339,27 @@ pub fn dht_2d<T: Real>(
             }
         }
         dht_columns(data, nx, ny, tw);
-        hao_bracewell_2d::<T, 0>(data, nx, ny);
+        hao_bracewell_2d(data, nx, ny);
     }
     Ok(())
 }
 
-/// The square path of [`dht_2d`] for `4 ≤ n < 128`, with the side fixed
-/// at compile time when `N ≠ 0` (then every offset within a tile or a
-/// chunk is an immediate on the M4F).
+/// The square path of [`dht_2d`] for `4 ≤ n < 128`. (Compiling it once per
+/// side, with `n` a constant, took the M4F's 64 × 64 transform from 186 k
+/// to 164 k instructions for about 25 KB of code with every side below 128,
+/// or a special case of one size; not done.)
 ///
 /// The first transpose also bit-reverses both indices: rows come out in
 /// the order the column pass wants, and its output columns in the
 /// bit-reversed row order the second pass wants after a plain transpose,
 /// so no pass reorders rows on its own. Each transpose also does the first
 /// two (untwiddled) stages of the pass after it.
-fn dht_2d_square<T: Real, const N: usize>(data: &mut [T], n: usize, tw: &Twiddles<'_, T>) {
-    let n = if N == 0 { n } else { N };
-    transpose_square_bit_reversed_radix4::<T, N>(data, n);
-    dht_columns_stages::<T, N>(data, n, n, 4, tw);
-    transpose_square_plain_radix4::<T, N>(data, n);
-    dht_columns_stages::<T, N>(data, n, n, 4, tw);
-    hao_bracewell_2d::<T, N>(data, n, n);
+fn dht_2d_square<T: Real>(data: &mut [T], n: usize, tw: &Twiddles<'_, T>) {
+    transpose_square_bit_reversed_radix4(data, n);
+    dht_columns_stages(data, n, n, 4, tw);
+    transpose_square_plain_radix4(data, n);
+    dht_columns_stages(data, n, n, 4, tw);
+    hao_bracewell_2d(data, n, n);
 }
 
 /// [`dht_2d`] line by line: each row transformed in place, then each
@@ -395,7 +392,7 @@ pub fn dht_2d_lines<T: Real>(
             data[x + nx * y] = *c;
         }
     }
-    hao_bracewell_2d::<T, 0>(data, nx, ny);
+    hao_bracewell_2d(data, nx, ny);
     Ok(())
 }
 
@@ -407,8 +404,7 @@ pub fn dht_2d_lines<T: Real>(
 /// and each point's value is `S` minus the point diagonally opposite
 /// (`H(u,v) = S − T(−u,−v)`, …): 8 operations instead of 16. Rows `v` and
 /// `ny − v` go together, with `u` and `nx − u` walked from both ends.
-fn hao_bracewell_2d<T: Real, const NX: usize>(data: &mut [T], nx: usize, ny: usize) {
-    let nx = if NX == 0 { nx } else { NX };
+fn hao_bracewell_2d<T: Real>(data: &mut [T], nx: usize, ny: usize) {
     if nx <= 2 || ny <= 2 {
         return;
     }
@@ -523,9 +519,8 @@ fn transpose_square<T>(data: &mut [T], n: usize) {
 /// value is loaded and stored once for both. Since `rev(4t) < n/4` and
 /// `rev(j)` is a whole number of quarters, a tile's values sit at one
 /// index of sixteen quarter rows, and one bounds check covers them all.
-fn transpose_square_bit_reversed_radix4<T: Real, const N: usize>(data: &mut [T], n: usize) {
+fn transpose_square_bit_reversed_radix4<T: Real>(data: &mut [T], n: usize) {
     const B: usize = 4;
-    let n = if N == 0 { n } else { N };
     // Quarter holding column rev(4t) + rev(j): rev(j) = QUARTER_OF[j]·n/4.
     const QUARTER_OF: [usize; B] = [0, 2, 1, 3];
     let quarter = n / B;
@@ -578,9 +573,8 @@ fn quarters<T>(rows: &mut [T], n: usize) -> [[&mut [T]; 4]; 4] {
 /// plain transpose, then the two untwiddled stages on every group of four
 /// rows. Written over row segments of four, which the M4F addresses with
 /// immediate offsets from one pointer per segment.
-fn transpose_square_plain_radix4<T: Real, const N: usize>(data: &mut [T], n: usize) {
+fn transpose_square_plain_radix4<T: Real>(data: &mut [T], n: usize) {
     const B: usize = 4;
-    let n = if N == 0 { n } else { N };
     for rt in 0..n / B {
         let (above, below) = data.split_at_mut(B * rt * n);
         let band = &mut below[..B * n];
@@ -702,14 +696,13 @@ fn dht_columns<T: Real>(data: &mut [T], nx: usize, ny: usize, tw: &Twiddles<'_, 
 /// and stored once per two stages. The butterflies and their operands are
 /// those of [`dht_stages`], in the same order, so the result is the same to
 /// the bit; a single radix-2 stage finishes odd `log₂ny`.
-fn dht_columns_stages<T: Real, const NX: usize>(
+fn dht_columns_stages<T: Real>(
     data: &mut [T],
     nx: usize,
     ny: usize,
     mut m: usize,
     tw: &Twiddles<'_, T>,
 ) {
-    let nx = if NX == 0 { nx } else { NX };
     while 4 * m <= ny {
         let stride1 = tw.len / (2 * m);
         let stride2 = tw.len / (4 * m);
