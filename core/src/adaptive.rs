@@ -28,7 +28,7 @@ use crate::filter::{Filter, KernelTable, MAX_WIDTH};
 use crate::geometry::Frame;
 use crate::real::{Real, Sample};
 use crate::render::signed_index;
-use crate::spectrum::Spectrum;
+use crate::spectrum::{CubeSide, Spectrum};
 
 /// `u32` words of a bitset over `n³` samples.
 pub const fn marks_words(n: usize) -> usize {
@@ -255,8 +255,8 @@ pub const MAX_LEVELS: usize = 2;
 /// More than [`MAX_LEVELS`] levels, marks of another side than the
 /// spectrum's, a kernel for another filter than the spectrum's, or a short
 /// grid.
-pub fn extract_slice_adaptive<S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+pub fn extract_slice_adaptive<S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
     levels: &[AdaptiveLevel<'_, '_, T>],
     frame: &Frame,
@@ -315,8 +315,8 @@ pub fn extract_slice_adaptive<S: Sample, T: Real>(
 
 /// The separable interpolation of `spec` at `q` with `table`'s kernel.
 #[inline(always)]
-fn interpolate<S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+fn interpolate<S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     table: &KernelTable<T>,
     q: [T; 3],
     mask: usize,

@@ -715,11 +715,14 @@ impl<T: Real, const W: usize> PhaseTable<T, W> {
                 v
             }
         };
-        for (i, [weights, differences]) in self.rows.iter_mut().enumerate() {
-            for m in 0..W {
-                let (w0, w1) = (entry(i, m), entry(i + 1, m));
+        // Each entry is read once: row `i + 1`'s weight is row `i`'s next.
+        for m in 0..W {
+            let mut w0 = entry(0, m);
+            for (i, [weights, differences]) in self.rows.iter_mut().enumerate() {
+                let w1 = entry(i + 1, m);
                 weights[m] = w0;
                 differences[m] = w1 - w0;
+                w0 = w1;
             }
         }
     }

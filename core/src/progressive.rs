@@ -17,7 +17,7 @@ use crate::real::{Real, Sample};
 use crate::render::{
     aux_len, check_image, extract_central_slice_on, finish_projection, placement_on_axes,
 };
-use crate::spectrum::Spectrum;
+use crate::spectrum::{CubeSide, Spectrum};
 
 /// Deepest level: the preview grid keeps at least 2 samples a side.
 pub fn max_level(n: usize) -> u32 {
@@ -38,8 +38,8 @@ pub fn preview_size(width: usize, height: usize, level: u32) -> (usize, usize) {
 ///
 /// # Errors
 /// As [`crate::render::render`], and a level beyond [`max_level`].
-pub fn render_level<S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+pub fn render_level<S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
     view: &View,
     width: usize,
@@ -74,8 +74,8 @@ pub fn render_level<S: Sample, T: Real>(
 ///
 /// # Errors
 /// As [`render_level`].
-pub fn render_level_sampled<S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+pub fn render_level_sampled<S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
     view: &View,
     sampling: &Sampling,

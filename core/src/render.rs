@@ -27,7 +27,7 @@ use crate::filter::{KernelTable, PhaseTable, MAX_WIDTH};
 use crate::format::BlockLayout;
 use crate::geometry::{dot, Frame, Sampling, SliceAxes, View};
 use crate::real::{Real, Sample};
-use crate::spectrum::Spectrum;
+use crate::spectrum::{CubeSide, Spectrum};
 
 /// Where a `W × H` image sits on the `m × m` projection grid.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -104,8 +104,8 @@ pub const fn aux_len(m: usize) -> usize {
 /// # Errors
 /// Bad view vectors, an image side of 0 or above `n`, short buffers, or a
 /// kernel for another filter than the spectrum was premultiplied for.
-pub fn render<S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+pub fn render<S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
     view: &View,
     width: usize,
@@ -136,8 +136,8 @@ pub fn render<S: Sample, T: Real>(
 ///
 /// # Errors
 /// As [`render`].
-pub fn render_sampled<S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+pub fn render_sampled<S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
     view: &View,
     sampling: &Sampling,
@@ -184,8 +184,8 @@ pub fn signed_index(k: usize, m: usize) -> i64 {
 /// Fill the `n × n` slice `grid` (`kx` fastest, natural DHT order) by
 /// interpolating the spectrum with `kernel` on the plane spanned by the
 /// frame's right and up vectors.
-pub fn extract_slice<S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+pub fn extract_slice<S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
     frame: &Frame,
     grid: &mut [T],
@@ -196,8 +196,8 @@ pub fn extract_slice<S: Sample, T: Real>(
 /// [`extract_slice`] restricted to the central `m × m` frequencies
 /// (`m ≤ n`, a power of two): the slice of a preview at pitch `n/m`
 /// ([`crate::progressive`]). `grid` holds `m²` values, `kx` fastest.
-pub fn extract_central_slice<S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+pub fn extract_central_slice<S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
     frame: &Frame,
     m: usize,
@@ -210,8 +210,8 @@ pub fn extract_central_slice<S: Sample, T: Real>(
 /// sample at `(kx, ky)` is the spectrum at `kx·axes.right + ky·axes.up`,
 /// zero outside the Nyquist cube): the physical-units slice with
 /// [`Sampling::slice_axes`].
-pub fn extract_central_slice_on<S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+pub fn extract_central_slice_on<S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
     axes: &SliceAxes,
     m: usize,
@@ -230,8 +230,8 @@ pub fn extract_central_slice_on<S: Sample, T: Real>(
 /// # Errors
 /// `rows.len()` not a multiple of `n`, or rows beyond the grid
 /// ([`Error::LengthMismatch`]).
-pub fn extract_slice_rows<S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+pub fn extract_slice_rows<S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
     axes: &SliceAxes,
     first_row: usize,
@@ -252,8 +252,8 @@ pub fn extract_slice_rows<S: Sample, T: Real>(
 
 /// Rows `first_row ..` (as many as `grid` holds) of the central `m × m`
 /// slice, by filter width.
-fn extract_rows<S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+fn extract_rows<S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
     axes: &SliceAxes,
     m: usize,
@@ -261,12 +261,12 @@ fn extract_rows<S: Sample, T: Real>(
     grid: &mut [T],
 ) {
     match kernel.filter().width() {
-        1 => extract_width::<1, S, T>(spec, kernel, axes, m, first_row, grid),
-        2 => extract_width::<2, S, T>(spec, kernel, axes, m, first_row, grid),
-        3 => extract_width::<3, S, T>(spec, kernel, axes, m, first_row, grid),
-        4 => extract_width::<4, S, T>(spec, kernel, axes, m, first_row, grid),
-        5 => extract_width::<5, S, T>(spec, kernel, axes, m, first_row, grid),
-        _ => extract_width::<MAX_WIDTH, S, T>(spec, kernel, axes, m, first_row, grid),
+        1 => extract_width::<1, S, Z, T>(spec, kernel, axes, m, first_row, grid),
+        2 => extract_width::<2, S, Z, T>(spec, kernel, axes, m, first_row, grid),
+        3 => extract_width::<3, S, Z, T>(spec, kernel, axes, m, first_row, grid),
+        4 => extract_width::<4, S, Z, T>(spec, kernel, axes, m, first_row, grid),
+        5 => extract_width::<5, S, Z, T>(spec, kernel, axes, m, first_row, grid),
+        _ => extract_width::<MAX_WIDTH, S, Z, T>(spec, kernel, axes, m, first_row, grid),
     }
 }
 
@@ -283,7 +283,7 @@ pub(crate) enum LineReads<'a> {
 
 impl<'a> LineReads<'a> {
     /// The reads for `spec`.
-    pub(crate) fn of<S: Sample>(spec: &Spectrum<'a, S>) -> Self {
+    pub(crate) fn of<S: Sample, Z: CubeSide>(spec: &Spectrum<'a, S, Z>) -> Self {
         match spec.blocks() {
             Some(b) if S::BLOCK_MANTISSA => match b.layout() {
                 BlockLayout::Line => LineReads::LineExponents(b.exponents()),
@@ -302,8 +302,8 @@ impl<'a> LineReads<'a> {
     /// The `W` coefficients from `line + x0` as one run, when `contiguous`
     /// (one bounds check for the run).
     #[inline(always)]
-    fn run<'s, const W: usize, S: Sample>(
-        spec: &Spectrum<'s, S>,
+    fn run<'s, const W: usize, S: Sample, Z: CubeSide>(
+        spec: &Spectrum<'s, S, Z>,
         line: usize,
         x0: usize,
         contiguous: bool,
@@ -327,7 +327,11 @@ impl<'a> LineReads<'a> {
 
     /// The block exponent's power of two for `line`, if lines carry one.
     #[inline(always)]
-    fn line_scale<S: Sample, T: Real>(self, spec: &Spectrum<'_, S>, line: usize) -> Option<T> {
+    fn line_scale<S: Sample, Z: CubeSide, T: Real>(
+        self,
+        spec: &Spectrum<'_, S, Z>,
+        line: usize,
+    ) -> Option<T> {
         match self {
             LineReads::LineExponents(e) => Some(T::exp2i(e[line / spec.n()] as i32)),
             _ => None,
@@ -338,23 +342,23 @@ impl<'a> LineReads<'a> {
     /// contiguous run from `x0` when `contiguous`, else through
     /// [`Spectrum::line_taps`] at the wrapped indices `xs`.
     #[inline(always)]
-    pub(crate) fn sum<const W: usize, S: Sample, T: Real>(
+    pub(crate) fn sum<const W: usize, S: Sample, Z: CubeSide, T: Real>(
         self,
-        spec: &Spectrum<'_, S>,
+        spec: &Spectrum<'_, S, Z>,
         line: usize,
         x0: usize,
         contiguous: bool,
         xs: &[usize; W],
         weights: &[T; W],
     ) -> T {
-        let Some(run) = Self::run::<W, S>(spec, line, x0, contiguous) else {
+        let Some(run) = Self::run::<W, S, Z>(spec, line, x0, contiguous) else {
             return spec.line_taps(line, xs, weights);
         };
         let mut sum = T::ZERO;
         for (wt, v) in weights.iter().zip(run) {
             sum += *wt * T::load(*v);
         }
-        match self.line_scale::<S, T>(spec, line) {
+        match self.line_scale::<S, Z, T>(spec, line) {
             Some(scale) => sum * scale,
             None => sum,
         }
@@ -365,9 +369,9 @@ impl<'a> LineReads<'a> {
     /// per-line-exponent reads only (never [`LineReads::General`], whose
     /// per-tap exponents this does not apply).
     #[inline(always)]
-    pub(crate) fn sum_raw<const W: usize, S: Sample, T: Real>(
+    pub(crate) fn sum_raw<const W: usize, S: Sample, Z: CubeSide, T: Real>(
         self,
-        spec: &Spectrum<'_, S>,
+        spec: &Spectrum<'_, S, Z>,
         line: usize,
         x0: usize,
         contiguous: bool,
@@ -375,7 +379,7 @@ impl<'a> LineReads<'a> {
         weights: &[T; W],
     ) -> T {
         let mut sum = T::ZERO;
-        match Self::run::<W, S>(spec, line, x0, contiguous) {
+        match Self::run::<W, S, Z>(spec, line, x0, contiguous) {
             Some(run) => {
                 for t in 0..W {
                     sum += weights[t] * T::load_raw(run[t]);
@@ -389,7 +393,7 @@ impl<'a> LineReads<'a> {
                 }
             }
         }
-        match self.line_scale::<S, T>(spec, line) {
+        match self.line_scale::<S, Z, T>(spec, line) {
             Some(scale) => sum * scale,
             None => sum,
         }
@@ -398,9 +402,9 @@ impl<'a> LineReads<'a> {
     /// [`LineReads::sum2`] with raw widening, as [`LineReads::sum_raw`]
     /// (both weight sets carry the `2^e`).
     #[inline(always)]
-    pub(crate) fn sum2_raw<const W: usize, S: Sample, T: Real>(
+    pub(crate) fn sum2_raw<const W: usize, S: Sample, Z: CubeSide, T: Real>(
         self,
-        spec: &Spectrum<'_, S>,
+        spec: &Spectrum<'_, S, Z>,
         line: usize,
         x0: usize,
         contiguous: bool,
@@ -409,7 +413,7 @@ impl<'a> LineReads<'a> {
         second: &[T; W],
     ) -> (T, T) {
         let (mut a, mut b) = (T::ZERO, T::ZERO);
-        match Self::run::<W, S>(spec, line, x0, contiguous) {
+        match Self::run::<W, S, Z>(spec, line, x0, contiguous) {
             Some(run) => {
                 for t in 0..W {
                     let v = T::load_raw(run[t]);
@@ -426,7 +430,7 @@ impl<'a> LineReads<'a> {
                 }
             }
         }
-        match self.line_scale::<S, T>(spec, line) {
+        match self.line_scale::<S, Z, T>(spec, line) {
             Some(scale) => (a * scale, b * scale),
             None => (a, b),
         }
@@ -435,9 +439,9 @@ impl<'a> LineReads<'a> {
     /// Two weighted sums over the same taps, each coefficient read once
     /// (the value and a derivative of [`LineReads::sum`]).
     #[inline(always)]
-    pub(crate) fn sum2<const W: usize, S: Sample, T: Real>(
+    pub(crate) fn sum2<const W: usize, S: Sample, Z: CubeSide, T: Real>(
         self,
-        spec: &Spectrum<'_, S>,
+        spec: &Spectrum<'_, S, Z>,
         line: usize,
         x0: usize,
         contiguous: bool,
@@ -445,7 +449,7 @@ impl<'a> LineReads<'a> {
         first: &[T; W],
         second: &[T; W],
     ) -> (T, T) {
-        let Some(run) = Self::run::<W, S>(spec, line, x0, contiguous) else {
+        let Some(run) = Self::run::<W, S, Z>(spec, line, x0, contiguous) else {
             return (
                 spec.line_taps(line, xs, first),
                 spec.line_taps(line, xs, second),
@@ -457,7 +461,7 @@ impl<'a> LineReads<'a> {
             a += first[t] * v;
             b += second[t] * v;
         }
-        match self.line_scale::<S, T>(spec, line) {
+        match self.line_scale::<S, Z, T>(spec, line) {
             Some(scale) => (a * scale, b * scale),
             None => (a, b),
         }
@@ -468,8 +472,8 @@ impl<'a> LineReads<'a> {
 /// and per-line-exponent spectra, the general one for the rest. Not
 /// inlined, so that only one width's phase table is on the stack.
 #[inline(never)]
-fn extract_width<const W: usize, S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+fn extract_width<const W: usize, S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
     axes: &SliceAxes,
     m: usize,
@@ -485,12 +489,12 @@ fn extract_width<const W: usize, S: Sample, T: Real>(
     let mut phases = PhaseTable::<T, W>::zeroed();
     match (phases.fill(kernel), LineReads::of(spec)) {
         (Ok(()), LineReads::Plain) => {
-            extract_lines::<W, false, S, T>(spec, &phases, &geometry, &[], grid)
+            extract_lines::<W, false, S, Z, T>(spec, &phases, &geometry, &[], grid)
         }
         (Ok(()), LineReads::LineExponents(e)) => {
-            extract_lines::<W, true, S, T>(spec, &phases, &geometry, e, grid)
+            extract_lines::<W, true, S, Z, T>(spec, &phases, &geometry, e, grid)
         }
-        _ => extract_general::<W, S, T>(spec, kernel, &geometry, grid),
+        _ => extract_general::<W, S, Z, T>(spec, kernel, &geometry, grid),
     }
 }
 
@@ -527,32 +531,56 @@ impl<T: Real> SliceRows<T> {
         }
     }
 
-    /// Calls `pixel(slot, y)` for every slice point of the rows inside the
-    /// Nyquist cube, with `y` its per-axis phase-table positions in fixed
-    /// point ([`PhaseTable::fixed_position`]), and zeroes the points
-    /// outside. One point of a row's interval is placed from
-    /// `q = kx·r + ky·u` in `T` as in [`SliceRows::for_each`]; along the row
-    /// `q` advances by `r`, so each next `y` is the last plus
+    /// Fills the rows inside the Nyquist cube from `pixel(y, plus, minus)`
+    /// and zeroes the points outside. `y` is a slice point's per-axis
+    /// phase-table position in fixed point
+    /// ([`PhaseTable::fixed_position`]); `pixel` returns the value there
+    /// (when `plus`) and the value at the mirrored point `−q` (when
+    /// `minus`), which has the same taps reflected through the origin with
+    /// the same weights: the setup of a point (positions, phase rows,
+    /// weights) serves both `(kx, ky)` and `(−kx, −ky)`.
+    ///
+    /// Points are placed per *mirror pair*: row `p = 0 … m/2` (signed
+    /// `ky = p`) is walked once for `kx` in its interval, writing the
+    /// point into row `p` and its mirror into row `−p` (row 0 pairs `kx`
+    /// with `−kx`). Row `−m/2` and column `−m/2`, whose mirrors are off the
+    /// grid, are the mirrors of `ky = m/2` and `kx = m/2`. So the value of
+    /// every point depends only on its pair, never on which rows the
+    /// caller asked for (threads get the same bits), and a point with its
+    /// mirror in the same call costs one setup for two.
+    ///
+    /// Along a row, one point is placed from `q = kx·r + ky·u` in `T`;
+    /// `q` then advances by `r`, so each next `y` is the last plus
     /// [`PhaseTable::fixed_step`]`(r)`: two integer additions an axis
     /// instead of a product, a sum and a floor in floating point.
     #[inline(always)]
-    fn for_each_fixed<const W: usize>(
+    fn for_each_fixed_pair<const W: usize>(
         &self,
         n: usize,
         grid: &mut [T],
-        mut pixel: impl FnMut(&mut T, [i64; 3]),
+        mut pixel: impl FnMut([i64; 3], bool, bool) -> (T, T),
     ) {
         let m = self.m;
+        grid.fill(T::ZERO);
+        let rows = grid.len() / m;
         let step = self.right.map(PhaseTable::<T, W>::fixed_step);
         // Signed frequencies of a row: −⌊m/2⌋ … ⌈m/2⌉ − 1 (`signed_index`).
-        let (k_min, k_max) = (-((m / 2) as i32), ((m - 1) / 2) as i32);
+        let (half, k_max) = ((m / 2) as i32, ((m - 1) / 2) as i32);
         let mask = m.wrapping_sub(1);
-        for (row_offset, row) in grid.chunks_exact_mut(m).enumerate() {
-            row.fill(T::ZERO);
-            let ky = T::from_i32(signed_index(self.first_row + row_offset, m) as i32);
+        // Row `r` of the grid as a slot in this call's rows, if there.
+        let local = |r: usize| r.checked_sub(self.first_row).filter(|&i| i < rows);
+        for p in 0..=m / 2 {
+            let plus_row = if p as i32 <= k_max { local(p) } else { None };
+            let minus_row = local((m - p) & mask);
+            if plus_row.is_none() && minus_row.is_none() {
+                continue;
+            }
+            let ky = T::from_usize(p);
             let kyu = self.up.map(|c| ky * c);
             let (low, high) = self.row_interval(n, kyu);
-            let (low, high) = (low.max(k_min), high.min(k_max));
+            // Row 0 is its own mirror: `kx ≥ 0` places both halves.
+            let k_low = if p == 0 { 0 } else { -half };
+            let (low, high) = (low.max(k_low), high.min(half));
             if low > high {
                 continue;
             }
@@ -567,9 +595,25 @@ impl<T: Real> SliceRows<T> {
                     + (low - anchor) as i64 * step[a]
             });
             for k in low..=high {
-                // `m` is a power of two: `k mod m` by a mask.
-                if let Some(g) = row.get_mut(k as usize & mask) {
-                    pixel(g, y);
+                // The point `(k, p)` is on the grid for `k ≤ k_max`, its
+                // mirror `(−k, −p)` for `−k ≤ k_max` (and `−k ≥ −m/2`, the
+                // loop's bound), on row 0 only for `k > 0` (`k = 0` is its
+                // own mirror).
+                let plus = plus_row.is_some() && k <= k_max;
+                let minus = minus_row.is_some() && -k <= k_max && (p > 0 || k > 0);
+                if plus || minus {
+                    let (value, mirror) = pixel(y, plus, minus);
+                    // `m` is a power of two: `k mod m` by a mask.
+                    if let (true, Some(r)) = (plus, plus_row) {
+                        if let Some(g) = grid.get_mut(r * m + (k as usize & mask)) {
+                            *g = value;
+                        }
+                    }
+                    if let (true, Some(r)) = (minus, minus_row) {
+                        if let Some(g) = grid.get_mut(r * m + (k.wrapping_neg() as usize & mask)) {
+                            *g = mirror;
+                        }
+                    }
                 }
                 for a in 0..3 {
                     y[a] += step[a];
@@ -607,39 +651,43 @@ impl<T: Real> SliceRows<T> {
     }
 }
 
-/// The extraction's hot loop: per slice point, three phase-table lookups
-/// for the weights, then `W²` x-lines of `W` taps, each line one
-/// contiguous run with one bounds check unless its taps wrap around the
-/// cube. The `W` x-weights carry the `2^e` of [`Real::load_raw`], so a tap
-/// costs a load, its raw widening, a multiplication and an addition; the
-/// products are the same numbers as with the full widening (a power of two
-/// moved between factors is exact). `LINE_EXP`: multiply each line's sum
-/// by its block exponent's power of two (`exponents`, one per x-line).
-fn extract_lines<const W: usize, const LINE_EXP: bool, S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
-    phases: &PhaseTable<T, W>,
-    geometry: &SliceRows<T>,
-    exponents: &[i8],
-    grid: &mut [T],
-) {
-    let n = spec.n();
-    let nn = n * n;
-    let mask = n - 1;
-    let data = spec.data();
-    let raw_gain = T::exp2i(T::raw_exponent::<S>());
-    let line_sum = |line: usize, acc_x: T| {
+/// The tap reads of [`extract_lines`]: a spectrum of side `n` stored as
+/// `data` (exactly `n³` values), with one block exponent per x-line in
+/// `exponents` when `LINE_EXP`.
+struct TapSums<'a, const W: usize, const LINE_EXP: bool, S> {
+    data: &'a [S],
+    n: usize,
+    exponents: &'a [i8],
+}
+
+impl<const W: usize, const LINE_EXP: bool, S: Sample> TapSums<'_, W, LINE_EXP, S> {
+    /// An x-line's sum `acc_x` times the line's power of two, if lines
+    /// carry one.
+    #[inline(always)]
+    fn line_sum<T: Real>(&self, line: usize, acc_x: T) -> T {
         if LINE_EXP {
-            let e = exponents.get(line / n).copied().unwrap_or(0);
+            let e = self.exponents.get(line / self.n).copied().unwrap_or(0);
             acc_x * T::exp2i(e as i32)
         } else {
             acc_x
         }
-    };
-    geometry.for_each_fixed::<W>(n, grid, |g, y| {
-        let (jx, wx) = phases.taps_fixed_point(y[0]);
-        let (jy, wy) = phases.taps_fixed_point(y[1]);
-        let (jz, wz) = phases.taps_fixed_point(y[2]);
-        let wx = wx.map(|w| w * raw_gain);
+    }
+
+    /// The value at the taps `j + t` of each axis (`t < W`, wrapping
+    /// around the cube) with weights `w[t]`; the x-weights carry the raw
+    /// gain of [`Real::load_raw`].
+    #[inline(always)]
+    fn value<T: Real>(
+        &self,
+        jx: i32,
+        wx: &[T; W],
+        jy: i32,
+        wy: &[T; W],
+        jz: i32,
+        wz: &[T; W],
+    ) -> T {
+        let (data, n) = (self.data, self.n);
+        let (nn, mask) = (n * n, n - 1);
         // `((j + b) mod n)·n` as `(j·n + b·n) mod n²`, in wrapping usize:
         // the offsets of the taps' lines and planes with one product an axis.
         let (y0, z0) = (
@@ -676,7 +724,7 @@ fn extract_lines<const W: usize, const LINE_EXP: bool, S: Sample, T: Real>(
                         }
                         None => T::ZERO,
                     };
-                    acc_y += wy[b] * line_sum(start, acc_x);
+                    acc_y += wy[b] * self.line_sum(start, acc_x);
                 }
                 acc += wz[c] * acc_y;
             }
@@ -691,19 +739,69 @@ fn extract_lines<const W: usize, const LINE_EXP: bool, S: Sample, T: Real>(
                         let v = data.get(line + xs[t]).copied().unwrap_or_default();
                         acc_x += wx[t] * T::load_raw(v);
                     }
-                    acc_y += wy[b] * line_sum(line, acc_x);
+                    acc_y += wy[b] * self.line_sum(line, acc_x);
                 }
                 acc += wz[c] * acc_y;
             }
         }
-        *g = acc;
+        acc
+    }
+}
+
+/// The extraction's hot loop: per slice point, three phase-table lookups
+/// for the weights, then `W²` x-lines of `W` taps, each line one
+/// contiguous run with one bounds check unless its taps wrap around the
+/// cube. The `W` x-weights carry the `2^e` of [`Real::load_raw`], so a tap
+/// costs a load, its raw widening, a multiplication and an addition; the
+/// products are the same numbers as with the full widening (a power of two
+/// moved between factors is exact). `LINE_EXP`: multiply each line's sum
+/// by its block exponent's power of two (`exponents`, one per x-line).
+fn extract_lines<const W: usize, const LINE_EXP: bool, S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
+    phases: &PhaseTable<T, W>,
+    geometry: &SliceRows<T>,
+    exponents: &[i8],
+    grid: &mut [T],
+) {
+    let n = spec.n();
+    let nn = n * n;
+    // Exactly `n³` (as `Spectrum` guarantees): with a compile-time side
+    // ([`CubeSide`]) the compiler then proves every masked tap index in
+    // range and drops the bounds tests.
+    let Some(data) = spec.data().get(..nn * n) else {
+        grid.fill(T::ZERO);
+        return;
+    };
+    let raw_gain = T::exp2i(T::raw_exponent::<S>());
+    let taps = TapSums::<W, LINE_EXP, S> { data, n, exponents };
+    // The mirror `−q` of a point: taps `−j − t`, i.e. the run from
+    // `−j − (W − 1)` with the weights reversed.
+    let mirror = |j: i32| -j - (W as i32 - 1);
+    let reversed = |w: &[T; W]| -> [T; W] { core::array::from_fn(|t| w[W - 1 - t]) };
+    geometry.for_each_fixed_pair::<W>(n, grid, |y, plus, minus| {
+        let (jx, wx) = phases.taps_fixed_point(y[0]);
+        let (jy, wy) = phases.taps_fixed_point(y[1]);
+        let (jz, wz) = phases.taps_fixed_point(y[2]);
+        let wx = wx.map(|w| w * raw_gain);
+        let value = if plus {
+            taps.value(jx, &wx, jy, &wy, jz, &wz)
+        } else {
+            T::ZERO
+        };
+        let mirrored = if minus {
+            let (rx, ry, rz) = (reversed(&wx), reversed(&wy), reversed(&wz));
+            taps.value(mirror(jx), &rx, mirror(jy), &ry, mirror(jz), &rz)
+        } else {
+            T::ZERO
+        };
+        (value, mirrored)
     });
 }
 
 /// The extraction for any storage (e.g. bricked block exponents): taps
 /// through [`LineReads::sum`], weights from the kernel table.
-fn extract_general<const W: usize, S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+fn extract_general<const W: usize, S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
     geometry: &SliceRows<T>,
     grid: &mut [T],
@@ -802,8 +900,16 @@ pub fn finish_channel<T: Real>(
     {
         let gy = row0.wrapping_sub(row) & mask;
         let grid_row = &grid[gy * m..(gy + 1) * m];
-        for (col, o) in line.chunks_exact_mut(channels).enumerate() {
-            o[channel] = grid_row[col0.wrapping_add(col) & mask] * g;
+        if channels == 1 {
+            // One channel (plain and cued frames): a plain loop over the
+            // row, without the per-pixel chunking of interleaved ones.
+            for (col, o) in line.iter_mut().enumerate() {
+                *o = grid_row[col0.wrapping_add(col) & mask] * g;
+            }
+        } else {
+            for (col, o) in line.chunks_exact_mut(channels).enumerate() {
+                o[channel] = grid_row[col0.wrapping_add(col) & mask] * g;
+            }
         }
     }
     Ok(())

@@ -43,7 +43,7 @@ use crate::real::{Real, Sample};
 use crate::render::LineReads;
 use crate::render::{aux_len, check_image, extract_slice, finish_channel, placement, signed_index};
 use crate::scene::{Scene, ViewPlan};
-use crate::spectrum::Spectrum;
+use crate::spectrum::{CubeSide, Spectrum};
 
 const PI: f64 = core::f64::consts::PI;
 
@@ -85,8 +85,8 @@ struct PassGeometry<T> {
     offset: [T; 3],
 }
 
-fn run_pass<S: Sample, T: Real, const MODE: u8>(
-    spec: &Spectrum<'_, S>,
+fn run_pass<S: Sample, Z: CubeSide, T: Real, const MODE: u8>(
+    spec: &Spectrum<'_, S, Z>,
     tables: &Tables<'_, T>,
     geo: &PassGeometry<T>,
     fields: &mut [T],
@@ -96,12 +96,12 @@ fn run_pass<S: Sample, T: Real, const MODE: u8>(
         return Err(Error::NoKernelDerivative);
     }
     match tables.kernel.filter().width() {
-        1 => run_pass_width::<1, S, T, MODE>(spec, tables, geo, fields, targets),
-        2 => run_pass_width::<2, S, T, MODE>(spec, tables, geo, fields, targets),
-        3 => run_pass_width::<3, S, T, MODE>(spec, tables, geo, fields, targets),
-        4 => run_pass_width::<4, S, T, MODE>(spec, tables, geo, fields, targets),
-        5 => run_pass_width::<5, S, T, MODE>(spec, tables, geo, fields, targets),
-        _ => run_pass_width::<MAX_WIDTH, S, T, MODE>(spec, tables, geo, fields, targets),
+        1 => run_pass_width::<1, S, Z, T, MODE>(spec, tables, geo, fields, targets),
+        2 => run_pass_width::<2, S, Z, T, MODE>(spec, tables, geo, fields, targets),
+        3 => run_pass_width::<3, S, Z, T, MODE>(spec, tables, geo, fields, targets),
+        4 => run_pass_width::<4, S, Z, T, MODE>(spec, tables, geo, fields, targets),
+        5 => run_pass_width::<5, S, Z, T, MODE>(spec, tables, geo, fields, targets),
+        _ => run_pass_width::<MAX_WIDTH, S, Z, T, MODE>(spec, tables, geo, fields, targets),
     }
     Ok(())
 }
@@ -123,8 +123,8 @@ struct Axis<T, const W: usize> {
 /// other storage reads through the kernel tables and [`LineReads::sum`].
 /// Not inlined, so that only one width's tables are on the stack.
 #[inline(never)]
-fn run_pass_width<const W: usize, S: Sample, T: Real, const MODE: u8>(
-    spec: &Spectrum<'_, S>,
+fn run_pass_width<const W: usize, S: Sample, Z: CubeSide, T: Real, const MODE: u8>(
+    spec: &Spectrum<'_, S, Z>,
     tables: &Tables<'_, T>,
     geo: &PassGeometry<T>,
     fields: &mut [T],
@@ -144,7 +144,7 @@ fn run_pass_width<const W: usize, S: Sample, T: Real, const MODE: u8>(
         if filled && (MODE != mode::VALUE_GRADIENT || slopes.is_some()) {
             let raw_gain = T::exp2i(T::raw_exponent::<S>());
             let mask = spec.n() - 1;
-            for_each_point::<W, S, T, MODE, true>(spec, reads, geo, fields, targets, |q| {
+            for_each_point::<W, S, Z, T, MODE, true>(spec, reads, geo, fields, targets, |q| {
                 let mut axes: [Axis<T, W>; 3] = core::array::from_fn(|a| {
                     let y = PhaseTable::<T, W>::fixed_position(q[a]);
                     let (j0, weights) = phases.taps_fixed_point(y);
@@ -167,7 +167,7 @@ fn run_pass_width<const W: usize, S: Sample, T: Real, const MODE: u8>(
         }
     }
     let mask = spec.n() - 1;
-    for_each_point::<W, S, T, MODE, false>(spec, reads, geo, fields, targets, |q| {
+    for_each_point::<W, S, Z, T, MODE, false>(spec, reads, geo, fields, targets, |q| {
         core::array::from_fn(|a| {
             let mut weights = [T::ZERO; W];
             let j0 = tables.kernel.taps_fixed(q[a], &mut weights);
@@ -191,8 +191,15 @@ fn run_pass_width<const W: usize, S: Sample, T: Real, const MODE: u8>(
 /// gives the per-axis taps of a point `q`, `RAW` says whether their
 /// x-weights carry the `2^e` of raw widening.
 #[inline(always)]
-fn for_each_point<const W: usize, S: Sample, T: Real, const MODE: u8, const RAW: bool>(
-    spec: &Spectrum<'_, S>,
+fn for_each_point<
+    const W: usize,
+    S: Sample,
+    Z: CubeSide,
+    T: Real,
+    const MODE: u8,
+    const RAW: bool,
+>(
+    spec: &Spectrum<'_, S, Z>,
     reads: LineReads<'_>,
     geo: &PassGeometry<T>,
     fields: &mut [T],
@@ -213,9 +220,11 @@ fn for_each_point<const W: usize, S: Sample, T: Real, const MODE: u8, const RAW:
             }
             let axes = taps(q);
             let (r0, r1) = match MODE {
-                mode::VALUE_GRADIENT => value_gradient::<W, RAW, S, T>(spec, reads, &axes, geo.dir),
-                mode::VALUE_MIRROR => value_mirror::<W, RAW, S, T>(spec, reads, &axes),
-                _ => (value::<W, RAW, S, T>(spec, reads, &axes), T::ZERO),
+                mode::VALUE_GRADIENT => {
+                    value_gradient::<W, RAW, S, Z, T>(spec, reads, &axes, geo.dir)
+                }
+                mode::VALUE_MIRROR => value_mirror::<W, RAW, S, Z, T>(spec, reads, &axes),
+                _ => (value::<W, RAW, S, Z, T>(spec, reads, &axes), T::ZERO),
             };
             let i = iy * n + ix;
             for t in targets {
@@ -228,8 +237,8 @@ fn for_each_point<const W: usize, S: Sample, T: Real, const MODE: u8, const RAW:
 /// One x-line's weighted sum, raw or fully widened ([`LineReads::sum_raw`],
 /// [`LineReads::sum`]).
 #[inline(always)]
-fn line_sum<const W: usize, const RAW: bool, S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+fn line_sum<const W: usize, const RAW: bool, S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     reads: LineReads<'_>,
     line: usize,
     x: (usize, bool, &[usize; W]),
@@ -244,8 +253,8 @@ fn line_sum<const W: usize, const RAW: bool, S: Sample, T: Real>(
 }
 
 #[inline(always)]
-fn value<const W: usize, const RAW: bool, S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+fn value<const W: usize, const RAW: bool, S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     reads: LineReads<'_>,
     axes: &[Axis<T, W>; 3],
 ) -> T {
@@ -259,7 +268,7 @@ fn value<const W: usize, const RAW: bool, S: Sample, T: Real>(
         for b in 0..W {
             let line = plane + y.index[b] * n;
             acc_y += y.weights[b]
-                * line_sum::<W, RAW, S, T>(
+                * line_sum::<W, RAW, S, Z, T>(
                     spec,
                     reads,
                     line,
@@ -275,8 +284,8 @@ fn value<const W: usize, const RAW: bool, S: Sample, T: Real>(
 /// `X(p)` and `(d·∇X)(p)` from one neighbourhood: the separable gradient
 /// `∂_x = k'⊗k⊗k`, `∂_y = k⊗k'⊗k`, `∂_z = k⊗k⊗k'`.
 #[inline(always)]
-fn value_gradient<const W: usize, const RAW: bool, S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+fn value_gradient<const W: usize, const RAW: bool, S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     reads: LineReads<'_>,
     axes: &[Axis<T, W>; 3],
     dir: [T; 3],
@@ -323,8 +332,8 @@ fn value_gradient<const W: usize, const RAW: bool, S: Sample, T: Real>(
 
 /// `X(p)` and `X(−p)`: the same weights on the taps `j` and `−j`.
 #[inline(always)]
-fn value_mirror<const W: usize, const RAW: bool, S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+fn value_mirror<const W: usize, const RAW: bool, S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     reads: LineReads<'_>,
     axes: &[Axis<T, W>; 3],
 ) -> (T, T) {
@@ -352,7 +361,7 @@ fn value_mirror<const W: usize, const RAW: bool, S: Sample, T: Real>(
             let yi = y.index[b];
             let (line, line_m) = (plane + yi * n, plane_m + ((n - yi) & mask) * n);
             d_y += y.weights[b]
-                * line_sum::<W, RAW, S, T>(
+                * line_sum::<W, RAW, S, Z, T>(
                     spec,
                     reads,
                     line,
@@ -360,7 +369,7 @@ fn value_mirror<const W: usize, const RAW: bool, S: Sample, T: Real>(
                     &x.weights,
                 );
             m_y += y.weights[b]
-                * line_sum::<W, RAW, S, T>(
+                * line_sum::<W, RAW, S, Z, T>(
                     spec,
                     reads,
                     line_m,
@@ -385,8 +394,8 @@ struct Accumulators {
 
 /// Accumulate the cued spectrum `spec` (times `gain`) into `acc`, and the
 /// `w'`-cued one into `acc_derivative` if given.
-fn accumulate_cue<S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
+fn accumulate_cue<S: Sample, Z: CubeSide, T: Real>(
+    spec: &Spectrum<'_, S, Z>,
     tables: &Tables<'_, T>,
     plan: &ViewPlan,
     frame: &crate::geometry::Frame,
@@ -422,10 +431,10 @@ fn accumulate_cue<S: Sample, T: Real>(
         if let Some(d) = acc_derivative {
             push(&mut targets, d.own, plan.slope, 0.0);
         }
-        run_pass::<S, T, { mode::VALUE_GRADIENT }>(spec, tables, &geo, fields, &targets)?;
+        run_pass::<S, Z, T, { mode::VALUE_GRADIENT }>(spec, tables, &geo, fields, &targets)?;
     } else if plan.base != 0.0 {
         push(&mut targets, acc.own, plan.base, 0.0);
-        run_pass::<S, T, { mode::VALUE }>(spec, tables, &geo, fields, &targets)?;
+        run_pass::<S, Z, T, { mode::VALUE }>(spec, tables, &geo, fields, &targets)?;
     }
     for wave in plan.waves.iter() {
         let Some(partner) = acc.partner else {
@@ -448,7 +457,7 @@ fn accumulate_cue<S: Sample, T: Real>(
                 push(&mut targets, dp, -half_d * s, half_d * c);
             }
         }
-        run_pass::<S, T, { mode::VALUE_MIRROR }>(spec, tables, &geo, fields, &targets)?;
+        run_pass::<S, Z, T, { mode::VALUE_MIRROR }>(spec, tables, &geo, fields, &targets)?;
     }
     Ok(())
 }
@@ -483,9 +492,9 @@ fn fold_partner<T: Real>(fields: &mut [T], n: usize, acc: Accumulators) {
 /// As [`crate::render::render`], plus invalid scene values
 /// ([`Scene::validate`]), a missing or mismatched gradient spectrum, and a
 /// missing derivative table.
-pub fn render_scene<S: Sample, T: Real>(
-    density: &Spectrum<'_, S>,
-    gradient: Option<&Spectrum<'_, S>>,
+pub fn render_scene<S: Sample, Z: CubeSide, T: Real>(
+    density: &Spectrum<'_, S, Z>,
+    gradient: Option<&Spectrum<'_, S, Z>>,
     kernel: &KernelTable<T>,
     derivative: Option<&DerivativeTable<T>>,
     scene: &Scene,

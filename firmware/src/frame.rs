@@ -23,7 +23,7 @@ use fvr_core::render::{
 };
 use fvr_core::scene_render::render_scene;
 
-use crate::scene::{FrameSpec, Shading, StoredKind, IMAGE_SIDE};
+use crate::scene::{FrameSpec, Shading, StoredKind, IMAGE_SIDE, SIDE};
 use crate::stored::{StoredDerivative, StoredSpectrum};
 
 /// A source of instruction counts (SysTick on the device; anything
@@ -440,7 +440,7 @@ fn render_cued_or_shaded<C: InstructionClock>(
 /// [`finish_channel`] (shift, 2D inverse DHT, crop) per channel, as
 /// `render` and `render_scene` do it.
 fn inverse_again(
-    spectrum: &fvr_core::spectrum::Spectrum<'_, fvr_core::f16>,
+    spectrum: &fvr_core::spectrum::Spectrum<'_, fvr_core::f16, fvr_core::spectrum::Side<SIDE>>,
     frame: &fvr_core::geometry::Frame,
     channels: usize,
     tw: &Twiddles<'_, f32>,

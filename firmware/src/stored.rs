@@ -8,7 +8,7 @@
 use fvr_core::dht::Twiddles;
 use fvr_core::f16;
 use fvr_core::filter::{DerivativeTable, Filter, FilterKind, KernelTable};
-use fvr_core::spectrum::Spectrum;
+use fvr_core::spectrum::{Side, Spectrum};
 use fvr_core::Result;
 
 use crate::scene::{StoredKind, SIDE};
@@ -50,10 +50,15 @@ impl StoredSpectrum {
 
     /// The core's view of the spectrum.
     ///
+    /// Its side is the scene's [`SIDE`], fixed at compile time
+    /// (`Spectrum::with_side`): the extraction's index arithmetic folds to
+    /// constants, with no bounds test per tap run.
+    ///
     /// # Errors
-    /// As `Spectrum::from_parts`.
-    pub fn spectrum(&self) -> Result<Spectrum<'static, f16>> {
-        Spectrum::from_parts(self.data, self.n, self.scale, self.filter()?, self.dims)
+    /// As `Spectrum::from_parts`; a side other than [`SIDE`].
+    pub fn spectrum(&self) -> Result<Spectrum<'static, f16, Side<SIDE>>> {
+        Spectrum::from_parts(self.data, self.n, self.scale, self.filter()?, self.dims)?
+            .with_side::<SIDE>()
     }
 
     /// The kernel table, copied from flash (12 KiB of f32 at most).

@@ -139,9 +139,16 @@ fn batched_2d_dht_matches_naive_and_the_line_path_bit_for_bit() {
     // f32 against the naive f64 sum: the radix-2 bound ε·log₂N per pass.
     let mut tw32 = vec![0.0f32; Twiddles::<f32>::buffer_len(128)];
     let tw32 = Twiddles::new(&mut tw32, 128).unwrap();
+    // Squares from 4 to 64 take the transposes that also run the first
+    // radix-2² stages (64 with its side fixed at compile time), 128 the
+    // tiled transposes; odd log₂n (8, 32) ends on a radix-2 stage.
     for (nx, ny) in [
         (1, 1),
         (2, 2),
+        (4, 4),
+        (8, 8),
+        (16, 16),
+        (32, 32),
         (4, 16),
         (16, 4),
         (64, 64),
