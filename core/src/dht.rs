@@ -140,7 +140,14 @@ pub fn idht<T: Real>(data: &mut [T], tw: &Twiddles<'_, T>) -> Result<()> {
 }
 
 fn bit_reverse<T>(data: &mut [T]) {
-    let n = data.len();
+    for_each_bit_reversed_swap(data.len(), |i, j| data.swap(i, j));
+}
+
+/// Calls `swap(i, j)` for every pair `i < j` with `j` the bit reversal of
+/// `i` among `0 … n − 1` (`n` a power of two): the swaps that put a
+/// sequence of `n` (elements or rows) in bit-reversed order.
+#[inline(always)]
+fn for_each_bit_reversed_swap(n: usize, mut swap: impl FnMut(usize, usize)) {
     let mut j = 0usize;
     for i in 1..n {
         let mut bit = n >> 1;
@@ -150,7 +157,7 @@ fn bit_reverse<T>(data: &mut [T]) {
         }
         j |= bit;
         if i < j {
-            data.swap(i, j);
+            swap(i, j);
         }
     }
 }
@@ -656,19 +663,10 @@ fn swap_across_diagonal<T, P: Fn(usize) -> usize>(data: &mut [T], n: usize, p: P
 
 /// Put the rows of an `nx × ny` array in bit-reversed order.
 fn bit_reverse_rows<T>(data: &mut [T], nx: usize, ny: usize) {
-    let mut j = 0usize;
-    for i in 1..ny {
-        let mut bit = ny >> 1;
-        while j & bit != 0 {
-            j ^= bit;
-            bit >>= 1;
-        }
-        j |= bit;
-        if i < j {
-            let (head, tail) = data.split_at_mut(j * nx);
-            head[i * nx..(i + 1) * nx].swap_with_slice(&mut tail[..nx]);
-        }
-    }
+    for_each_bit_reversed_swap(ny, |i, j| {
+        let (head, tail) = data.split_at_mut(j * nx);
+        head[i * nx..(i + 1) * nx].swap_with_slice(&mut tail[..nx]);
+    });
 }
 
 /// [`bit_reverse_rows`] then every stage of the column transform, one
