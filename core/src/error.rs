@@ -303,6 +303,10 @@ impl fmt::Display for Error {
     }
 }
 
+/// Lets host code carry a core error as a source (`?` into `Box<dyn Error>`,
+/// `thiserror`'s `#[from]`) instead of flattening it to a string.
+impl core::error::Error for Error {}
+
 struct V3([f64; 3]);
 
 impl fmt::Display for V3 {

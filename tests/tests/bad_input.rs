@@ -29,6 +29,10 @@ fn nan_and_infinite_voxels_are_named_by_index() {
         }
     );
     assert!(Filter::fit(FilterKind::Kb4, 1, &vol).is_err());
+    // A core error travels as a standard error with its message intact.
+    let boxed: Box<dyn std::error::Error> = Box::new(err);
+    assert_eq!(boxed.to_string(), err.to_string());
+    assert!(boxed.to_string().contains("voxel (3, 4, 5)"));
 }
 
 #[test]
