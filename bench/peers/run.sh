@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Peers side by side in one run: fvr's frequency-domain view (turntable, all
+# cores), RTK's Joseph forward projector (pip itk-rtk, all cores) and
+# scipy.fft.rfftn (f32, all cores) on the same Gaussian-mixture volume, with
+# each image's SNR against the closed-form line integrals
+# (bench/peers/peers.py says how).
+#
+# Installs itk-rtk, numpy and scipy from PyPI into a venv under the Cargo
+# target directory, builds fvr in release, then prints the table and writes
+# it to docs/performance/peers.md.
+#
+# Usage: bash bench/peers/run.sh [--sizes 128,256] [--filters kb3,kb4,kb6]
+#                                [--precision f16] [--views 7]
+# This is a manual benchmark: it is not part of scripts/test-all.sh. Run it
+# on an idle machine; the ratios come from one run, the absolute times drift.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+
+TARGET="${CARGO_TARGET_DIR:-target}"
+VENV="$TARGET/peers/venv"
+if [ ! -x "$VENV/bin/python" ]; then
+    python3 -m venv "$VENV"
+fi
+if ! "$VENV/bin/python" -c "import itk, scipy; from itk import RTK" 2>/dev/null; then
+    "$VENV/bin/pip" install --quiet itk-rtk numpy scipy
+fi
+cargo build --locked --release -p fvr-host
+echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
+mkdir -p docs/performance
+"$VENV/bin/python" bench/peers/peers.py --fvr "$TARGET/release/fvr" \
+    --work "$TARGET/peers/work" --out docs/performance/peers.md "$@"
