@@ -272,13 +272,13 @@ fn run_inner(
 }
 
 /// On the target's own arithmetic: the fast f16 → f32 widening of the core
-/// (`fvr_core::real::f16_bits_to_f32`) against `half`'s, for all 65,536
+/// (`fvr_core::num::f16_bits_to_f32`) against `half`'s, for all 65,536
 /// patterns, and the instructions per conversion of each over the 63,488
 /// finite patterns (a spectrum holds only finite values).
 fn f16_codec_report(clock: &SysTickClock) -> Result<(), RunError> {
     use core::hint::black_box;
     use fvr_core::f16;
-    use fvr_core::real::f16_bits_to_f32;
+    use fvr_core::num::f16_bits_to_f32;
 
     let differing = (0..=u16::MAX)
         .filter(|&b| f16_bits_to_f32(b).to_bits() != f16::from_bits(b).to_f32().to_bits())

@@ -8,7 +8,7 @@
 //! bit, which checks that the stages are the whole of `render`.
 //!
 //! A depth-cued or shaded frame is rendered once, by
-//! `fvr_core::scene_render::render_scene`, whose stages are not public. Its
+//! `fvr_core::render::render_scene`, whose stages are not public. Its
 //! inverse (one [`finish_channel`] per channel) is timed again afterwards on
 //! the scratch it left: that cost depends on the geometry only, not on the
 //! data (the plain frame checks this, [`Split::Staged::inverse_again`]), and
@@ -18,10 +18,9 @@ use core::fmt;
 
 use fvr_core::dht::{dht_2d, Twiddles};
 use fvr_core::filter::FilterKind;
-use fvr_core::render::{
-    aux_len, extract_slice, finish_channel, finish_projection, grid_len, placement, render,
-};
-use fvr_core::scene_render::render_scene;
+use fvr_core::image::{aux_len, finish, grid_len, placement, Crop};
+use fvr_core::render::{render, Buffers, Request, Source};
+use fvr_core::slice::extract_slice;
 
 use crate::scene::{FrameSpec, Shading, StoredKind, IMAGE_SIDE, SIDE};
 use crate::stored::{StoredDerivative, StoredSpectrum};
@@ -319,28 +318,23 @@ fn render_plain<C: InstructionClock>(
     let n = spectrum.n();
     let t0 = clock.now();
     render(
-        &spectrum,
-        kernel,
-        &spec.view,
-        w,
-        h,
-        tw,
-        bufs.fields,
-        bufs.aux,
-        bufs.image,
+        &Source::new(&spectrum, kernel, tw),
+        &Request::new(spec.view, w, h),
+        Buffers {
+            grid: bufs.fields,
+            aux: bufs.aux,
+            out: bufs.image,
+        },
     )?;
     let t1 = clock.now();
     let frame = spec.view.frame()?;
     extract_slice(&spectrum, kernel, &frame, &mut bufs.fields[..n * n]);
     let t2 = clock.now();
     let place = placement(spectrum.dims(), &frame, w, h);
-    finish_projection(
+    finish(
         &mut bufs.fields[..n * n],
         n,
-        &place,
-        1.0 / spectrum.scale(),
-        w,
-        h,
+        &Crop::new(place, 1.0 / spectrum.scale(), w, h),
         tw,
         bufs.aux,
         bufs.staged,
@@ -399,19 +393,23 @@ fn render_cued_or_shaded<C: InstructionClock>(
         None => None,
     };
     let t0 = clock.now();
-    let channels = render_scene(
-        &spectrum,
-        gradient.as_ref(),
-        kernel,
-        derivative,
-        &scene,
-        &spec.view,
-        IMAGE_SIDE,
-        IMAGE_SIDE,
-        tw,
-        bufs.fields,
-        bufs.aux,
-        bufs.image,
+    let channels = render(
+        &Source {
+            spectrum: &spectrum,
+            gradient: gradient.as_ref(),
+            kernel,
+            derivative,
+            twiddles: tw,
+        },
+        &Request {
+            scene: Some(&scene),
+            ..Request::new(spec.view, IMAGE_SIDE, IMAGE_SIDE)
+        },
+        Buffers {
+            grid: bufs.fields,
+            aux: bufs.aux,
+            out: bufs.image,
+        },
     )?;
     let t1 = clock.now();
     let frame = spec.view.frame()?;
@@ -451,18 +449,17 @@ fn inverse_again(
     let place = placement(spectrum.dims(), frame, w, h);
     let gain = 1.0 / spectrum.scale();
     for c in 0..channels {
-        finish_channel(
+        finish(
             &mut bufs.fields[..n * n],
             n,
-            &place,
-            gain,
-            w,
-            h,
+            &Crop {
+                channels,
+                channel: c,
+                ..Crop::new(place, gain, w, h)
+            },
             tw,
             bufs.aux,
             bufs.staged,
-            channels,
-            c,
         )?;
     }
     Ok(())

@@ -9,7 +9,7 @@
 //! # Adding a frame
 //! A [`FrameSpec`] names a stored filter, a view and what it computes
 //! ([`Shading`]). A plain frame reads the density spectrum. A
-//! [`Shading::Scene`] frame is rendered by `fvr_core::scene_render::render_scene`
+//! [`Shading::Scene`] frame is rendered by `fvr_core::render::render_scene`
 //! and needs, besides the density spectrum:
 //! - with a linear depth cue, the kernel-derivative table of its filter
 //!   (paper eq. 5), listed in [`DERIVATIVES`]: `W·512 + 1` f32 (6 KiB for
@@ -26,7 +26,7 @@
 
 use fvr_core::filter::FilterKind;
 use fvr_core::geometry::View;
-use fvr_core::scene::{DepthCue, Light, Scene};
+use fvr_core::shading::{DepthCue, Light, Scene};
 
 /// Side of the phantom's cube (voxels); also the padded spectrum side at
 /// oversampling 1.
@@ -131,7 +131,7 @@ pub enum StoredKind {
     /// `F{f·p_m}`: the density, for every frame.
     Density(FilterKind),
     /// `F{|∇f|·p_m}`: the gradient magnitude of the band-limited interpolant
-    /// (`fvr_core::gradient::gradient_magnitude`), for frames with a light.
+    /// (`fvr_core::shading::gradient::gradient_magnitude`), for frames with a light.
     /// It is premultiplied for the same filter (the same β) as the density.
     GradientMagnitude(FilterKind),
 }
@@ -168,7 +168,7 @@ pub const STORED: [StoredKind; 4] = [
 /// with a linear depth cue).
 pub const DERIVATIVES: [FilterKind; 1] = [FilterKind::Kb3];
 
-/// A depth cue a frame uses: the part of `fvr_core::scene::DepthCue` this
+/// A depth cue a frame uses: the part of `fvr_core::shading::DepthCue` this
 /// scene needs, in a form that can be a constant.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Cue {
@@ -184,7 +184,7 @@ pub enum Cue {
 }
 
 /// A depth-cued and/or shaded view's scene (the core's
-/// `fvr_core::scene::Scene`, as a constant).
+/// `fvr_core::shading::Scene`, as a constant).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SceneSpec {
     /// The depth cue.
@@ -272,7 +272,7 @@ pub enum Shading {
     /// `fvr_core::render::render`.
     Plain,
     /// A depth-cued and/or shaded image (paper §3), by
-    /// `fvr_core::scene_render::render_scene`.
+    /// `fvr_core::render::render_scene`.
     Scene(SceneSpec),
 }
 

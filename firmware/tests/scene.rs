@@ -10,8 +10,9 @@ use common::{exact_image, floor_db, host_image, snr_db, tables};
 use fvr_core::dht::Twiddles;
 use fvr_core::f16;
 use fvr_core::filter::{DerivativeTable, Filter, FilterKind, KernelTable};
-use fvr_core::scene::ViewPlan;
-use fvr_core::spectrum::{DenseVolume, Spectrum};
+use fvr_core::shading::ViewPlan;
+use fvr_core::spectrum::Spectrum;
+use fvr_core::volume::DenseVolume;
 use fvr_firmware::frame::{
     check_linked_tables, render_frame, tables_for, FrameBuffers, FrameError, InstructionClock,
     Split, AUX_LEN, IMAGE_LEN,

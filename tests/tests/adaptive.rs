@@ -1,9 +1,9 @@
 //! Adaptive filtering (paper §4): the tolerance holds, the marks are what
 //! the paper defines, and the statistics add up.
 
-use fvr_core::adaptive::{mark, marks_words, threshold_for, Marks};
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
+use fvr_core::slice::adaptive::{mark, marks_words, threshold_for, Marks};
 use fvr_host::adaptive::{parse_chain, parse_tolerance, AdaptiveMarks, AdaptiveSettings, Bound};
 use fvr_host::phantom::{sample, GaussianMixture, SheppLogan};
 use fvr_host::pipeline::{AnySpectrum, OwnedSpectrum};
@@ -150,7 +150,7 @@ fn direct_error_ratio(spec: &OwnedSpectrum<f16>, tau: f64, gain: f64) -> f64 {
     let f_weak = fvr_host::reference::naive_dht_3d(&weak, [n; 3]);
     let small = Filter::new(FilterKind::Nearest, 2).unwrap();
     let large = spec.filter();
-    let pos = |k: usize| fvr_core::render::signed_index(k, n) as f64 / n as f64;
+    let pos = |k: usize| fvr_core::dht::signed_index(k, n) as f64 / n as f64;
     let (mut err, mut reference) = (0.0, 0.0);
     for z in 0..n {
         for y in 0..n {

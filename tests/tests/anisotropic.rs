@@ -15,9 +15,9 @@
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::{Sampling, View};
-use fvr_core::progressive::{render_level, render_level_sampled};
-use fvr_core::render::{aux_len, grid_len, render, render_sampled};
-use fvr_core::scene::{DepthCue, Light, Scene};
+use fvr_core::image::{aux_len, grid_len};
+use fvr_core::render::{render, Buffers, Request, Source};
+use fvr_core::shading::{DepthCue, Light, Scene};
 use fvr_core::Error;
 use fvr_host::accuracy::{CONFIGS, VIEWS};
 use fvr_host::phantom::{sample, sample_spaced, GaussianMixture};
@@ -175,18 +175,27 @@ fn unit_sampling_is_bit_identical_to_voxel_units() {
         let mut old = vec![0.0f32; w * h];
         let mut new = vec![0.0f32; w * h];
         let s = spec.view();
-        render(&s, &kernel, &view, w, h, &tw, &mut grid, &mut aux, &mut old).unwrap();
-        render_sampled(
-            &s,
-            &kernel,
-            &view,
-            &Sampling::UNIT,
-            w,
-            h,
-            &tw,
-            &mut grid,
-            &mut aux,
-            &mut new,
+        render(
+            &Source::new(&s, &kernel, &tw),
+            &Request::new(view, w, h),
+            Buffers {
+                grid: &mut grid,
+                aux: &mut aux,
+                out: &mut old,
+            },
+        )
+        .unwrap();
+        render(
+            &Source::new(&s, &kernel, &tw),
+            &Request {
+                sampling: Sampling::UNIT,
+                ..Request::new(view, w, h)
+            },
+            Buffers {
+                grid: &mut grid,
+                aux: &mut aux,
+                out: &mut new,
+            },
         )
         .unwrap();
         assert!(old.iter().any(|&v| v != 0.0));
@@ -198,31 +207,31 @@ fn unit_sampling_is_bit_identical_to_voxel_units() {
         let mut old = vec![0.0f32; pw * ph];
         let mut new = vec![0.0f32; pw * ph];
         let m = n / 2;
-        render_level(
-            &s,
-            &kernel,
-            &view,
-            pw,
-            ph,
-            1,
-            &tw,
-            &mut grid[..m * m],
-            &mut aux,
-            &mut old,
+        render(
+            &Source::new(&s, &kernel, &tw),
+            &Request {
+                level: 1,
+                ..Request::new(view, pw, ph)
+            },
+            Buffers {
+                grid: &mut grid[..m * m],
+                aux: &mut aux,
+                out: &mut old,
+            },
         )
         .unwrap();
-        render_level_sampled(
-            &s,
-            &kernel,
-            &view,
-            &Sampling::UNIT,
-            pw,
-            ph,
-            1,
-            &tw,
-            &mut grid[..m * m],
-            &mut aux,
-            &mut new,
+        render(
+            &Source::new(&s, &kernel, &tw),
+            &Request {
+                sampling: Sampling::UNIT,
+                level: 1,
+                ..Request::new(view, pw, ph)
+            },
+            Buffers {
+                grid: &mut grid[..m * m],
+                aux: &mut aux,
+                out: &mut new,
+            },
         )
         .unwrap();
         assert_eq!(

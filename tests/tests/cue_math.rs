@@ -3,9 +3,9 @@
 
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::{DerivativeTable, Filter, FilterKind, TABLE_RESOLUTION};
-use fvr_core::gradient::{gradient_magnitude, gradient_scratch_len};
-use fvr_core::scene::{CueTerms, DepthCue};
-use fvr_core::spectrum::DenseVolume;
+use fvr_core::shading::gradient::{gradient_magnitude, gradient_scratch_len};
+use fvr_core::shading::{CueTerms, DepthCue};
+use fvr_core::volume::DenseVolume;
 use fvr_host::phantom::{sample, Gaussian, Phantom};
 use fvr_host::reference::snr_db;
 

@@ -5,7 +5,8 @@
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::View;
-use fvr_core::render::{aux_len, grid_len, render};
+use fvr_core::image::{aux_len, grid_len};
+use fvr_core::render::{render, Buffers, Request, Source};
 use fvr_core::spectrum::{CubeSide, Spectrum};
 use fvr_core::Error;
 use fvr_host::phantom::{sample, GaussianMixture};
@@ -22,7 +23,13 @@ fn render_view<Z: CubeSide>(spec: &Spectrum<'_, f16, Z>, filter: Filter, view: &
     let (mut grid, mut aux) = (vec![0.0f32; grid_len(n)], vec![0.0f32; aux_len(n)]);
     let mut out = vec![0.0f32; n * n];
     render(
-        spec, &kernel, view, n, n, &tw, &mut grid, &mut aux, &mut out,
+        &Source::new(spec, &kernel, &tw),
+        &Request::new(*view, n, n),
+        Buffers {
+            grid: &mut grid,
+            aux: &mut aux,
+            out: &mut out,
+        },
     )
     .unwrap();
     out

@@ -3,11 +3,11 @@
 //! underflow; and bit-identity of the generic minifloat with `half`'s f16 and
 //! bf16.
 
-use fvr_core::format::{
+use fvr_core::num::Sample;
+use fvr_core::num::{
     bf16, Arithmetic, BlockLayout, Blocking, FloatLayout, Format, FormatName, Minifloat16,
     Minifloat8, Q15, Q7,
 };
-use fvr_core::real::Sample;
 use fvr_core::Error;
 use half::f16;
 
@@ -298,7 +298,8 @@ fn format_names_and_bytes_per_voxel() {
 fn q15_line_blocks_prepared_in_place_match_the_f64_spectrum_within_five_roundings() {
     use fvr_core::dht::{Rounding, Twiddles};
     use fvr_core::filter::{Filter, FilterKind};
-    use fvr_core::spectrum::{prepare_scratch_len, DenseVolume, Spectrum};
+    use fvr_core::spectrum::{prepare_scratch_len, Spectrum};
+    use fvr_core::volume::DenseVolume;
     let n = 16usize;
     let mut state = 7u64;
     let data: Vec<f32> = (0..n * n * n)

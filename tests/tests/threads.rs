@@ -3,7 +3,7 @@
 
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::View;
-use fvr_core::render::{extract_slice, extract_slice_rows};
+use fvr_core::slice::{extract_slice, extract_slice_rows};
 use fvr_core::Error;
 use fvr_host::phantom::{sample, GaussianMixture};
 use fvr_host::pipeline::{OwnedSpectrum, ViewRenderer};

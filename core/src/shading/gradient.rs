@@ -18,8 +18,8 @@
 
 use crate::dht::{dht, neg_mod, Twiddles};
 use crate::error::{mismatch, require_len, Error, Result};
-use crate::real::Real;
-use crate::spectrum::VoxelSource;
+use crate::num::Real;
+use crate::volume::VoxelSource;
 
 /// Line length used along axis `a` of size `len`: `2·next_pow2(len)`.
 pub fn padded_line_len(len: usize) -> usize {

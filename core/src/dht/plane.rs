@@ -1,0 +1,452 @@
+//! The true 2D DHT in place: batched row and column passes, then the
+//! Hao–Bracewell correction.
+
+use super::line::butterfly_pair;
+use super::line::{dht_unchecked, for_each_bit_reversed_swap};
+use super::transpose::{
+    transpose_square, transpose_square_bit_reversed_radix4, transpose_square_plain_radix4,
+    TILED_TRANSPOSE_FROM,
+};
+use super::Twiddles;
+use crate::error::{check_len, require_len, Result};
+use crate::num::Real;
+
+/// True 2D DHT in place of an `nx × ny` array stored with `x` fastest,
+/// unnormalized: `H(u,v) = Σ f(x,y) cas(2π(ux/nx + vy/ny))`.
+///
+/// Row and column passes give the separable `T = cas⊗cas` transform; the
+/// Hao–Bracewell correction `H(u,v) = ½[T(u,v) + T(−u,v) + T(u,−v) − T(−u,−v)]`
+/// then runs in place over each group of four symmetric points.
+///
+/// The column pass is *batched*: its radix-2 stages run over whole rows at
+/// once (every butterfly of a stage applies one twiddle pair to `nx`
+/// contiguous columns), so nothing is copied, each twiddle is looked up
+/// once per row pair instead of once per column, and the inner loop
+/// vectorizes. Square arrays get their row pass the same way, between two
+/// in-place transposes. Every value goes through exactly the arithmetic of
+/// [`dht_2d_lines`] (the same butterflies on the same operands), so the two
+/// agree bit for bit. `column` is not needed here; it is checked for the
+/// signature's sake (the line path's scratch).
+///
+/// # Errors
+/// A side not a power of two or longer than the table, a `data` length other
+/// than `nx·ny`, or short scratch.
+pub fn dht_2d<T: Real>(
+    data: &mut [T],
+    nx: usize,
+    ny: usize,
+    column: &mut [T],
+    tw: &Twiddles<'_, T>,
+) -> Result<()> {
+    tw.check(nx)?;
+    tw.check(ny)?;
+    check_len("2D array", nx * ny, data.len())?;
+    require_len("column scratch", ny, column.len())?;
+    if nx == ny && (4..TILED_TRANSPOSE_FROM).contains(&nx) {
+        dht_2d_square(data, nx, tw);
+    } else {
+        if nx == ny {
+            transpose_square(data, nx);
+            dht_columns(data, nx, ny, tw);
+            transpose_square(data, nx);
+        } else {
+            for row in data.chunks_exact_mut(nx) {
+                dht_unchecked(row, tw);
+            }
+        }
+        dht_columns(data, nx, ny, tw);
+        hao_bracewell_2d(data, nx, ny);
+    }
+    Ok(())
+}
+
+/// The square path of [`dht_2d`] for `4 ≤ n < 128`. (Compiling it once per
+/// side, with `n` a constant, took the M4F's 64 × 64 transform from 186 k
+/// to 164 k instructions for about 25 KB of code with every side below 128,
+/// or a special case of one size; not done.)
+///
+/// The first transpose also bit-reverses both indices: rows come out in
+/// the order the column pass wants, and its output columns in the
+/// bit-reversed row order the second pass wants after a plain transpose,
+/// so no pass reorders rows on its own. Each transpose also does the first
+/// two (untwiddled) stages of the pass after it.
+fn dht_2d_square<T: Real>(data: &mut [T], n: usize, tw: &Twiddles<'_, T>) {
+    transpose_square_bit_reversed_radix4(data, n);
+    dht_columns_stages(data, n, n, 4, tw);
+    transpose_square_plain_radix4(data, n);
+    dht_columns_stages(data, n, n, 4, tw);
+    hao_bracewell_2d(data, n, n);
+}
+
+/// [`dht_2d`] line by line: each row transformed in place, then each
+/// column copied to `column` (`ny` elements), transformed and copied back.
+/// The reference for the batched path and the smallest code.
+///
+/// # Errors
+/// As [`dht_2d`].
+pub fn dht_2d_lines<T: Real>(
+    data: &mut [T],
+    nx: usize,
+    ny: usize,
+    column: &mut [T],
+    tw: &Twiddles<'_, T>,
+) -> Result<()> {
+    tw.check(nx)?;
+    tw.check(ny)?;
+    check_len("2D array", nx * ny, data.len())?;
+    require_len("column scratch", ny, column.len())?;
+    for row in data.chunks_exact_mut(nx) {
+        dht_unchecked(row, tw);
+    }
+    let col = &mut column[..ny];
+    for x in 0..nx {
+        for (y, c) in col.iter_mut().enumerate() {
+            *c = data[x + nx * y];
+        }
+        dht_unchecked(col, tw);
+        for (y, c) in col.iter().enumerate() {
+            data[x + nx * y] = *c;
+        }
+    }
+    hao_bracewell_2d(data, nx, ny);
+    Ok(())
+}
+
+/// `H(u,v) = ½[T(u,v) + T(−u,v) + T(u,−v) − T(−u,−v)]` in place.
+///
+/// Where `u ≡ −u` (`u = 0`, `nx/2`) or `v ≡ −v` the bracket is `2·T(u,v)`
+/// exactly, so those rows and columns stay as they are. Every other group
+/// of four points shares `S = ½[T(u,v) + T(−u,v) + T(u,−v) + T(−u,−v)]`,
+/// and each point's value is `S` minus the point diagonally opposite
+/// (`H(u,v) = S − T(−u,−v)`, …): 8 operations instead of 16. Rows `v` and
+/// `ny − v` go together, with `u` and `nx − u` walked from both ends.
+fn hao_bracewell_2d<T: Real>(data: &mut [T], nx: usize, ny: usize) {
+    if nx <= 2 || ny <= 2 {
+        return;
+    }
+    let h = nx / 2;
+    for v in 1..ny / 2 {
+        let (top, bottom) = data.split_at_mut((ny - v) * nx);
+        let (lo_v, hi_v) = split_row(&mut top[v * nx..(v + 1) * nx], h);
+        let (lo_m, hi_m) = split_row(&mut bottom[..nx], h);
+        // Four groups at a time: `u` ascending in chunks from the front of
+        // `lo_*`, `nx − u` descending in chunks from the back of `hi_*`.
+        let mut streams = [lo_v, hi_v, lo_m, hi_m];
+        for _ in 0..streams[0].len() / 4 {
+            let [lo_v, hi_v, lo_m, hi_m] = &mut streams;
+            let (lo_v, hi_v) = (take_first4(lo_v), take_last4(hi_v));
+            let (lo_m, hi_m) = (take_first4(lo_m), take_last4(hi_m));
+            for k in 0..4 {
+                hao_bracewell_group(
+                    &mut lo_v[k],
+                    &mut hi_v[3 - k],
+                    &mut lo_m[k],
+                    &mut hi_m[3 - k],
+                );
+            }
+        }
+        let [lo_v, hi_v, lo_m, hi_m] = streams;
+        let rest = lo_v.len();
+        let (hi_v, lo_m, hi_m) = (&mut hi_v[..rest], &mut lo_m[..rest], &mut hi_m[..rest]);
+        for j in 0..rest {
+            let r = rest - 1 - j;
+            hao_bracewell_group(&mut lo_v[j], &mut hi_v[r], &mut lo_m[j], &mut hi_m[r]);
+        }
+    }
+}
+
+/// The first four values of `*s`, which then starts after them.
+#[inline(always)]
+fn take_first4<'a, T>(s: &mut &'a mut [T]) -> &'a mut [T; 4] {
+    match core::mem::take(s).split_first_chunk_mut::<4>() {
+        Some((chunk, tail)) => {
+            *s = tail;
+            chunk
+        }
+        None => chunk_out_of_range(),
+    }
+}
+
+/// The last four values of `*s`, which then ends before them.
+#[inline(always)]
+fn take_last4<'a, T>(s: &mut &'a mut [T]) -> &'a mut [T; 4] {
+    match core::mem::take(s).split_last_chunk_mut::<4>() {
+        Some((head, chunk)) => {
+            *s = head;
+            chunk
+        }
+        None => chunk_out_of_range(),
+    }
+}
+
+#[cold]
+pub(super) fn chunk_out_of_range() -> ! {
+    panic!("chunk of four past the end of its slice")
+}
+
+/// The correction on one group: `a, b, c, d` at `(u, v)`, `(−u, v)`,
+/// `(u, −v)`, `(−u, −v)`.
+#[inline(always)]
+fn hao_bracewell_group<T: Real>(a: &mut T, b: &mut T, c: &mut T, d: &mut T) {
+    let s = T::HALF * ((*a + *b) + (*c + *d));
+    (*a, *b, *c, *d) = (s - *d, s - *c, s - *b, s - *a);
+}
+
+/// Columns `1..h` and `h+1..2h` of a row of `2h`.
+#[inline(always)]
+fn split_row<T>(row: &mut [T], h: usize) -> (&mut [T], &mut [T]) {
+    let (lo, hi) = row.split_at_mut(h);
+    (&mut lo[1..], &mut hi[1..])
+}
+
+/// Put the rows of an `nx × ny` array in bit-reversed order.
+fn bit_reverse_rows<T>(data: &mut [T], nx: usize, ny: usize) {
+    for_each_bit_reversed_swap(ny, |i, j| {
+        let (head, tail) = data.split_at_mut(j * nx);
+        head[i * nx..(i + 1) * nx].swap_with_slice(&mut tail[..nx]);
+    });
+}
+
+/// [`bit_reverse_rows`] then every stage of the column transform, one
+/// radix-2 stage at a time: the path for large and non-square arrays on
+/// cached hosts, where the four-row butterfly loops vectorize and the
+/// radix-2² kernels (eight rows, six twiddles) run out of SIMD registers.
+fn dht_columns<T: Real>(data: &mut [T], nx: usize, ny: usize, tw: &Twiddles<'_, T>) {
+    bit_reverse_rows(data, nx, ny);
+    let mut m = 1;
+    while m < ny {
+        radix2_columns_stage(data, nx, m, tw);
+        m *= 2;
+    }
+}
+
+/// The radix-2 DHT of [`dht_unchecked`] along `y` for all `nx` columns at
+/// once, from the stage of half-length `m` on (rows already in bit-reversed
+/// order, the stages below `m` done): rows take the place of elements, so
+/// every butterfly is a loop over `nx` contiguous values with one twiddle
+/// pair.
+///
+/// Stages go two at a time (radix 2²): the stages of half-lengths `m` and
+/// `2m` touch the rows `k, m−k, m+k, 2m−k` and those `2m` further on
+/// together, eight rows closed under both stages, so each value is loaded
+/// and stored once per two stages. The butterflies and their operands are
+/// those of [`dht_stages`], in the same order, so the result is the same to
+/// the bit; a single radix-2 stage finishes odd `log₂ny`.
+fn dht_columns_stages<T: Real>(
+    data: &mut [T],
+    nx: usize,
+    ny: usize,
+    mut m: usize,
+    tw: &Twiddles<'_, T>,
+) {
+    while 4 * m <= ny {
+        let stride1 = tw.len / (2 * m);
+        let stride2 = tw.len / (4 * m);
+        for block in data.chunks_exact_mut(4 * m * nx) {
+            let [r0, r1, r2, r3] = rows_mut(block, nx, [0, m, 2 * m, 3 * m]);
+            radix4_rows_plain(r0, r1, r2, r3);
+            if m >= 2 {
+                let h = m / 2;
+                let [r0, r1, r2, r3] = rows_mut(block, nx, [h, 3 * h, 5 * h, 7 * h]);
+                let (c, s) = tw.cos_sin(h * stride2);
+                radix4_rows_half(r0, r1, r2, r3, c, s);
+                for k in 1..h {
+                    let rows = rows_mut(
+                        block,
+                        nx,
+                        [
+                            k,
+                            m - k,
+                            m + k,
+                            2 * m - k,
+                            2 * m + k,
+                            3 * m - k,
+                            3 * m + k,
+                            4 * m - k,
+                        ],
+                    );
+                    let first = tw.cos_sin(k * stride1);
+                    let second = [tw.cos_sin(k * stride2), tw.cos_sin((m - k) * stride2)];
+                    radix4_rows_twiddled(rows, first, second);
+                }
+            }
+        }
+        m *= 4;
+    }
+    if m < ny {
+        radix2_columns_stage(data, nx, m, tw);
+    }
+}
+
+/// One radix-2 stage of half-length `m` of [`dht_columns`].
+fn radix2_columns_stage<T: Real>(data: &mut [T], nx: usize, m: usize, tw: &Twiddles<'_, T>) {
+    let stride = tw.len / (2 * m);
+    for block in data.chunks_exact_mut(2 * m * nx) {
+        let (x, y) = block.split_at_mut(m * nx);
+        butterfly_rows(&mut x[..nx], &mut y[..nx]);
+        if m >= 2 {
+            let h = m / 2;
+            butterfly_rows(&mut x[h * nx..(h + 1) * nx], &mut y[h * nx..(h + 1) * nx]);
+            for k in 1..h {
+                let (c, s) = tw.cos_sin(k * stride);
+                let (x_low, x_high) = x.split_at_mut((m - k) * nx);
+                let (y_low, y_high) = y.split_at_mut((m - k) * nx);
+                butterfly_rows_twiddled(
+                    &mut x_low[k * nx..(k + 1) * nx],
+                    &mut x_high[..nx],
+                    &mut y_low[k * nx..(k + 1) * nx],
+                    &mut y_high[..nx],
+                    c,
+                    s,
+                );
+            }
+        }
+    }
+}
+
+/// Rows `idx[0] < idx[1] < …` (each `nx` long) of `block`, borrowed apart.
+#[inline(always)]
+pub(super) fn rows_mut<T, const K: usize>(
+    block: &mut [T],
+    nx: usize,
+    idx: [usize; K],
+) -> [&mut [T]; K] {
+    let mut rest = block;
+    let mut next = 0;
+    core::array::from_fn(|j| {
+        let (_, tail) = core::mem::take(&mut rest).split_at_mut((idx[j] - next) * nx);
+        let (row, tail) = tail.split_at_mut(nx);
+        rest = tail;
+        next = idx[j] + 1;
+        row
+    })
+}
+
+/// The twiddled butterfly of [`dht_stages`] on one set of operands:
+/// `(x[k], x[m−k], y[k], y[m−k])` in, the same four out.
+#[inline(always)]
+fn twiddled<T: Real>(xk: T, xmk: T, yk: T, ymk: T, c: T, s: T) -> [T; 4] {
+    let t1 = c * yk + s * ymk;
+    let t2 = s * yk - c * ymk;
+    [xk + t1, xmk + t2, xk - t1, xmk - t2]
+}
+
+/// Radix-2² on rows `0, m, 2m, 3m` of a block: both stages untwiddled
+/// (`k = 0` of each, and the middle `k = m` of the second).
+#[inline(always)]
+fn radix4_rows_plain<T: Real>(r0: &mut [T], r1: &mut [T], r2: &mut [T], r3: &mut [T]) {
+    for_each_column([r0, r1, r2, r3], radix4_plain);
+}
+
+/// Both untwiddled stages on four values in bit-reversed order: the pairs
+/// `(0, 1)` and `(2, 3)`, then `(0, 2)` and `(1, 3)`.
+#[inline(always)]
+pub(super) fn radix4_plain<T: Real>([r0, r1, r2, r3]: [T; 4]) -> [T; 4] {
+    let (a, b) = (r0 + r1, r0 - r1);
+    let (c, d) = (r2 + r3, r2 - r3);
+    [a + c, b + d, a - c, b - d]
+}
+
+/// Radix-2² on rows `h, 3h, 5h, 7h` (`h = m/2`): the middle butterflies of
+/// the first stage, then the twiddled one of the second at `k = h`.
+#[inline(always)]
+fn radix4_rows_half<T: Real>(r0: &mut [T], r1: &mut [T], r2: &mut [T], r3: &mut [T], c: T, s: T) {
+    for_each_column([r0, r1, r2, r3], |[r0, r1, r2, r3]| {
+        let (a, b) = (r0 + r1, r0 - r1);
+        let (y, ym) = (r2 + r3, r2 - r3);
+        twiddled(a, b, y, ym, c, s)
+    });
+}
+
+/// Radix-2² on the rows `k, m−k, m+k, 2m−k, 2m+k, 3m−k, 3m+k, 4m−k`
+/// (`0 < k < m/2`): the first stage's twiddled butterflies at `k` in both
+/// halves (`first`), then the second's at `k` and `m − k` (`second`).
+#[inline(always)]
+fn radix4_rows_twiddled<T: Real>(rows: [&mut [T]; 8], first: (T, T), second: [(T, T); 2]) {
+    let (c1, s1) = first;
+    let [(c2, s2), (c3, s3)] = second;
+    for_each_column(rows, |[r0, r1, r2, r3, r4, r5, r6, r7]| {
+        // First stage, half-length m: blocks [0, 2m) and [2m, 4m).
+        let [a0, a1, a2, a3] = twiddled(r0, r1, r2, r3, c1, s1);
+        let [b0, b1, b2, b3] = twiddled(r4, r5, r6, r7, c1, s1);
+        // Second stage, half-length 2m: k pairs rows k, 2m−k with 2m+k,
+        // 4m−k; m−k pairs rows m−k, m+k with 3m−k, 3m+k.
+        let [k0, k1, k2, k3] = twiddled(a0, a3, b0, b3, c2, s2);
+        let [j0, j1, j2, j3] = twiddled(a1, a2, b1, b2, c3, s3);
+        [k0, j0, j1, k1, k2, j2, j3, k3]
+    });
+}
+
+/// Apply `f` to every column of `R` equal-length rows: the values of the
+/// column in, its new values out. Runs over chunks of four columns
+/// (`[T; 4]`), which the M4F addresses with immediate offsets from one
+/// pointer per row, then over the rest.
+#[inline(always)]
+fn for_each_column<T: Copy, const R: usize>(
+    rows: [&mut [T]; R],
+    mut f: impl FnMut([T; R]) -> [T; R],
+) {
+    let len = rows.iter().map(|r| r.len()).min().unwrap_or(0);
+    let mut rest = rows.map(|r| &mut r[..len]);
+    for _ in 0..len / 4 {
+        let mut chunks = rest.each_mut().map(take_first4);
+        for k in 0..4 {
+            let out = f(core::array::from_fn(|r| chunks[r][k]));
+            for (chunk, v) in chunks.iter_mut().zip(out) {
+                chunk[k] = v;
+            }
+        }
+    }
+    for k in 0..len % 4 {
+        let out = f(core::array::from_fn(|r| rest[r][k]));
+        for (row, v) in rest.iter_mut().zip(out) {
+            row[k] = v;
+        }
+    }
+}
+
+/// The twiddled butterfly of [`dht_stages`] over whole rows: `xk`, `yk`
+/// hold index `k` and `xmk`, `ymk` index `m − k` of every column. Written
+/// over equal-length slices indexed in step, so that it vectorizes.
+#[inline(always)]
+fn butterfly_rows_twiddled<T: Real>(
+    xk: &mut [T],
+    xmk: &mut [T],
+    yk: &mut [T],
+    ymk: &mut [T],
+    c: T,
+    s: T,
+) {
+    let len = xk.len();
+    let (xmk, yk, ymk) = (&mut xmk[..len], &mut yk[..len], &mut ymk[..len]);
+    for i in 0..len {
+        [xk[i], xmk[i], yk[i], ymk[i]] = twiddled(xk[i], xmk[i], yk[i], ymk[i], c, s);
+    }
+}
+
+/// [`butterfly_pair`] over two rows.
+#[inline(always)]
+fn butterfly_rows<T: Real>(x: &mut [T], y: &mut [T]) {
+    for (a, b) in x.iter_mut().zip(y.iter_mut()) {
+        butterfly_pair(a, b);
+    }
+}
+
+/// Inverse of [`dht_2d`]: the same transform divided by `nx·ny`.
+///
+/// # Errors
+/// As [`dht_2d`].
+pub fn idht_2d<T: Real>(
+    data: &mut [T],
+    nx: usize,
+    ny: usize,
+    column: &mut [T],
+    tw: &Twiddles<'_, T>,
+) -> Result<()> {
+    dht_2d(data, nx, ny, column, tw)?;
+    let inv = T::from_f64(1.0 / (nx * ny) as f64);
+    for v in data.iter_mut() {
+        *v *= inv;
+    }
+    Ok(())
+}
