@@ -18,7 +18,7 @@ use semihosting::fs::File;
 use semihosting::io::Write as _;
 
 use crate::capture::{ByteSink, CaptureBus};
-use crate::display::{DcsPanel, Window};
+use crate::display::{DcsPanel, Image, Window};
 use crate::frame::{
     check_linked_tables, render_frame, tables_for, FrameBuffers, FrameError, InstructionClock,
     Split, IMAGE_LEN,
@@ -212,12 +212,14 @@ fn run_inner(
         )?);
         let mut panel = DcsPanel::new(bus.spi(), bus.dc());
         let mut row = [0u8; 2 * IMAGE_SIDE];
-        let drawn = if channels == 1 {
-            panel.draw_gray(0, 0, image, IMAGE_SIDE, &window, &mut row)
-        } else {
-            panel.draw_rgb(0, 0, image, IMAGE_SIDE, &window, &mut row)
+        let picture = Image {
+            pixels: image,
+            width: IMAGE_SIDE,
+            channels,
         };
-        drawn.map_err(|_| RunError::Display)?;
+        panel
+            .draw((0, 0), picture, &window, &mut row)
+            .map_err(|_| RunError::Display)?;
         let display = clock.now() - t0;
 
         let mut nrrd = HostFile::create(Name::new(program, spec.name, "nrrd")?.as_str())?;

@@ -19,7 +19,7 @@ use fvr_core::num::{
 };
 use fvr_core::num::{Real, Sample};
 use fvr_core::render::{render, Buffers, Request, Source};
-use fvr_core::spectrum::{prepare_scratch_len, Spectrum};
+use fvr_core::spectrum::{prepare_scratch_len, LineBlockStorage, Spectrum};
 use fvr_core::volume::{padded_size, DenseVolume};
 use half::f16;
 
@@ -93,9 +93,11 @@ impl<S: Sample> StoredSpectrum<S> {
         let spec = Spectrum::prepare_line_blocks(
             &source,
             filter,
-            &mut data,
-            &mut exps,
-            &mut exps_scratch,
+            LineBlockStorage {
+                mantissas: &mut data,
+                exponents: &mut exps,
+                exponent_scratch: &mut exps_scratch,
+            },
             &mut scratch,
             &tw,
             rounding,

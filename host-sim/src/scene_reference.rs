@@ -167,6 +167,8 @@ pub fn exact_scene_projection(
 ///
 /// # Errors
 /// As [`exact_scene_projection`].
+// TODO(layout-host): group the parameters (the workspace allow is gone).
+#[allow(clippy::too_many_arguments)]
 pub fn exact_scene_projection_sampled(
     mixture: &GaussianMixture,
     dims: [usize; 3],

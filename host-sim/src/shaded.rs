@@ -161,7 +161,7 @@ impl SceneSpectra {
     /// Render one view of `scene`; the image comes back in f64.
     ///
     /// # Errors
-    /// As [`render_scene`], and a scene that needs a `|∇f|` spectrum these
+    /// As [`fvr_core::render::render`], and a scene that needs a `|∇f|` spectrum these
     /// spectra were not prepared with.
     pub fn render(
         &self,
@@ -261,8 +261,9 @@ impl<T: Real> SceneRenderer<T> {
     /// returns the channel count.
     ///
     /// # Errors
-    /// As [`render_scene`]; a scene with more fields than this renderer was
+    /// As [`fvr_core::render::render`]; a scene with more fields than this renderer was
     /// built for.
+    // TODO(layout-host): group the parameters (the workspace allow is gone).
     #[allow(clippy::too_many_arguments)]
     pub fn render_into<S: Sample>(
         &mut self,

@@ -298,7 +298,7 @@ fn format_names_and_bytes_per_voxel() {
 fn q15_line_blocks_prepared_in_place_match_the_f64_spectrum_within_five_roundings() {
     use fvr_core::dht::{Rounding, Twiddles};
     use fvr_core::filter::{Filter, FilterKind};
-    use fvr_core::spectrum::{prepare_scratch_len, Spectrum};
+    use fvr_core::spectrum::{prepare_scratch_len, LineBlockStorage, Spectrum};
     use fvr_core::volume::DenseVolume;
     let n = 16usize;
     let mut state = 7u64;
@@ -326,7 +326,16 @@ fn q15_line_blocks_prepared_in_place_match_the_f64_spectrum_within_five_rounding
         let mut m = vec![Q15::default(); grid * grid * grid];
         let (mut e, mut e2) = (vec![0i8; grid * grid], vec![0i8; grid * grid]);
         let spec = Spectrum::prepare_line_blocks(
-            &source, filter, &mut m, &mut e, &mut e2, &mut s32, &tw32, rounding,
+            &source,
+            filter,
+            LineBlockStorage {
+                mantissas: &mut m,
+                exponents: &mut e,
+                exponent_scratch: &mut e2,
+            },
+            &mut s32,
+            &tw32,
+            rounding,
         )
         .unwrap();
         assert!(spec.blocks().is_some());

@@ -8,7 +8,7 @@ use crate::error::{Error, Result};
 use crate::filter::{DerivativeTable, KernelTable, PhaseTable, MAX_WIDTH};
 use crate::geometry::Frame;
 use crate::num::{Real, Sample};
-use crate::slice::LineReads;
+use crate::slice::{LineReads, XRun};
 use crate::spectrum::{CubeSide, Spectrum};
 
 const PI: f64 = core::f64::consts::PI;
@@ -75,12 +75,24 @@ struct Axis<T, const W: usize> {
     index: [usize; W],
 }
 
+impl<T, const W: usize> Axis<T, W> {
+    /// The x-taps as one read ([`XRun`]).
+    #[inline(always)]
+    fn run(&self, reads: LineReads<'_>, n: usize) -> XRun<'_, W> {
+        XRun {
+            first: self.first,
+            contiguous: reads.contiguous::<W>(self.first, n),
+            index: &self.index,
+        }
+    }
+}
+
 /// One pass over the `n × n` slice for filter width `W`. Plain and
 /// per-line-exponent spectra take their weights from phase tables
 /// ([`PhaseTable`], an odd one for `k'`) and widen raw, with the `2^e` of
 /// [`Real::load_raw`] folded into the x-weights (exact: a power of two moved
 /// between the factors of each product), as the plain extraction does;
-/// other storage reads through the kernel tables and [`LineReads::sum`].
+/// other storage reads through the kernel tables and [`LineReads::sums`].
 /// Not inlined, so that only one width's tables are on the stack.
 #[inline(never)]
 fn run_pass_width<const W: usize, S: Sample, Z: CubeSide, T: Real, const MODE: u8>(
@@ -194,24 +206,6 @@ fn for_each_point<
     }
 }
 
-/// One x-line's weighted sum, raw or fully widened ([`LineReads::sum_raw`],
-/// [`LineReads::sum`]).
-#[inline(always)]
-fn line_sum<const W: usize, const RAW: bool, S: Sample, Z: CubeSide, T: Real>(
-    spec: &Spectrum<'_, S, Z>,
-    reads: LineReads<'_>,
-    line: usize,
-    x: (usize, bool, &[usize; W]),
-    weights: &[T; W],
-) -> T {
-    let (first, contiguous, index) = x;
-    if RAW {
-        reads.sum_raw(spec, line, first, contiguous, index, weights)
-    } else {
-        reads.sum(spec, line, first, contiguous, index, weights)
-    }
-}
-
 #[inline(always)]
 fn value<const W: usize, const RAW: bool, S: Sample, Z: CubeSide, T: Real>(
     spec: &Spectrum<'_, S, Z>,
@@ -220,21 +214,15 @@ fn value<const W: usize, const RAW: bool, S: Sample, Z: CubeSide, T: Real>(
 ) -> T {
     let n = spec.n();
     let [x, y, z] = axes;
-    let contiguous = reads.contiguous::<W>(x.first, n);
+    let run = x.run(reads, n);
     let mut acc = T::ZERO;
     for c in 0..W {
         let plane = z.index[c] * n * n;
         let mut acc_y = T::ZERO;
         for b in 0..W {
             let line = plane + y.index[b] * n;
-            acc_y += y.weights[b]
-                * line_sum::<W, RAW, S, Z, T>(
-                    spec,
-                    reads,
-                    line,
-                    (x.first, contiguous, &x.index),
-                    &x.weights,
-                );
+            let [v] = reads.sums::<W, 1, RAW, S, Z, T>(spec, line, &run, [&x.weights]);
+            acc_y += y.weights[b] * v;
         }
         acc += z.weights[c] * acc_y;
     }
@@ -252,34 +240,15 @@ fn value_gradient<const W: usize, const RAW: bool, S: Sample, Z: CubeSide, T: Re
 ) -> (T, T) {
     let n = spec.n();
     let [x, y, z] = axes;
-    let contiguous = reads.contiguous::<W>(x.first, n);
+    let run = x.run(reads, n);
     let (mut value, mut grad) = (T::ZERO, T::ZERO);
     for c in 0..W {
         let plane = z.index[c] * n * n;
         let (mut v_y, mut gx_y, mut gy_y) = (T::ZERO, T::ZERO, T::ZERO);
         for b in 0..W {
             let line = plane + y.index[b] * n;
-            let (v_x, gx_x) = if RAW {
-                reads.sum2_raw(
-                    spec,
-                    line,
-                    x.first,
-                    contiguous,
-                    &x.index,
-                    &x.weights,
-                    &x.derivative,
-                )
-            } else {
-                reads.sum2(
-                    spec,
-                    line,
-                    x.first,
-                    contiguous,
-                    &x.index,
-                    &x.weights,
-                    &x.derivative,
-                )
-            };
+            let [v_x, gx_x] =
+                reads.sums::<W, 2, RAW, S, Z, T>(spec, line, &run, [&x.weights, &x.derivative]);
             v_y += y.weights[b] * v_x;
             gx_y += y.weights[b] * gx_x;
             gy_y += y.derivative[b] * v_x;
@@ -309,9 +278,13 @@ fn value_mirror<const W: usize, const RAW: bool, S: Sample, Z: CubeSide, T: Real
         mirror_weights[t] = x.weights[W - 1 - t];
     }
     let mirror_first = mirror_index[0];
-    let contiguous = reads.contiguous::<W>(x.first, n);
-    let mirror_contiguous =
-        reads.contiguous::<W>(mirror_first, n) && mirror_index[W - 1] == mirror_first + W - 1;
+    let run = x.run(reads, n);
+    let mirror_run = XRun {
+        first: mirror_first,
+        contiguous: reads.contiguous::<W>(mirror_first, n)
+            && mirror_index[W - 1] == mirror_first + W - 1,
+        index: &mirror_index,
+    };
     let (mut direct, mut mirror) = (T::ZERO, T::ZERO);
     for c in 0..W {
         let zi = z.index[c];
@@ -320,22 +293,11 @@ fn value_mirror<const W: usize, const RAW: bool, S: Sample, Z: CubeSide, T: Real
         for b in 0..W {
             let yi = y.index[b];
             let (line, line_m) = (plane + yi * n, plane_m + ((n - yi) & mask) * n);
-            d_y += y.weights[b]
-                * line_sum::<W, RAW, S, Z, T>(
-                    spec,
-                    reads,
-                    line,
-                    (x.first, contiguous, &x.index),
-                    &x.weights,
-                );
-            m_y += y.weights[b]
-                * line_sum::<W, RAW, S, Z, T>(
-                    spec,
-                    reads,
-                    line_m,
-                    (mirror_first, mirror_contiguous, &mirror_index),
-                    &mirror_weights,
-                );
+            let [d] = reads.sums::<W, 1, RAW, S, Z, T>(spec, line, &run, [&x.weights]);
+            let [m] =
+                reads.sums::<W, 1, RAW, S, Z, T>(spec, line_m, &mirror_run, [&mirror_weights]);
+            d_y += y.weights[b] * d;
+            m_y += y.weights[b] * m;
         }
         direct += z.weights[c] * d_y;
         mirror += z.weights[c] * m_y;

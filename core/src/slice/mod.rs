@@ -20,7 +20,7 @@ mod reads;
 mod rows;
 mod taps;
 
-pub(crate) use reads::LineReads;
+pub(crate) use reads::{LineReads, XRun};
 
 use crate::error::{Error, Result};
 use crate::filter::{KernelTable, PhaseTable, MAX_WIDTH};

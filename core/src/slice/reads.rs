@@ -73,132 +73,70 @@ impl<'a> LineReads<'a> {
         }
     }
 
-    /// `Σ_t w[t]·c[line + xs[t]]` with block exponents applied: one
-    /// contiguous run from `x0` when `contiguous`, else through
-    /// [`Spectrum::line_taps`] at the wrapped indices `xs`.
+    /// `K` weighted sums `Σ_t w_k[t]·c[line + x.index[t]]` over the same
+    /// `W` taps of one x-line, each coefficient read once, with block
+    /// exponents applied: one contiguous run from `x.first` when
+    /// `x.contiguous`, else tap by tap at the wrapped indices.
+    ///
+    /// `RAW`: widen with [`Real::load_raw`]; the weights must carry the
+    /// `2^e` of [`Real::raw_exponent`]. Plain and per-line-exponent reads
+    /// only (never [`LineReads::General`], whose per-tap exponents raw
+    /// reads do not apply). Otherwise widen fully, and read taps that do
+    /// not form a run through [`Spectrum::line_taps`].
     #[inline(always)]
-    pub(crate) fn sum<const W: usize, S: Sample, Z: CubeSide, T: Real>(
+    pub(crate) fn sums<const W: usize, const K: usize, const RAW: bool, S, Z, T>(
         self,
         spec: &Spectrum<'_, S, Z>,
         line: usize,
-        x0: usize,
-        contiguous: bool,
-        xs: &[usize; W],
-        weights: &[T; W],
-    ) -> T {
-        let Some(run) = Self::run::<W, S, Z>(spec, line, x0, contiguous) else {
-            return spec.line_taps(line, xs, weights);
-        };
-        let mut sum = T::ZERO;
-        for (wt, v) in weights.iter().zip(run) {
-            sum += *wt * T::load(*v);
+        x: &XRun<'_, W>,
+        weights: [&[T; W]; K],
+    ) -> [T; K]
+    where
+        S: Sample,
+        Z: CubeSide,
+        T: Real,
+    {
+        let run = Self::run::<W, S, Z>(spec, line, x.first, x.contiguous);
+        if !RAW && run.is_none() {
+            return weights.map(|w| spec.line_taps(line, x.index, w));
         }
-        match self.line_scale::<S, Z, T>(spec, line) {
-            Some(scale) => sum * scale,
-            None => sum,
-        }
-    }
-
-    /// [`LineReads::sum`] with raw widening ([`Real::load_raw`]): the
-    /// weights must carry the `2^e` of [`Real::raw_exponent`]. Plain and
-    /// per-line-exponent reads only (never [`LineReads::General`], whose
-    /// per-tap exponents this does not apply).
-    #[inline(always)]
-    pub(crate) fn sum_raw<const W: usize, S: Sample, Z: CubeSide, T: Real>(
-        self,
-        spec: &Spectrum<'_, S, Z>,
-        line: usize,
-        x0: usize,
-        contiguous: bool,
-        xs: &[usize; W],
-        weights: &[T; W],
-    ) -> T {
-        let mut sum = T::ZERO;
-        match Self::run::<W, S, Z>(spec, line, x0, contiguous) {
+        let load = |v: S| if RAW { T::load_raw(v) } else { T::load(v) };
+        let mut sums = [T::ZERO; K];
+        match run {
             Some(run) => {
                 for t in 0..W {
-                    sum += weights[t] * T::load_raw(run[t]);
+                    let v = load(run[t]);
+                    for k in 0..K {
+                        sums[k] += weights[k][t] * v;
+                    }
                 }
             }
             None => {
                 let data = spec.data();
                 for t in 0..W {
-                    let v = data.get(line + xs[t]).copied().unwrap_or_default();
-                    sum += weights[t] * T::load_raw(v);
+                    let v = load(data.get(line + x.index[t]).copied().unwrap_or_default());
+                    for k in 0..K {
+                        sums[k] += weights[k][t] * v;
+                    }
                 }
             }
         }
         match self.line_scale::<S, Z, T>(spec, line) {
-            Some(scale) => sum * scale,
-            None => sum,
+            Some(scale) => sums.map(|s| s * scale),
+            None => sums,
         }
     }
+}
 
-    /// [`LineReads::sum2`] with raw widening, as [`LineReads::sum_raw`]
-    /// (both weight sets carry the `2^e`).
-    #[inline(always)]
-    pub(crate) fn sum2_raw<const W: usize, S: Sample, Z: CubeSide, T: Real>(
-        self,
-        spec: &Spectrum<'_, S, Z>,
-        line: usize,
-        x0: usize,
-        contiguous: bool,
-        xs: &[usize; W],
-        first: &[T; W],
-        second: &[T; W],
-    ) -> (T, T) {
-        let (mut a, mut b) = (T::ZERO, T::ZERO);
-        match Self::run::<W, S, Z>(spec, line, x0, contiguous) {
-            Some(run) => {
-                for t in 0..W {
-                    let v = T::load_raw(run[t]);
-                    a += first[t] * v;
-                    b += second[t] * v;
-                }
-            }
-            None => {
-                let data = spec.data();
-                for t in 0..W {
-                    let v = T::load_raw(data.get(line + xs[t]).copied().unwrap_or_default());
-                    a += first[t] * v;
-                    b += second[t] * v;
-                }
-            }
-        }
-        match self.line_scale::<S, Z, T>(spec, line) {
-            Some(scale) => (a * scale, b * scale),
-            None => (a, b),
-        }
-    }
-
-    /// Two weighted sums over the same taps, each coefficient read once
-    /// (the value and a derivative of [`LineReads::sum`]).
-    #[inline(always)]
-    pub(crate) fn sum2<const W: usize, S: Sample, Z: CubeSide, T: Real>(
-        self,
-        spec: &Spectrum<'_, S, Z>,
-        line: usize,
-        x0: usize,
-        contiguous: bool,
-        xs: &[usize; W],
-        first: &[T; W],
-        second: &[T; W],
-    ) -> (T, T) {
-        let Some(run) = Self::run::<W, S, Z>(spec, line, x0, contiguous) else {
-            return (
-                spec.line_taps(line, xs, first),
-                spec.line_taps(line, xs, second),
-            );
-        };
-        let (mut a, mut b) = (T::ZERO, T::ZERO);
-        for t in 0..W {
-            let v = T::load(run[t]);
-            a += first[t] * v;
-            b += second[t] * v;
-        }
-        match self.line_scale::<S, Z, T>(spec, line) {
-            Some(scale) => (a * scale, b * scale),
-            None => (a, b),
-        }
-    }
+/// The x-taps of one sample point: the first index, whether the `W` taps
+/// run contiguously from it ([`LineReads::contiguous`]), and the wrapped
+/// indices.
+#[derive(Clone, Copy)]
+pub(crate) struct XRun<'a, const W: usize> {
+    /// Index of the first tap on the x-line.
+    pub(crate) first: usize,
+    /// Whether the taps are `first .. first + W`, read as one run.
+    pub(crate) contiguous: bool,
+    /// The taps' indices, wrapped around the line.
+    pub(crate) index: &'a [usize; W],
 }

@@ -2,7 +2,7 @@
 //! tables (plain and per-line-exponent spectra) or from the kernel table
 //! (any storage).
 
-use super::reads::LineReads;
+use super::reads::{LineReads, XRun};
 use super::rows::SliceRows;
 use crate::filter::{KernelTable, PhaseTable};
 use crate::num::{Real, Sample};
@@ -162,7 +162,7 @@ pub(super) fn extract_lines<
 }
 
 /// The extraction for any storage (e.g. bricked block exponents): taps
-/// through [`LineReads::sum`], weights from the kernel table.
+/// through [`LineReads::sums`], weights from the kernel table.
 pub(super) fn extract_general<const W: usize, S: Sample, Z: CubeSide, T: Real>(
     spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
@@ -179,15 +179,19 @@ pub(super) fn extract_general<const W: usize, S: Sample, Z: CubeSide, T: Real>(
         let jy = kernel.taps_fixed(q[1], &mut wy);
         let jz = kernel.taps_fixed(q[2], &mut wz);
         let x0 = jx as usize & mask;
-        let contiguous = reads.contiguous::<W>(x0, n);
         let xs: [usize; W] = core::array::from_fn(|t| (jx + t as i64) as usize & mask);
+        let run = XRun {
+            first: x0,
+            contiguous: reads.contiguous::<W>(x0, n),
+            index: &xs,
+        };
         let mut acc = T::ZERO;
         for (c, wzc) in wz.iter().enumerate() {
             let z = ((jz + c as i64) as usize & mask) * nn;
             let mut acc_y = T::ZERO;
             for (b, wyb) in wy.iter().enumerate() {
                 let line = z + ((jy + b as i64) as usize & mask) * n;
-                let acc_x = reads.sum(spec, line, x0, contiguous, &xs, &wx);
+                let [acc_x] = reads.sums::<W, 1, false, S, Z, T>(spec, line, &run, [&wx]);
                 acc_y += *wyb * acc_x;
             }
             acc += *wzc * acc_y;

@@ -23,5 +23,7 @@
 mod prepare;
 mod stored;
 
-pub use prepare::{premultiplier_table, prepare_scratch_len, scale_for, scale_for_target};
+pub use prepare::{
+    premultiplier_table, prepare_scratch_len, scale_for, scale_for_target, LineBlockStorage,
+};
 pub use stored::{CubeSide, Side, Spectrum};

@@ -54,16 +54,12 @@ impl<'a, S: Sample> Spectrum<'a, S> {
         tw: &Twiddles<'_, T>,
         rounding: Rounding,
     ) -> Result<Self> {
-        let dims = volume.dims();
-        let n = padded_size(dims, filter.oversample())?;
-        let cube = cube_len(dims, n)?;
-        require_len("spectrum storage", cube, storage.len())?;
+        let (dims, n, cube) = cube_for(volume, &filter, storage.len())?;
         let storage = &mut storage[..cube];
         storage.fill(S::default());
-        let scale = prepare_into(
+        let scale = prepare_into::<S, _, _, _>(
             volume,
             &filter,
-            S::SCALE_LOG2,
             &mut Elements(&mut *storage),
             n,
             scratch,
@@ -91,17 +87,17 @@ impl<'a, S: Sample> Spectrum<'a, S> {
     pub fn prepare_line_blocks<T: Real, V: VoxelSource>(
         volume: &V,
         filter: Filter,
-        mantissas: &'a mut [S],
-        exponents: &'a mut [i8],
-        exponent_scratch: &mut [i8],
+        storage: LineBlockStorage<'a, '_, S>,
         scratch: &mut [T],
         tw: &Twiddles<'_, T>,
         rounding: Rounding,
     ) -> Result<Self> {
-        let dims = volume.dims();
-        let n = padded_size(dims, filter.oversample())?;
-        let cube = cube_len(dims, n)?;
-        require_len("spectrum storage", cube, mantissas.len())?;
+        let LineBlockStorage {
+            mantissas,
+            exponents,
+            exponent_scratch,
+        } = storage;
+        let (dims, n, cube) = cube_for(volume, &filter, mantissas.len())?;
         require_len("block exponents", n * n, exponents.len())?;
         require_len("block exponent scratch", n * n, exponent_scratch.len())?;
         let mantissas = &mut mantissas[..cube];
@@ -116,16 +112,8 @@ impl<'a, S: Sample> Spectrum<'a, S> {
             &mut exponents[..n * n],
             n,
         )?;
-        let scale = prepare_into(
-            volume,
-            &filter,
-            S::SCALE_LOG2,
-            &mut store,
-            n,
-            scratch,
-            tw,
-            rounding,
-        )?;
+        let scale =
+            prepare_into::<S, _, _, _>(volume, &filter, &mut store, n, scratch, tw, rounding)?;
         store.finish(&mut scratch[n..2 * n])?;
         let exponents: &'a [i8] = exponents;
         let blocks = BlockExponents::new(BlockLayout::Line, &exponents[..n * n], n)?;
@@ -140,19 +128,41 @@ impl<'a, S: Sample> Spectrum<'a, S> {
     }
 }
 
-fn cube_len(dims: [usize; 3], n: usize) -> Result<usize> {
-    n.checked_mul(n)
+/// Where a spectrum in block floating point with one exponent per line is
+/// prepared ([`Spectrum::prepare_line_blocks`]).
+#[derive(Debug)]
+pub struct LineBlockStorage<'a, 's, S> {
+    /// The mantissas, `n³`.
+    pub mantissas: &'a mut [S],
+    /// The finished spectrum's per-x-line exponents, `n²`.
+    pub exponents: &'a mut [i8],
+    /// The transform's second exponent table, `n²`.
+    pub exponent_scratch: &'s mut [i8],
+}
+
+/// The volume's dims, the padded side `n` and the cube's length `n³`,
+/// checking that `storage` elements hold the cube.
+fn cube_for<V: VoxelSource>(
+    volume: &V,
+    filter: &Filter,
+    storage: usize,
+) -> Result<([usize; 3], usize, usize)> {
+    let dims = volume.dims();
+    let n = padded_size(dims, filter.oversample())?;
+    let cube = n
+        .checked_mul(n)
         .and_then(|v| v.checked_mul(n))
-        .ok_or(Error::VolumeTooLarge { dims, grid: n })
+        .ok_or(Error::VolumeTooLarge { dims, grid: n })?;
+    require_len("spectrum storage", cube, storage)?;
+    Ok((dims, n, cube))
 }
 
 /// Premultiply `volume`, place it in `store` (x-line by x-line, circularly
-/// shifted, scaled by the rule for `scale_log2`) and transform it. `store`
+/// shifted, scaled by the rule for `S::SCALE_LOG2`) and transform it. `store`
 /// must hold zeros. Returns the scale.
-fn prepare_into<T: Real, V: VoxelSource, L: LineStore<T>>(
+fn prepare_into<S: Sample, T: Real, V: VoxelSource, L: LineStore<T>>(
     volume: &V,
     filter: &Filter,
-    scale_log2: i32,
     store: &mut L,
     n: usize,
     scratch: &mut [T],
@@ -189,7 +199,7 @@ fn prepare_into<T: Real, V: VoxelSource, L: LineStore<T>>(
             stage: "premultiplication (volume magnitude beyond f64)",
         });
     }
-    let scale = scale_for_target(bound, scale_log2);
+    let scale = scale_for_target(bound, S::SCALE_LOG2);
 
     // Pass 2: place the scaled, premultiplied volume, circularly shifted,
     // one x-line at a time (rows the volume does not reach stay zero).
