@@ -364,6 +364,7 @@ pub(crate) fn require_len(what: &'static str, needed: usize, got: usize) -> Resu
 }
 
 /// `Ok` if `got == expected`, else [`Error::LengthMismatch`].
+#[inline]
 pub(crate) fn check_len(what: &'static str, expected: usize, got: usize) -> Result<()> {
     if expected == got {
         Ok(())

@@ -21,7 +21,6 @@ mod cube;
 mod line;
 mod plane;
 mod store;
-mod transpose;
 mod twiddles;
 
 pub use cube::{dht_3d, dht_3d_rounding, dht_3d_scratch_len, dht_3d_store, Rounding};

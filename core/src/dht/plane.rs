@@ -1,12 +1,8 @@
-//! The true 2D DHT in place: batched row and column passes, then the
-//! Hao–Bracewell correction.
+//! The true 2D DHT in place: batched row and column passes (square arrays
+//! between two in-place transposes), then the Hao–Bracewell correction.
 
 use super::line::butterfly_pair;
 use super::line::{dht_unchecked, for_each_bit_reversed_swap};
-use super::transpose::{
-    transpose_square, transpose_square_bit_reversed_radix4, transpose_square_plain_radix4,
-    TILED_TRANSPOSE_FROM,
-};
 use super::Twiddles;
 use crate::error::{check_len, require_len, Result};
 use crate::num::Real;
@@ -31,6 +27,7 @@ use crate::num::Real;
 /// # Errors
 /// A side not a power of two or longer than the table, a `data` length other
 /// than `nx·ny`, or short scratch.
+#[inline]
 pub fn dht_2d<T: Real>(
     data: &mut [T],
     nx: usize,
@@ -70,6 +67,7 @@ pub fn dht_2d<T: Real>(
 /// bit-reversed row order the second pass wants after a plain transpose,
 /// so no pass reorders rows on its own. Each transpose also does the first
 /// two (untwiddled) stages of the pass after it.
+#[inline]
 fn dht_2d_square<T: Real>(data: &mut [T], n: usize, tw: &Twiddles<'_, T>) {
     transpose_square_bit_reversed_radix4(data, n);
     dht_columns_stages(data, n, n, 4, tw);
@@ -120,6 +118,7 @@ pub fn dht_2d_lines<T: Real>(
 /// and each point's value is `S` minus the point diagonally opposite
 /// (`H(u,v) = S − T(−u,−v)`, …): 8 operations instead of 16. Rows `v` and
 /// `ny − v` go together, with `u` and `nx − u` walked from both ends.
+#[inline]
 fn hao_bracewell_2d<T: Real>(data: &mut [T], nx: usize, ny: usize) {
     if nx <= 2 || ny <= 2 {
         return;
@@ -180,7 +179,7 @@ fn take_last4<'a, T>(s: &mut &'a mut [T]) -> &'a mut [T; 4] {
 }
 
 #[cold]
-pub(super) fn chunk_out_of_range() -> ! {
+fn chunk_out_of_range() -> ! {
     panic!("chunk of four past the end of its slice")
 }
 
@@ -199,7 +198,198 @@ fn split_row<T>(row: &mut [T], h: usize) -> (&mut [T], &mut [T]) {
     (&mut lo[1..], &mut hi[1..])
 }
 
+/// Side from which [`transpose_square`] works in tiles.
+const TILED_TRANSPOSE_FROM: usize = 128;
+
+/// Transpose an `n × n` array in place: row by row below `n = 128`, in
+/// tiles of 16 × 16 from there (a row-by-row transpose walks one side with
+/// a stride of `n` and misses the cache on every element once rows outgrow
+/// it; on a cacheless core the plain loop costs fewer instructions).
+#[inline]
+fn transpose_square<T>(data: &mut [T], n: usize) {
+    const TILE: usize = 16;
+    if n < TILED_TRANSPOSE_FROM || n % TILE != 0 {
+        swap_across_diagonal(data, n, |i| i);
+        return;
+    }
+    for bi in (0..n).step_by(TILE) {
+        for bj in (bi..n).step_by(TILE) {
+            for i in bi..bi + TILE {
+                let first = if bi == bj { i + 1 } else { bj };
+                for j in first..bj + TILE {
+                    data.swap(i * n + j, j * n + i);
+                }
+            }
+        }
+    }
+}
+
+/// `data[r][c] ← data[rev c][rev r]` in place for an `n × n` array (`n` a
+/// power of two, at least 4, `rev` reversing `log₂n` bits), then the first
+/// two (untwiddled) stages of [`dht_columns_stages`] on every group of
+/// four rows `4t .. 4t+3`.
+///
+/// The permutation is a transpose that also puts rows and columns in
+/// bit-reversed order. The groups of four rows are closed under it in
+/// 4 × 4 tiles (`rev(4t + j) = rev(4t) + rev(j)` for `j < 4`), so each
+/// value is loaded and stored once for both. Since `rev(4t) < n/4` and
+/// `rev(j)` is a whole number of quarters, a tile's values sit at one
+/// index of sixteen quarter rows, and one bounds check covers them all.
+#[inline]
+fn transpose_square_bit_reversed_radix4<T: Real>(data: &mut [T], n: usize) {
+    const B: usize = 4;
+    // Quarter holding column rev(4t) + rev(j): rev(j) = QUARTER_OF[j]·n/4.
+    const QUARTER_OF: [usize; B] = [0, 2, 1, 3];
+    let quarter = n / B;
+    let shift = usize::BITS - quarter.trailing_zeros();
+    let rev4 = |t: usize| t.reverse_bits().checked_shr(shift).unwrap_or(0);
+    for rt in 0..n / B {
+        let (above, below) = data.split_at_mut(B * rt * n);
+        let band = quarters(&mut below[..B * n], n);
+        let pr = rev4(rt);
+        if pr >= quarter {
+            return;
+        }
+        let tile: [[T; B]; B] =
+            core::array::from_fn(|i| core::array::from_fn(|j| band[i][QUARTER_OF[j]][pr]));
+        for (j, column) in tile.iter().enumerate() {
+            for (i, v) in radix4_plain(*column).into_iter().enumerate() {
+                band[i][QUARTER_OF[j]][pr] = v;
+            }
+        }
+        for (st, other) in above.chunks_exact_mut(B * n).enumerate() {
+            let ps = rev4(st);
+            if ps >= quarter {
+                return;
+            }
+            let other = quarters(other, n);
+            let saved: [[T; B]; B] =
+                core::array::from_fn(|i| core::array::from_fn(|j| band[i][QUARTER_OF[j]][ps]));
+            for j in 0..B {
+                let theirs: [T; B] = core::array::from_fn(|i| other[j][QUARTER_OF[i]][pr]);
+                for (i, v) in radix4_plain(theirs).into_iter().enumerate() {
+                    band[i][QUARTER_OF[j]][ps] = v;
+                }
+            }
+            for (i, row) in saved.iter().enumerate() {
+                for (j, v) in radix4_plain(*row).into_iter().enumerate() {
+                    other[j][QUARTER_OF[i]][pr] = v;
+                }
+            }
+        }
+    }
+}
+
+/// Four rows of `n` as four quarter rows each.
+#[inline(always)]
+fn quarters<T>(rows: &mut [T], n: usize) -> [[&mut [T]; 4]; 4] {
+    // Explicit arrays rather than `[_; 4]::map`, and every function of the
+    // 2D transform `#[inline]`: in the 2D module's own codegen unit the
+    // std array helpers (`try_map`, `try_from_fn`) were left out of line
+    // on the M4F, which cost its 64 × 64 transform 150 k instructions.
+    let [r0, r1, r2, r3] = rows_mut(rows, n, [0, 1, 2, 3]);
+    let quarter = |row| rows_mut(row, n / 4, [0, 1, 2, 3]);
+    [quarter(r0), quarter(r1), quarter(r2), quarter(r3)]
+}
+
+/// [`transpose_square_bit_reversed_radix4`] without the bit reversal: the
+/// plain transpose, then the two untwiddled stages on every group of four
+/// rows. Written over row segments of four, which the M4F addresses with
+/// immediate offsets from one pointer per segment.
+#[inline]
+fn transpose_square_plain_radix4<T: Real>(data: &mut [T], n: usize) {
+    const B: usize = 4;
+    for rt in 0..n / B {
+        let (above, below) = data.split_at_mut(B * rt * n);
+        let band = &mut below[..B * n];
+        let c = B * rt;
+        let tile: [[T; B]; B] = core::array::from_fn(|i| *segment(band, i * n + c));
+        for (j, column) in tile.iter().enumerate() {
+            for (i, v) in radix4_plain(*column).into_iter().enumerate() {
+                segment(band, i * n + c)[j] = v;
+            }
+        }
+        for (st, other) in above.chunks_exact_mut(B * n).enumerate() {
+            let cs = B * st;
+            let [b0, b1, b2, b3] = rows_mut(band, n, [0, 1, 2, 3]);
+            let mine = [
+                segment(b0, cs),
+                segment(b1, cs),
+                segment(b2, cs),
+                segment(b3, cs),
+            ];
+            let [o0, o1, o2, o3] = rows_mut(other, n, [0, 1, 2, 3]);
+            let theirs = [
+                segment(o0, c),
+                segment(o1, c),
+                segment(o2, c),
+                segment(o3, c),
+            ];
+            let saved: [[T; B]; B] = core::array::from_fn(|i| *mine[i]);
+            for (j, row) in theirs.iter().enumerate() {
+                for (i, v) in radix4_plain(**row).into_iter().enumerate() {
+                    mine[i][j] = v;
+                }
+            }
+            for (i, row) in saved.iter().enumerate() {
+                for (j, v) in radix4_plain(*row).into_iter().enumerate() {
+                    theirs[j][i] = v;
+                }
+            }
+        }
+    }
+}
+
+/// The four values of `row` from `start` on, as an array.
+#[inline(always)]
+fn segment<T>(row: &mut [T], start: usize) -> &mut [T; 4] {
+    let (_, tail) = row.split_at_mut(start);
+    match tail.first_chunk_mut::<4>() {
+        Some(s) => s,
+        None => chunk_out_of_range(),
+    }
+}
+
+/// Swap `data[r·n + p(s)]` with `data[s·n + p(r)]` for all `s < r < n`,
+/// `p` a permutation of `0..n` with `p(4t + j) = p(4t) + p(j)` for `j < 4`
+/// (an involution of the array: the identity gives the transpose).
+///
+/// Works in 4 × 4 tiles, so that one tile's sixteen swaps share their
+/// row and column offsets.
+#[inline(always)]
+fn swap_across_diagonal<T, P: Fn(usize) -> usize>(data: &mut [T], n: usize, p: P) {
+    const B: usize = 4;
+    if n % B != 0 {
+        for r in 1..n {
+            for s in 0..r {
+                data.swap(r * n + p(s), s * n + p(r));
+            }
+        }
+        return;
+    }
+    let q: [usize; B] = core::array::from_fn(&p);
+    for rt in 0..n / B {
+        let (above, below) = data.split_at_mut(B * rt * n);
+        let band = &mut below[..B * n];
+        let pr = p(B * rt);
+        for i in 1..B {
+            for j in 0..i {
+                band.swap(i * n + pr + q[j], j * n + pr + q[i]);
+            }
+        }
+        for (st, other) in above.chunks_exact_mut(B * n).enumerate() {
+            let ps = p(B * st);
+            for i in 0..B {
+                for j in 0..B {
+                    core::mem::swap(&mut band[i * n + ps + q[j]], &mut other[j * n + pr + q[i]]);
+                }
+            }
+        }
+    }
+}
+
 /// Put the rows of an `nx × ny` array in bit-reversed order.
+#[inline]
 fn bit_reverse_rows<T>(data: &mut [T], nx: usize, ny: usize) {
     for_each_bit_reversed_swap(ny, |i, j| {
         let (head, tail) = data.split_at_mut(j * nx);
@@ -211,6 +401,7 @@ fn bit_reverse_rows<T>(data: &mut [T], nx: usize, ny: usize) {
 /// radix-2 stage at a time: the path for large and non-square arrays on
 /// cached hosts, where the four-row butterfly loops vectorize and the
 /// radix-2² kernels (eight rows, six twiddles) run out of SIMD registers.
+#[inline]
 fn dht_columns<T: Real>(data: &mut [T], nx: usize, ny: usize, tw: &Twiddles<'_, T>) {
     bit_reverse_rows(data, nx, ny);
     let mut m = 1;
@@ -232,6 +423,7 @@ fn dht_columns<T: Real>(data: &mut [T], nx: usize, ny: usize, tw: &Twiddles<'_, 
 /// and stored once per two stages. The butterflies and their operands are
 /// those of [`dht_stages`], in the same order, so the result is the same to
 /// the bit; a single radix-2 stage finishes odd `log₂ny`.
+#[inline]
 fn dht_columns_stages<T: Real>(
     data: &mut [T],
     nx: usize,
@@ -279,6 +471,7 @@ fn dht_columns_stages<T: Real>(
 }
 
 /// One radix-2 stage of half-length `m` of [`dht_columns`].
+#[inline]
 fn radix2_columns_stage<T: Real>(data: &mut [T], nx: usize, m: usize, tw: &Twiddles<'_, T>) {
     let stride = tw.len / (2 * m);
     for block in data.chunks_exact_mut(2 * m * nx) {
@@ -306,11 +499,7 @@ fn radix2_columns_stage<T: Real>(data: &mut [T], nx: usize, m: usize, tw: &Twidd
 
 /// Rows `idx[0] < idx[1] < …` (each `nx` long) of `block`, borrowed apart.
 #[inline(always)]
-pub(super) fn rows_mut<T, const K: usize>(
-    block: &mut [T],
-    nx: usize,
-    idx: [usize; K],
-) -> [&mut [T]; K] {
+fn rows_mut<T, const K: usize>(block: &mut [T], nx: usize, idx: [usize; K]) -> [&mut [T]; K] {
     let mut rest = block;
     let mut next = 0;
     core::array::from_fn(|j| {
@@ -341,7 +530,7 @@ fn radix4_rows_plain<T: Real>(r0: &mut [T], r1: &mut [T], r2: &mut [T], r3: &mut
 /// Both untwiddled stages on four values in bit-reversed order: the pairs
 /// `(0, 1)` and `(2, 3)`, then `(0, 2)` and `(1, 3)`.
 #[inline(always)]
-pub(super) fn radix4_plain<T: Real>([r0, r1, r2, r3]: [T; 4]) -> [T; 4] {
+fn radix4_plain<T: Real>([r0, r1, r2, r3]: [T; 4]) -> [T; 4] {
     let (a, b) = (r0 + r1, r0 - r1);
     let (c, d) = (r2 + r3, r2 - r3);
     [a + c, b + d, a - c, b - d]
@@ -387,9 +576,12 @@ fn for_each_column<T: Copy, const R: usize>(
     mut f: impl FnMut([T; R]) -> [T; R],
 ) {
     let len = rows.iter().map(|r| r.len()).min().unwrap_or(0);
-    let mut rest = rows.map(|r| &mut r[..len]);
+    // `from_fn` rather than `[_; R]::map` (see `quarters`).
+    let mut rows = rows;
+    let mut rest: [&mut [T]; R] =
+        core::array::from_fn(|r| &mut core::mem::take(&mut rows[r])[..len]);
     for _ in 0..len / 4 {
-        let mut chunks = rest.each_mut().map(take_first4);
+        let mut chunks: [&mut [T; 4]; R] = core::array::from_fn(|r| take_first4(&mut rest[r]));
         for k in 0..4 {
             let out = f(core::array::from_fn(|r| chunks[r][k]));
             for (chunk, v) in chunks.iter_mut().zip(out) {

@@ -97,11 +97,14 @@ impl<'a> LineReads<'a> {
         T: Real,
     {
         let run = Self::run::<W, S, Z>(spec, line, x.first, x.contiguous);
+        let mut sums = [T::ZERO; K];
         if !RAW && run.is_none() {
-            return weights.map(|w| spec.line_taps(line, x.index, w));
+            for k in 0..K {
+                sums[k] = spec.line_taps(line, x.index, weights[k]);
+            }
+            return sums;
         }
         let load = |v: S| if RAW { T::load_raw(v) } else { T::load(v) };
-        let mut sums = [T::ZERO; K];
         match run {
             Some(run) => {
                 for t in 0..W {
@@ -121,10 +124,12 @@ impl<'a> LineReads<'a> {
                 }
             }
         }
-        match self.line_scale::<S, Z, T>(spec, line) {
-            Some(scale) => sums.map(|s| s * scale),
-            None => sums,
+        if let Some(scale) = self.line_scale::<S, Z, T>(spec, line) {
+            for s in sums.iter_mut() {
+                *s *= scale;
+            }
         }
+        sums
     }
 }
 
