@@ -8,6 +8,7 @@ use fvr_host::adaptive::{parse_chain, parse_tolerance, AdaptiveMarks, AdaptiveSe
 use fvr_host::phantom::{sample, GaussianMixture, SheppLogan};
 use fvr_host::pipeline::{AnySpectrum, OwnedSpectrum};
 use fvr_host::reference::snr_db;
+use fvr_tests::mixture_spectrum;
 use half::f16;
 
 /// Adaptive settings with the 1³ filter and the given bound.
@@ -80,9 +81,7 @@ fn adaptive_images_stay_within_the_requested_tolerance() {
 #[test]
 fn exact_bound_is_within_budget_and_no_tighter_than_the_papers() {
     let n = 32;
-    let volume = sample(&GaussianMixture::random(5, n, 8), [n; 3]);
-    let filter = Filter::new(FilterKind::Kb4, 2).unwrap();
-    let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+    let (spec, _) = mixture_spectrum::<f16, f32>((5, n, 8), [n; 3], FilterKind::Kb4, 2);
     for tol in [30.0, 45.0, 60.0] {
         let exact = AdaptiveMarks::build(&spec, &nearest(tol, Bound::Exact)).unwrap();
         let paper = AdaptiveMarks::build(&spec, &nearest(tol, Bound::Paper)).unwrap();
@@ -243,9 +242,7 @@ fn threshold_meets_the_energy_budget_and_is_nearly_the_largest() {
 #[test]
 fn statistics_add_up_and_report_no_effect() {
     let n = 32;
-    let volume = sample(&GaussianMixture::random(3, n, 6), [n; 3]);
-    let filter = Filter::new(FilterKind::Kb4, 2).unwrap();
-    let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+    let (spec, _) = mixture_spectrum::<f16, f32>((3, n, 6), [n; 3], FilterKind::Kb4, 2);
     let view = View::along([1.0, 0.4, 0.1]);
     let settings = AdaptiveSettings {
         chain: parse_chain("nearest").unwrap(),

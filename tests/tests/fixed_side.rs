@@ -11,6 +11,7 @@ use fvr_core::spectrum::{CubeSide, Spectrum};
 use fvr_core::Error;
 use fvr_host::phantom::{sample, GaussianMixture};
 use fvr_host::pipeline::OwnedSpectrum;
+use fvr_tests::mixture_spectrum;
 use half::f16;
 
 const N: usize = 32;
@@ -71,9 +72,7 @@ fn a_compile_time_side_renders_the_run_time_image_bit_for_bit() {
 
 #[test]
 fn a_wrong_compile_time_side_is_an_error_naming_both_sides() {
-    let volume = sample(&GaussianMixture::random(3, N, 2), [N; 3]);
-    let filter = Filter::new(FilterKind::Kb3, 1).unwrap();
-    let owned = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+    let (owned, _) = mixture_spectrum::<f16, f32>((3, N, 2), [N; 3], FilterKind::Kb3, 1);
     match owned.view().with_side::<64>() {
         Err(Error::LengthMismatch {
             what,

@@ -88,23 +88,21 @@ fn check_float_codec<S: Sample>(layout: FloatLayout, bits: u32, make: impl Fn(u3
     assert!(t == 14 || 2f64.powi(t + 2) > S::MAX_FINITE, "{}", S::NAME);
 }
 
+/// [`check_float_codec`] for each exponent width `E` of a minifloat type.
+macro_rules! check_splits {
+    ($ty:ident, $bits:ty, $width:expr; $($e:literal),+) => {
+        $(check_float_codec($ty::<$e>::LAYOUT, $width, |b| $ty::<$e>(b as $bits));)+
+    };
+}
+
 #[test]
 fn every_16_bit_minifloat_split_round_trips_orders_and_rounds_to_nearest_even() {
-    check_float_codec(Minifloat16::<2>::LAYOUT, 16, |b| Minifloat16::<2>(b as u16));
-    check_float_codec(Minifloat16::<3>::LAYOUT, 16, |b| Minifloat16::<3>(b as u16));
-    check_float_codec(Minifloat16::<4>::LAYOUT, 16, |b| Minifloat16::<4>(b as u16));
-    check_float_codec(Minifloat16::<5>::LAYOUT, 16, |b| Minifloat16::<5>(b as u16));
-    check_float_codec(Minifloat16::<6>::LAYOUT, 16, |b| Minifloat16::<6>(b as u16));
-    check_float_codec(Minifloat16::<7>::LAYOUT, 16, |b| Minifloat16::<7>(b as u16));
-    check_float_codec(Minifloat16::<8>::LAYOUT, 16, |b| Minifloat16::<8>(b as u16));
+    check_splits!(Minifloat16, u16, 16; 2, 3, 4, 5, 6, 7, 8);
 }
 
 #[test]
 fn every_8_bit_minifloat_split_round_trips_orders_and_rounds_to_nearest_even() {
-    check_float_codec(Minifloat8::<2>::LAYOUT, 8, |b| Minifloat8::<2>(b as u8));
-    check_float_codec(Minifloat8::<3>::LAYOUT, 8, |b| Minifloat8::<3>(b as u8));
-    check_float_codec(Minifloat8::<4>::LAYOUT, 8, |b| Minifloat8::<4>(b as u8));
-    check_float_codec(Minifloat8::<5>::LAYOUT, 8, |b| Minifloat8::<5>(b as u8));
+    check_splits!(Minifloat8, u8, 8; 2, 3, 4, 5);
     assert_eq!(<Minifloat8<4> as Sample>::MAX_FINITE, 240.0);
     assert_eq!(<Minifloat8<5> as Sample>::MAX_FINITE, 57344.0);
 }

@@ -2,23 +2,19 @@
 //! projection low-passed to the central (n/2^L)² frequencies and sampled
 //! every 2^L voxels.
 
-use fvr_core::dht::signed_index;
-use fvr_core::dht::Twiddles;
-use fvr_core::filter::{Filter, FilterKind, KernelTable};
+use fvr_core::dht::{signed_index, Twiddles};
+use fvr_core::filter::{FilterKind, KernelTable};
 use fvr_core::geometry::View;
 use fvr_core::image::{aux_len, finish, placement, Crop};
 use fvr_core::render::{max_level, preview_size, render, Buffers, Request, Source};
 use fvr_core::slice::extract_slice;
-use fvr_host::phantom::{sample, GaussianMixture};
-use fvr_host::pipeline::OwnedSpectrum;
 use fvr_host::reference::snr_db;
+use fvr_tests::mixture_spectrum;
 
 #[test]
 fn preview_is_the_low_passed_projection_sampled_at_its_pitch() {
     let n = 64;
-    let volume = sample(&GaussianMixture::random(6, n, 8), [n; 3]);
-    let filter = Filter::new(FilterKind::Kb4, 1).unwrap();
-    let owned = OwnedSpectrum::<f64>::prepare::<f64>(&volume, filter).unwrap();
+    let (owned, filter) = mixture_spectrum::<f64, f64>((6, n, 8), [n; 3], FilterKind::Kb4, 1);
     let spec = owned.view();
     let kernel = KernelTable::<f64>::new(filter);
     let mut tw_buf = vec![0.0; Twiddles::<f64>::buffer_len(n)];
@@ -80,30 +76,17 @@ fn preview_is_the_low_passed_projection_sampled_at_its_pitch() {
     }
     let mut big = vec![0.0; n * n];
     let mut aux = vec![0.0; aux_len(n)];
-    assert!(render(
-        &Source::new(&spec, &kernel, &tw),
-        &Request {
-            level: 6,
-            ..Request::new(view, 1, 1)
-        },
-        Buffers {
+    // A level beyond max_level, and an image larger than the level's grid.
+    for (level, side) in [(6, 1), (1, 33)] {
+        let request = Request {
+            level,
+            ..Request::new(view, side, side)
+        };
+        let buffers = Buffers {
             grid: &mut big,
             aux: &mut aux,
-            out: &mut [0.0]
-        }
-    )
-    .is_err());
-    assert!(render(
-        &Source::new(&spec, &kernel, &tw),
-        &Request {
-            level: 1,
-            ..Request::new(view, 33, 33)
-        },
-        Buffers {
-            grid: &mut big,
-            aux: &mut aux,
-            out: &mut vec![0.0; 33 * 33]
-        }
-    )
-    .is_err());
+            out: &mut vec![0.0; side * side],
+        };
+        assert!(render(&Source::new(&spec, &kernel, &tw), &request, buffers).is_err());
+    }
 }
