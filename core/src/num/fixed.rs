@@ -18,59 +18,40 @@ fn fixed_round(v: f64, frac: i32, limit: f64) -> Option<f64> {
     (libm::fabs(r) <= limit).then_some(r)
 }
 
-impl Sample for Q15 {
-    const NAME: &'static str = "q15";
-    const MAX_FINITE: f64 = 32767.0 / 32768.0;
-    const BITS: u32 = 16;
-    // Values met during a transform stay within 2^(t+1) = 1/2 < MAX_FINITE.
-    const SCALE_LOG2: i32 = -2;
-    const BLOCK_MANTISSA: bool = true;
-    #[inline]
-    fn from_f32(v: f32) -> Self {
-        Self::from_f64(v as f64)
-    }
-    #[inline]
-    fn from_f64(v: f64) -> Self {
-        Self(fixed_round(v, 15, 32767.0).map_or(i16::MIN, |r| r as i16))
-    }
-    #[inline]
-    fn to_f32(self) -> f32 {
-        self.0 as f32 * (1.0 / 32768.0)
-    }
-    #[inline]
-    fn to_f64(self) -> f64 {
-        self.0 as f64 / 32768.0
-    }
-    #[inline]
-    fn is_finite(self) -> bool {
-        self.0 != i16::MIN
-    }
+/// [`Sample`] for the fraction type `$ty`: `i/2^$frac` stored in the
+/// signed integer `$int`, whose most negative value flags overflow.
+macro_rules! fixed_sample {
+    ($ty:ident, $int:ty, $name:literal, $frac:literal) => {
+        impl Sample for $ty {
+            const NAME: &'static str = $name;
+            const MAX_FINITE: f64 = <$int>::MAX as f64 / (1u32 << $frac) as f64;
+            const BITS: u32 = <$int>::BITS;
+            // Values met during a transform stay within 2^(t+1) = 1/2 < MAX_FINITE.
+            const SCALE_LOG2: i32 = -2;
+            const BLOCK_MANTISSA: bool = true;
+            #[inline]
+            fn from_f32(v: f32) -> Self {
+                Self::from_f64(v as f64)
+            }
+            #[inline]
+            fn from_f64(v: f64) -> Self {
+                Self(fixed_round(v, $frac, <$int>::MAX as f64).map_or(<$int>::MIN, |r| r as $int))
+            }
+            #[inline]
+            fn to_f32(self) -> f32 {
+                self.0 as f32 * (1.0 / (1u32 << $frac) as f32)
+            }
+            #[inline]
+            fn to_f64(self) -> f64 {
+                self.0 as f64 / (1u32 << $frac) as f64
+            }
+            #[inline]
+            fn is_finite(self) -> bool {
+                self.0 != <$int>::MIN
+            }
+        }
+    };
 }
 
-impl Sample for Q7 {
-    const NAME: &'static str = "q7";
-    const MAX_FINITE: f64 = 127.0 / 128.0;
-    const BITS: u32 = 8;
-    const SCALE_LOG2: i32 = -2;
-    const BLOCK_MANTISSA: bool = true;
-    #[inline]
-    fn from_f32(v: f32) -> Self {
-        Self::from_f64(v as f64)
-    }
-    #[inline]
-    fn from_f64(v: f64) -> Self {
-        Self(fixed_round(v, 7, 127.0).map_or(i8::MIN, |r| r as i8))
-    }
-    #[inline]
-    fn to_f32(self) -> f32 {
-        self.0 as f32 * (1.0 / 128.0)
-    }
-    #[inline]
-    fn to_f64(self) -> f64 {
-        self.0 as f64 / 128.0
-    }
-    #[inline]
-    fn is_finite(self) -> bool {
-        self.0 != i8::MIN
-    }
-}
+fixed_sample!(Q15, i16, "q15", 15);
+fixed_sample!(Q7, i8, "q7", 7);

@@ -163,33 +163,6 @@ impl<const E: u32> Minifloat16<E> {
     }
 }
 
-impl<const E: u32> Sample for Minifloat16<E> {
-    const NAME: &'static str = MINIFLOAT16_NAMES[E as usize];
-    const MAX_FINITE: f64 = Self::LAYOUT.max_finite();
-    const BITS: u32 = 16;
-    const SCALE_LOG2: i32 = Self::LAYOUT.scale_log2();
-    #[inline]
-    fn from_f32(v: f32) -> Self {
-        Self(Self::LAYOUT.encode(v as f64) as u16)
-    }
-    #[inline]
-    fn from_f64(v: f64) -> Self {
-        Self(Self::LAYOUT.encode(v) as u16)
-    }
-    #[inline]
-    fn to_f32(self) -> f32 {
-        Self::LAYOUT.decode(self.0 as u32)
-    }
-    #[inline]
-    fn to_f64(self) -> f64 {
-        Self::LAYOUT.decode(self.0 as u32) as f64
-    }
-    #[inline]
-    fn is_finite(self) -> bool {
-        (self.0 >> Self::LAYOUT.mantissa) as u32 & ((1 << E) - 1) != (1 << E) - 1
-    }
-}
-
 /// An 8-bit float with `E` exponent bits and `7 − E` mantissa bits (module
 /// docs). `2 ≤ E ≤ 5`, checked at compile time. `Minifloat8<4>` is the
 /// e4m3 layout with IEEE rules (largest value 240).
@@ -210,29 +183,38 @@ impl<const E: u32> Minifloat8<E> {
     };
 }
 
-impl<const E: u32> Sample for Minifloat8<E> {
-    const NAME: &'static str = MINIFLOAT8_NAMES[E as usize];
-    const MAX_FINITE: f64 = Self::LAYOUT.max_finite();
-    const BITS: u32 = 8;
-    const SCALE_LOG2: i32 = Self::LAYOUT.scale_log2();
-    #[inline]
-    fn from_f32(v: f32) -> Self {
-        Self(Self::LAYOUT.encode(v as f64) as u8)
-    }
-    #[inline]
-    fn from_f64(v: f64) -> Self {
-        Self(Self::LAYOUT.encode(v) as u8)
-    }
-    #[inline]
-    fn to_f32(self) -> f32 {
-        Self::LAYOUT.decode(self.0 as u32)
-    }
-    #[inline]
-    fn to_f64(self) -> f64 {
-        Self::LAYOUT.decode(self.0 as u32) as f64
-    }
-    #[inline]
-    fn is_finite(self) -> bool {
-        (self.0 >> Self::LAYOUT.mantissa) as u32 & ((1 << E) - 1) != (1 << E) - 1
-    }
+/// [`Sample`] for the minifloat `$ty<E>` stored in `$bits` (`$width` bits,
+/// named from `$names`), by its [`FloatLayout`].
+macro_rules! minifloat_sample {
+    ($ty:ident, $bits:ty, $width:literal, $names:ident) => {
+        impl<const E: u32> Sample for $ty<E> {
+            const NAME: &'static str = $names[E as usize];
+            const MAX_FINITE: f64 = Self::LAYOUT.max_finite();
+            const BITS: u32 = $width;
+            const SCALE_LOG2: i32 = Self::LAYOUT.scale_log2();
+            #[inline]
+            fn from_f32(v: f32) -> Self {
+                Self(Self::LAYOUT.encode(v as f64) as $bits)
+            }
+            #[inline]
+            fn from_f64(v: f64) -> Self {
+                Self(Self::LAYOUT.encode(v) as $bits)
+            }
+            #[inline]
+            fn to_f32(self) -> f32 {
+                Self::LAYOUT.decode(self.0 as u32)
+            }
+            #[inline]
+            fn to_f64(self) -> f64 {
+                Self::LAYOUT.decode(self.0 as u32) as f64
+            }
+            #[inline]
+            fn is_finite(self) -> bool {
+                (self.0 >> Self::LAYOUT.mantissa) as u32 & ((1 << E) - 1) != (1 << E) - 1
+            }
+        }
+    };
 }
+
+minifloat_sample!(Minifloat16, u16, 16, MINIFLOAT16_NAMES);
+minifloat_sample!(Minifloat8, u8, 8, MINIFLOAT8_NAMES);

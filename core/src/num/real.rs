@@ -67,19 +67,50 @@ pub trait Real:
     fn raw_exponent<S: Sample>() -> i32;
 }
 
-impl Real for f32 {
-    const ZERO: Self = 0.0;
-    const ONE: Self = 1.0;
-    const HALF: Self = 0.5;
-    const EPSILON_HALF: f64 = 5.960_464_477_539_063e-8;
-    #[inline(always)]
-    fn from_f64(v: f64) -> Self {
-        v as f32
-    }
-    #[inline(always)]
-    fn to_f64(self) -> f64 {
-        self as f64
-    }
+/// [`Real`] for the float type `$t` (`v as $t` conversions, which round to
+/// nearest even), with its own `EPSILON_HALF` and the methods that differ
+/// between the types.
+macro_rules! impl_real {
+    ($t:ty, $epsilon_half:expr, { $($specific:item)* }) => {
+        impl Real for $t {
+            const ZERO: Self = 0.0;
+            const ONE: Self = 1.0;
+            const HALF: Self = 0.5;
+            const EPSILON_HALF: f64 = $epsilon_half;
+            #[inline(always)]
+            fn from_f64(v: f64) -> Self {
+                v as $t
+            }
+            #[inline(always)]
+            fn to_f64(self) -> f64 {
+                self as f64
+            }
+            #[inline(always)]
+            fn is_finite(self) -> bool {
+                <$t>::is_finite(self)
+            }
+            #[inline(always)]
+            fn from_usize(n: usize) -> Self {
+                n as $t
+            }
+            #[inline(always)]
+            fn from_i32(n: i32) -> Self {
+                n as $t
+            }
+            #[inline(always)]
+            fn trunc_usize(self) -> usize {
+                self as usize
+            }
+            #[inline(always)]
+            fn trunc_i32(self) -> i32 {
+                self as i32
+            }
+            $($specific)*
+        }
+    };
+}
+
+impl_real!(f32, 5.960_464_477_539_063e-8, {
     #[inline(always)]
     fn load<S: Sample>(s: S) -> Self {
         s.to_f32()
@@ -87,18 +118,6 @@ impl Real for f32 {
     #[inline(always)]
     fn store<S: Sample>(self) -> S {
         S::from_f32(self)
-    }
-    #[inline(always)]
-    fn is_finite(self) -> bool {
-        f32::is_finite(self)
-    }
-    #[inline(always)]
-    fn from_usize(n: usize) -> Self {
-        n as f32
-    }
-    #[inline(always)]
-    fn from_i32(n: i32) -> Self {
-        n as f32
     }
     /// In the i32 range, by the hardware float → int conversion (a
     /// truncation) and one correction for negative non-integers; `libm`
@@ -115,14 +134,6 @@ impl Real for f32 {
         }
     }
     #[inline(always)]
-    fn trunc_usize(self) -> usize {
-        self as usize
-    }
-    #[inline(always)]
-    fn trunc_i32(self) -> i32 {
-        self as i32
-    }
-    #[inline(always)]
     fn exp2i(e: i32) -> Self {
         libm::scalbnf(1.0, e)
     }
@@ -134,21 +145,9 @@ impl Real for f32 {
     fn raw_exponent<S: Sample>() -> i32 {
         S::RAW_EXPONENT_F32
     }
-}
+});
 
-impl Real for f64 {
-    const ZERO: Self = 0.0;
-    const ONE: Self = 1.0;
-    const HALF: Self = 0.5;
-    const EPSILON_HALF: f64 = 1.110_223_024_625_156_5e-16;
-    #[inline(always)]
-    fn from_f64(v: f64) -> Self {
-        v
-    }
-    #[inline(always)]
-    fn to_f64(self) -> f64 {
-        self
-    }
+impl_real!(f64, 1.110_223_024_625_156_5e-16, {
     #[inline(always)]
     fn load<S: Sample>(s: S) -> Self {
         s.to_f64()
@@ -158,28 +157,8 @@ impl Real for f64 {
         S::from_f64(self)
     }
     #[inline(always)]
-    fn is_finite(self) -> bool {
-        f64::is_finite(self)
-    }
-    #[inline(always)]
-    fn from_usize(n: usize) -> Self {
-        n as f64
-    }
-    #[inline(always)]
-    fn from_i32(n: i32) -> Self {
-        n as f64
-    }
-    #[inline(always)]
     fn floor_i64(self) -> i64 {
         libm::floor(self) as i64
-    }
-    #[inline(always)]
-    fn trunc_usize(self) -> usize {
-        self as usize
-    }
-    #[inline(always)]
-    fn trunc_i32(self) -> i32 {
-        self as i32
     }
     #[inline(always)]
     fn exp2i(e: i32) -> Self {
@@ -193,4 +172,4 @@ impl Real for f64 {
     fn raw_exponent<S: Sample>() -> i32 {
         0
     }
-}
+});
