@@ -8,6 +8,23 @@ pub trait VoxelSource {
     fn dims(&self) -> [usize; 3];
     /// Value of voxel `(i, j, k)`; indices are within `dims`.
     fn voxel(&self, i: usize, j: usize, k: usize) -> f64;
+
+    /// [`VoxelSource::voxel`], refusing NaN and infinities.
+    ///
+    /// # Errors
+    /// [`Error::NonFiniteVoxel`], naming the voxel.
+    #[inline]
+    fn finite_voxel(&self, i: usize, j: usize, k: usize) -> Result<f64> {
+        let v = self.voxel(i, j, k);
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(Error::NonFiniteVoxel {
+                index: [i, j, k],
+                value: v,
+            })
+        }
+    }
 }
 
 /// A dense volume borrowed from a slice, `i` fastest.
@@ -23,16 +40,7 @@ impl<'a, V: Copy + Into<f64>> DenseVolume<'a, V> {
     /// # Errors
     /// `data.len() != nx·ny·nz`, or a zero dimension.
     pub fn new(dims: [usize; 3], data: &'a [V]) -> Result<Self> {
-        if dims.contains(&0) {
-            return Err(Error::EmptyVolume);
-        }
-        let count = dims[0]
-            .checked_mul(dims[1])
-            .and_then(|v| v.checked_mul(dims[2]))
-            .ok_or(Error::VolumeTooLarge { dims, grid: 0 })?;
-        if count != data.len() {
-            return Err(mismatch("volume data", count, data.len()));
-        }
+        require_voxels("volume data", dims, data.len())?;
         Ok(Self { dims, data })
     }
 }
@@ -61,4 +69,22 @@ pub fn padded_size(dims: [usize; 3], oversample: u32) -> Result<usize> {
         .checked_mul(oversample as usize)
         .and_then(usize::checked_next_power_of_two)
         .ok_or(Error::VolumeTooLarge { dims, grid: 0 })
+}
+
+/// `Ok` if `got` values are exactly the voxels of `dims`.
+///
+/// # Errors
+/// A zero dimension, a count beyond `usize`, or a length mismatch (`what`).
+pub(crate) fn require_voxels(what: &'static str, dims: [usize; 3], got: usize) -> Result<()> {
+    if dims.contains(&0) {
+        return Err(Error::EmptyVolume);
+    }
+    let count = dims[0]
+        .checked_mul(dims[1])
+        .and_then(|v| v.checked_mul(dims[2]))
+        .ok_or(Error::VolumeTooLarge { dims, grid: 0 })?;
+    if got != count {
+        return Err(mismatch(what, count, got));
+    }
+    Ok(())
 }

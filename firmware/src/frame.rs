@@ -3,13 +3,13 @@
 //! A plain frame is rendered twice from the same tables: once by
 //! `fvr_core::render::render` (the image written out, and the total count),
 //! and once stage by stage (`View::frame` and [`extract_slice`], then
-//! [`placement`] and [`finish_projection`]: the shift, the 2D inverse DHT
+//! [`placement`] and [`finish`]: the shift, the 2D inverse DHT
 //! and the crop), to count each stage. The two images must agree bit for
 //! bit, which checks that the stages are the whole of `render`.
 //!
 //! A depth-cued or shaded frame is rendered once, by
-//! `fvr_core::render::render_scene`, whose stages are not public. Its
-//! inverse (one [`finish_channel`] per channel) is timed again afterwards on
+//! `fvr_core::render::render` with a scene, whose stages are not public. Its
+//! inverse (one [`finish`] per channel) is timed again afterwards on
 //! the scratch it left: that cost depends on the geometry only, not on the
 //! data (the plain frame checks this, [`Split::Staged::inverse_again`]), and
 //! extraction with the per-channel combination is the rest.
@@ -44,7 +44,7 @@ pub enum Split {
         /// which [`Split::Retimed`] relies on.
         inverse_again: u64,
     },
-    /// The inverse (`channels` × [`finish_channel`]) timed again after
+    /// The inverse (`channels` × [`finish`]) timed again after
     /// `render_scene`; extraction (with the per-channel combination of the
     /// accumulated spectra) is `render − inverse`.
     Retimed {
@@ -101,6 +101,18 @@ pub struct FrameBuffers<'a> {
     /// The image of the staged render, or of the re-timed inverse (as
     /// long as `image`).
     pub staged: &'a mut [f32],
+}
+
+impl FrameBuffers<'_> {
+    /// The buffers [`render`] writes: the scratch grids, the auxiliary
+    /// scratch and the image.
+    fn core(&mut self) -> Buffers<'_, f32> {
+        Buffers {
+            grid: self.fields,
+            aux: self.aux,
+            out: self.image,
+        }
+    }
 }
 
 /// Why a frame failed.
@@ -320,11 +332,7 @@ fn render_plain<C: InstructionClock>(
     render(
         &Source::new(&spectrum, kernel, tw),
         &Request::new(spec.view, w, h),
-        Buffers {
-            grid: bufs.fields,
-            aux: bufs.aux,
-            out: bufs.image,
-        },
+        bufs.core(),
     )?;
     let t1 = clock.now();
     let frame = spec.view.frame()?;
@@ -405,11 +413,7 @@ fn render_cued_or_shaded<C: InstructionClock>(
             scene: Some(&scene),
             ..Request::new(spec.view, IMAGE_SIDE, IMAGE_SIDE)
         },
-        Buffers {
-            grid: bufs.fields,
-            aux: bufs.aux,
-            out: bufs.image,
-        },
+        bufs.core(),
     )?;
     let t1 = clock.now();
     let frame = spec.view.frame()?;
@@ -435,7 +439,7 @@ fn render_cued_or_shaded<C: InstructionClock>(
 
 /// The inverse of a frame of `channels` again, on whatever the first
 /// scratch grid holds, into `bufs.staged`: the placement, then one
-/// [`finish_channel`] (shift, 2D inverse DHT, crop) per channel, as
+/// [`finish`] (shift, 2D inverse DHT, crop) per channel, as
 /// `render` and `render_scene` do it.
 fn inverse_again(
     spectrum: &fvr_core::spectrum::Spectrum<'_, fvr_core::f16, fvr_core::spectrum::Side<SIDE>>,

@@ -367,13 +367,7 @@ fn axis_energy_profile<V: VoxelSource>(volume: &V, n: usize) -> Result<[f64; PRO
         for j in 0..dims[1] {
             let by = bin(j, 1);
             for i in 0..dims[0] {
-                let v = volume.voxel(i, j, k);
-                if !v.is_finite() {
-                    return Err(Error::NonFiniteVoxel {
-                        index: [i, j, k],
-                        value: v,
-                    });
-                }
+                let v = volume.finite_voxel(i, j, k)?;
                 let e = v * v;
                 energy[bin(i, 0)] += e;
                 energy[by] += e;

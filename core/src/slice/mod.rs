@@ -39,26 +39,15 @@ pub fn extract_slice<S: Sample, Z: CubeSide, T: Real>(
     frame: &Frame,
     grid: &mut [T],
 ) {
-    extract_central_slice(spec, kernel, frame, spec.n(), grid);
+    extract_central_slice_on(spec, kernel, &frame.slice_axes(), spec.n(), grid);
 }
 
 /// [`extract_slice`] restricted to the central `m × m` frequencies
-/// (`m ≤ n`, a power of two): the slice of a preview at pitch `n/m`
-/// ([`mod@crate::render`]). `grid` holds `m²` values, `kx` fastest.
-pub fn extract_central_slice<S: Sample, Z: CubeSide, T: Real>(
-    spec: &Spectrum<'_, S, Z>,
-    kernel: &KernelTable<T>,
-    frame: &Frame,
-    m: usize,
-    grid: &mut [T],
-) {
-    extract_central_slice_on(spec, kernel, &frame.slice_axes(), m, grid);
-}
-
-/// [`extract_central_slice`] on the plane spanned by `axes` (the slice
-/// sample at `(kx, ky)` is the spectrum at `kx·axes.right + ky·axes.up`,
-/// zero outside the Nyquist cube): the physical-units slice with
-/// [`crate::geometry::Sampling::slice_axes`].
+/// (`m ≤ n`, a power of two: the slice of a preview at pitch `n/m`,
+/// [`mod@crate::render`]) on the plane spanned by `axes` (the slice sample
+/// at `(kx, ky)` is the spectrum at `kx·axes.right + ky·axes.up`, zero
+/// outside the Nyquist cube): with [`crate::geometry::Sampling::slice_axes`]
+/// the physical-units slice. `grid` holds `m²` values, `kx` fastest.
 pub fn extract_central_slice_on<S: Sample, Z: CubeSide, T: Real>(
     spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,

@@ -183,13 +183,7 @@ fn prepare_into<S: Sample, T: Real, V: VoxelSource, L: LineStore<T>>(
         for j in 0..dims[1] {
             let pyz = pm(j, 1) * pm(k, 2);
             for i in 0..dims[0] {
-                let v = volume.voxel(i, j, k);
-                if !v.is_finite() {
-                    return Err(Error::NonFiniteVoxel {
-                        index: [i, j, k],
-                        value: v,
-                    });
-                }
+                let v = volume.finite_voxel(i, j, k)?;
                 bound += libm::fabs(v * pm(i, 0) * pyz);
             }
         }

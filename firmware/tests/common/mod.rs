@@ -23,7 +23,7 @@ pub fn tables(spec: &FrameSpec) -> FrameTables {
 
 /// The host core's image of a frame, `channels·IMAGE_SIDE²` values
 /// (channel fastest): `fvr_core::render::render` or
-/// `fvr_core::render::render_scene` in f32 from the same flash tables
+/// `fvr_core::render::render` with a scene in f32 from the same flash tables
 /// the firmware links.
 pub fn host_image(spec: &FrameSpec) -> Vec<f32> {
     let t = tables(spec);
