@@ -184,11 +184,7 @@ fn unit_sampling_is_bit_identical_to_voxel_units() {
             };
             let [old, new] = [defaults, sampled].map(|request| {
                 let mut out = vec![0.0f32; w * h];
-                let buffers = Buffers {
-                    grid: &mut grid[..m * m],
-                    aux: &mut aux,
-                    out: &mut out,
-                };
+                let buffers = Buffers::new(&mut grid[..m * m], &mut aux, &mut out);
                 render(&Source::new(&spec.view(), &kernel, &tw), &request, buffers).unwrap();
                 out
             });

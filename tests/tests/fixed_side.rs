@@ -26,11 +26,7 @@ fn render_view<Z: CubeSide>(spec: &Spectrum<'_, f16, Z>, filter: Filter, view: &
     render(
         &Source::new(spec, &kernel, &tw),
         &Request::new(*view, n, n),
-        Buffers {
-            grid: &mut grid,
-            aux: &mut aux,
-            out: &mut out,
-        },
+        Buffers::new(&mut grid, &mut aux, &mut out),
     )
     .unwrap();
     out

@@ -36,11 +36,7 @@ fn preview_is_the_low_passed_projection_sampled_at_its_pitch() {
                 level,
                 ..Request::new(view, w, h)
             },
-            Buffers {
-                grid: &mut grid,
-                aux: &mut aux,
-                out: &mut out,
-            },
+            Buffers::new(&mut grid, &mut aux, &mut out),
         )
         .unwrap();
         // Reference: the full slice with the outer frequencies zeroed.
@@ -82,11 +78,8 @@ fn preview_is_the_low_passed_projection_sampled_at_its_pitch() {
             level,
             ..Request::new(view, side, side)
         };
-        let buffers = Buffers {
-            grid: &mut big,
-            aux: &mut aux,
-            out: &mut vec![0.0; side * side],
-        };
+        let mut out = vec![0.0; side * side];
+        let buffers = Buffers::new(&mut big, &mut aux, &mut out);
         assert!(render(&Source::new(&spec, &kernel, &tw), &request, buffers).is_err());
     }
 }

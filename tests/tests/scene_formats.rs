@@ -43,11 +43,7 @@ fn render_scene<S: fvr_core::num::Sample>(
             scene: Some(scene),
             ..Request::new(*view, n, n)
         },
-        Buffers {
-            grid: &mut fields,
-            aux: &mut aux,
-            out: &mut out,
-        },
+        Buffers::new(&mut fields, &mut aux, &mut out),
     )
     .unwrap();
     out

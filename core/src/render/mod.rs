@@ -119,6 +119,13 @@ pub struct Buffers<'a, T> {
     pub out: &'a mut [T],
 }
 
+impl<'a, T> Buffers<'a, T> {
+    /// The slice grid(s), the auxiliary scratch and the image.
+    pub fn new(grid: &'a mut [T], aux: &'a mut [T], out: &'a mut [T]) -> Self {
+        Self { grid, aux, out }
+    }
+}
+
 /// Deepest level: the preview grid keeps at least 2 samples a side.
 pub fn max_level(n: usize) -> u32 {
     n.max(2).trailing_zeros().saturating_sub(1)

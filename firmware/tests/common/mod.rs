@@ -39,11 +39,7 @@ pub fn host_image(spec: &FrameSpec) -> Vec<f32> {
             render(
                 &Source::new(&spectrum, &kernel, &tw),
                 &Request::new(spec.view, IMAGE_SIDE, IMAGE_SIDE),
-                Buffers {
-                    grid: &mut grid,
-                    aux: &mut aux,
-                    out: &mut out,
-                },
+                Buffers::new(&mut grid, &mut aux, &mut out),
             )
             .unwrap();
             out
@@ -66,11 +62,7 @@ pub fn host_image(spec: &FrameSpec) -> Vec<f32> {
                     scene: Some(&scene),
                     ..Request::new(spec.view, IMAGE_SIDE, IMAGE_SIDE)
                 },
-                Buffers {
-                    grid: &mut fields,
-                    aux: &mut aux,
-                    out: &mut out,
-                },
+                Buffers::new(&mut fields, &mut aux, &mut out),
             )
             .unwrap();
             assert_eq!(channels, s.channels());
