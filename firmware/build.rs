@@ -21,8 +21,9 @@ use std::path::{Path, PathBuf};
 
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::{DerivativeTable, Filter, FilterKind, KernelTable};
-use fvr_core::gradient::{gradient_magnitude, gradient_scratch_len};
-use fvr_core::spectrum::{padded_size, prepare_scratch_len, DenseVolume, Spectrum};
+use fvr_core::shading::gradient::{gradient_magnitude, gradient_scratch_len};
+use fvr_core::spectrum::{prepare_scratch_len, Spectrum};
+use fvr_core::volume::{padded_size, DenseVolume};
 use half::f16;
 
 #[allow(dead_code)]

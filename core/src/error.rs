@@ -180,6 +180,12 @@ pub enum Error {
         /// Why not.
         reason: &'static str,
     },
+    /// A scene ([`crate::shading::Scene`]) was asked for in a rendering it
+    /// does not support (a progressive level, or physical units).
+    SceneUnsupported {
+        /// What was asked for.
+        what: &'static str,
+    },
 }
 
 /// Shorthand for results of this crate.
@@ -262,6 +268,9 @@ impl fmt::Display for Error {
                 f,
                 "the nearest-neighbour kernel has no usable derivative: linear depth cueing needs another filter"
             ),
+            Error::SceneUnsupported { what } => {
+                write!(f, "scenes are rendered at level 0 in voxel units, not {what}")
+            }
             Error::GradientSpectrum { problem } => {
                 write!(f, "gradient-magnitude spectrum: {problem}")
             }
@@ -351,5 +360,15 @@ pub(crate) fn require_len(what: &'static str, needed: usize, got: usize) -> Resu
         Ok(())
     } else {
         Err(too_small(what, needed, got))
+    }
+}
+
+/// `Ok` if `got == expected`, else [`Error::LengthMismatch`].
+#[inline]
+pub(crate) fn check_len(what: &'static str, expected: usize, got: usize) -> Result<()> {
+    if expected == got {
+        Ok(())
+    } else {
+        Err(mismatch(what, expected, got))
     }
 }

@@ -18,7 +18,7 @@ use semihosting::fs::File;
 use semihosting::io::Write as _;
 
 use crate::capture::{ByteSink, CaptureBus};
-use crate::display::{DcsPanel, Window};
+use crate::display::{DcsPanel, Image, Window};
 use crate::frame::{
     check_linked_tables, render_frame, tables_for, FrameBuffers, FrameError, InstructionClock,
     Split, IMAGE_LEN,
@@ -212,12 +212,14 @@ fn run_inner(
         )?);
         let mut panel = DcsPanel::new(bus.spi(), bus.dc());
         let mut row = [0u8; 2 * IMAGE_SIDE];
-        let drawn = if channels == 1 {
-            panel.draw_gray(0, 0, image, IMAGE_SIDE, &window, &mut row)
-        } else {
-            panel.draw_rgb(0, 0, image, IMAGE_SIDE, &window, &mut row)
+        let picture = Image {
+            pixels: image,
+            width: IMAGE_SIDE,
+            channels,
         };
-        drawn.map_err(|_| RunError::Display)?;
+        panel
+            .draw((0, 0), picture, &window, &mut row)
+            .map_err(|_| RunError::Display)?;
         let display = clock.now() - t0;
 
         let mut nrrd = HostFile::create(Name::new(program, spec.name, "nrrd")?.as_str())?;
@@ -272,13 +274,13 @@ fn run_inner(
 }
 
 /// On the target's own arithmetic: the fast f16 → f32 widening of the core
-/// (`fvr_core::real::f16_bits_to_f32`) against `half`'s, for all 65,536
+/// (`fvr_core::num::f16_bits_to_f32`) against `half`'s, for all 65,536
 /// patterns, and the instructions per conversion of each over the 63,488
 /// finite patterns (a spectrum holds only finite values).
 fn f16_codec_report(clock: &SysTickClock) -> Result<(), RunError> {
     use core::hint::black_box;
     use fvr_core::f16;
-    use fvr_core::real::f16_bits_to_f32;
+    use fvr_core::num::f16_bits_to_f32;
 
     let differing = (0..=u16::MAX)
         .filter(|&b| f16_bits_to_f32(b).to_bits() != f16::from_bits(b).to_f32().to_bits())

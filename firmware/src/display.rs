@@ -122,6 +122,28 @@ impl<S: fmt::Debug, P: fmt::Debug> fmt::Display for PanelError<S, P> {
     }
 }
 
+/// An image for the panel: rows of `width` pixels of `channels` values
+/// each (1 gray, 3 RGB with red first), row 0 at the top.
+#[derive(Clone, Copy, Debug)]
+pub struct Image<'a> {
+    /// The values, row-major, channel fastest.
+    pub pixels: &'a [f32],
+    /// Pixels a row.
+    pub width: usize,
+    /// Values a pixel: 1 or 3.
+    pub channels: usize,
+}
+
+impl Image<'_> {
+    fn bad_shape<S, P>(self) -> PanelError<S, P> {
+        PanelError::BadShape {
+            len: self.pixels.len(),
+            width: self.width,
+            channels: self.channels,
+        }
+    }
+}
+
 /// A DCS panel on an SPI device and a D/C pin.
 #[derive(Debug)]
 pub struct DcsPanel<SPI, DC> {
@@ -140,64 +162,51 @@ impl<SPI: SpiDevice, DC: OutputPin> DcsPanel<SPI, DC> {
         (self.spi, self.dc)
     }
 
-    /// Send `image` (`width` pixels a row, row 0 at the top) to the panel
-    /// window whose top-left corner is `(x0, y0)`, in gray through `window`.
-    /// `row` is scratch of at least `2·width` bytes.
+    /// Send `image` to the panel window whose top-left corner is `at`
+    /// (column, row), every channel through `window` (one window keeps the
+    /// colour balance of an RGB image; fit it over all values). `row` is
+    /// scratch of at least `2·width` bytes.
     ///
     /// # Errors
-    /// [`PanelError`]: the bus or pin failed, or the shapes do not fit.
-    pub fn draw_gray(
+    /// [`PanelError`]: the bus or pin failed, or the shapes do not fit
+    /// (also a channel count other than 1 or 3).
+    pub fn draw(
         &mut self,
-        x0: u16,
-        y0: u16,
-        image: &[f32],
-        width: usize,
+        at: (u16, u16),
+        image: Image<'_>,
         window: &Window,
         row: &mut [u8],
     ) -> Result<(), PanelError<SPI::Error, DC::Error>> {
-        self.draw(x0, y0, image, 1, width, row, |px| {
-            rgb565_gray(window.gray(px[0]))
-        })
+        match image.channels {
+            1 => self.send(at, image, row, |px| rgb565_gray(window.gray(px[0]))),
+            3 => self.send(at, image, row, |px| {
+                rgb565(window.gray(px[0]), window.gray(px[1]), window.gray(px[2]))
+            }),
+            _ => Err(image.bad_shape()),
+        }
     }
 
-    /// Send an RGB `image` (`width` pixels a row of 3 values each, red
-    /// first, row 0 at the top) like [`DcsPanel::draw_gray`], every channel
-    /// through the same `window` (one window keeps the colour balance; fit
-    /// it over all values).
-    ///
-    /// # Errors
-    /// [`PanelError`]: the bus or pin failed, or the shapes do not fit.
-    pub fn draw_rgb(
+    /// [`DcsPanel::draw`] with each pixel's RGB565 from `pixel`.
+    fn send(
         &mut self,
-        x0: u16,
-        y0: u16,
-        image: &[f32],
-        width: usize,
-        window: &Window,
-        row: &mut [u8],
-    ) -> Result<(), PanelError<SPI::Error, DC::Error>> {
-        self.draw(x0, y0, image, 3, width, row, |px| {
-            rgb565(window.gray(px[0]), window.gray(px[1]), window.gray(px[2]))
-        })
-    }
-
-    fn draw(
-        &mut self,
-        x0: u16,
-        y0: u16,
-        image: &[f32],
-        channels: usize,
-        width: usize,
+        (x0, y0): (u16, u16),
+        image: Image<'_>,
         row: &mut [u8],
         pixel: impl Fn(&[f32]) -> u16,
     ) -> Result<(), PanelError<SPI::Error, DC::Error>> {
+        let Image {
+            pixels: image,
+            width,
+            channels,
+        } = image;
         let stride = width * channels;
         if width == 0 || image.is_empty() || image.len() % stride != 0 {
-            return Err(PanelError::BadShape {
-                len: image.len(),
+            return Err(Image {
+                pixels: image,
                 width,
                 channels,
-            });
+            }
+            .bad_shape());
         }
         let height = image.len() / stride;
         let got = row.len();

@@ -3,13 +3,13 @@
 //! A plain frame is rendered twice from the same tables: once by
 //! `fvr_core::render::render` (the image written out, and the total count),
 //! and once stage by stage (`View::frame` and [`extract_slice`], then
-//! [`placement`] and [`finish_projection`]: the shift, the 2D inverse DHT
+//! [`placement`] and [`finish`]: the shift, the 2D inverse DHT
 //! and the crop), to count each stage. The two images must agree bit for
 //! bit, which checks that the stages are the whole of `render`.
 //!
 //! A depth-cued or shaded frame is rendered once, by
-//! `fvr_core::scene_render::render_scene`, whose stages are not public. Its
-//! inverse (one [`finish_channel`] per channel) is timed again afterwards on
+//! `fvr_core::render::render` with a scene, whose stages are not public. Its
+//! inverse (one [`finish`] per channel) is timed again afterwards on
 //! the scratch it left: that cost depends on the geometry only, not on the
 //! data (the plain frame checks this, [`Split::Staged::inverse_again`]), and
 //! extraction with the per-channel combination is the rest.
@@ -18,10 +18,9 @@ use core::fmt;
 
 use fvr_core::dht::{dht_2d, Twiddles};
 use fvr_core::filter::FilterKind;
-use fvr_core::render::{
-    aux_len, extract_slice, finish_channel, finish_projection, grid_len, placement, render,
-};
-use fvr_core::scene_render::render_scene;
+use fvr_core::image::{aux_len, finish, grid_len, placement, Crop};
+use fvr_core::render::{render, Buffers, Request, Source};
+use fvr_core::slice::extract_slice;
 
 use crate::scene::{FrameSpec, Shading, StoredKind, IMAGE_SIDE, SIDE};
 use crate::stored::{StoredDerivative, StoredSpectrum};
@@ -45,7 +44,7 @@ pub enum Split {
         /// which [`Split::Retimed`] relies on.
         inverse_again: u64,
     },
-    /// The inverse (`channels` × [`finish_channel`]) timed again after
+    /// The inverse (`channels` × [`finish`]) timed again after
     /// `render_scene`; extraction (with the per-channel combination of the
     /// accumulated spectra) is `render − inverse`.
     Retimed {
@@ -102,6 +101,18 @@ pub struct FrameBuffers<'a> {
     /// The image of the staged render, or of the re-timed inverse (as
     /// long as `image`).
     pub staged: &'a mut [f32],
+}
+
+impl FrameBuffers<'_> {
+    /// The buffers [`render`] writes: the scratch grids, the auxiliary
+    /// scratch and the image.
+    fn core(&mut self) -> Buffers<'_, f32> {
+        Buffers {
+            grid: self.fields,
+            aux: self.aux,
+            out: self.image,
+        }
+    }
 }
 
 /// Why a frame failed.
@@ -319,28 +330,19 @@ fn render_plain<C: InstructionClock>(
     let n = spectrum.n();
     let t0 = clock.now();
     render(
-        &spectrum,
-        kernel,
-        &spec.view,
-        w,
-        h,
-        tw,
-        bufs.fields,
-        bufs.aux,
-        bufs.image,
+        &Source::new(&spectrum, kernel, tw),
+        &Request::new(spec.view, w, h),
+        bufs.core(),
     )?;
     let t1 = clock.now();
     let frame = spec.view.frame()?;
     extract_slice(&spectrum, kernel, &frame, &mut bufs.fields[..n * n]);
     let t2 = clock.now();
     let place = placement(spectrum.dims(), &frame, w, h);
-    finish_projection(
+    finish(
         &mut bufs.fields[..n * n],
         n,
-        &place,
-        1.0 / spectrum.scale(),
-        w,
-        h,
+        &Crop::new(place, 1.0 / spectrum.scale(), w, h),
         tw,
         bufs.aux,
         bufs.staged,
@@ -399,19 +401,19 @@ fn render_cued_or_shaded<C: InstructionClock>(
         None => None,
     };
     let t0 = clock.now();
-    let channels = render_scene(
-        &spectrum,
-        gradient.as_ref(),
-        kernel,
-        derivative,
-        &scene,
-        &spec.view,
-        IMAGE_SIDE,
-        IMAGE_SIDE,
-        tw,
-        bufs.fields,
-        bufs.aux,
-        bufs.image,
+    let channels = render(
+        &Source {
+            spectrum: &spectrum,
+            gradient: gradient.as_ref(),
+            kernel,
+            derivative,
+            twiddles: tw,
+        },
+        &Request {
+            scene: Some(&scene),
+            ..Request::new(spec.view, IMAGE_SIDE, IMAGE_SIDE)
+        },
+        bufs.core(),
     )?;
     let t1 = clock.now();
     let frame = spec.view.frame()?;
@@ -437,7 +439,7 @@ fn render_cued_or_shaded<C: InstructionClock>(
 
 /// The inverse of a frame of `channels` again, on whatever the first
 /// scratch grid holds, into `bufs.staged`: the placement, then one
-/// [`finish_channel`] (shift, 2D inverse DHT, crop) per channel, as
+/// [`finish`] (shift, 2D inverse DHT, crop) per channel, as
 /// `render` and `render_scene` do it.
 fn inverse_again(
     spectrum: &fvr_core::spectrum::Spectrum<'_, fvr_core::f16, fvr_core::spectrum::Side<SIDE>>,
@@ -451,18 +453,17 @@ fn inverse_again(
     let place = placement(spectrum.dims(), frame, w, h);
     let gain = 1.0 / spectrum.scale();
     for c in 0..channels {
-        finish_channel(
+        finish(
             &mut bufs.fields[..n * n],
             n,
-            &place,
-            gain,
-            w,
-            h,
+            &Crop {
+                channels,
+                channel: c,
+                ..Crop::new(place, gain, w, h)
+            },
             tw,
             bufs.aux,
             bufs.staged,
-            channels,
-            c,
         )?;
     }
     Ok(())

@@ -7,7 +7,7 @@
 //! ([`stored`]). On the device a plain frame is rendered twice, once by
 //! `fvr_core::render::render` and once stage by stage to count instructions;
 //! a depth-cued or shaded frame once, by
-//! `fvr_core::scene_render::render_scene` ([`frame`]). The image (grey or
+//! `fvr_core::render::render` with a scene ([`frame`]). The image (grey or
 //! RGB) goes back to the host as a NRRD over semihosting ([`nrrd`]) and to
 //! a display through an `embedded-hal` 1.0 `SpiDevice` ([`display`]), whose
 //! bytes a capture bus ([`capture`]) records for the host to check.

@@ -9,7 +9,7 @@
 //! # Adding a frame
 //! A [`FrameSpec`] names a stored filter, a view and what it computes
 //! ([`Shading`]). A plain frame reads the density spectrum. A
-//! [`Shading::Scene`] frame is rendered by `fvr_core::scene_render::render_scene`
+//! [`Shading::Scene`] frame is rendered by `fvr_core::render::render` with a scene
 //! and needs, besides the density spectrum:
 //! - with a linear depth cue, the kernel-derivative table of its filter
 //!   (paper eq. 5), listed in [`DERIVATIVES`]: `W·512 + 1` f32 (6 KiB for
@@ -26,7 +26,7 @@
 
 use fvr_core::filter::FilterKind;
 use fvr_core::geometry::View;
-use fvr_core::scene::{DepthCue, Light, Scene};
+use fvr_core::shading::{DepthCue, Light, Scene};
 
 /// Side of the phantom's cube (voxels); also the padded spectrum side at
 /// oversampling 1.
@@ -62,48 +62,28 @@ const ROT_Z_3_4_5: [[f64; 3]; 3] = [[0.6, -0.8, 0.0], [0.8, 0.6, 0.0], [0.0, 0.0
 const ROT_X_7_24_25: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 0.28, -0.96], [0.0, 0.96, 0.28]];
 const ROT_Y_4_3_5: [[f64; 3]; 3] = [[0.8, 0.0, 0.6], [0.0, 1.0, 0.0], [-0.6, 0.0, 0.8]];
 
+/// A [`Blob`] in one line of the table below.
+const fn blob(amplitude: f64, center: [f64; 3], sigmas: [f64; 3], rotation: [[f64; 3]; 3]) -> Blob {
+    Blob {
+        amplitude,
+        center,
+        sigmas,
+        rotation,
+    }
+}
+
 /// The phantom: six smooth blobs, each within `|μ − c| + 4σ_max ≤ 25.6`
 /// voxels of the centre `c = 32` (the sphere of radius 0.4·n used by the
 /// host's accuracy table), so Kaiser–Bessel at σ = 1 keeps its accuracy
 /// (README, "Warning"). Hand-picked, not random, so the image has distinct
 /// features at several scales and orientations.
 pub const BLOBS: [Blob; 6] = [
-    Blob {
-        amplitude: 1.0,
-        center: [32.0, 32.0, 32.0],
-        sigmas: [6.0, 4.0, 3.0],
-        rotation: ROT_Z_3_4_5,
-    },
-    Blob {
-        amplitude: 0.6,
-        center: [24.0, 38.0, 30.0],
-        sigmas: [3.0, 3.0, 3.5],
-        rotation: ROT_X_7_24_25,
-    },
-    Blob {
-        amplitude: 0.8,
-        center: [40.0, 26.0, 36.0],
-        sigmas: [2.5, 3.5, 2.0],
-        rotation: IDENTITY,
-    },
-    Blob {
-        amplitude: 0.5,
-        center: [30.0, 24.0, 22.0],
-        sigmas: [2.0, 2.0, 2.0],
-        rotation: IDENTITY,
-    },
-    Blob {
-        amplitude: 0.7,
-        center: [37.0, 38.0, 37.0],
-        sigmas: [4.0, 2.0, 2.5],
-        rotation: ROT_Y_4_3_5,
-    },
-    Blob {
-        amplitude: 0.4,
-        center: [28.0, 30.0, 42.0],
-        sigmas: [1.8, 3.0, 2.0],
-        rotation: ROT_Z_3_4_5,
-    },
+    blob(1.0, [32.0, 32.0, 32.0], [6.0, 4.0, 3.0], ROT_Z_3_4_5),
+    blob(0.6, [24.0, 38.0, 30.0], [3.0, 3.0, 3.5], ROT_X_7_24_25),
+    blob(0.8, [40.0, 26.0, 36.0], [2.5, 3.5, 2.0], IDENTITY),
+    blob(0.5, [30.0, 24.0, 22.0], [2.0, 2.0, 2.0], IDENTITY),
+    blob(0.7, [37.0, 38.0, 37.0], [4.0, 2.0, 2.5], ROT_Y_4_3_5),
+    blob(0.4, [28.0, 30.0, 42.0], [1.8, 3.0, 2.0], ROT_Z_3_4_5),
 ];
 
 /// Density of the phantom at `p` (voxel units), in f64.
@@ -131,7 +111,7 @@ pub enum StoredKind {
     /// `F{f·p_m}`: the density, for every frame.
     Density(FilterKind),
     /// `F{|∇f|·p_m}`: the gradient magnitude of the band-limited interpolant
-    /// (`fvr_core::gradient::gradient_magnitude`), for frames with a light.
+    /// (`fvr_core::shading::gradient::gradient_magnitude`), for frames with a light.
     /// It is premultiplied for the same filter (the same β) as the density.
     GradientMagnitude(FilterKind),
 }
@@ -168,7 +148,7 @@ pub const STORED: [StoredKind; 4] = [
 /// with a linear depth cue).
 pub const DERIVATIVES: [FilterKind; 1] = [FilterKind::Kb3];
 
-/// A depth cue a frame uses: the part of `fvr_core::scene::DepthCue` this
+/// A depth cue a frame uses: the part of `fvr_core::shading::DepthCue` this
 /// scene needs, in a form that can be a constant.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Cue {
@@ -184,7 +164,7 @@ pub enum Cue {
 }
 
 /// A depth-cued and/or shaded view's scene (the core's
-/// `fvr_core::scene::Scene`, as a constant).
+/// `fvr_core::shading::Scene`, as a constant).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SceneSpec {
     /// The depth cue.
@@ -272,7 +252,7 @@ pub enum Shading {
     /// `fvr_core::render::render`.
     Plain,
     /// A depth-cued and/or shaded image (paper §3), by
-    /// `fvr_core::scene_render::render_scene`.
+    /// `fvr_core::render::render` with a scene.
     Scene(SceneSpec),
 }
 
@@ -402,68 +382,44 @@ pub const LINEAR_CUE: Cue = Cue::Linear {
 /// The ambient colour of the lit frames.
 pub const AMBIENT: [f64; 3] = [0.15, 0.15, 0.2];
 
+/// A frame of [`VIEW`] in one line of the tables below.
+const fn frame(name: &'static str, filter: FilterKind, shading: Shading) -> FrameSpec {
+    FrameSpec {
+        name,
+        filter,
+        shading,
+        view: VIEW,
+    }
+}
+
+/// A cued or shaded frame's [`Shading`].
+const fn lit(cue: Cue, ambient: [f64; 3], lights: &'static [Light]) -> Shading {
+    Shading::Scene(SceneSpec {
+        cue,
+        ambient,
+        lights,
+    })
+}
+
 /// The scene program (`fvr-scene`): the paper's 3³ filter, the plain
 /// X-ray view, a depth-cued one (paper fig. 6b), a shaded one with three
 /// coloured lights (fig. 8) and both (fig. 6d).
 pub const SCENE_FRAMES: [FrameSpec; 4] = [
-    FrameSpec {
-        name: "plain-kb3",
-        filter: FilterKind::Kb3,
-        shading: Shading::Plain,
-        view: VIEW,
-    },
-    FrameSpec {
-        name: "cued-kb3",
-        filter: FilterKind::Kb3,
-        shading: Shading::Scene(SceneSpec {
-            cue: LINEAR_CUE,
-            ambient: [1.0; 3],
-            lights: &[],
-        }),
-        view: VIEW,
-    },
-    FrameSpec {
-        name: "lit-kb3",
-        filter: FilterKind::Kb3,
-        shading: Shading::Scene(SceneSpec {
-            cue: Cue::None,
-            ambient: AMBIENT,
-            lights: &LIGHTS,
-        }),
-        view: VIEW,
-    },
-    FrameSpec {
-        name: "lit-cued-kb3",
-        filter: FilterKind::Kb3,
-        shading: Shading::Scene(SceneSpec {
-            cue: LINEAR_CUE,
-            ambient: AMBIENT,
-            lights: &LIGHTS,
-        }),
-        view: VIEW,
-    },
+    frame("plain-kb3", FilterKind::Kb3, Shading::Plain),
+    frame("cued-kb3", FilterKind::Kb3, lit(LINEAR_CUE, [1.0; 3], &[])),
+    frame("lit-kb3", FilterKind::Kb3, lit(Cue::None, AMBIENT, &LIGHTS)),
+    frame(
+        "lit-cued-kb3",
+        FilterKind::Kb3,
+        lit(LINEAR_CUE, AMBIENT, &LIGHTS),
+    ),
 ];
 /// The filter benchmark (`fvr-filter-bench`): the same view with kb3, kb4
 /// and kb6, for instruction counts.
 pub const BENCH_FRAMES: [FrameSpec; 3] = [
-    FrameSpec {
-        name: "plain-kb3",
-        filter: FilterKind::Kb3,
-        shading: Shading::Plain,
-        view: VIEW,
-    },
-    FrameSpec {
-        name: "plain-kb4",
-        filter: FilterKind::Kb4,
-        shading: Shading::Plain,
-        view: VIEW,
-    },
-    FrameSpec {
-        name: "plain-kb6",
-        filter: FilterKind::Kb6,
-        shading: Shading::Plain,
-        view: VIEW,
-    },
+    frame("plain-kb3", FilterKind::Kb3, Shading::Plain),
+    frame("plain-kb4", FilterKind::Kb4, Shading::Plain),
+    frame("plain-kb6", FilterKind::Kb6, Shading::Plain),
 ];
 
 /// The programs and their frames, for the host-side checks.

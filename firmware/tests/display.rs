@@ -7,7 +7,7 @@ use std::convert::Infallible;
 use embedded_hal::spi::{ErrorKind, ErrorType, Operation, SpiDevice};
 use fvr_firmware::capture::{decode_frame, ByteSink, CaptureBus, CaptureError, DecodeError};
 use fvr_firmware::display::{
-    rgb565, rgb565_gray, DcsPanel, PanelError, Window, CASET, RAMWR, RASET,
+    rgb565, rgb565_gray, DcsPanel, Image, PanelError, Window, CASET, RAMWR, RASET,
 };
 
 #[derive(Default)]
@@ -33,6 +33,16 @@ fn records(rec: &[u8]) -> Vec<(u8, Vec<u8>)> {
     out
 }
 
+/// The panel's view of `pixels`: rows of `width` pixels of `channels`
+/// values.
+fn picture(pixels: &[f32], width: usize, channels: usize) -> Image<'_> {
+    Image {
+        pixels,
+        width,
+        channels,
+    }
+}
+
 #[test]
 fn a_frame_is_caset_raset_ramwr_then_rgb565_rows_with_dc_levels() {
     // 3 × 2 image at (10, 300): values 0..5, window 0..5 → gray 0, 51, …, 255.
@@ -49,7 +59,7 @@ fn a_frame_is_caset_raset_ramwr_then_rgb565_rows_with_dc_levels() {
     let mut panel = DcsPanel::new(bus.spi(), bus.dc());
     let mut row = [0u8; 6];
     panel
-        .draw_gray(10, 300, &image, 3, &window, &mut row)
+        .draw((10, 300), picture(&image, 3, 1), &window, &mut row)
         .unwrap();
     let _ = panel.release();
     let rec = records(&bus.into_inner().0);
@@ -84,7 +94,9 @@ fn a_recording_decodes_to_the_window_and_the_quantized_image() {
     let bus = CaptureBus::new(Memory::default());
     let mut panel = DcsPanel::new(bus.spi(), bus.dc());
     let mut row = vec![0u8; 2 * w];
-    panel.draw_gray(5, 7, &image, w, &window, &mut row).unwrap();
+    panel
+        .draw((5, 7), picture(&image, w, 1), &window, &mut row)
+        .unwrap();
     let _ = panel.release();
     let rec = bus.into_inner().0;
     let mut pixels = vec![0u16; w * h];
@@ -106,7 +118,9 @@ fn an_rgb_frame_sends_one_rgb565_pixel_per_three_values_through_one_window() {
     let bus = CaptureBus::new(Memory::default());
     let mut panel = DcsPanel::new(bus.spi(), bus.dc());
     let mut row = [0u8; 4];
-    panel.draw_rgb(3, 4, &image, 2, &window, &mut row).unwrap();
+    panel
+        .draw((3, 4), picture(&image, 2, 3), &window, &mut row)
+        .unwrap();
     let _ = panel.release();
     let rec = bus.into_inner().0;
     let mut pixels = vec![0u16; 4];
@@ -153,7 +167,7 @@ fn bad_shapes_are_refused_before_anything_is_sent() {
     let w = Window::fit(&image);
     let mut row = [0u8; 4];
     assert_eq!(
-        panel.draw_gray(0, 0, &image, 4, &w, &mut [0u8; 8]),
+        panel.draw((0, 0), picture(&image, 4, 1), &w, &mut [0u8; 8]),
         Err(PanelError::BadShape {
             len: 6,
             width: 4,
@@ -161,7 +175,7 @@ fn bad_shapes_are_refused_before_anything_is_sent() {
         })
     );
     assert_eq!(
-        panel.draw_gray(0, 0, &image, 0, &w, &mut row),
+        panel.draw((0, 0), picture(&image, 0, 1), &w, &mut row),
         Err(PanelError::BadShape {
             len: 6,
             width: 0,
@@ -169,15 +183,15 @@ fn bad_shapes_are_refused_before_anything_is_sent() {
         })
     );
     assert_eq!(
-        panel.draw_gray(0, 0, &image, 3, &w, &mut row),
+        panel.draw((0, 0), picture(&image, 3, 1), &w, &mut row),
         Err(PanelError::RowBufferTooSmall { needed: 6, got: 4 })
     );
     assert_eq!(
-        panel.draw_gray(u16::MAX - 1, 0, &image, 3, &w, &mut [0u8; 6]),
+        panel.draw((u16::MAX - 1, 0), picture(&image, 3, 1), &w, &mut [0u8; 6]),
         Err(PanelError::OutOfRange)
     );
     // Six values are two RGB pixels: not rows of 4 pixels, nor of 3.
-    let err = panel.draw_rgb(0, 0, &image, 3, &w, &mut [0u8; 6]);
+    let err = panel.draw((0, 0), picture(&image, 3, 3), &w, &mut [0u8; 6]);
     assert_eq!(
         err,
         Err(PanelError::BadShape {
@@ -213,7 +227,12 @@ fn bus_errors_reach_the_caller() {
     let mut panel = DcsPanel::new(Broken, bus.dc());
     let image = [1.0f32, 2.0];
     let err = panel
-        .draw_gray(0, 0, &image, 2, &Window::fit(&image), &mut [0u8; 4])
+        .draw(
+            (0, 0),
+            picture(&image, 2, 1),
+            &Window::fit(&image),
+            &mut [0u8; 4],
+        )
         .unwrap_err();
     assert_eq!(err, PanelError::Spi(ErrorKind::ModeFault));
     assert_eq!(err.to_string(), "SPI write failed: ModeFault");

@@ -10,8 +10,9 @@ use common::{exact_image, floor_db, host_image, snr_db, tables};
 use fvr_core::dht::Twiddles;
 use fvr_core::f16;
 use fvr_core::filter::{DerivativeTable, Filter, FilterKind, KernelTable};
-use fvr_core::scene::ViewPlan;
-use fvr_core::spectrum::{DenseVolume, Spectrum};
+use fvr_core::shading::ViewPlan;
+use fvr_core::spectrum::Spectrum;
+use fvr_core::volume::DenseVolume;
 use fvr_firmware::frame::{
     check_linked_tables, render_frame, tables_for, FrameBuffers, FrameError, InstructionClock,
     Split, AUX_LEN, IMAGE_LEN,
@@ -68,7 +69,7 @@ fn phantom_volume() -> Volume {
 /// The floor is kb3's at oversampling 1 in f16 (40 dB, README accuracy
 /// table). It applies to the cued and shaded frames too: the cue's gradient
 /// filter and the first moment are exact Hartley identities of the same
-/// interpolation (core/src/scene_render.rs), so they inherit kb3's aliasing;
+/// interpolation (core/src/shading/passes.rs), so they inherit kb3's aliasing;
 /// and the `|∇f|` spectrum's own aliasing, about 47 dB for Gaussians 1.6
 /// voxels wide (README, "Depth cueing and shading"; these are 1.8 or
 /// wider), is above the floor. The f64 pipeline lands at the same dB as

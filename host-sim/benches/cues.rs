@@ -10,7 +10,7 @@ use std::hint::black_box;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
-use fvr_core::scene::{DepthCue, Scene};
+use fvr_core::shading::{DepthCue, Scene};
 use fvr_host::phantom::{sample, GaussianMixture};
 use fvr_host::pipeline::OwnedSpectrum;
 use fvr_host::shaded::{gradient_volume, light_ring, SceneRenderer};

@@ -4,15 +4,16 @@
 
 use crate::pipeline::OwnedSpectrum;
 use crate::timing::median_ms;
-use fvr_core::adaptive::{
-    extract_slice_adaptive, mark, marks_words, response_difference, threshold_for, AdaptiveLevel,
-    AdaptiveStats, Marks, MAX_LEVELS,
-};
+use fvr_core::dht::signed_index;
 use fvr_core::dht::{dht_3d, dht_3d_scratch_len, Twiddles};
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::View;
-use fvr_core::real::{Real, Sample};
-use fvr_core::render::{aux_len, check_image, finish_projection, placement, signed_index};
+use fvr_core::image::{aux_len, check_image, finish, placement, Crop};
+use fvr_core::num::{Real, Sample};
+use fvr_core::slice::adaptive::{
+    extract_slice_adaptive, mark, marks_words, response_difference, threshold_for, AdaptiveLevel,
+    AdaptiveStats, Marks, MAX_LEVELS,
+};
 use fvr_core::spectrum::Spectrum;
 
 /// The cheaper filters tried, cheapest first, as the user names them.
@@ -465,13 +466,10 @@ impl AdaptiveMarks {
         let mut aux = vec![T::ZERO; aux_len(n)];
         let mut out = vec![T::ZERO; width * height];
         let place = placement(core_spec.dims(), &frame, width, height);
-        finish_projection(
+        finish(
             &mut grid,
             n,
-            &place,
-            1.0 / core_spec.scale(),
-            width,
-            height,
+            &Crop::new(place, 1.0 / core_spec.scale(), width, height),
             &tw,
             &mut aux,
             &mut out,

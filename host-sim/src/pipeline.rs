@@ -11,12 +11,12 @@ use std::str::FromStr;
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::{Sampling, View};
-use fvr_core::real::{Real, Sample};
-use fvr_core::render::{
-    aux_len, check_image, extract_slice_rows, finish_projection, grid_len, placement_on_axes,
-    render_sampled,
-};
-use fvr_core::spectrum::{padded_size, prepare_scratch_len, DenseVolume, Spectrum};
+use fvr_core::image::{aux_len, check_image, finish, grid_len, placement_on_axes, Crop};
+use fvr_core::num::{Real, Sample};
+use fvr_core::render::{render, Buffers, Request, Source};
+use fvr_core::slice::extract_slice_rows;
+use fvr_core::spectrum::{prepare_scratch_len, Spectrum};
+use fvr_core::volume::{padded_size, DenseVolume};
 use half::f16;
 
 use crate::volume::Volume;
@@ -201,7 +201,7 @@ impl<T: Real> ViewRenderer<T> {
     /// Render one view into `out` (`width × height`, row 0 at the top).
     ///
     /// The slice is extracted in blocks of rows on the renderer's threads
-    /// ([`fvr_core::render::extract_slice_rows`]; the core stays
+    /// ([`fvr_core::slice::extract_slice_rows`]; the core stays
     /// single-threaded), then inverse-transformed on this one.
     ///
     /// # Errors
@@ -241,18 +241,19 @@ impl<T: Real> ViewRenderer<T> {
         // Blocks of at least 16 rows: below that a thread costs more than it saves.
         let blocks = threads.min(n / 16).max(1);
         if blocks == 1 || self.grid.len() != grid_len(n) || self.kernel.filter() != spec.filter() {
-            return render_sampled(
-                &spec,
-                &self.kernel,
-                view,
-                sampling,
-                width,
-                height,
-                &tw,
-                &mut self.grid,
-                &mut self.aux,
-                out,
-            );
+            return render(
+                &Source::new(&spec, &self.kernel, &tw),
+                &Request {
+                    sampling: *sampling,
+                    ..Request::new(*view, width, height)
+                },
+                Buffers {
+                    grid: &mut self.grid,
+                    aux: &mut self.aux,
+                    out,
+                },
+            )
+            .map(|_| ());
         }
         let axes = sampling.slice_axes(&view.frame()?);
         check_image(width, height, n)?;
@@ -276,13 +277,10 @@ impl<T: Real> ViewRenderer<T> {
                 .try_for_each(|w| w.join().expect("an extraction thread panicked"))
         })?;
         let place = placement_on_axes(spec.dims(), &axes, width, height, 1.0);
-        finish_projection(
+        finish(
             &mut self.grid,
             n,
-            &place,
-            sampling.gain() / spec.scale(),
-            width,
-            height,
+            &Crop::new(place, sampling.gain() / spec.scale(), width, height),
             &tw,
             &mut self.aux,
             out,
@@ -574,7 +572,7 @@ impl AnySpectrum {
     /// a `width × height` image at pitch `2^level` voxels.
     ///
     /// # Errors
-    /// As [`fvr_core::progressive::render_level`].
+    /// As [`fvr_core::render::render_level`].
     pub fn render_level(
         &self,
         view: &View,
@@ -589,7 +587,7 @@ impl AnySpectrum {
     /// `2^level·sampling.pixel_size()` mm apart.
     ///
     /// # Errors
-    /// As [`fvr_core::progressive::render_level_sampled`].
+    /// As [`fvr_core::render::render_level_sampled`].
     pub fn render_level_sampled(
         &self,
         view: &View,
@@ -614,18 +612,18 @@ impl AnySpectrum {
             let mut grid = vec![T::ZERO; m * m];
             let mut aux = vec![T::ZERO; aux_len(m)];
             let mut out = vec![T::ZERO; w * h];
-            fvr_core::progressive::render_level_sampled(
-                &s.view(),
-                &kernel,
-                view,
-                sampling,
-                w,
-                h,
-                level,
-                &tw,
-                &mut grid,
-                &mut aux,
-                &mut out,
+            render(
+                &Source::new(&s.view(), &kernel, &tw),
+                &Request {
+                    sampling: *sampling,
+                    level,
+                    ..Request::new(*view, w, h)
+                },
+                Buffers {
+                    grid: &mut grid,
+                    aux: &mut aux,
+                    out: &mut out,
+                },
             )?;
             Ok(out.into_iter().map(T::to_f64).collect())
         }

@@ -11,14 +11,16 @@ use std::fmt::Write as _;
 
 use fvr_core::dht::{Rounding, Twiddles};
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
-use fvr_core::format::{
+use fvr_core::geometry::View;
+use fvr_core::image::{aux_len, grid_len};
+use fvr_core::num::{
     bf16, encode_blocks, encode_elements, Arithmetic, BlockExponents, BlockLayout, Blocking,
     Format, FormatName, Minifloat16, Minifloat8, Q15, Q7,
 };
-use fvr_core::geometry::View;
-use fvr_core::real::{Real, Sample};
-use fvr_core::render::{aux_len, grid_len, render};
-use fvr_core::spectrum::{padded_size, prepare_scratch_len, DenseVolume, Spectrum};
+use fvr_core::num::{Real, Sample};
+use fvr_core::render::{render, Buffers, Request, Source};
+use fvr_core::spectrum::{prepare_scratch_len, LineBlockStorage, Spectrum};
+use fvr_core::volume::{padded_size, DenseVolume};
 use half::f16;
 
 use crate::phantom::Phantom;
@@ -91,9 +93,11 @@ impl<S: Sample> StoredSpectrum<S> {
         let spec = Spectrum::prepare_line_blocks(
             &source,
             filter,
-            &mut data,
-            &mut exps,
-            &mut exps_scratch,
+            LineBlockStorage {
+                mantissas: &mut data,
+                exponents: &mut exps,
+                exponent_scratch: &mut exps_scratch,
+            },
             &mut scratch,
             &tw,
             rounding,
@@ -200,15 +204,13 @@ impl<S: Sample> StoredSpectrum<S> {
         let mut aux = vec![T::ZERO; aux_len(n)];
         let mut out = vec![T::ZERO; width * height];
         render(
-            &self.view(),
-            &kernel,
-            view,
-            width,
-            height,
-            &tw,
-            &mut grid,
-            &mut aux,
-            &mut out,
+            &Source::new(&self.view(), &kernel, &tw),
+            &Request::new(*view, width, height),
+            Buffers {
+                grid: &mut grid,
+                aux: &mut aux,
+                out: &mut out,
+            },
         )?;
         Ok(out.into_iter().map(T::to_f64).collect())
     }

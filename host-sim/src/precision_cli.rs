@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use clap::Args;
 use fvr_core::filter::FilterKind;
-use fvr_core::format::{Arithmetic, Format, FormatName};
+use fvr_core::num::{Arithmetic, Format, FormatName};
 
 use crate::plot::{Point, Scatter};
 use crate::precision::{
@@ -123,9 +123,8 @@ pub fn run(args: &PrecisionArgs) -> Result<(), String> {
         let mut subject = Subject::load(spec, kind, oversampling)?;
         // Formats this grid cannot hold (a brick that does not divide it) are
         // configuration errors, reported before any transform.
-        let grid =
-            fvr_core::spectrum::padded_size(subject.volume.dims, subject.filter.oversample())
-                .map_err(|e| e.to_string())?;
+        let grid = fvr_core::volume::padded_size(subject.volume.dims, subject.filter.oversample())
+            .map_err(|e| e.to_string())?;
         for &f in &formats {
             for a in crate::precision::modes_for(f) {
                 f.check(a, grid)

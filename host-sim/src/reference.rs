@@ -10,10 +10,11 @@
 
 use std::f64::consts::PI;
 
+use fvr_core::dht::signed_index;
 use fvr_core::dht::Twiddles;
 use fvr_core::geometry::{center, Sampling, View};
-use fvr_core::render::{check_image, finish_projection, placement, signed_index};
-use fvr_core::spectrum::padded_size;
+use fvr_core::image::{check_image, finish, placement, Crop};
+use fvr_core::volume::padded_size;
 
 use crate::phantom::Phantom;
 use crate::volume::Volume;
@@ -221,8 +222,13 @@ pub fn ideal_projection(
     let mut aux = vec![0.0f64; 4 * n];
     let mut out = vec![0.0f64; width * height];
     let place = placement(dims, &frame, width, height);
-    finish_projection(
-        &mut grid, n, &place, 1.0, width, height, &tw, &mut aux, &mut out,
+    finish(
+        &mut grid,
+        n,
+        &Crop::new(place, 1.0, width, height),
+        &tw,
+        &mut aux,
+        &mut out,
     )?;
     Ok(out)
 }

@@ -61,7 +61,7 @@
 use std::path::{Path, PathBuf};
 
 use fvr_core::filter::FilterKind;
-use fvr_core::scene::{Light, MAX_LIGHTS};
+use fvr_core::shading::{Light, MAX_LIGHTS};
 use toml::{Table, Value};
 
 use crate::nrrd::{Endian, SampleType};

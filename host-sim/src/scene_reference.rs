@@ -22,9 +22,9 @@ use crate::shaded::Image;
 use crate::volume::Volume;
 use fvr_core::dht::Twiddles;
 use fvr_core::geometry::{center, Sampling, View};
-use fvr_core::gradient::{gradient_scratch_len, partial_derivative};
-use fvr_core::scene::{CueTerms, Scene};
-use fvr_core::spectrum::DenseVolume;
+use fvr_core::shading::gradient::{gradient_scratch_len, partial_derivative};
+use fvr_core::shading::{CueTerms, Scene};
+use fvr_core::volume::DenseVolume;
 
 /// Per-channel coefficients `(A_c, K_c, M_c)`.
 fn channel_terms(scene: &Scene) -> Vec<(f64, f64, [f64; 3])> {
@@ -167,6 +167,8 @@ pub fn exact_scene_projection(
 ///
 /// # Errors
 /// As [`exact_scene_projection`].
+// TODO(layout-host): group the parameters (the workspace allow is gone).
+#[allow(clippy::too_many_arguments)]
 pub fn exact_scene_projection_sampled(
     mixture: &GaussianMixture,
     dims: [usize; 3],

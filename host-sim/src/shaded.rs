@@ -6,12 +6,13 @@ use crate::volume::Volume;
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::{DerivativeTable, Filter, KernelTable};
 use fvr_core::geometry::{Sampling, View};
-use fvr_core::gradient::{gradient_magnitude, gradient_scratch_len};
-use fvr_core::real::{Real, Sample};
-use fvr_core::render::aux_len;
-use fvr_core::scene::{DepthCue, Light, Scene, MAX_PROFILE_POINTS};
-use fvr_core::scene_render::{fields_len, render_scene};
-use fvr_core::spectrum::DenseVolume;
+use fvr_core::image::aux_len;
+use fvr_core::num::{Real, Sample};
+use fvr_core::render::{render, Buffers, Request, Source};
+use fvr_core::shading::fields_len;
+use fvr_core::shading::gradient::{gradient_magnitude, gradient_scratch_len};
+use fvr_core::shading::{DepthCue, Light, Scene, MAX_PROFILE_POINTS};
+use fvr_core::volume::DenseVolume;
 
 /// An image of 1 (grey) or 3 (RGB) interleaved channels, row 0 at the top.
 #[derive(Clone, Debug, PartialEq)]
@@ -160,7 +161,7 @@ impl SceneSpectra {
     /// Render one view of `scene`; the image comes back in f64.
     ///
     /// # Errors
-    /// As [`render_scene`], and a scene that needs a `|∇f|` spectrum these
+    /// As [`fvr_core::render::render`], and a scene that needs a `|∇f|` spectrum these
     /// spectra were not prepared with.
     pub fn render(
         &self,
@@ -260,8 +261,9 @@ impl<T: Real> SceneRenderer<T> {
     /// returns the channel count.
     ///
     /// # Errors
-    /// As [`render_scene`]; a scene with more fields than this renderer was
+    /// As [`fvr_core::render::render`]; a scene with more fields than this renderer was
     /// built for.
+    // TODO(layout-host): group the parameters (the workspace allow is gone).
     #[allow(clippy::too_many_arguments)]
     pub fn render_into<S: Sample>(
         &mut self,
@@ -282,19 +284,23 @@ impl<T: Real> SceneRenderer<T> {
         }
         let tw = Twiddles::from_table(&self.tw, self.n)?;
         let g = gradient.map(OwnedSpectrum::view);
-        render_scene(
-            &density.view(),
-            g.as_ref(),
-            &self.kernel,
-            self.derivative.as_ref(),
-            scene,
-            view,
-            width,
-            height,
-            &tw,
-            &mut self.fields,
-            &mut self.aux,
-            out,
+        render(
+            &Source {
+                spectrum: &density.view(),
+                gradient: g.as_ref(),
+                kernel: &self.kernel,
+                derivative: self.derivative.as_ref(),
+                twiddles: &tw,
+            },
+            &Request {
+                scene: Some(scene),
+                ..Request::new(*view, width, height)
+            },
+            Buffers {
+                grid: &mut self.fields,
+                aux: &mut self.aux,
+                out,
+            },
         )
     }
 }
@@ -493,7 +499,7 @@ pub fn negative_cue_share(
     let dims = volume.dims;
     let c = fvr_core::geometry::center(dims);
     let radius = dims.iter().copied().max().unwrap_or(1) as f64 / 2.0;
-    let terms = fvr_core::scene::CueTerms::new(&scene.cue, radius)?;
+    let terms = fvr_core::shading::CueTerms::new(&scene.cue, radius)?;
     // The weight on a table over the box's depth range (it is smooth).
     let reach: f64 = (0..3)
         .map(|a| d[a].abs() * dims[a] as f64 / 2.0)
@@ -579,7 +585,7 @@ pub fn parse_light_ring(s: &str) -> Result<(usize, f64), String> {
         .trim()
         .parse()
         .ok()
-        .filter(|c| (1..=fvr_core::scene::MAX_LIGHTS).contains(c))
+        .filter(|c| (1..=fvr_core::shading::MAX_LIGHTS).contains(c))
         .ok_or_else(|| format!("light ring needs a count from 1 to 8, got `{s}`"))?;
     let tilt = match tilt {
         Some(t) => t

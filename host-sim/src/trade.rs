@@ -21,14 +21,14 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
-use fvr_core::adaptive::{extract_slice_adaptive, marks_words, AdaptiveLevel, Marks};
 use fvr_core::dht::{Rounding, Twiddles};
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
-use fvr_core::format::{bf16, BlockLayout, Blocking, Format, FormatName, Minifloat16, Q15};
 use fvr_core::geometry::View;
-use fvr_core::progressive::render_level;
-use fvr_core::real::Sample;
-use fvr_core::render::{aux_len, finish_projection, placement, render};
+use fvr_core::image::{aux_len, finish, placement, Crop};
+use fvr_core::num::Sample;
+use fvr_core::num::{bf16, BlockLayout, Blocking, Format, FormatName, Minifloat16, Q15};
+use fvr_core::render::{render, Buffers, Request, Source};
+use fvr_core::slice::adaptive::{extract_slice_adaptive, marks_words, AdaptiveLevel, Marks};
 use fvr_core::spectrum::{prepare_scratch_len, Spectrum};
 use half::f16;
 
@@ -806,42 +806,39 @@ impl<'s, 'm, S: Sample> Renderer<'s, 'm, S> {
             self.taps += stats.taps;
             self.full_taps += stats.full_taps;
             let place = placement(self.spec.dims(), &frame, side, side);
-            finish_projection(
+            finish(
                 &mut self.grid,
                 n,
-                &place,
-                1.0 / self.spec.scale(),
-                side,
-                side,
+                &Crop::new(place, 1.0 / self.spec.scale(), side, side),
                 &tw,
                 &mut self.aux,
                 &mut self.out,
             )
         } else if self.level == 0 {
             render(
-                self.spec,
-                &self.kernel,
-                view,
-                side,
-                side,
-                &tw,
-                &mut self.grid,
-                &mut self.aux,
-                &mut self.out,
+                &Source::new(self.spec, &self.kernel, &tw),
+                &Request::new(*view, side, side),
+                Buffers {
+                    grid: &mut self.grid,
+                    aux: &mut self.aux,
+                    out: &mut self.out,
+                },
             )
+            .map(|_| ())
         } else {
-            render_level(
-                self.spec,
-                &self.kernel,
-                view,
-                side,
-                side,
-                self.level,
-                &tw,
-                &mut self.grid,
-                &mut self.aux,
-                &mut self.out,
+            render(
+                &Source::new(self.spec, &self.kernel, &tw),
+                &Request {
+                    level: self.level,
+                    ..Request::new(*view, side, side)
+                },
+                Buffers {
+                    grid: &mut self.grid,
+                    aux: &mut self.aux,
+                    out: &mut self.out,
+                },
             )
+            .map(|_| ())
         }
     }
 }
@@ -1317,7 +1314,7 @@ pub fn run(args: &TradeArgs) -> Result<(), String> {
 mod tests {
     use super::*;
     use crate::phantom::SplitMix64;
-    use fvr_core::spectrum::padded_size;
+    use fvr_core::volume::padded_size;
 
     /// On a random cloud with ties, no front point is dominated by any
     /// point, and every point off the front is dominated by one on it.

@@ -7,7 +7,7 @@
 use std::f64::consts::TAU;
 
 use fvr_core::geometry::{Sampling, View};
-use fvr_core::real::{Real, Sample};
+use fvr_core::num::{Real, Sample};
 use indicatif::ProgressBar;
 
 use crate::pipeline::{AnySpectrum, OwnedSpectrum, ViewRenderer};

@@ -1,1 +1,34 @@
-//! Cross-crate integration tests live in `tests/tests/`.
+//! Cross-crate integration tests live in `tests/tests/`; this library holds
+//! the setup they share.
+
+use fvr_core::filter::{Filter, FilterKind};
+use fvr_core::num::{Real, Sample};
+use fvr_host::phantom::{sample, GaussianMixture};
+use fvr_host::pipeline::OwnedSpectrum;
+
+/// A random Gaussian mixture (`GaussianMixture::random(seed, n, count)`)
+/// sampled on `dims`, prepared for `kind` at `oversample` in storage `S`
+/// with arithmetic `T`; with the filter.
+pub fn mixture_spectrum<S: Sample, T: Real>(
+    (seed, n, count): (u64, usize, usize),
+    dims: [usize; 3],
+    kind: FilterKind,
+    oversample: u32,
+) -> (OwnedSpectrum<S>, Filter) {
+    let volume = sample(&GaussianMixture::random(seed, n, count), dims);
+    let filter = Filter::new(kind, oversample).unwrap();
+    let spec = OwnedSpectrum::<S>::prepare::<T>(&volume, filter).unwrap();
+    (spec, filter)
+}
+
+/// `let` bindings of twiddle tables serving lengths up to `n`, one per
+/// arithmetic type: `twiddles!(n; tw64: f64, tw32: f32)`.
+#[macro_export]
+macro_rules! twiddles {
+    ($n:expr; $($name:ident: $t:ty),+) => {
+        $(
+            let mut $name = vec![<$t>::default(); ::fvr_core::dht::Twiddles::<$t>::buffer_len($n)];
+            let $name = ::fvr_core::dht::Twiddles::new(&mut $name, $n).unwrap();
+        )+
+    };
+}

@@ -1,13 +1,14 @@
 //! Adaptive filtering (paper §4): the tolerance holds, the marks are what
 //! the paper defines, and the statistics add up.
 
-use fvr_core::adaptive::{mark, marks_words, threshold_for, Marks};
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
+use fvr_core::slice::adaptive::{mark, marks_words, threshold_for, Marks};
 use fvr_host::adaptive::{parse_chain, parse_tolerance, AdaptiveMarks, AdaptiveSettings, Bound};
 use fvr_host::phantom::{sample, GaussianMixture, SheppLogan};
 use fvr_host::pipeline::{AnySpectrum, OwnedSpectrum};
 use fvr_host::reference::snr_db;
+use fvr_tests::mixture_spectrum;
 use half::f16;
 
 /// Adaptive settings with the 1³ filter and the given bound.
@@ -80,9 +81,7 @@ fn adaptive_images_stay_within_the_requested_tolerance() {
 #[test]
 fn exact_bound_is_within_budget_and_no_tighter_than_the_papers() {
     let n = 32;
-    let volume = sample(&GaussianMixture::random(5, n, 8), [n; 3]);
-    let filter = Filter::new(FilterKind::Kb4, 2).unwrap();
-    let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+    let (spec, _) = mixture_spectrum::<f16, f32>((5, n, 8), [n; 3], FilterKind::Kb4, 2);
     for tol in [30.0, 45.0, 60.0] {
         let exact = AdaptiveMarks::build(&spec, &nearest(tol, Bound::Exact)).unwrap();
         let paper = AdaptiveMarks::build(&spec, &nearest(tol, Bound::Paper)).unwrap();
@@ -150,7 +149,7 @@ fn direct_error_ratio(spec: &OwnedSpectrum<f16>, tau: f64, gain: f64) -> f64 {
     let f_weak = fvr_host::reference::naive_dht_3d(&weak, [n; 3]);
     let small = Filter::new(FilterKind::Nearest, 2).unwrap();
     let large = spec.filter();
-    let pos = |k: usize| fvr_core::render::signed_index(k, n) as f64 / n as f64;
+    let pos = |k: usize| fvr_core::dht::signed_index(k, n) as f64 / n as f64;
     let (mut err, mut reference) = (0.0, 0.0);
     for z in 0..n {
         for y in 0..n {
@@ -243,9 +242,7 @@ fn threshold_meets_the_energy_budget_and_is_nearly_the_largest() {
 #[test]
 fn statistics_add_up_and_report_no_effect() {
     let n = 32;
-    let volume = sample(&GaussianMixture::random(3, n, 6), [n; 3]);
-    let filter = Filter::new(FilterKind::Kb4, 2).unwrap();
-    let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+    let (spec, _) = mixture_spectrum::<f16, f32>((3, n, 6), [n; 3], FilterKind::Kb4, 2);
     let view = View::along([1.0, 0.4, 0.1]);
     let settings = AdaptiveSettings {
         chain: parse_chain("nearest").unwrap(),

@@ -15,16 +15,17 @@
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::{Sampling, View};
-use fvr_core::progressive::{render_level, render_level_sampled};
-use fvr_core::render::{aux_len, grid_len, render, render_sampled};
-use fvr_core::scene::{DepthCue, Light, Scene};
+use fvr_core::image::{aux_len, grid_len};
+use fvr_core::render::{render, Buffers, Request, Source};
+use fvr_core::shading::{DepthCue, Light, Scene};
 use fvr_core::Error;
 use fvr_host::accuracy::{CONFIGS, VIEWS};
-use fvr_host::phantom::{sample, sample_spaced, GaussianMixture};
-use fvr_host::pipeline::{choose_filter, AnySpectrum, KbDesign, OwnedSpectrum, Precision};
+use fvr_host::phantom::{sample_spaced, GaussianMixture};
+use fvr_host::pipeline::{choose_filter, AnySpectrum, KbDesign, Precision};
 use fvr_host::reference::{exact_projection_sampled, snr_db};
 use fvr_host::scene_reference::exact_scene_projection_sampled;
 use fvr_host::shaded::SceneSpectra;
+use fvr_tests::mixture_spectrum;
 use half::f16;
 
 /// The anisotropic spacing under test (mm).
@@ -160,75 +161,39 @@ fn anisotropic_and_isotropic_samplings_of_one_object_agree() {
 fn unit_sampling_is_bit_identical_to_voxel_units() {
     assert_eq!(Sampling::new([1.0; 3], 1.0).unwrap(), Sampling::UNIT);
     let dims = [40, 37, 33];
-    let volume = sample(&GaussianMixture::random(5, 40, 6), dims);
-    let filter = Filter::new(FilterKind::Kb4, 1).unwrap();
-    let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+    let (spec, filter) = mixture_spectrum::<f16, f32>((5, 40, 6), dims, FilterKind::Kb4, 1);
     let n = spec.n();
     let kernel = KernelTable::<f32>::new(filter);
     let mut tw_buf = vec![0.0f32; Twiddles::<f32>::buffer_len(n)];
     let tw = Twiddles::new(&mut tw_buf, n).unwrap();
     let mut grid = vec![0.0f32; grid_len(n)];
     let mut aux = vec![0.0f32; aux_len(n)];
+    let unit = Sampling::new([1.0; 3], 1.0).unwrap();
     for dir in [[1.0, 0.3, 0.2], [-0.4, 1.0, 0.7]] {
         let view = View::along(dir);
-        let (w, h) = (63, 50);
-        let mut old = vec![0.0f32; w * h];
-        let mut new = vec![0.0f32; w * h];
-        let s = spec.view();
-        render(&s, &kernel, &view, w, h, &tw, &mut grid, &mut aux, &mut old).unwrap();
-        render_sampled(
-            &s,
-            &kernel,
-            &view,
-            &Sampling::UNIT,
-            w,
-            h,
-            &tw,
-            &mut grid,
-            &mut aux,
-            &mut new,
-        )
-        .unwrap();
-        assert!(old.iter().any(|&v| v != 0.0));
-        assert_eq!(
-            old.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
-            new.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
-        );
-        let (pw, ph) = (31, 25);
-        let mut old = vec![0.0f32; pw * ph];
-        let mut new = vec![0.0f32; pw * ph];
-        let m = n / 2;
-        render_level(
-            &s,
-            &kernel,
-            &view,
-            pw,
-            ph,
-            1,
-            &tw,
-            &mut grid[..m * m],
-            &mut aux,
-            &mut old,
-        )
-        .unwrap();
-        render_level_sampled(
-            &s,
-            &kernel,
-            &view,
-            &Sampling::UNIT,
-            pw,
-            ph,
-            1,
-            &tw,
-            &mut grid[..m * m],
-            &mut aux,
-            &mut new,
-        )
-        .unwrap();
-        assert_eq!(
-            old.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
-            new.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
-        );
+        // The full view, then a progressive preview.
+        for (level, (w, h)) in [(0, (63, 50)), (1, (31, 25))] {
+            let m = n >> level;
+            let defaults = Request {
+                level,
+                ..Request::new(view, w, h)
+            };
+            let sampled = Request {
+                sampling: unit,
+                ..defaults
+            };
+            let [old, new] = [defaults, sampled].map(|request| {
+                let mut out = vec![0.0f32; w * h];
+                let buffers = Buffers::new(&mut grid[..m * m], &mut aux, &mut out);
+                render(&Source::new(&spec.view(), &kernel, &tw), &request, buffers).unwrap();
+                out
+            });
+            assert!(old.iter().any(|&v| v != 0.0));
+            assert_eq!(
+                old.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                new.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+            );
+        }
     }
 }
 

@@ -3,7 +3,8 @@
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
-use fvr_core::spectrum::{prepare_scratch_len, DenseVolume, Spectrum};
+use fvr_core::spectrum::{prepare_scratch_len, Spectrum};
+use fvr_core::volume::DenseVolume;
 use fvr_core::Error;
 use fvr_host::pipeline::{AnySpectrum, OwnedSpectrum, Precision};
 use fvr_host::reference::snr_db;

@@ -1,6 +1,6 @@
 //! The f16 storage codec over all 65,536 bit patterns.
 
-use fvr_core::real::{Real, Sample};
+use fvr_core::num::{Real, Sample};
 use half::f16;
 
 #[test]
@@ -61,7 +61,7 @@ fn values_beyond_the_f16_range_become_infinite_and_are_reported_non_finite() {
 #[test]
 fn fast_f16_widening_is_bit_identical_to_half_for_every_pattern() {
     for bits in 0..=u16::MAX {
-        let fast = fvr_core::real::f16_bits_to_f32(bits);
+        let fast = fvr_core::num::f16_bits_to_f32(bits);
         let reference = f16::from_bits(bits).to_f32();
         assert_eq!(fast.to_bits(), reference.to_bits(), "{bits:#06x}");
         // And the storage trait uses it.
@@ -71,18 +71,18 @@ fn fast_f16_widening_is_bit_identical_to_half_for_every_pattern() {
         );
     }
     // The subnormal and boundary cases the rebias relies on, by value.
-    assert_eq!(fvr_core::real::f16_bits_to_f32(0x0001), 2f32.powi(-24));
+    assert_eq!(fvr_core::num::f16_bits_to_f32(0x0001), 2f32.powi(-24));
     assert_eq!(
-        fvr_core::real::f16_bits_to_f32(0x03FF),
+        fvr_core::num::f16_bits_to_f32(0x03FF),
         1023.0 * 2f32.powi(-24)
     );
-    assert_eq!(fvr_core::real::f16_bits_to_f32(0x0400), 2f32.powi(-14));
-    assert_eq!(fvr_core::real::f16_bits_to_f32(0x7BFF), 65504.0);
+    assert_eq!(fvr_core::num::f16_bits_to_f32(0x0400), 2f32.powi(-14));
+    assert_eq!(fvr_core::num::f16_bits_to_f32(0x7BFF), 65504.0);
     assert_eq!(
-        fvr_core::real::f16_bits_to_f32(0x8000).to_bits(),
+        fvr_core::num::f16_bits_to_f32(0x8000).to_bits(),
         (-0.0f32).to_bits()
     );
-    assert_eq!(fvr_core::real::f16_bits_to_f32(0xFC00), f32::NEG_INFINITY);
+    assert_eq!(fvr_core::num::f16_bits_to_f32(0xFC00), f32::NEG_INFINITY);
 }
 
 #[test]
@@ -92,7 +92,7 @@ fn raw_f16_widening_times_two_pow_112_is_the_value_for_every_finite_pattern() {
     let two_pow_112 = f32::exp2i(112);
     assert_eq!(<f32 as Real>::raw_exponent::<f16>(), 112);
     for bits in (0..0x7C00u16).chain(0x8000..0xFC00u16) {
-        let raw = fvr_core::real::f16_bits_to_f32_raw(bits);
+        let raw = fvr_core::num::f16_bits_to_f32_raw(bits);
         let value = f16::from_bits(bits).to_f32();
         assert_eq!(
             (raw * two_pow_112).to_bits(),

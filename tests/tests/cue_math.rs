@@ -3,9 +3,9 @@
 
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::{DerivativeTable, Filter, FilterKind, TABLE_RESOLUTION};
-use fvr_core::gradient::{gradient_magnitude, gradient_scratch_len};
-use fvr_core::scene::{CueTerms, DepthCue};
-use fvr_core::spectrum::DenseVolume;
+use fvr_core::shading::gradient::{gradient_magnitude, gradient_scratch_len};
+use fvr_core::shading::{CueTerms, DepthCue};
+use fvr_core::volume::DenseVolume;
 use fvr_host::phantom::{sample, Gaussian, Phantom};
 use fvr_host::reference::snr_db;
 
@@ -90,28 +90,22 @@ fn linear_and_sine_cues_pass_through_front_and_back() {
     }
 }
 
+/// The sine and linear cues from 1 at the front to `back`, over radius `r`.
+fn sine_and_linear(back: f64, r: f64) -> (CueTerms, CueTerms) {
+    let terms = |cue| CueTerms::new(&cue, r).unwrap();
+    (
+        terms(DepthCue::Sine { front: 1.0, back }),
+        terms(DepthCue::Linear { front: 1.0, back }),
+    )
+}
+
 /// The documented distance of the sine cue from the linear one: for 1,0 it
 /// is `sin(π(R − t)/4R)`, at most 0.2105 above the ramp, near t = −0.121R;
 /// for 1,0.5 at most 0.1163.
 #[test]
 fn sine_cue_departs_from_linear_as_documented() {
     let r = 50.0;
-    let sine = CueTerms::new(
-        &DepthCue::Sine {
-            front: 1.0,
-            back: 0.0,
-        },
-        r,
-    )
-    .unwrap();
-    let linear = CueTerms::new(
-        &DepthCue::Linear {
-            front: 1.0,
-            back: 0.0,
-        },
-        r,
-    )
-    .unwrap();
+    let (sine, linear) = sine_and_linear(0.0, r);
     let (mut worst, mut at) = (0.0f64, 0.0);
     for s in 0..=10000 {
         let t = -r + 2.0 * r * s as f64 / 10000.0;
@@ -124,22 +118,7 @@ fn sine_cue_departs_from_linear_as_documented() {
     }
     assert!((worst - 0.2105).abs() < 1e-3, "{worst}");
     assert!((at / r + 0.121).abs() < 2e-3, "{at}");
-    let sine = CueTerms::new(
-        &DepthCue::Sine {
-            front: 1.0,
-            back: 0.5,
-        },
-        r,
-    )
-    .unwrap();
-    let linear = CueTerms::new(
-        &DepthCue::Linear {
-            front: 1.0,
-            back: 0.5,
-        },
-        r,
-    )
-    .unwrap();
+    let (sine, linear) = sine_and_linear(0.5, r);
     let worst = (0..=10000)
         .map(|s| -r + 2.0 * r * s as f64 / 10000.0)
         .map(|t| sine.weight(t) - linear.weight(t))

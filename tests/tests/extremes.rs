@@ -11,9 +11,9 @@
 //! to be free of NaN and infinity.
 
 use fvr_core::filter::{Filter, FilterKind};
-use fvr_core::format::{Arithmetic, BlockLayout, Blocking, Format, FormatName};
 use fvr_core::geometry::View;
-use fvr_core::real::Sample;
+use fvr_core::num::Sample;
+use fvr_core::num::{Arithmetic, BlockLayout, Blocking, Format, FormatName};
 use fvr_core::spectrum::{premultiplier_table, scale_for_target};
 use fvr_host::pipeline::{
     choose_filter, choose_oversampling, premultiplication_gain_db, KbDesign, CONDITIONING_LIMIT_DB,
@@ -178,7 +178,7 @@ fn constant_volume_projects_to_c_times_n_along_an_axis_up_to_kb4_aliasing_in_f64
 #[test]
 fn impulse_spectrum_is_exactly_flat_in_every_format_and_images_reach_their_floor() {
     use fvr_core::dht::Rounding;
-    use fvr_core::format::{bf16, Minifloat16, Minifloat8};
+    use fvr_core::num::{bf16, Minifloat16, Minifloat8};
     use fvr_host::precision::StoredSpectrum;
     use half::f16;
     let mut volume = Volume::zeros([16; 3]);
@@ -237,7 +237,7 @@ fn nyquist_checkerboard_projects_to_near_zero_in_every_16_bit_format_and_8_bit_s
 /// both oversamplings, with a scale f32 arithmetic holds exactly.
 #[test]
 fn full_range_u16_volume_at_512_cubed_cannot_overflow_any_format_by_the_scaling_rule() {
-    use fvr_core::format::{bf16, Minifloat16, Minifloat8, Q15, Q7};
+    use fvr_core::num::{bf16, Minifloat16, Minifloat8, Q15, Q7};
     use half::f16;
     let c = 65535.0f64;
     let side = 512usize;
@@ -471,7 +471,7 @@ fn sizes_1_2_and_4_work_in_every_format() {
             let mut s = Subject::new("small", volume.clone(), None, filter, views);
             let (reference, _) = s.render_format(Format::F64, Arithmetic::PerPass).unwrap();
             assert!(reference.iter().flatten().all(|v| v.is_finite()));
-            let grid = fvr_core::spectrum::padded_size([n; 3], o).unwrap();
+            let grid = fvr_core::volume::padded_size([n; 3], o).unwrap();
             for format in fvr_host::precision::default_formats() {
                 for arithmetic in fvr_host::precision::modes_for(format) {
                     if let Format::Q15(Blocking::Blocks(BlockLayout::Brick(b)))

@@ -5,11 +5,13 @@
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::View;
-use fvr_core::render::{aux_len, grid_len, render};
+use fvr_core::image::{aux_len, grid_len};
+use fvr_core::render::{render, Buffers, Request, Source};
 use fvr_core::spectrum::{CubeSide, Spectrum};
 use fvr_core::Error;
 use fvr_host::phantom::{sample, GaussianMixture};
 use fvr_host::pipeline::OwnedSpectrum;
+use fvr_tests::mixture_spectrum;
 use half::f16;
 
 const N: usize = 32;
@@ -22,7 +24,9 @@ fn render_view<Z: CubeSide>(spec: &Spectrum<'_, f16, Z>, filter: Filter, view: &
     let (mut grid, mut aux) = (vec![0.0f32; grid_len(n)], vec![0.0f32; aux_len(n)]);
     let mut out = vec![0.0f32; n * n];
     render(
-        spec, &kernel, view, n, n, &tw, &mut grid, &mut aux, &mut out,
+        &Source::new(spec, &kernel, &tw),
+        &Request::new(*view, n, n),
+        Buffers::new(&mut grid, &mut aux, &mut out),
     )
     .unwrap();
     out
@@ -64,9 +68,7 @@ fn a_compile_time_side_renders_the_run_time_image_bit_for_bit() {
 
 #[test]
 fn a_wrong_compile_time_side_is_an_error_naming_both_sides() {
-    let volume = sample(&GaussianMixture::random(3, N, 2), [N; 3]);
-    let filter = Filter::new(FilterKind::Kb3, 1).unwrap();
-    let owned = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+    let (owned, _) = mixture_spectrum::<f16, f32>((3, N, 2), [N; 3], FilterKind::Kb3, 1);
     match owned.view().with_side::<64>() {
         Err(Error::LengthMismatch {
             what,

@@ -3,11 +3,11 @@
 //! underflow; and bit-identity of the generic minifloat with `half`'s f16 and
 //! bf16.
 
-use fvr_core::format::{
+use fvr_core::num::Sample;
+use fvr_core::num::{
     bf16, Arithmetic, BlockLayout, Blocking, FloatLayout, Format, FormatName, Minifloat16,
     Minifloat8, Q15, Q7,
 };
-use fvr_core::real::Sample;
 use fvr_core::Error;
 use half::f16;
 
@@ -88,23 +88,21 @@ fn check_float_codec<S: Sample>(layout: FloatLayout, bits: u32, make: impl Fn(u3
     assert!(t == 14 || 2f64.powi(t + 2) > S::MAX_FINITE, "{}", S::NAME);
 }
 
+/// [`check_float_codec`] for each exponent width `E` of a minifloat type.
+macro_rules! check_splits {
+    ($ty:ident, $bits:ty, $width:expr; $($e:literal),+) => {
+        $(check_float_codec($ty::<$e>::LAYOUT, $width, |b| $ty::<$e>(b as $bits));)+
+    };
+}
+
 #[test]
 fn every_16_bit_minifloat_split_round_trips_orders_and_rounds_to_nearest_even() {
-    check_float_codec(Minifloat16::<2>::LAYOUT, 16, |b| Minifloat16::<2>(b as u16));
-    check_float_codec(Minifloat16::<3>::LAYOUT, 16, |b| Minifloat16::<3>(b as u16));
-    check_float_codec(Minifloat16::<4>::LAYOUT, 16, |b| Minifloat16::<4>(b as u16));
-    check_float_codec(Minifloat16::<5>::LAYOUT, 16, |b| Minifloat16::<5>(b as u16));
-    check_float_codec(Minifloat16::<6>::LAYOUT, 16, |b| Minifloat16::<6>(b as u16));
-    check_float_codec(Minifloat16::<7>::LAYOUT, 16, |b| Minifloat16::<7>(b as u16));
-    check_float_codec(Minifloat16::<8>::LAYOUT, 16, |b| Minifloat16::<8>(b as u16));
+    check_splits!(Minifloat16, u16, 16; 2, 3, 4, 5, 6, 7, 8);
 }
 
 #[test]
 fn every_8_bit_minifloat_split_round_trips_orders_and_rounds_to_nearest_even() {
-    check_float_codec(Minifloat8::<2>::LAYOUT, 8, |b| Minifloat8::<2>(b as u8));
-    check_float_codec(Minifloat8::<3>::LAYOUT, 8, |b| Minifloat8::<3>(b as u8));
-    check_float_codec(Minifloat8::<4>::LAYOUT, 8, |b| Minifloat8::<4>(b as u8));
-    check_float_codec(Minifloat8::<5>::LAYOUT, 8, |b| Minifloat8::<5>(b as u8));
+    check_splits!(Minifloat8, u8, 8; 2, 3, 4, 5);
     assert_eq!(<Minifloat8<4> as Sample>::MAX_FINITE, 240.0);
     assert_eq!(<Minifloat8<5> as Sample>::MAX_FINITE, 57344.0);
 }
@@ -298,7 +296,8 @@ fn format_names_and_bytes_per_voxel() {
 fn q15_line_blocks_prepared_in_place_match_the_f64_spectrum_within_five_roundings() {
     use fvr_core::dht::{Rounding, Twiddles};
     use fvr_core::filter::{Filter, FilterKind};
-    use fvr_core::spectrum::{prepare_scratch_len, DenseVolume, Spectrum};
+    use fvr_core::spectrum::{prepare_scratch_len, LineBlockStorage, Spectrum};
+    use fvr_core::volume::DenseVolume;
     let n = 16usize;
     let mut state = 7u64;
     let data: Vec<f32> = (0..n * n * n)
@@ -325,7 +324,16 @@ fn q15_line_blocks_prepared_in_place_match_the_f64_spectrum_within_five_rounding
         let mut m = vec![Q15::default(); grid * grid * grid];
         let (mut e, mut e2) = (vec![0i8; grid * grid], vec![0i8; grid * grid]);
         let spec = Spectrum::prepare_line_blocks(
-            &source, filter, &mut m, &mut e, &mut e2, &mut s32, &tw32, rounding,
+            &source,
+            filter,
+            LineBlockStorage {
+                mantissas: &mut m,
+                exponents: &mut e,
+                exponent_scratch: &mut e2,
+            },
+            &mut s32,
+            &tw32,
+            rounding,
         )
         .unwrap();
         assert!(spec.blocks().is_some());

@@ -2,21 +2,19 @@
 //! projection low-passed to the central (n/2^L)² frequencies and sampled
 //! every 2^L voxels.
 
-use fvr_core::dht::Twiddles;
-use fvr_core::filter::{Filter, FilterKind, KernelTable};
+use fvr_core::dht::{signed_index, Twiddles};
+use fvr_core::filter::{FilterKind, KernelTable};
 use fvr_core::geometry::View;
-use fvr_core::progressive::{max_level, preview_size, render_level};
-use fvr_core::render::{aux_len, extract_slice, finish_projection, placement, signed_index};
-use fvr_host::phantom::{sample, GaussianMixture};
-use fvr_host::pipeline::OwnedSpectrum;
+use fvr_core::image::{aux_len, finish, placement, Crop};
+use fvr_core::render::{max_level, preview_size, render, Buffers, Request, Source};
+use fvr_core::slice::extract_slice;
 use fvr_host::reference::snr_db;
+use fvr_tests::mixture_spectrum;
 
 #[test]
 fn preview_is_the_low_passed_projection_sampled_at_its_pitch() {
     let n = 64;
-    let volume = sample(&GaussianMixture::random(6, n, 8), [n; 3]);
-    let filter = Filter::new(FilterKind::Kb4, 1).unwrap();
-    let owned = OwnedSpectrum::<f64>::prepare::<f64>(&volume, filter).unwrap();
+    let (owned, filter) = mixture_spectrum::<f64, f64>((6, n, 8), [n; 3], FilterKind::Kb4, 1);
     let spec = owned.view();
     let kernel = KernelTable::<f64>::new(filter);
     let mut tw_buf = vec![0.0; Twiddles::<f64>::buffer_len(n)];
@@ -32,8 +30,13 @@ fn preview_is_the_low_passed_projection_sampled_at_its_pitch() {
         let mut grid = vec![0.0; m * m];
         let mut aux = vec![0.0; aux_len(m)];
         let mut out = vec![0.0; w * h];
-        render_level(
-            &spec, &kernel, &view, w, h, level, &tw, &mut grid, &mut aux, &mut out,
+        render(
+            &Source::new(&spec, &kernel, &tw),
+            &Request {
+                level,
+                ..Request::new(view, w, h)
+            },
+            Buffers::new(&mut grid, &mut aux, &mut out),
         )
         .unwrap();
         // Reference: the full slice with the outer frequencies zeroed.
@@ -51,13 +54,10 @@ fn preview_is_the_low_passed_projection_sampled_at_its_pitch() {
         let mut image = vec![0.0; n * n];
         let mut aux_full = vec![0.0; aux_len(n)];
         let place = placement(spec.dims(), &frame, n, n);
-        finish_projection(
+        finish(
             &mut full,
             n,
-            &place,
-            1.0 / spec.scale(),
-            n,
-            n,
+            &Crop::new(place, 1.0 / spec.scale(), n, n),
             &tw,
             &mut aux_full,
             &mut image,
@@ -72,30 +72,14 @@ fn preview_is_the_low_passed_projection_sampled_at_its_pitch() {
     }
     let mut big = vec![0.0; n * n];
     let mut aux = vec![0.0; aux_len(n)];
-    assert!(render_level(
-        &spec,
-        &kernel,
-        &view,
-        1,
-        1,
-        6,
-        &tw,
-        &mut big,
-        &mut aux,
-        &mut [0.0]
-    )
-    .is_err());
-    assert!(render_level(
-        &spec,
-        &kernel,
-        &view,
-        33,
-        33,
-        1,
-        &tw,
-        &mut big,
-        &mut aux,
-        &mut vec![0.0; 33 * 33]
-    )
-    .is_err());
+    // A level beyond max_level, and an image larger than the level's grid.
+    for (level, side) in [(6, 1), (1, 33)] {
+        let request = Request {
+            level,
+            ..Request::new(view, side, side)
+        };
+        let mut out = vec![0.0; side * side];
+        let buffers = Buffers::new(&mut big, &mut aux, &mut out);
+        assert!(render(&Source::new(&spec, &kernel, &tw), &request, buffers).is_err());
+    }
 }

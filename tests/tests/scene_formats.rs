@@ -4,18 +4,19 @@
 
 use fvr_core::dht::{Rounding, Twiddles};
 use fvr_core::filter::{DerivativeTable, Filter, FilterKind, KernelTable};
-use fvr_core::format::{BlockLayout, Blocking, Q15};
 use fvr_core::geometry::View;
-use fvr_core::render::aux_len;
-use fvr_core::scene::{DepthCue, Light, Scene};
-use fvr_core::scene_render::{fields_len, render_scene};
+use fvr_core::image::aux_len;
+use fvr_core::num::{BlockLayout, Blocking, Q15};
+use fvr_core::render::{render, Buffers, Request, Source};
+use fvr_core::shading::fields_len;
+use fvr_core::shading::{DepthCue, Light, Scene};
 use fvr_core::spectrum::Spectrum;
 use fvr_host::phantom::{sample, GaussianMixture};
 use fvr_host::precision::StoredSpectrum;
 use fvr_host::reference::snr_db;
 use fvr_host::shaded::gradient_volume;
 
-fn render<S: fvr_core::real::Sample>(
+fn render_scene<S: fvr_core::num::Sample>(
     density: &Spectrum<'_, S>,
     gradient: &Spectrum<'_, S>,
     scene: &Scene,
@@ -30,19 +31,19 @@ fn render<S: fvr_core::real::Sample>(
     let mut fields = vec![0.0f32; fields_len(scene, n)];
     let mut aux = vec![0.0f32; aux_len(n)];
     let mut out = vec![0.0f32; 3 * n * n];
-    render_scene(
-        density,
-        Some(gradient),
-        &kernel,
-        Some(&derivative),
-        scene,
-        view,
-        n,
-        n,
-        &tw,
-        &mut fields,
-        &mut aux,
-        &mut out,
+    render(
+        &Source {
+            spectrum: density,
+            gradient: Some(gradient),
+            kernel: &kernel,
+            derivative: Some(&derivative),
+            twiddles: &tw,
+        },
+        &Request {
+            scene: Some(scene),
+            ..Request::new(*view, n, n)
+        },
+        Buffers::new(&mut fields, &mut aux, &mut out),
     )
     .unwrap();
     out
@@ -74,7 +75,7 @@ fn block_floating_point_spectra_render_cued_and_shaded_scenes() {
         let d = StoredSpectrum::<f32>::prepare::<f32>(&volume, filter, Rounding::PerPass).unwrap();
         let g =
             StoredSpectrum::<f32>::prepare::<f32>(&gradient, filter, Rounding::PerPass).unwrap();
-        render(&d.view(), &g.view(), &scene, &view)
+        render_scene(&d.view(), &g.view(), &scene, &view)
     };
     let to_f64 = |v: &[f32]| v.iter().map(|&x| x as f64).collect::<Vec<_>>();
 
@@ -83,7 +84,7 @@ fn block_floating_point_spectra_render_cued_and_shaded_scenes() {
         .unwrap();
     let g = StoredSpectrum::<Q15>::prepare_line_blocks::<f32>(&gradient, filter, Rounding::PerPass)
         .unwrap();
-    let line = render(&d.view(), &g.view(), &scene, &view);
+    let line = render_scene(&d.view(), &g.view(), &scene, &view);
     let snr_line = snr_db(&to_f64(&reference), &to_f64(&line));
 
     // Per-brick exponents, encoded from the f32 spectrum: the general path.
@@ -92,7 +93,7 @@ fn block_floating_point_spectra_render_cued_and_shaded_scenes() {
     let layout = Blocking::Blocks(BlockLayout::Brick(4));
     let db = StoredSpectrum::<Q15>::encode(&d32, layout).unwrap();
     let gb = StoredSpectrum::<Q15>::encode(&g32, layout).unwrap();
-    let brick = render(&db.view(), &gb.view(), &scene, &view);
+    let brick = render_scene(&db.view(), &gb.view(), &scene, &view);
     let snr_brick = snr_db(&to_f64(&reference), &to_f64(&brick));
 
     eprintln!("per-line {snr_line:.1} dB, per-brick {snr_brick:.1} dB");

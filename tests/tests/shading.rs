@@ -9,7 +9,7 @@
 
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
-use fvr_core::scene::{DepthCue, Light, Scene, MAX_LIGHTS};
+use fvr_core::shading::{DepthCue, Light, Scene, MAX_LIGHTS};
 use fvr_core::Error;
 use fvr_host::phantom::{sample, Gaussian, GaussianMixture};
 use fvr_host::pipeline::{choose_filter, AnySpectrum, KbDesign, Precision};

@@ -35,28 +35,15 @@ fn kernel_table_from_values_equals_the_computed_table_bit_for_bit() {
 fn kernel_table_from_values_rejects_wrong_lengths_and_non_finite_entries() {
     let filter = Filter::new(FilterKind::Kb3, 1).unwrap();
     let good = KernelTable::<f32>::new(filter).values().to_vec();
-    let short = &good[..good.len() - 1];
-    assert!(matches!(
-        KernelTable::from_values(filter, short),
-        Err(Error::LengthMismatch { what: "kernel table", expected, got })
-            if expected == good.len() && got == good.len() - 1
-    ));
-    // A kb4 table does not serve a kb3 filter.
     let kb4 = KernelTable::<f32>::new(Filter::new(FilterKind::Kb4, 1).unwrap());
-    assert!(KernelTable::from_values(filter, kb4.values()).is_err());
-    for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
-        let mut values = good.clone();
-        values[700] = bad;
-        let err = KernelTable::from_values(filter, &values).unwrap_err();
-        assert_eq!(
-            err,
-            Error::NonFiniteTableEntry {
-                what: "kernel table",
-                index: 700
-            }
-        );
-        assert_eq!(err.to_string(), "kernel table entry 700 is NaN or infinite");
-    }
+    let refusals = Refusals {
+        filter,
+        good: &good,
+        other_filter: kb4.values(),
+        what: "kernel table",
+        index: 700,
+    };
+    refusals.check(KernelTable::from_values);
 }
 
 #[test]
@@ -110,29 +97,54 @@ fn derivative_table_from_values_rejects_nearest_wrong_lengths_and_non_finite_ent
         DerivativeTable::from_values(nearest, &vec![0.0f32; nearest_len]).unwrap_err(),
         Error::NoKernelDerivative
     );
-    let short = &good[..good.len() - 1];
-    assert!(matches!(
-        DerivativeTable::from_values(filter, short),
-        Err(Error::LengthMismatch { what: "kernel derivative table", expected, got })
-            if expected == good.len() && got == good.len() - 1
-    ));
     // A kb4 derivative table does not serve a kb3 filter.
     let kb4 = DerivativeTable::<f32>::new(Filter::new(FilterKind::Kb4, 1).unwrap()).unwrap();
-    assert!(DerivativeTable::from_values(filter, kb4.values()).is_err());
-    for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
-        let mut values = good.clone();
-        values[1200] = bad;
-        let err = DerivativeTable::from_values(filter, &values).unwrap_err();
-        assert_eq!(
-            err,
-            Error::NonFiniteTableEntry {
-                what: "kernel derivative table",
-                index: 1200
-            }
-        );
-        assert_eq!(
-            err.to_string(),
-            "kernel derivative table entry 1200 is NaN or infinite"
-        );
+    let refusals = Refusals {
+        filter,
+        good: &good,
+        other_filter: kb4.values(),
+        what: "kernel derivative table",
+        index: 1200,
+    };
+    refusals.check(DerivativeTable::from_values);
+}
+
+/// What a table's `from_values` must refuse: `good` shortened by one, the
+/// table of another filter, and a NaN or infinity at `index`, each named
+/// `what`.
+struct Refusals<'a> {
+    filter: Filter,
+    good: &'a [f32],
+    other_filter: &'a [f32],
+    what: &'static str,
+    index: usize,
+}
+
+impl Refusals<'_> {
+    fn check<T: std::fmt::Debug>(&self, from_values: impl Fn(Filter, &[f32]) -> Result<T, Error>) {
+        let (filter, good, what) = (self.filter, self.good, self.what);
+        let short = &good[..good.len() - 1];
+        assert!(matches!(
+            from_values(filter, short),
+            Err(Error::LengthMismatch { what: w, expected, got })
+                if w == what && expected == good.len() && got == good.len() - 1
+        ));
+        assert!(from_values(filter, self.other_filter).is_err());
+        for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            let mut values = good.to_vec();
+            values[self.index] = bad;
+            let err = from_values(filter, &values).unwrap_err();
+            assert_eq!(
+                err,
+                Error::NonFiniteTableEntry {
+                    what,
+                    index: self.index
+                }
+            );
+            assert_eq!(
+                err.to_string(),
+                format!("{what} entry {} is NaN or infinite", self.index)
+            );
+        }
     }
 }

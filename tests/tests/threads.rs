@@ -3,10 +3,11 @@
 
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::View;
-use fvr_core::render::{extract_slice, extract_slice_rows};
+use fvr_core::slice::{extract_slice, extract_slice_rows};
 use fvr_core::Error;
 use fvr_host::phantom::{sample, GaussianMixture};
 use fvr_host::pipeline::{OwnedSpectrum, ViewRenderer};
+use fvr_tests::mixture_spectrum;
 use half::f16;
 
 #[test]
@@ -42,9 +43,7 @@ fn threaded_views_equal_the_single_threaded_view_bit_for_bit() {
 #[test]
 fn row_blocks_in_any_split_equal_the_whole_slice() {
     let n = 32;
-    let volume = sample(&GaussianMixture::random(5, n, 4), [n; 3]);
-    let filter = Filter::new(FilterKind::Kb4, 1).unwrap();
-    let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+    let (spec, filter) = mixture_spectrum::<f16, f32>((5, n, 4), [n; 3], FilterKind::Kb4, 1);
     let spec = spec.view();
     let kernel = KernelTable::<f32>::new(filter);
     let frame = View::along([0.2, -1.0, 0.7]).frame().unwrap();

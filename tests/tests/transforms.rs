@@ -5,6 +5,7 @@ use fvr_core::dht::{
 };
 use fvr_core::Error;
 use fvr_host::reference::{naive_dht, naive_dht_2d, naive_dht_3d};
+use fvr_tests::twiddles;
 use half::f16;
 
 /// Deterministic test signal in [−1, 1) (SplitMix64).
@@ -38,10 +39,7 @@ fn budget(unit_roundoff: f64, n: usize) -> f64 {
 
 #[test]
 fn dht_matches_naive_for_all_sizes_1_to_2048() {
-    let mut tw64 = vec![0.0f64; Twiddles::<f64>::buffer_len(4096)];
-    let tw64 = Twiddles::new(&mut tw64, 4096).unwrap();
-    let mut tw32 = vec![0.0f32; Twiddles::<f32>::buffer_len(4096)];
-    let tw32 = Twiddles::new(&mut tw32, 4096).unwrap();
+    twiddles!(4096; tw64: f64, tw32: f32);
     let mut n = 1;
     while n <= 2048 {
         let x = signal(n, n as u64);
@@ -64,8 +62,7 @@ fn dht_matches_naive_for_all_sizes_1_to_2048() {
 
 #[test]
 fn forward_then_inverse_is_identity_up_to_4096() {
-    let mut tw = vec![0.0f64; Twiddles::<f64>::buffer_len(4096)];
-    let tw = Twiddles::new(&mut tw, 4096).unwrap();
+    twiddles!(4096; tw: f64);
     for log in 0..=12 {
         let n = 1 << log;
         let x = signal(n, 7 + n as u64);
@@ -116,8 +113,7 @@ fn non_power_of_two_and_short_tables_are_errors() {
 
 #[test]
 fn true_2d_dht_matches_naive() {
-    let mut tw = vec![0.0f64; Twiddles::<f64>::buffer_len(64)];
-    let tw = Twiddles::new(&mut tw, 64).unwrap();
+    twiddles!(64; tw: f64);
     for (nx, ny) in [(1, 1), (2, 4), (8, 8), (16, 4), (32, 16)] {
         let x = signal(nx * ny, (nx * 100 + ny) as u64);
         let reference = naive_dht_2d(&x, nx, ny);
@@ -137,8 +133,7 @@ fn true_2d_dht_matches_naive() {
 #[test]
 fn batched_2d_dht_matches_naive_and_the_line_path_bit_for_bit() {
     // f32 against the naive f64 sum: the radix-2 bound ε·log₂N per pass.
-    let mut tw32 = vec![0.0f32; Twiddles::<f32>::buffer_len(128)];
-    let tw32 = Twiddles::new(&mut tw32, 128).unwrap();
+    twiddles!(128; tw32: f32);
     // Squares from 4 to 64 take the transposes that also run the first
     // radix-2² stages (64 with its side fixed at compile time), 128 the
     // tiled transposes; odd log₂n (8, 32) ends on a radix-2 stage.
@@ -178,10 +173,7 @@ fn batched_2d_dht_matches_naive_and_the_line_path_bit_for_bit() {
 
 #[test]
 fn true_3d_dht_matches_naive_in_f64_f32_and_f16_storage() {
-    let mut tw64 = vec![0.0f64; Twiddles::<f64>::buffer_len(16)];
-    let tw64 = Twiddles::new(&mut tw64, 16).unwrap();
-    let mut tw32 = vec![0.0f32; Twiddles::<f32>::buffer_len(16)];
-    let tw32 = Twiddles::new(&mut tw32, 16).unwrap();
+    twiddles!(16; tw64: f64, tw32: f32);
     for dims in [
         [1, 1, 1],
         [2, 2, 2],
@@ -228,8 +220,7 @@ fn true_3d_dht_matches_naive_in_f64_f32_and_f16_storage() {
 
 #[test]
 fn f16_overflow_in_the_3d_transform_is_an_error() {
-    let mut tw = vec![0.0f32; Twiddles::<f32>::buffer_len(8)];
-    let tw = Twiddles::new(&mut tw, 8).unwrap();
+    twiddles!(8; tw: f32);
     let mut data = vec![f16::from_f32(60000.0); 512];
     let mut scratch = vec![0.0f32; dht_3d_scratch_len([8, 8, 8])];
     let err = dht_3d(&mut data, [8, 8, 8], &mut scratch, &tw).unwrap_err();

@@ -2,8 +2,9 @@
 #![allow(dead_code)] // each test binary uses a different part
 
 use fvr_core::geometry::{center, Frame};
-use fvr_core::render::{aux_len, grid_len};
-use fvr_core::scene_render::{fields_len, render_scene};
+use fvr_core::image::{aux_len, grid_len};
+use fvr_core::render::{render, Buffers, Request, Source};
+use fvr_core::shading::fields_len;
 use fvr_firmware::frame::{tables_for, FrameTables};
 use fvr_firmware::scene::{Blob, FrameSpec, Shading, BLOBS, DIMS, IMAGE_SIDE};
 use fvr_firmware::stored::{all, all_derivatives, twiddles};
@@ -22,7 +23,7 @@ pub fn tables(spec: &FrameSpec) -> FrameTables {
 
 /// The host core's image of a frame, `channels·IMAGE_SIDE²` values
 /// (channel fastest): `fvr_core::render::render` or
-/// `fvr_core::scene_render::render_scene` in f32 from the same flash tables
+/// `fvr_core::render::render` with a scene in f32 from the same flash tables
 /// the firmware links.
 pub fn host_image(spec: &FrameSpec) -> Vec<f32> {
     let t = tables(spec);
@@ -35,9 +36,10 @@ pub fn host_image(spec: &FrameSpec) -> Vec<f32> {
         Shading::Plain => {
             let mut grid = vec![0.0f32; grid_len(n)];
             let mut out = vec![0.0f32; IMAGE_SIDE * IMAGE_SIDE];
-            fvr_core::render::render(
-                &spectrum, &kernel, &spec.view, IMAGE_SIDE, IMAGE_SIDE, &tw, &mut grid, &mut aux,
-                &mut out,
+            render(
+                &Source::new(&spectrum, &kernel, &tw),
+                &Request::new(spec.view, IMAGE_SIDE, IMAGE_SIDE),
+                Buffers::new(&mut grid, &mut aux, &mut out),
             )
             .unwrap();
             out
@@ -48,19 +50,19 @@ pub fn host_image(spec: &FrameSpec) -> Vec<f32> {
             let derivative = t.derivative.map(|d| d.table().unwrap());
             let mut fields = vec![0.0f32; fields_len(&scene, n)];
             let mut out = vec![0.0f32; scene.channels() * IMAGE_SIDE * IMAGE_SIDE];
-            let channels = render_scene(
-                &spectrum,
-                gradient.as_ref(),
-                &kernel,
-                derivative.as_ref(),
-                &scene,
-                &spec.view,
-                IMAGE_SIDE,
-                IMAGE_SIDE,
-                &tw,
-                &mut fields,
-                &mut aux,
-                &mut out,
+            let channels = render(
+                &Source {
+                    spectrum: &spectrum,
+                    gradient: gradient.as_ref(),
+                    kernel: &kernel,
+                    derivative: derivative.as_ref(),
+                    twiddles: &tw,
+                },
+                &Request {
+                    scene: Some(&scene),
+                    ..Request::new(spec.view, IMAGE_SIDE, IMAGE_SIDE)
+                },
+                Buffers::new(&mut fields, &mut aux, &mut out),
             )
             .unwrap();
             assert_eq!(channels, s.channels());

@@ -8,7 +8,7 @@ use clap::parser::ValueSource;
 use clap::{ArgMatches, Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 use fvr_core::filter::FilterKind;
 use fvr_core::geometry::{Sampling, View, DEFAULT_UP};
-use fvr_core::scene::{Light, Scene, MAX_LIGHTS};
+use fvr_core::shading::{Light, Scene, MAX_LIGHTS};
 use fvr_host::adaptive::{parse_chain, parse_tolerance, AdaptiveSettings, Bound};
 use fvr_host::datasets::DATASETS_HELP;
 use fvr_host::formats::FORMATS_HELP;
@@ -948,7 +948,7 @@ fn render(args: &RenderArgs) -> Result<(), String> {
     let mut adaptive_report = None;
     let t2 = Instant::now();
     let (image, w, h) = if args.preview_level > 0 {
-        let (pw, ph) = fvr_core::progressive::preview_size(w, h, args.preview_level);
+        let (pw, ph) = fvr_core::render::preview_size(w, h, args.preview_level);
         let data = spectra
             .density
             .render_level_sampled(&view, &sampling, pw, ph, args.preview_level)
@@ -1383,7 +1383,7 @@ fn json_num(v: f64) -> String {
 struct AdaptiveReport {
     image: Vec<f64>,
     marks: fvr_host::adaptive::AdaptiveMarks,
-    stats: fvr_core::adaptive::AdaptiveStats,
+    stats: fvr_core::slice::adaptive::AdaptiveStats,
     mark_time: std::time::Duration,
     view_time: std::time::Duration,
     full_view_time: std::time::Duration,
@@ -1487,7 +1487,7 @@ fn adaptive_render(
     h: usize,
     settings: &AdaptiveSettings,
 ) -> Result<AdaptiveReport, String> {
-    fn go<S: fvr_core::real::Sample, T: fvr_core::real::Real>(
+    fn go<S: fvr_core::num::Sample, T: fvr_core::num::Real>(
         any: &AnySpectrum,
         spec: &fvr_host::pipeline::OwnedSpectrum<S>,
         view: &View,

@@ -775,6 +775,7 @@ pub fn read_dicom_with_progress(path: &Path, progress: &ProgressBar) -> Result<V
 ///
 /// # Panics
 /// If `pixels.len()` is not `columns × rows`.
+// TODO(layout-host): group the parameters (the workspace allow is gone).
 #[allow(clippy::too_many_arguments)]
 pub fn encode_ct_slice(
     series: &str,

@@ -1,306 +1,11 @@
-//! In-place radix-2 discrete Hartley transforms.
-//!
-//! # Normalization and order
-//! The forward transform of a length-`N` sequence is
-//! `H(k) = Σ_x f(x) cas(2πkx/N)`, with `cas θ = cos θ + sin θ`, unnormalized.
-//! The DHT is its own inverse up to `1/N`: [`idht`] divides by `N`.
-//! Output is in natural order, `H(0)` (DC) first; index `k ≥ N/2` holds the
-//! signed frequency `k − N`.
-//!
-//! The 2D and 3D transforms are the *true* multidimensional DHT with kernel
-//! `cas(2π(k·x)/N)` (not the separable `cas·cas` product): row-column passes
-//! followed by the Hao–Bracewell correction.
-//!
-//! # Precision
-//! Each radix-2 stage adds at most a few units of roundoff, so the relative
-//! RMS error of a length-`N` transform grows like `ε·log₂N` (ε the unit
-//! roundoff of the arithmetic type); the tests check this bound against a
-//! naive O(N²) transform evaluated in f64.
+//! The true 2D DHT in place: batched row and column passes (square arrays
+//! between two in-place transposes), then the Hao–Bracewell correction.
 
-use crate::error::{mismatch, require_len, require_pow2, Error, Result};
-use crate::real::{Real, Sample};
-
-/// Quarter-wave sine table for transforms of length up to `len`.
-///
-/// Holds `sin(2πk/len)` for `k = 0 ..= len/4` in a caller-provided buffer.
-/// Any power-of-two length `n ≤ len` uses every `(len/n)`-th entry, so one
-/// table built for the largest size serves all smaller ones.
-///
-/// # Provenance and accuracy
-/// Entries are computed once by `libm::sin` in f64 (error below 1 ulp of
-/// f64), then rounded to `T`: each entry is within 0.5 ulp of `T` of the true
-/// value (plus < 1e-16 absolute). Cosines come from the same table by
-/// quarter-wave symmetry, so `sin² + cos²` is 1 to that accuracy.
-#[derive(Debug)]
-pub struct Twiddles<'a, T> {
-    len: usize,
-    quarter: &'a [T],
-}
-
-impl<'a, T: Real> Twiddles<'a, T> {
-    /// Entries a table for transforms of length up to `len` needs.
-    pub const fn buffer_len(len: usize) -> usize {
-        len / 4 + 1
-    }
-
-    /// Fill `buf` with the table for transform lengths up to `len`.
-    ///
-    /// # Errors
-    /// `len` not a power of two, or `buf` shorter than
-    /// [`Twiddles::buffer_len`]`(len)`.
-    pub fn new(buf: &'a mut [T], len: usize) -> Result<Self> {
-        require_pow2("twiddle table length", len)?;
-        let entries = Self::buffer_len(len);
-        require_len("twiddle buffer", entries, buf.len())?;
-        let step = 2.0 * core::f64::consts::PI / len as f64;
-        for (k, slot) in buf[..entries].iter_mut().enumerate() {
-            // Exact symmetric values where the quarter-wave table is tight.
-            *slot = if 4 * k == len {
-                T::ONE
-            } else {
-                T::from_f64(libm::sin(step * k as f64))
-            };
-        }
-        Ok(Self {
-            len,
-            quarter: &buf[..entries],
-        })
-    }
-
-    /// Wrap a table filled earlier by [`Twiddles::new`] (or stored, e.g. in
-    /// flash, from its output) for lengths up to `len`.
-    ///
-    /// # Errors
-    /// `len` not a power of two, or `table` shorter than
-    /// [`Twiddles::buffer_len`]`(len)`.
-    pub fn from_table(table: &'a [T], len: usize) -> Result<Self> {
-        require_pow2("twiddle table length", len)?;
-        let entries = Self::buffer_len(len);
-        require_len("twiddle table", entries, table.len())?;
-        Ok(Self {
-            len,
-            quarter: &table[..entries],
-        })
-    }
-
-    /// Largest transform length this table serves.
-    pub fn len(&self) -> usize {
-        self.len
-    }
-
-    /// `false`: a table always serves at least length 1.
-    pub fn is_empty(&self) -> bool {
-        false
-    }
-
-    /// `(cos, sin)` of `2πk/len` for `k < len/2`.
-    #[inline(always)]
-    fn cos_sin(&self, k: usize) -> (T, T) {
-        let q = self.len / 4;
-        if k <= q {
-            (self.quarter[q - k], self.quarter[k])
-        } else {
-            (-self.quarter[k - q], self.quarter[2 * q - k])
-        }
-    }
-
-    pub(crate) fn check(&self, n: usize) -> Result<()> {
-        require_pow2("transform length", n)?;
-        if n > self.len {
-            return Err(Error::TwiddlesTooShort {
-                table_len: self.len,
-                needed: n,
-            });
-        }
-        Ok(())
-    }
-}
-
-/// Forward DHT of `data` in place, unnormalized (see the module docs).
-///
-/// # Errors
-/// The length is not a power of two, or exceeds the twiddle table's length.
-pub fn dht<T: Real>(data: &mut [T], tw: &Twiddles<'_, T>) -> Result<()> {
-    tw.check(data.len())?;
-    dht_unchecked(data, tw);
-    Ok(())
-}
-
-/// Inverse DHT in place: the forward transform divided by `N`.
-///
-/// # Errors
-/// As [`dht`].
-pub fn idht<T: Real>(data: &mut [T], tw: &Twiddles<'_, T>) -> Result<()> {
-    dht(data, tw)?;
-    let inv = T::from_f64(1.0 / data.len() as f64);
-    for v in data.iter_mut() {
-        *v *= inv;
-    }
-    Ok(())
-}
-
-fn bit_reverse<T>(data: &mut [T]) {
-    for_each_bit_reversed_swap(data.len(), |i, j| data.swap(i, j));
-}
-
-/// Calls `swap(i, j)` for every pair `i < j` with `j` the bit reversal of
-/// `i` among `0 … n − 1` (`n` a power of two): the swaps that put a
-/// sequence of `n` (elements or rows) in bit-reversed order.
-#[inline(always)]
-fn for_each_bit_reversed_swap(n: usize, mut swap: impl FnMut(usize, usize)) {
-    let mut j = 0usize;
-    for i in 1..n {
-        let mut bit = n >> 1;
-        while j & bit != 0 {
-            j ^= bit;
-            bit >>= 1;
-        }
-        j |= bit;
-        if i < j {
-            swap(i, j);
-        }
-    }
-}
-
-/// Radix-2 decimation in time. A block of length `2m` combines the DHTs `X`
-/// (even samples) and `Y` (odd samples) of length `m`:
-/// `H(k) = X(k) + cos(πk/m)·Y(k) + sin(πk/m)·Y(m−k)` and
-/// `H(k+m) = X(k) − (same)`, with `Y(m) ≡ Y(0)`.
-pub(crate) fn dht_unchecked<T: Real>(data: &mut [T], tw: &Twiddles<'_, T>) {
-    dht_stages(data, tw, |_| {});
-}
-
-/// [`dht_unchecked`] calling `after_stage` on the whole line after every
-/// butterfly stage (a no-op closure compiles away).
-#[inline(always)]
-fn dht_stages<T: Real, F: FnMut(&mut [T])>(
-    data: &mut [T],
-    tw: &Twiddles<'_, T>,
-    mut after_stage: F,
-) {
-    let n = data.len();
-    if n <= 1 {
-        return;
-    }
-    bit_reverse(data);
-    let mut m = 1;
-    while m < n {
-        let stride = tw.len / (2 * m);
-        for block in data.chunks_exact_mut(2 * m) {
-            let (x, y) = block.split_at_mut(m);
-            butterfly_pair(&mut x[0], &mut y[0]);
-            if m >= 2 {
-                let h = m / 2;
-                butterfly_pair(&mut x[h], &mut y[h]);
-                for k in 1..h {
-                    let (c, s) = tw.cos_sin(k * stride);
-                    let (yk, ymk) = (y[k], y[m - k]);
-                    let t1 = c * yk + s * ymk;
-                    let t2 = s * yk - c * ymk;
-                    let (xk, xmk) = (x[k], x[m - k]);
-                    x[k] = xk + t1;
-                    y[k] = xk - t1;
-                    x[m - k] = xmk + t2;
-                    y[m - k] = xmk - t2;
-                }
-            }
-        }
-        after_stage(data);
-        m *= 2;
-    }
-}
-
-/// Where the 3D transform rounds to the storage format.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Rounding {
-    /// Once per pass: after the x pass, the y pass and the fused z pass.
-    PerPass,
-    /// Also after every radix-2 butterfly stage of every line, as a
-    /// transform computing in the storage format itself would.
-    PerStage,
-}
-
-/// The pass of the 3D transform a line is loaded or stored in.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Pass {
-    /// Lines along x (contiguous); also the placement of the input.
-    X,
-    /// Lines along y.
-    Y,
-    /// Lines along z, fused with the Hao–Bracewell correction.
-    Z,
-}
-
-/// Storage that the 3D transform reads and writes one line at a time.
-///
-/// Element formats ([`Elements`]) round each value on its own; block
-/// floating point ([`crate::format::LineBlocks`]) gives each stored line a
-/// shared exponent, which is why a whole line is stored at once.
-pub trait LineStore<T: Real> {
-    /// Load the values at `base + i·stride`, `i < out.len()`, as `pass` reads them.
-    fn load(&self, pass: Pass, base: usize, stride: usize, out: &mut [T]);
-    /// Round `line` to the storage and write it at `base + i·stride`;
-    /// `false` if a value overflowed.
-    fn store(&mut self, pass: Pass, base: usize, stride: usize, line: &[T]) -> bool;
-    /// Round `line` in place exactly as storing and reloading it would.
-    fn round(&self, line: &mut [T]);
-}
-
-/// Element-wise storage in format `S`.
-#[derive(Debug)]
-pub struct Elements<'a, S>(pub &'a mut [S]);
-
-impl<S: Sample, T: Real> LineStore<T> for Elements<'_, S> {
-    #[inline(always)]
-    fn load(&self, _: Pass, base: usize, stride: usize, out: &mut [T]) {
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = T::load(self.0[base + i * stride]);
-        }
-    }
-    #[inline(always)]
-    fn store(&mut self, _: Pass, base: usize, stride: usize, line: &[T]) -> bool {
-        let mut finite = true;
-        for (i, l) in line.iter().enumerate() {
-            let s: S = l.store();
-            finite &= s.is_finite();
-            self.0[base + i * stride] = s;
-        }
-        finite
-    }
-    #[inline(always)]
-    fn round(&self, line: &mut [T]) {
-        for v in line.iter_mut() {
-            *v = T::load(v.store::<S>());
-        }
-    }
-}
-
-/// One line's transform, rounding through the storage after each stage if asked.
-#[inline(always)]
-fn line_dht<T: Real, L: LineStore<T>>(
-    line: &mut [T],
-    tw: &Twiddles<'_, T>,
-    rounding: Rounding,
-    store: &L,
-) {
-    match rounding {
-        Rounding::PerPass => dht_unchecked(line, tw),
-        Rounding::PerStage => dht_stages(line, tw, |l| store.round(l)),
-    }
-}
-
-#[inline(always)]
-fn butterfly_pair<T: Real>(a: &mut T, b: &mut T) {
-    let (x, y) = (*a, *b);
-    *a = x + y;
-    *b = x - y;
-}
-
-/// Index of `−k` modulo `n` (a power of two).
-#[inline(always)]
-pub(crate) fn neg_mod(k: usize, n: usize) -> usize {
-    (n - k) & (n - 1)
-}
+use super::line::butterfly_pair;
+use super::line::{dht_unchecked, for_each_bit_reversed_swap};
+use super::Twiddles;
+use crate::error::{check_len, require_len, Result};
+use crate::num::Real;
 
 /// True 2D DHT in place of an `nx × ny` array stored with `x` fastest,
 /// unnormalized: `H(u,v) = Σ f(x,y) cas(2π(ux/nx + vy/ny))`.
@@ -322,6 +27,7 @@ pub(crate) fn neg_mod(k: usize, n: usize) -> usize {
 /// # Errors
 /// A side not a power of two or longer than the table, a `data` length other
 /// than `nx·ny`, or short scratch.
+#[inline]
 pub fn dht_2d<T: Real>(
     data: &mut [T],
     nx: usize,
@@ -361,6 +67,7 @@ pub fn dht_2d<T: Real>(
 /// bit-reversed row order the second pass wants after a plain transpose,
 /// so no pass reorders rows on its own. Each transpose also does the first
 /// two (untwiddled) stages of the pass after it.
+#[inline]
 fn dht_2d_square<T: Real>(data: &mut [T], n: usize, tw: &Twiddles<'_, T>) {
     transpose_square_bit_reversed_radix4(data, n);
     dht_columns_stages(data, n, n, 4, tw);
@@ -411,6 +118,7 @@ pub fn dht_2d_lines<T: Real>(
 /// and each point's value is `S` minus the point diagonally opposite
 /// (`H(u,v) = S − T(−u,−v)`, …): 8 operations instead of 16. Rows `v` and
 /// `ny − v` go together, with `u` and `nx − u` walked from both ends.
+#[inline]
 fn hao_bracewell_2d<T: Real>(data: &mut [T], nx: usize, ny: usize) {
     if nx <= 2 || ny <= 2 {
         return;
@@ -497,6 +205,7 @@ const TILED_TRANSPOSE_FROM: usize = 128;
 /// tiles of 16 × 16 from there (a row-by-row transpose walks one side with
 /// a stride of `n` and misses the cache on every element once rows outgrow
 /// it; on a cacheless core the plain loop costs fewer instructions).
+#[inline]
 fn transpose_square<T>(data: &mut [T], n: usize) {
     const TILE: usize = 16;
     if n < TILED_TRANSPOSE_FROM || n % TILE != 0 {
@@ -526,6 +235,7 @@ fn transpose_square<T>(data: &mut [T], n: usize) {
 /// value is loaded and stored once for both. Since `rev(4t) < n/4` and
 /// `rev(j)` is a whole number of quarters, a tile's values sit at one
 /// index of sixteen quarter rows, and one bounds check covers them all.
+#[inline]
 fn transpose_square_bit_reversed_radix4<T: Real>(data: &mut [T], n: usize) {
     const B: usize = 4;
     // Quarter holding column rev(4t) + rev(j): rev(j) = QUARTER_OF[j]·n/4.
@@ -573,13 +283,20 @@ fn transpose_square_bit_reversed_radix4<T: Real>(data: &mut [T], n: usize) {
 /// Four rows of `n` as four quarter rows each.
 #[inline(always)]
 fn quarters<T>(rows: &mut [T], n: usize) -> [[&mut [T]; 4]; 4] {
-    rows_mut(rows, n, [0, 1, 2, 3]).map(|row| rows_mut(row, n / 4, [0, 1, 2, 3]))
+    // Explicit arrays rather than `[_; 4]::map`, and every function of the
+    // 2D transform `#[inline]`: in the 2D module's own codegen unit the
+    // std array helpers (`try_map`, `try_from_fn`) were left out of line
+    // on the M4F, which cost its 64 × 64 transform 150 k instructions.
+    let [r0, r1, r2, r3] = rows_mut(rows, n, [0, 1, 2, 3]);
+    let quarter = |row| rows_mut(row, n / 4, [0, 1, 2, 3]);
+    [quarter(r0), quarter(r1), quarter(r2), quarter(r3)]
 }
 
 /// [`transpose_square_bit_reversed_radix4`] without the bit reversal: the
 /// plain transpose, then the two untwiddled stages on every group of four
 /// rows. Written over row segments of four, which the M4F addresses with
 /// immediate offsets from one pointer per segment.
+#[inline]
 fn transpose_square_plain_radix4<T: Real>(data: &mut [T], n: usize) {
     const B: usize = 4;
     for rt in 0..n / B {
@@ -595,9 +312,19 @@ fn transpose_square_plain_radix4<T: Real>(data: &mut [T], n: usize) {
         for (st, other) in above.chunks_exact_mut(B * n).enumerate() {
             let cs = B * st;
             let [b0, b1, b2, b3] = rows_mut(band, n, [0, 1, 2, 3]);
-            let mine = [b0, b1, b2, b3].map(|row| segment(row, cs));
+            let mine = [
+                segment(b0, cs),
+                segment(b1, cs),
+                segment(b2, cs),
+                segment(b3, cs),
+            ];
             let [o0, o1, o2, o3] = rows_mut(other, n, [0, 1, 2, 3]);
-            let theirs = [o0, o1, o2, o3].map(|row| segment(row, c));
+            let theirs = [
+                segment(o0, c),
+                segment(o1, c),
+                segment(o2, c),
+                segment(o3, c),
+            ];
             let saved: [[T; B]; B] = core::array::from_fn(|i| *mine[i]);
             for (j, row) in theirs.iter().enumerate() {
                 for (i, v) in radix4_plain(**row).into_iter().enumerate() {
@@ -662,6 +389,7 @@ fn swap_across_diagonal<T, P: Fn(usize) -> usize>(data: &mut [T], n: usize, p: P
 }
 
 /// Put the rows of an `nx × ny` array in bit-reversed order.
+#[inline]
 fn bit_reverse_rows<T>(data: &mut [T], nx: usize, ny: usize) {
     for_each_bit_reversed_swap(ny, |i, j| {
         let (head, tail) = data.split_at_mut(j * nx);
@@ -673,6 +401,7 @@ fn bit_reverse_rows<T>(data: &mut [T], nx: usize, ny: usize) {
 /// radix-2 stage at a time: the path for large and non-square arrays on
 /// cached hosts, where the four-row butterfly loops vectorize and the
 /// radix-2² kernels (eight rows, six twiddles) run out of SIMD registers.
+#[inline]
 fn dht_columns<T: Real>(data: &mut [T], nx: usize, ny: usize, tw: &Twiddles<'_, T>) {
     bit_reverse_rows(data, nx, ny);
     let mut m = 1;
@@ -694,6 +423,7 @@ fn dht_columns<T: Real>(data: &mut [T], nx: usize, ny: usize, tw: &Twiddles<'_, 
 /// and stored once per two stages. The butterflies and their operands are
 /// those of [`dht_stages`], in the same order, so the result is the same to
 /// the bit; a single radix-2 stage finishes odd `log₂ny`.
+#[inline]
 fn dht_columns_stages<T: Real>(
     data: &mut [T],
     nx: usize,
@@ -741,6 +471,7 @@ fn dht_columns_stages<T: Real>(
 }
 
 /// One radix-2 stage of half-length `m` of [`dht_columns`].
+#[inline]
 fn radix2_columns_stage<T: Real>(data: &mut [T], nx: usize, m: usize, tw: &Twiddles<'_, T>) {
     let stride = tw.len / (2 * m);
     for block in data.chunks_exact_mut(2 * m * nx) {
@@ -845,9 +576,12 @@ fn for_each_column<T: Copy, const R: usize>(
     mut f: impl FnMut([T; R]) -> [T; R],
 ) {
     let len = rows.iter().map(|r| r.len()).min().unwrap_or(0);
-    let mut rest = rows.map(|r| &mut r[..len]);
+    // `from_fn` rather than `[_; R]::map` (see `quarters`).
+    let mut rows = rows;
+    let mut rest: [&mut [T]; R] =
+        core::array::from_fn(|r| &mut core::mem::take(&mut rows[r])[..len]);
     for _ in 0..len / 4 {
-        let mut chunks = rest.each_mut().map(take_first4);
+        let mut chunks: [&mut [T; 4]; R] = core::array::from_fn(|r| take_first4(&mut rest[r]));
         for k in 0..4 {
             let out = f(core::array::from_fn(|r| chunks[r][k]));
             for (chunk, v) in chunks.iter_mut().zip(out) {
@@ -907,160 +641,4 @@ pub fn idht_2d<T: Real>(
         *v *= inv;
     }
     Ok(())
-}
-
-fn check_len(what: &'static str, expected: usize, got: usize) -> Result<()> {
-    if expected == got {
-        Ok(())
-    } else {
-        Err(mismatch(what, expected, got))
-    }
-}
-
-/// Scratch elements [`dht_3d`] needs for dims `[nx, ny, nz]`.
-pub const fn dht_3d_scratch_len(dims: [usize; 3]) -> usize {
-    let a = if dims[0] > dims[1] { dims[0] } else { dims[1] };
-    let b = 4 * dims[2];
-    if a > b {
-        a
-    } else {
-        b
-    }
-}
-
-/// True 3D DHT in place over stored samples, unnormalized:
-/// `H(u,v,w) = Σ f(x,y,z) cas(2π(ux/nx + vy/ny + wz/nz))`, `x` fastest.
-///
-/// Lines are loaded into `scratch` in the arithmetic type `T`, transformed
-/// and rounded back to `S`, to nearest even. There are three roundings:
-/// after the x pass, after the y pass, and after the z pass fused with the
-/// Hao–Bracewell correction
-/// `H(u,v,w) = ½[T(−u,v,w) + T(u,−v,w) + T(u,v,−w) − T(−u,−v,−w)]`, which
-/// loads the four z-lines `(±u, ±v)` together so that the correction works
-/// on unrounded values. `scratch` needs [`dht_3d_scratch_len`] elements,
-/// `4·nz` for a cube: O(n), however large the volume.
-///
-/// # Errors
-/// A side not a power of two or longer than the table, a `data` length other
-/// than `nx·ny·nz`, short scratch, or a value that overflows `S`
-/// ([`Error::Overflow`]; the data is then partly transformed).
-pub fn dht_3d<S: Sample, T: Real>(
-    data: &mut [S],
-    dims: [usize; 3],
-    scratch: &mut [T],
-    tw: &Twiddles<'_, T>,
-) -> Result<()> {
-    dht_3d_rounding(data, dims, scratch, tw, Rounding::PerPass)
-}
-
-/// [`dht_3d`] with a choice of where to round ([`Rounding`]). With
-/// [`Rounding::PerStage`] every line is also rounded to `S` after each of its
-/// `log₂n` stages, which models arithmetic in the storage format.
-///
-/// # Errors
-/// As [`dht_3d`].
-pub fn dht_3d_rounding<S: Sample, T: Real>(
-    data: &mut [S],
-    dims: [usize; 3],
-    scratch: &mut [T],
-    tw: &Twiddles<'_, T>,
-    rounding: Rounding,
-) -> Result<()> {
-    let [nx, ny, nz] = dims;
-    check_len("3D array", nx * ny * nz, data.len())?;
-    dht_3d_store(&mut Elements(data), dims, scratch, tw, rounding)
-}
-
-/// [`dht_3d_rounding`] over any [`LineStore`] holding `nx·ny·nz` values.
-///
-/// # Errors
-/// As [`dht_3d`] (the caller checks the storage's length).
-pub fn dht_3d_store<T: Real, L: LineStore<T>>(
-    store: &mut L,
-    dims: [usize; 3],
-    scratch: &mut [T],
-    tw: &Twiddles<'_, T>,
-    rounding: Rounding,
-) -> Result<()> {
-    let [nx, ny, nz] = dims;
-    for n in dims {
-        tw.check(n)?;
-    }
-    require_len(
-        "3D transform scratch",
-        dht_3d_scratch_len(dims),
-        scratch.len(),
-    )?;
-
-    let mut finite = true;
-    // x pass: contiguous lines.
-    let line = &mut scratch[..nx];
-    for row in 0..ny * nz {
-        let base = row * nx;
-        store.load(Pass::X, base, 1, line);
-        line_dht(line, tw, rounding, store);
-        finite &= store.store(Pass::X, base, 1, line);
-    }
-    overflow_check(finite, "x pass of the 3D transform")?;
-
-    // y pass: lines of stride nx.
-    let line = &mut scratch[..ny];
-    for z in 0..nz {
-        for x in 0..nx {
-            let base = x + nx * ny * z;
-            store.load(Pass::Y, base, nx, line);
-            line_dht(line, tw, rounding, store);
-            finite &= store.store(Pass::Y, base, nx, line);
-        }
-    }
-    overflow_check(finite, "y pass of the 3D transform")?;
-
-    // z pass fused with the correction, over groups of four z-lines.
-    let plane = nx * ny;
-    let lines = &mut scratch[..4 * nz];
-    for v in 0..=ny / 2 {
-        let vm = neg_mod(v, ny);
-        for u in 0..=nx / 2 {
-            let um = neg_mod(u, nx);
-            // Slot s = a + 2b holds the line at (a ? −u : u, b ? −v : v).
-            let bases = [u + nx * v, um + nx * v, u + nx * vm, um + nx * vm];
-            for (slot, base) in bases.iter().enumerate() {
-                let l = &mut lines[slot * nz..(slot + 1) * nz];
-                store.load(Pass::Z, *base, plane, l);
-                line_dht(l, tw, rounding, store);
-            }
-            for w in 0..=nz / 2 {
-                let wm = neg_mod(w, nz);
-                // t[a + 2b + 4c]: sign bits a, b, c for u, v, w.
-                let mut t = [T::ZERO; 8];
-                for (i, e) in t.iter_mut().enumerate() {
-                    let z = if i & 4 == 0 { w } else { wm };
-                    *e = lines[(i & 3) * nz + z];
-                }
-                for (i, _) in t.iter().enumerate() {
-                    let h = T::HALF * (t[i ^ 1] + t[i ^ 2] + t[i ^ 4] - t[i ^ 7]);
-                    let z = if i & 4 == 0 { w } else { wm };
-                    lines[(i & 3) * nz + z] = h;
-                }
-            }
-            for (slot, base) in bases.iter().enumerate() {
-                let l = &lines[slot * nz..(slot + 1) * nz];
-                finite &= store.store(Pass::Z, *base, plane, l);
-            }
-        }
-    }
-    overflow_check(finite, "z pass of the 3D transform")
-}
-
-fn overflow_check(finite: bool, stage: &'static str) -> Result<()> {
-    if finite {
-        Ok(())
-    } else {
-        Err(overflow(stage))
-    }
-}
-
-#[cold]
-fn overflow(stage: &'static str) -> Error {
-    Error::Overflow { stage }
 }

@@ -23,11 +23,11 @@
 //! nearest the slice point. Marks are a bitset: `n³` bits, `n³/8` bytes
 //! (256 KiB at 128³, 1/16 of an f16 spectrum).
 
+use crate::dht::signed_index;
 use crate::error::{mismatch, require_len, Error, Result};
 use crate::filter::{Filter, KernelTable, MAX_WIDTH};
 use crate::geometry::Frame;
-use crate::real::{Real, Sample};
-use crate::render::signed_index;
+use crate::num::{Real, Sample};
 use crate::spectrum::{CubeSide, Spectrum};
 
 /// `u32` words of a bitset over `n³` samples.
@@ -246,7 +246,7 @@ pub struct AdaptiveStats {
 /// Most cheaper filters in a chain.
 pub const MAX_LEVELS: usize = 2;
 
-/// [`crate::render::extract_slice`] with adaptive filtering: at each slice
+/// [`crate::slice::extract_slice`] with adaptive filtering: at each slice
 /// point, the spectrum sample nearest to it is looked up in each level's
 /// marks (cheapest first); the first level that marks it filters the point,
 /// otherwise the large `kernel` does.

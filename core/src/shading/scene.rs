@@ -1,47 +1,4 @@
-//! Shape cues in the frequency domain: depth cueing (paper §3.1, eq. 3–5),
-//! hemispherical directional shading with coloured lights (§3.2, eq. 7–11)
-//! and both together (§3.3, eq. 12–14).
-//!
-//! # The image model
-//! For each colour channel `c` the image is
-//!
-//! `I_c = ∫ w(t)·[ A_c·f + Σ_l ½·D_{l,c}·(|∇f| − ∇f·L_l) ] dt`
-//!
-//! along the ray of each pixel, where
-//! - `t = d·(x − c)` is the depth from the volume's centre `c` along the unit
-//!   view direction `d` (voxel units), and `w(t)` the depth-cue weight;
-//! - `A_c` is the ambient colour, `D_{l,c}` light `l`'s colour and `L_l` the
-//!   unit vector *towards* light `l`;
-//! - `N = −∇f/|∇f|` is the outward normal of structures denser than their
-//!   surroundings, so `½·(|∇f| − ∇f·L) = ½·|∇f|·(1 + N·L)` is the
-//!   hemispherical irradiance of eq. 8–10: a surface facing a light is
-//!   bright, one facing away is dark, and the term is never negative.
-//!
-//! # Depth cues
-//! - [`DepthCue::Linear`]: `w(t) = C_avg + C_cue·t` (eq. 3) through `FRONT`
-//!   at `t = −R` and `BACK` at `t = +R`, `R` half the volume's largest
-//!   dimension. Rendered with the composite filter `H' = C_avg·H −
-//!   (C_cue/2π)·(d·∇H)` of eq. 5 (see [`crate::scene_render`] for its
-//!   Hartley form).
-//! - [`DepthCue::Sine`]: the paper's single-impulse form, `w(t) = A·sin(ωt +
-//!   φ)` with no DC term, through `FRONT` and `BACK`, one end at the sine's
-//!   crest. It is one shifted `H`. For `FRONT = 1, BACK = 0` it is
-//!   `sin(π(R − t)/4R)`, which departs from the linear ramp by at most 0.21
-//!   (at `t ≈ −0.12R`); for `1, 0.5` by 0.12.
-//! - [`DepthCue::Profile`]: any profile, given as weights at equally spaced
-//!   depths from `−R` (front) to `+R` (back), joined linearly, and fitted by
-//!   the cosine series `w(u) = Σ_{m=0}^{M} c_m·cos(πmu)`, `u = (t + R)/2R`.
-//!   Each harmonic is one more shifted `H` (the convolution `H * D` of eq. 5
-//!   with `D` a sum of `2M + 1` impulses): the composite filter spans
-//!   `W + 2M·n/(4R)` samples per axis, `W + 2M` at oversampling 2, and costs
-//!   about `1 + 2M` times the plain extraction.
-//!
-//! Outside `[−R, R]` (the corners of the volume on oblique views) the linear
-//! and sine weights are extrapolated and the profile repeats evenly. Weights
-//! given below zero are refused ([`Error::InvalidSceneValue`]): a negative
-//! weight would subtract density and silently produce a wrong image.
-//! Extrapolation into the corners can still go negative on oblique views;
-//! [`ViewPlan::min_weight_in_box`] reports it so front ends can warn.
+//! The scene model: lights, depth cues, and their per-view plan.
 
 use crate::error::{Error, Result};
 use crate::filter::gauss_legendre_16;
@@ -236,7 +193,7 @@ impl Scene {
     }
 
     /// Slice-sized scratch grids the scene's render needs (see
-    /// [`crate::scene_render::fields_len`]): 1 for a plain or cued grey
+    /// [`crate::shading::fields_len`]): 1 for a plain or cued grey
     /// image; otherwise one accumulator per spectrum term plus one output.
     pub fn field_count(&self) -> usize {
         let pair = if self.has_partner_terms() { 2 } else { 1 };

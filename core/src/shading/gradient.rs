@@ -17,9 +17,9 @@
 //! little; that is part of the shading model's error budget.
 
 use crate::dht::{dht, neg_mod, Twiddles};
-use crate::error::{mismatch, require_len, Error, Result};
-use crate::real::Real;
-use crate::spectrum::VoxelSource;
+use crate::error::{require_len, Error, Result};
+use crate::num::Real;
+use crate::volume::{require_voxels, VoxelSource};
 
 /// Line length used along axis `a` of size `len`: `2·next_pow2(len)`.
 pub fn padded_line_len(len: usize) -> usize {
@@ -46,7 +46,7 @@ pub fn gradient_magnitude<V: VoxelSource, T: Real>(
     line: &mut [T],
     tw: &Twiddles<'_, T>,
 ) -> Result<()> {
-    out_len(volume.dims(), out.len())?;
+    require_voxels("derivative volume", volume.dims(), out.len())?;
     out.fill(T::ZERO);
     for axis in 0..3 {
         for_each_derivative(volume, axis, line, tw, |index, d| out[index] += d * d)?;
@@ -69,22 +69,8 @@ pub fn partial_derivative<V: VoxelSource, T: Real>(
     line: &mut [T],
     tw: &Twiddles<'_, T>,
 ) -> Result<()> {
-    out_len(volume.dims(), out.len())?;
+    require_voxels("derivative volume", volume.dims(), out.len())?;
     for_each_derivative(volume, axis, line, tw, |index, d| out[index] = d)
-}
-
-fn out_len(dims: [usize; 3], got: usize) -> Result<()> {
-    if dims.contains(&0) {
-        return Err(Error::EmptyVolume);
-    }
-    let count = dims[0]
-        .checked_mul(dims[1])
-        .and_then(|v| v.checked_mul(dims[2]))
-        .ok_or(Error::VolumeTooLarge { dims, grid: 0 })?;
-    if got != count {
-        return Err(mismatch("derivative volume", count, got));
-    }
-    Ok(())
 }
 
 /// Call `sink(voxel index, ∂f/∂x_axis)` for every voxel.

@@ -1,0 +1,158 @@
+//! The IEEE storage types (binary16, bfloat16, binary32, binary64) as
+//! [`Sample`]s, and the fast binary16 widening the extraction uses.
+
+use half::{bf16, f16};
+
+use super::Sample;
+
+/// IEEE binary16 bits to the binary32 of the same value, exactly, by
+/// exponent rebias: the 15 magnitude bits shifted into binary32 position
+/// read as `2^-112` times the value (a binary16 subnormal lands on a
+/// binary32 subnormal), so one multiplication by `2^112` rebiases normals
+/// and normalizes subnormals, exactly because it is a power of two. Infinity
+/// and NaN (exponent all ones) take `half`'s path, which quiets NaNs.
+///
+/// Bit-identical to `half::f16::to_f32` for all 65,536 patterns (tested
+/// exhaustively on the host and, in the firmware, on the Cortex-M4F). It
+/// needs subnormal f32 arithmetic: a flush-to-zero FPU mode (FPSCR.FZ on
+/// Arm, off at reset) would zero binary16 subnormals.
+///
+/// Why: `half` converts in software on targets without F16C or FP16
+/// (Cortex-M4F, x86-64 without `target-feature=+f16c`) through a branchy
+/// path of about 25 instructions; this is about 8, and slice extraction does
+/// one per filter tap.
+#[inline(always)]
+pub fn f16_bits_to_f32(bits: u16) -> f32 {
+    const TWO_POW_112: f32 = f32::from_bits((127 + 112) << 23);
+    let magnitude = (bits & 0x7FFF) as u32;
+    if magnitude >= 0x7C00 {
+        return f16::from_bits(bits).to_f32();
+    }
+    let value = f32::from_bits(magnitude << 13) * TWO_POW_112;
+    f32::from_bits(value.to_bits() | ((bits as u32 & 0x8000) << 16))
+}
+
+/// The finite binary16 `bits` as binary32 times `2^−112`, exactly: the
+/// rebias of [`f16_bits_to_f32`] without its multiplication by `2^112` and
+/// without its infinity/NaN branch. The sign-extending read puts copies of
+/// the sign in bits 28–31 after the shift; clearing bits 28–30 leaves the
+/// sign in bit 31 over the 15 magnitude bits. Three integer instructions
+/// on a Cortex-M4F; exponent-all-ones patterns come out finite and wrong,
+/// which is why it is only for data known to be finite.
+#[inline(always)]
+pub fn f16_bits_to_f32_raw(bits: u16) -> f32 {
+    f32::from_bits((((bits as i16 as i32) << 13) as u32) & 0x8FFF_FFFF)
+}
+
+impl Sample for f16 {
+    const NAME: &'static str = "f16";
+    const BITS: u32 = 16;
+    const SCALE_LOG2: i32 = 14;
+    const MAX_FINITE: f64 = 65504.0;
+    const RAW_EXPONENT_F32: i32 = 112;
+    #[inline(always)]
+    fn to_f32_raw(self) -> f32 {
+        f16_bits_to_f32_raw(self.to_bits())
+    }
+    #[inline(always)]
+    fn from_f32(v: f32) -> Self {
+        f16::from_f32(v)
+    }
+    #[inline(always)]
+    fn from_f64(v: f64) -> Self {
+        f16::from_f64(v)
+    }
+    #[inline(always)]
+    fn to_f32(self) -> f32 {
+        f16_bits_to_f32(self.to_bits())
+    }
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        f16::to_f64(self)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        f16::is_finite(self)
+    }
+}
+
+impl Sample for f32 {
+    const NAME: &'static str = "f32";
+    const BITS: u32 = 32;
+    const SCALE_LOG2: i32 = 14;
+    const MAX_FINITE: f64 = f32::MAX as f64;
+    #[inline(always)]
+    fn from_f32(v: f32) -> Self {
+        v
+    }
+    #[inline(always)]
+    fn from_f64(v: f64) -> Self {
+        v as f32
+    }
+    #[inline(always)]
+    fn to_f32(self) -> f32 {
+        self
+    }
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self as f64
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        f32::is_finite(self)
+    }
+}
+
+impl Sample for f64 {
+    const NAME: &'static str = "f64";
+    const BITS: u32 = 64;
+    const SCALE_LOG2: i32 = 14;
+    const MAX_FINITE: f64 = f64::MAX;
+    #[inline(always)]
+    fn from_f32(v: f32) -> Self {
+        v as f64
+    }
+    #[inline(always)]
+    fn from_f64(v: f64) -> Self {
+        v
+    }
+    #[inline(always)]
+    fn to_f32(self) -> f32 {
+        self as f32
+    }
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        f64::is_finite(self)
+    }
+}
+
+impl Sample for bf16 {
+    const NAME: &'static str = "bf16";
+    const MAX_FINITE: f64 = 3.389_531_389_251_535_5e38;
+    const BITS: u32 = 16;
+    const SCALE_LOG2: i32 = 14;
+    #[inline(always)]
+    fn from_f32(v: f32) -> Self {
+        bf16::from_f32(v)
+    }
+    #[inline(always)]
+    fn from_f64(v: f64) -> Self {
+        bf16::from_f64(v)
+    }
+    #[inline(always)]
+    fn to_f32(self) -> f32 {
+        bf16::to_f32(self)
+    }
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        bf16::to_f64(self)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        bf16::is_finite(self)
+    }
+}

@@ -1,0 +1,147 @@
+//! How x-lines are read by extractions that serve any storage (the
+//! scene passes, the general extraction): plain, with one block exponent
+//! per line, or tap by tap.
+
+use crate::num::{BlockLayout, Real, Sample};
+use crate::spectrum::{CubeSide, Spectrum};
+
+/// How x-lines are read in the extraction's inner loops.
+#[derive(Clone, Copy)]
+pub(crate) enum LineReads<'a> {
+    /// Plain coefficients.
+    Plain,
+    /// One block exponent per x-line.
+    LineExponents(&'a [i8]),
+    /// Anything else (bricks): through [`Spectrum::line_taps`].
+    General,
+}
+
+impl<'a> LineReads<'a> {
+    /// The reads for `spec`.
+    pub(crate) fn of<S: Sample, Z: CubeSide>(spec: &Spectrum<'a, S, Z>) -> Self {
+        match spec.blocks() {
+            Some(b) if S::BLOCK_MANTISSA => match b.layout() {
+                BlockLayout::Line => LineReads::LineExponents(b.exponents()),
+                _ => LineReads::General,
+            },
+            _ => LineReads::Plain,
+        }
+    }
+
+    /// Whether a run of `W` taps from `x0` can be read contiguously.
+    #[inline(always)]
+    pub(crate) fn contiguous<const W: usize>(self, x0: usize, n: usize) -> bool {
+        x0 + W <= n && !matches!(self, LineReads::General)
+    }
+
+    /// The `W` coefficients from `line + x0` as one run, when `contiguous`
+    /// (one bounds check for the run).
+    #[inline(always)]
+    fn run<'s, const W: usize, S: Sample, Z: CubeSide>(
+        spec: &Spectrum<'s, S, Z>,
+        line: usize,
+        x0: usize,
+        contiguous: bool,
+    ) -> Option<&'s [S; W]> {
+        if !contiguous {
+            return None;
+        }
+        let start = line + x0;
+        // As in `extract_lines`: for W ≤ 4 the tail's first chunk (no
+        // overflow test of `start + W`).
+        if W <= 4 {
+            spec.data()
+                .get(start..)
+                .and_then(|rest| rest.first_chunk::<W>())
+        } else {
+            spec.data()
+                .get(start..start + W)
+                .and_then(|s| <&[S; W]>::try_from(s).ok())
+        }
+    }
+
+    /// The block exponent's power of two for `line`, if lines carry one.
+    #[inline(always)]
+    fn line_scale<S: Sample, Z: CubeSide, T: Real>(
+        self,
+        spec: &Spectrum<'_, S, Z>,
+        line: usize,
+    ) -> Option<T> {
+        match self {
+            LineReads::LineExponents(e) => Some(T::exp2i(e[line / spec.n()] as i32)),
+            _ => None,
+        }
+    }
+
+    /// `K` weighted sums `Σ_t w_k[t]·c[line + x.index[t]]` over the same
+    /// `W` taps of one x-line, each coefficient read once, with block
+    /// exponents applied: one contiguous run from `x.first` when
+    /// `x.contiguous`, else tap by tap at the wrapped indices.
+    ///
+    /// `RAW`: widen with [`Real::load_raw`]; the weights must carry the
+    /// `2^e` of [`Real::raw_exponent`]. Plain and per-line-exponent reads
+    /// only (never [`LineReads::General`], whose per-tap exponents raw
+    /// reads do not apply). Otherwise widen fully, and read taps that do
+    /// not form a run through [`Spectrum::line_taps`].
+    #[inline(always)]
+    pub(crate) fn sums<const W: usize, const K: usize, const RAW: bool, S, Z, T>(
+        self,
+        spec: &Spectrum<'_, S, Z>,
+        line: usize,
+        x: &XRun<'_, W>,
+        weights: [&[T; W]; K],
+    ) -> [T; K]
+    where
+        S: Sample,
+        Z: CubeSide,
+        T: Real,
+    {
+        let run = Self::run::<W, S, Z>(spec, line, x.first, x.contiguous);
+        let mut sums = [T::ZERO; K];
+        if !RAW && run.is_none() {
+            for k in 0..K {
+                sums[k] = spec.line_taps(line, x.index, weights[k]);
+            }
+            return sums;
+        }
+        let load = |v: S| if RAW { T::load_raw(v) } else { T::load(v) };
+        match run {
+            Some(run) => {
+                for t in 0..W {
+                    let v = load(run[t]);
+                    for k in 0..K {
+                        sums[k] += weights[k][t] * v;
+                    }
+                }
+            }
+            None => {
+                let data = spec.data();
+                for t in 0..W {
+                    let v = load(data.get(line + x.index[t]).copied().unwrap_or_default());
+                    for k in 0..K {
+                        sums[k] += weights[k][t] * v;
+                    }
+                }
+            }
+        }
+        if let Some(scale) = self.line_scale::<S, Z, T>(spec, line) {
+            for s in sums.iter_mut() {
+                *s *= scale;
+            }
+        }
+        sums
+    }
+}
+
+/// The x-taps of one sample point: the first index, whether the `W` taps
+/// run contiguously from it ([`LineReads::contiguous`]), and the wrapped
+/// indices.
+#[derive(Clone, Copy)]
+pub(crate) struct XRun<'a, const W: usize> {
+    /// Index of the first tap on the x-line.
+    pub(crate) first: usize,
+    /// Whether the taps are `first .. first + W`, read as one run.
+    pub(crate) contiguous: bool,
+    /// The taps' indices, wrapped around the line.
+    pub(crate) index: &'a [usize; W],
+}

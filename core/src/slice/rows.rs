@@ -1,0 +1,159 @@
+//! The rows of a slice and the walk over its points inside the
+//! spectrum's Nyquist cube: row intervals, and mirror pairs.
+
+use crate::dht::signed_index;
+use crate::filter::PhaseTable;
+use crate::num::Real;
+
+/// Which rows of the slice to fill, and its axes in index units.
+pub(super) struct SliceRows<T> {
+    pub(super) right: [T; 3],
+    pub(super) up: [T; 3],
+    pub(super) m: usize,
+    pub(super) first_row: usize,
+}
+
+impl<T: Real> SliceRows<T> {
+    /// Calls `pixel(slot, q)` for every slice point of the rows inside
+    /// the spectrum's Nyquist cube, with `q = kx·r + ky·u` (`ky·u` once per
+    /// row), and zeroes the points outside. The cube `|q_a| ≤ n/2` cuts each
+    /// row to one interval of `kx`, found once per row
+    /// ([`SliceRows::row_interval`]).
+    #[inline(always)]
+    pub(super) fn for_each(&self, n: usize, grid: &mut [T], mut pixel: impl FnMut(&mut T, [T; 3])) {
+        let m = self.m;
+        for (row_offset, row) in grid.chunks_exact_mut(m).enumerate() {
+            let ky = T::from_i32(signed_index(self.first_row + row_offset, m) as i32);
+            let kyu = self.up.map(|c| ky * c);
+            let (low, high) = self.row_interval(n, kyu);
+            for (ix, g) in row.iter_mut().enumerate() {
+                let k = signed_index(ix, m) as i32;
+                if k < low || k > high {
+                    *g = T::ZERO;
+                    continue;
+                }
+                let kx = T::from_i32(k);
+                pixel(g, core::array::from_fn(|a| kx * self.right[a] + kyu[a]));
+            }
+        }
+    }
+
+    /// Fills the rows inside the Nyquist cube from `pixel(y, plus, minus)`
+    /// and zeroes the points outside. `y` is a slice point's per-axis
+    /// phase-table position in fixed point
+    /// ([`PhaseTable::fixed_position`]); `pixel` returns the value there
+    /// (when `plus`) and the value at the mirrored point `−q` (when
+    /// `minus`), which has the same taps reflected through the origin with
+    /// the same weights: the setup of a point (positions, phase rows,
+    /// weights) serves both `(kx, ky)` and `(−kx, −ky)`.
+    ///
+    /// Points are placed per *mirror pair*: row `p = 0 … m/2` (signed
+    /// `ky = p`) is walked once for `kx` in its interval, writing the
+    /// point into row `p` and its mirror into row `−p` (row 0 pairs `kx`
+    /// with `−kx`). Row `−m/2` and column `−m/2`, whose mirrors are off the
+    /// grid, are the mirrors of `ky = m/2` and `kx = m/2`. So the value of
+    /// every point depends only on its pair, never on which rows the
+    /// caller asked for (threads get the same bits), and a point with its
+    /// mirror in the same call costs one setup for two.
+    ///
+    /// Along a row, one point is placed from `q = kx·r + ky·u` in `T`;
+    /// `q` then advances by `r`, so each next `y` is the last plus
+    /// [`PhaseTable::fixed_step`]`(r)`: two integer additions an axis
+    /// instead of a product, a sum and a floor in floating point.
+    #[inline(always)]
+    pub(super) fn for_each_fixed_pair<const W: usize>(
+        &self,
+        n: usize,
+        grid: &mut [T],
+        mut pixel: impl FnMut([i64; 3], bool, bool) -> (T, T),
+    ) {
+        let m = self.m;
+        grid.fill(T::ZERO);
+        let rows = grid.len() / m;
+        let step = self.right.map(PhaseTable::<T, W>::fixed_step);
+        // Signed frequencies of a row: −⌊m/2⌋ … ⌈m/2⌉ − 1 (`signed_index`).
+        let (half, k_max) = ((m / 2) as i32, ((m - 1) / 2) as i32);
+        let mask = m.wrapping_sub(1);
+        // Row `r` of the grid as a slot in this call's rows, if there.
+        let local = |r: usize| r.checked_sub(self.first_row).filter(|&i| i < rows);
+        for p in 0..=m / 2 {
+            let plus_row = if p as i32 <= k_max { local(p) } else { None };
+            let minus_row = local((m - p) & mask);
+            if plus_row.is_none() && minus_row.is_none() {
+                continue;
+            }
+            let ky = T::from_usize(p);
+            let kyu = self.up.map(|c| ky * c);
+            let (low, high) = self.row_interval(n, kyu);
+            // Row 0 is its own mirror: `kx ≥ 0` places both halves.
+            let k_low = if p == 0 { 0 } else { -half };
+            let (low, high) = (low.max(k_low), high.min(half));
+            if low > high {
+                continue;
+            }
+            // The row is anchored at `kx = 0` (or the nearest point of its
+            // interval), where `q = ky·u` is as exact as `T` makes it: the
+            // low frequencies, which carry most of the energy, then get
+            // the least rounding (the steps are exact multiples of `r`).
+            let anchor = 0.clamp(low, high);
+            let kx = T::from_i32(anchor);
+            let mut y: [i64; 3] = core::array::from_fn(|a| {
+                PhaseTable::<T, W>::fixed_position(kx * self.right[a] + kyu[a])
+                    + (low - anchor) as i64 * step[a]
+            });
+            for k in low..=high {
+                // The point `(k, p)` is on the grid for `k ≤ k_max`, its
+                // mirror `(−k, −p)` for `−k ≤ k_max` (and `−k ≥ −m/2`, the
+                // loop's bound), on row 0 only for `k > 0` (`k = 0` is its
+                // own mirror).
+                let plus = plus_row.is_some() && k <= k_max;
+                let minus = minus_row.is_some() && -k <= k_max && (p > 0 || k > 0);
+                if plus || minus {
+                    let (value, mirror) = pixel(y, plus, minus);
+                    // `m` is a power of two: `k mod m` by a mask.
+                    if let (true, Some(r)) = (plus, plus_row) {
+                        if let Some(g) = grid.get_mut(r * m + (k as usize & mask)) {
+                            *g = value;
+                        }
+                    }
+                    if let (true, Some(r)) = (minus, minus_row) {
+                        if let Some(g) = grid.get_mut(r * m + (k.wrapping_neg() as usize & mask)) {
+                            *g = mirror;
+                        }
+                    }
+                }
+                for a in 0..3 {
+                    y[a] += step[a];
+                }
+            }
+        }
+    }
+
+    /// The integers `kx` in `[low, high]` for which `|kx·r_a + c_a| ≤ n/2` on
+    /// every axis (`c = ky·u`): the intersection of three intervals, each
+    /// `(±n/2 − c_a)/r_a`, rounded inwards. Points within rounding of the
+    /// cube's faces may fall on either side; their interpolated value is
+    /// next to nothing there (the band-limited spectrum ends at the faces).
+    fn row_interval(&self, n: usize, c: [T; 3]) -> (i32, i32) {
+        let half = T::from_usize(n) * T::HALF;
+        let (mut low, mut high) = (-T::from_usize(n), T::from_usize(n));
+        for a in 0..3 {
+            let (r, c) = (self.right[a], c[a]);
+            if r == T::ZERO {
+                if c > half || -c > half {
+                    return (1, 0);
+                }
+                continue;
+            }
+            let (t1, t2) = ((-half - c) / r, (half - c) / r);
+            let (t_low, t_high) = if t1 < t2 { (t1, t2) } else { (t2, t1) };
+            if t_low > low {
+                low = t_low;
+            }
+            if t_high < high {
+                high = t_high;
+            }
+        }
+        (-((-low).floor_i64() as i32), high.floor_i64() as i32)
+    }
+}
