@@ -6,7 +6,7 @@ use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
     if let Ok(text) = std::str::from_utf8(data) {
-        let _ = fvr_host::formats::parse_plist(text);
-        let _ = fvr_host::formats::inv3::parse_main_plist(text);
+        let _ = fvr_host::io::parse_plist(text);
+        let _ = fvr_host::io::inv3::parse_main_plist(text);
     }
 });

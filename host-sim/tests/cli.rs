@@ -3,7 +3,7 @@
 mod common;
 use common::{assert_error, assert_ok, fvr, temp_dir};
 
-use fvr_host::nrrd::{encode_nrrd, Encoding, Endian, SampleType};
+use fvr_host::io::nrrd::{encode_nrrd, Encoding, Endian, SampleType};
 
 #[test]
 fn no_arguments_renders_the_default_scene_and_says_where() {

@@ -7,9 +7,9 @@ use common::{assert_error, fvr, temp_dir};
 use std::path::Path;
 use std::process::Output;
 
-use fvr_host::formats::den::encode_den;
-use fvr_host::formats::nifti::encode_nifti_f32;
-use fvr_host::nrrd::Endian;
+use fvr_host::io::den::encode_den;
+use fvr_host::io::nifti::encode_nifti_f32;
+use fvr_host::io::nrrd::Endian;
 
 fn stdout(out: &Output) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
@@ -315,7 +315,7 @@ fn renders_a_dicom_series_directory() {
     let orientation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
     for k in 0..6u32 {
         let pixels: Vec<i16> = (0..64).map(|i| ((i * 7 + k * 13) % 50) as i16).collect();
-        let bytes = fvr_host::formats::dicom::encode_ct_slice(
+        let bytes = fvr_host::io::dicom::encode_ct_slice(
             "1.2.3.4",
             k + 1,
             [8, 8],

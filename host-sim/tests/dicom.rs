@@ -3,8 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use fvr_host::formats::dicom::{encode_ct_slice, parse_slice, read_dicom};
-use fvr_host::formats::{detect, read_volume, Format};
+use fvr_host::io::dicom::{encode_ct_slice, parse_slice, read_dicom};
+use fvr_host::io::{detect, read_volume, Format};
 
 const AXIAL: [f64; 6] = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
 

@@ -4,12 +4,14 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use fvr_host::datasets::{BRAINSMALL_DEN_GZ, BRAINSMALL_DIMS};
-use fvr_host::formats::den::{encode_den, parse_den, read_den, HEADER_BYTES as DEN_HEADER};
-use fvr_host::formats::inv3::{encode_archive, encode_inv3_i16, main_plist_text, parse_inv3};
-use fvr_host::formats::nifti::{encode_nifti_f32, offsets, parse_nifti, read_nifti};
-use fvr_host::formats::{detect, read_volume, Format};
-use fvr_host::nrrd::{encode_nrrd, parse_nrrd, read_nrrd, Encoding, Endian, IoError, SampleType};
+use fvr_host::io::den::{encode_den, parse_den, read_den, HEADER_BYTES as DEN_HEADER};
+use fvr_host::io::inv3::{encode_archive, encode_inv3_i16, main_plist_text, parse_inv3};
+use fvr_host::io::nifti::{encode_nifti_f32, offsets, parse_nifti, read_nifti};
+use fvr_host::io::nrrd::{
+    encode_nrrd, parse_nrrd, read_nrrd, Encoding, Endian, IoError, SampleType,
+};
+use fvr_host::io::{detect, read_volume, Format};
+use fvr_host::sources::datasets::{BRAINSMALL_DEN_GZ, BRAINSMALL_DIMS};
 use fvr_host::volume::{check_spacing, Volume, DEFAULT_SPACING};
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -533,7 +535,7 @@ fn sizes_whose_product_overflows_are_refused_before_allocating() {
         msg.contains("`sizes`") && msg.contains("overflows"),
         "{msg}"
     );
-    let raw = fvr_host::nrrd::parse_raw(&[0; 8], [big, 3, 1], SampleType::U8, Endian::Little);
+    let raw = fvr_host::io::nrrd::parse_raw(&[0; 8], [big, 3, 1], SampleType::U8, Endian::Little);
     assert!(raw.unwrap_err().to_string().contains("overflows"));
     // A header that claims a large volume but holds a few bytes fails on
     // the missing bytes, not on memory.
@@ -607,9 +609,9 @@ fn formats_are_detected_by_magic_before_extension() {
 
 #[test]
 fn named_volumes_load_through_the_scene() {
-    let brain = fvr_host::scene::load_volume("brainsmall", None).expect("embedded");
+    let brain = fvr_host::sources::load_volume("brainsmall", None).expect("embedded");
     assert_eq!(brain.dims, BRAINSMALL_DIMS);
-    let msg = fvr_host::scene::load_volume("no-such-thing", None).unwrap_err();
+    let msg = fvr_host::sources::load_volume("no-such-thing", None).unwrap_err();
     assert!(
         msg.contains("ct-head") && msg.contains("NIfTI-1") && msg.contains("shepp-logan"),
         "{msg}"
@@ -638,17 +640,17 @@ fn spacing_checks_reject_zero_negative_and_non_finite() {
 /// it first, so this test fails rather than skips when it is missing.
 #[test]
 fn ct_head_reads_with_its_shape_spacing_and_hounsfield_range() {
-    let path = fvr_host::datasets::ct_head_path()
+    let path = fvr_host::sources::datasets::ct_head_path()
         .unwrap_or_else(|e| panic!("{e} (scripts/test-all.sh installs it)"));
     let vol = read_volume(Path::new(&path)).expect("CT head");
-    assert_eq!(vol.dims, fvr_host::datasets::CT_HEAD_DIMS);
-    assert_eq!(vol.spacing, fvr_host::datasets::CT_HEAD_SPACING);
+    assert_eq!(vol.dims, fvr_host::sources::datasets::CT_HEAD_DIMS);
+    assert_eq!(vol.spacing, fvr_host::sources::datasets::CT_HEAD_SPACING);
     let min = vol.data.iter().cloned().fold(f32::INFINITY, f32::min);
     let max = vol.data.iter().cloned().fold(f32::NEG_INFINITY, f32::max);
     // main.plist's scalar_range is [-1024, 3033]; air is -1024 HU.
     assert_eq!(min, -1024.0);
     assert!((1000.0..=3033.0).contains(&max), "max {max}");
-    let loaded = fvr_host::scene::load_volume("ct-head", None).expect("by name");
+    let loaded = fvr_host::sources::load_volume("ct-head", None).expect("by name");
     assert_eq!(loaded.data, vol.data);
 }
 

@@ -87,7 +87,7 @@ fn flags_override_the_scene() {
         &dir,
     ));
     assert!(stdout.contains("wrote over.nrrd (16x16 RGB)"), "{stdout}");
-    let image = fvr_host::nrrd::read_nrrd(&dir.join("over.nrrd")).unwrap();
+    let image = fvr_host::io::nrrd::read_nrrd(&dir.join("over.nrrd")).unwrap();
     assert_eq!(image.dims, [3, 16, 16]);
     assert!(image.data.chunks(3).all(|p| p[0] == p[1] && p[1] == p[2]));
     assert!(image.data.iter().any(|&v| v > 0.0));
@@ -177,7 +177,7 @@ fn example_scenes_parse_and_render() {
     scenes.sort();
     assert!(scenes.len() >= 4, "{scenes:?}");
     for path in &scenes {
-        let scene = fvr_host::scene_file::SceneFile::load(path)
+        let scene = fvr_host::render::scene_file::SceneFile::load(path)
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let spec = scene
             .volume

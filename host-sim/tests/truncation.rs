@@ -4,12 +4,12 @@
 
 use std::io::Write;
 
-use fvr_host::formats::den::{encode_den, parse_den};
-use fvr_host::formats::dicom::{encode_ct_slice, parse_slice};
-use fvr_host::formats::inv3::{encode_inv3_i16, parse_inv3};
-use fvr_host::formats::nifti::{encode_nifti_f32, parse_nifti};
-use fvr_host::nrrd::IoError;
-use fvr_host::nrrd::{encode_nrrd, parse_nrrd, Encoding, Endian, SampleType};
+use fvr_host::io::den::{encode_den, parse_den};
+use fvr_host::io::dicom::{encode_ct_slice, parse_slice};
+use fvr_host::io::inv3::{encode_inv3_i16, parse_inv3};
+use fvr_host::io::nifti::{encode_nifti_f32, parse_nifti};
+use fvr_host::io::nrrd::IoError;
+use fvr_host::io::nrrd::{encode_nrrd, parse_nrrd, Encoding, Endian, SampleType};
 use fvr_host::volume::Volume;
 
 fn gzip(bytes: &[u8]) -> Vec<u8> {

@@ -19,12 +19,12 @@ use fvr_core::progressive::{render_level, render_level_sampled};
 use fvr_core::render::{aux_len, grid_len, render, render_sampled};
 use fvr_core::scene::{DepthCue, Light, Scene};
 use fvr_core::Error;
-use fvr_host::accuracy::{CONFIGS, VIEWS};
-use fvr_host::phantom::{sample, sample_spaced, GaussianMixture};
-use fvr_host::pipeline::{choose_filter, AnySpectrum, KbDesign, OwnedSpectrum, Precision};
+use fvr_host::reference::shaded::exact_scene_projection_sampled;
 use fvr_host::reference::{exact_projection_sampled, snr_db};
-use fvr_host::scene_reference::exact_scene_projection_sampled;
-use fvr_host::shaded::SceneSpectra;
+use fvr_host::render::shaded::SceneSpectra;
+use fvr_host::render::spectrum::{choose_filter, AnySpectrum, KbDesign, OwnedSpectrum, Precision};
+use fvr_host::sources::phantom::{sample, sample_spaced, GaussianMixture};
+use fvr_host::studies::accuracy::{CONFIGS, VIEWS};
 use half::f16;
 
 /// The anisotropic spacing under test (mm).

@@ -8,8 +8,8 @@ use fvr_core::geometry::View;
 use fvr_core::render::{aux_len, grid_len, render};
 use fvr_core::spectrum::{CubeSide, Spectrum};
 use fvr_core::Error;
-use fvr_host::phantom::{sample, GaussianMixture};
-use fvr_host::pipeline::OwnedSpectrum;
+use fvr_host::render::spectrum::OwnedSpectrum;
+use fvr_host::sources::phantom::{sample, GaussianMixture};
 use half::f16;
 
 const N: usize = 32;

@@ -7,9 +7,9 @@ use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::View;
 use fvr_core::progressive::{max_level, preview_size, render_level};
 use fvr_core::render::{aux_len, extract_slice, finish_projection, placement, signed_index};
-use fvr_host::phantom::{sample, GaussianMixture};
-use fvr_host::pipeline::OwnedSpectrum;
 use fvr_host::reference::snr_db;
+use fvr_host::render::spectrum::OwnedSpectrum;
+use fvr_host::sources::phantom::{sample, GaussianMixture};
 
 #[test]
 fn preview_is_the_low_passed_projection_sampled_at_its_pitch() {

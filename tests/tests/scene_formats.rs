@@ -10,10 +10,10 @@ use fvr_core::render::aux_len;
 use fvr_core::scene::{DepthCue, Light, Scene};
 use fvr_core::scene_render::{fields_len, render_scene};
 use fvr_core::spectrum::Spectrum;
-use fvr_host::phantom::{sample, GaussianMixture};
-use fvr_host::precision::StoredSpectrum;
 use fvr_host::reference::snr_db;
-use fvr_host::shaded::gradient_volume;
+use fvr_host::render::shaded::gradient_volume;
+use fvr_host::sources::phantom::{sample, GaussianMixture};
+use fvr_host::studies::precision::StoredSpectrum;
 
 fn render<S: fvr_core::real::Sample>(
     density: &Spectrum<'_, S>,

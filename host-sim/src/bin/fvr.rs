@@ -9,21 +9,22 @@ use clap::{ArgMatches, Args, CommandFactory, FromArgMatches, Parser, Subcommand}
 use fvr_core::filter::FilterKind;
 use fvr_core::geometry::{Sampling, View, DEFAULT_UP};
 use fvr_core::scene::{Light, Scene, MAX_LIGHTS};
-use fvr_host::adaptive::{parse_chain, parse_tolerance, AdaptiveSettings, Bound};
-use fvr_host::datasets::DATASETS_HELP;
-use fvr_host::formats::FORMATS_HELP;
-use fvr_host::nrrd::{read_nrrd, Endian, SampleType};
-use fvr_host::output::{write_apng, write_png, Bits, Colormap, Style, Window};
-use fvr_host::pipeline::{choose_filter, AnySpectrum, KbDesign, Precision};
+use fvr_host::image::output::{write_apng, write_png, Bits, Colormap, Style, Window};
+use fvr_host::io::nrrd::{read_nrrd, Endian, SampleType};
+use fvr_host::io::FORMATS_HELP;
+use fvr_host::progress;
+use fvr_host::reference::shaded::exact_scene_projection_sampled;
 use fvr_host::reference::{exact_projection_sampled, max_abs_error, snr_db};
-use fvr_host::scene::{load_volume_with_progress, phantom_by_name, RawLayout, PHANTOM_HELP};
-use fvr_host::scene_file::{parse_endian, SceneFile};
-use fvr_host::scene_reference::exact_scene_projection_sampled;
-use fvr_host::shaded::{
+use fvr_host::render::adaptive::{parse_chain, parse_tolerance, AdaptiveSettings, Bound};
+use fvr_host::render::scene_file::{parse_endian, SceneFile};
+use fvr_host::render::shaded::{
     light_ring, negative_cue_share, parse_depth_cue, parse_light, parse_light_ring, parse_rgb,
     SceneRenderer, SceneSpectra, DEFAULT_PROFILE_HARMONICS, DEPTH_CUE_HELP,
 };
-use fvr_host::{progress, turntable};
+use fvr_host::render::spectrum::{choose_filter, AnySpectrum, KbDesign, Precision};
+use fvr_host::render::turntable;
+use fvr_host::sources::datasets::DATASETS_HELP;
+use fvr_host::sources::{load_volume_with_progress, phantom_by_name, RawLayout, PHANTOM_HELP};
 
 /// Below this estimated storage SNR the renderer warns (see
 /// `OwnedSpectrum::storage_snr_estimate_db`).
@@ -127,13 +128,13 @@ enum Command {
     /// The precision study: SNR of every storage format and arithmetic
     /// against the f64 pipeline and exact line integrals, with bytes per
     /// voxel; writes a Markdown table, a CSV and a PNG plot.
-    Precision(fvr_host::precision_cli::PrecisionArgs),
+    Precision(fvr_host::studies::precision_cli::PrecisionArgs),
     /// The speed-accuracy map: time per view, SNR against exact line
     /// integrals and memory held over filter, oversampling, storage format,
     /// adaptive tolerance, progressive level and volume size, on the
     /// Gaussian-mixture phantom; writes trade.csv, trade.png (dB against ms,
     /// Pareto fronts) and trade.md (the settings on each front).
-    Trade(fvr_host::trade::TradeArgs),
+    Trade(fvr_host::studies::trade::TradeArgs),
     /// How the time per view grows with the volume's side: the kb3 f16
     /// frequency-domain view against the f32 ray caster (both on all cores),
     /// medians of RUNS views per size; writes growth.csv, growth.md and a
@@ -597,14 +598,14 @@ fn main() -> ExitCode {
             volumes,
             runs,
         }) => adaptive_table(tolerance, bound, filter, oversample, &volumes, runs),
-        Some(Command::Precision(args)) => fvr_host::precision_cli::run(&args),
-        Some(Command::Trade(args)) => fvr_host::trade::run(&args),
+        Some(Command::Precision(args)) => fvr_host::studies::precision_cli::run(&args),
+        Some(Command::Trade(args)) => fvr_host::studies::trade::run(&args),
         Some(Command::Growth {
             sizes,
             runs,
             large,
             out_dir,
-        }) => fvr_host::growth::run(&sizes, runs, large, &out_dir, |r| {
+        }) => fvr_host::studies::growth::run(&sizes, runs, large, &out_dir, |r| {
             eprintln!(
                 "fvr: {}³: {:.3} ms against {:.2} ms",
                 r.n, r.frequency_ms, r.raycast_ms
@@ -827,7 +828,7 @@ fn apply_scene_to_turntable(
         ("volume.resample", scene.volume.resample.is_some()),
         (
             "[shading]",
-            scene.shading != fvr_host::scene_file::ShadingSection::default(),
+            scene.shading != fvr_host::render::scene_file::ShadingSection::default(),
         ),
         (
             "[[lights]]",
@@ -954,7 +955,7 @@ fn render(args: &RenderArgs) -> Result<(), String> {
             .render_level_sampled(&view, &sampling, pw, ph, args.preview_level)
             .map_err(|e| e.to_string())?;
         (
-            fvr_host::shaded::Image {
+            fvr_host::render::shaded::Image {
                 channels: 1,
                 width: pw,
                 height: ph,
@@ -978,7 +979,7 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         let data = report.image.iter().map(|v| v * gain).collect();
         adaptive_report = Some(report);
         (
-            fvr_host::shaded::Image {
+            fvr_host::render::shaded::Image {
                 channels: 1,
                 width: w,
                 height: h,
@@ -1352,8 +1353,8 @@ fn compare(a: &Path, b: &Path) -> Result<(), String> {
 }
 
 fn accuracy(sizes: &[usize]) -> Result<(), String> {
-    let rows = fvr_host::accuracy::accuracy_table(sizes).map_err(|e| e.to_string())?;
-    print!("{}", fvr_host::accuracy::markdown(&rows));
+    let rows = fvr_host::studies::accuracy::accuracy_table(sizes).map_err(|e| e.to_string())?;
+    print!("{}", fvr_host::studies::accuracy::markdown(&rows));
     Ok(())
 }
 
@@ -1382,7 +1383,7 @@ fn json_num(v: f64) -> String {
 /// An adaptive render with what it did.
 struct AdaptiveReport {
     image: Vec<f64>,
-    marks: fvr_host::adaptive::AdaptiveMarks,
+    marks: fvr_host::render::adaptive::AdaptiveMarks,
     stats: fvr_core::adaptive::AdaptiveStats,
     mark_time: std::time::Duration,
     view_time: std::time::Duration,
@@ -1489,14 +1490,14 @@ fn adaptive_render(
 ) -> Result<AdaptiveReport, String> {
     fn go<S: fvr_core::real::Sample, T: fvr_core::real::Real>(
         any: &AnySpectrum,
-        spec: &fvr_host::pipeline::OwnedSpectrum<S>,
+        spec: &fvr_host::render::spectrum::OwnedSpectrum<S>,
         view: &View,
         w: usize,
         h: usize,
         settings: &AdaptiveSettings,
     ) -> Result<AdaptiveReport, String> {
         let t0 = Instant::now();
-        let marks = fvr_host::adaptive::AdaptiveMarks::build(spec, settings)?;
+        let marks = fvr_host::render::adaptive::AdaptiveMarks::build(spec, settings)?;
         let mark_time = t0.elapsed();
         let t1 = Instant::now();
         let (image, stats) = marks
@@ -1544,7 +1545,7 @@ fn adaptive_table(
             bound,
             ..AdaptiveSettings::new(tolerance)
         };
-        rows.push(fvr_host::adaptive::table1_row(
+        rows.push(fvr_host::render::adaptive::table1_row(
             name,
             &volume,
             filter,
@@ -1554,7 +1555,10 @@ fn adaptive_table(
         )?);
         eprintln!("fvr: measured {name}");
     }
-    print!("{}", fvr_host::adaptive::table1_markdown(&rows, tolerance));
+    print!(
+        "{}",
+        fvr_host::render::adaptive::table1_markdown(&rows, tolerance)
+    );
     Ok(())
 }
 

@@ -16,9 +16,9 @@
 //!   derivatives and of `|∇f|` (the same samples the frequency-domain path
 //!   transforms).
 
-use crate::phantom::{Gaussian, GaussianMixture};
 use crate::reference::trilinear;
-use crate::shaded::Image;
+use crate::render::shaded::Image;
+use crate::sources::phantom::{Gaussian, GaussianMixture};
 use crate::volume::Volume;
 use fvr_core::dht::Twiddles;
 use fvr_core::geometry::{center, Sampling, View};

@@ -566,12 +566,12 @@ fn placement(n: usize) -> (f64, [f64; 3]) {
 /// Voxelize the teapot into an `n`³ volume (see the module for the method).
 ///
 /// # Errors
-/// `n` below 8 or above [`crate::scene::MAX_PHANTOM_SIZE`].
+/// `n` below 8 or above [`crate::sources::MAX_PHANTOM_SIZE`].
 pub fn voxelize_teapot(n: usize) -> Result<TeapotVoxels, String> {
-    if !(8..=crate::scene::MAX_PHANTOM_SIZE).contains(&n) {
+    if !(8..=crate::sources::MAX_PHANTOM_SIZE).contains(&n) {
         return Err(format!(
             "teapot size {n} must be from 8 to {}",
-            crate::scene::MAX_PHANTOM_SIZE
+            crate::sources::MAX_PHANTOM_SIZE
         ));
     }
     let s = TEAPOT_SUPERSAMPLING;

@@ -64,10 +64,10 @@ use fvr_core::filter::FilterKind;
 use fvr_core::scene::{Light, MAX_LIGHTS};
 use toml::{Table, Value};
 
-use crate::nrrd::{Endian, SampleType};
-use crate::output::{Bits, Colormap, Window};
-use crate::pipeline::{KbDesign, Precision};
-use crate::shaded::{parse_depth_cue, DEFAULT_PROFILE_HARMONICS};
+use crate::image::output::{Bits, Colormap, Window};
+use crate::io::nrrd::{Endian, SampleType};
+use crate::render::shaded::{parse_depth_cue, DEFAULT_PROFILE_HARMONICS};
+use crate::render::spectrum::{KbDesign, Precision};
 
 /// Largest number of turntable frames (as `fvr turntable --frames`).
 pub const MAX_FRAMES: u32 = 3600;

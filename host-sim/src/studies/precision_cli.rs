@@ -8,12 +8,12 @@ use clap::Args;
 use fvr_core::filter::FilterKind;
 use fvr_core::format::{Arithmetic, Format, FormatName};
 
-use crate::plot::{Point, Scatter};
-use crate::precision::{
+use crate::image::plot::{Point, Scatter};
+use crate::sources::phantom_by_name;
+use crate::studies::precision::{
     csv, default_formats, markdown, parse_format, study_subject, summary, Cell, Oversampling,
     Subject,
 };
-use crate::scene::phantom_by_name;
 
 /// Arguments of `fvr precision`.
 #[derive(Args, Debug)]
@@ -87,10 +87,10 @@ pub fn run(args: &PrecisionArgs) -> Result<(), String> {
             ("Oversampling 1", Some(1)),
             ("Automatic oversampling", None),
         ] {
-            let rows = crate::precision::measure_extremes(n, &formats, o)?;
+            let rows = crate::studies::precision::measure_extremes(n, &formats, o)?;
             md += &format!(
                 "## {title}\n\n{}\n",
-                crate::precision::extremes_markdown(&rows)
+                crate::studies::precision::extremes_markdown(&rows)
             );
         }
         return match &args.out_dir {
@@ -127,7 +127,7 @@ pub fn run(args: &PrecisionArgs) -> Result<(), String> {
             fvr_core::spectrum::padded_size(subject.volume.dims, subject.filter.oversample())
                 .map_err(|e| e.to_string())?;
         for &f in &formats {
-            for a in crate::precision::modes_for(f) {
+            for a in crate::studies::precision::modes_for(f) {
                 f.check(a, grid)
                     .map_err(|e| format!("format {} on {spec}: {e}", FormatName(f)))?;
             }
@@ -209,7 +209,7 @@ fn report(cells: &[Cell], args: &PrecisionArgs) -> String {
 
 /// SNR against f64 over bytes per voxel; formats that share a size are
 /// spread sideways and named under the axis.
-pub fn plot(cells: &[Cell]) -> crate::plot::Canvas {
+pub fn plot(cells: &[Cell]) -> crate::image::plot::Canvas {
     let mut formats: Vec<(Format, f64)> = Vec::new();
     for c in cells
         .iter()

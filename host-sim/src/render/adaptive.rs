@@ -2,7 +2,7 @@
 //! spectrum for a tolerance in dB, then views that read the cheaper filters
 //! wherever the marks allow, with statistics.
 
-use crate::pipeline::OwnedSpectrum;
+use crate::render::spectrum::OwnedSpectrum;
 use crate::timing::median_ms;
 use fvr_core::adaptive::{
     extract_slice_adaptive, mark, marks_words, response_difference, threshold_for, AdaptiveLevel,
@@ -545,7 +545,7 @@ pub fn table1_row(
         OwnedSpectrum::<half::f16>::prepare::<f32>(volume, filter).map_err(|e| e.to_string())?;
     let n = spec.n();
     let side = n / filter.oversample() as usize;
-    let any = crate::pipeline::AnySpectrum::F16(spec.clone());
+    let any = crate::render::spectrum::AnySpectrum::F16(spec.clone());
     let t_marks = std::time::Instant::now();
     let marks = AdaptiveMarks::build(&spec, settings)?;
     let mark_ms = t_marks.elapsed().as_secs_f64() * 1e3;
@@ -564,7 +564,7 @@ pub fn table1_row(
             .map(drop)
             .map_err(|e| e.to_string())
     })?;
-    let caster = crate::raycast::RayCaster::new(volume);
+    let caster = crate::reference::raycast::RayCaster::new(volume);
     let spatial_ms = median_ms(runs, || caster.project(view, side, side, 1.0, 0).map(drop))?;
     Ok(Table1Row {
         name: name.to_string(),

@@ -7,15 +7,15 @@
 //!   `$FVR_CT_HEAD` if set, else where Debian's `invesalius-examples`
 //!   installs it; `scripts/fetch-ct-head.sh` installs it.
 //!
-//! Other modules get either with [`crate::scene::load_volume`]`("ct-head", None)`,
+//! Other modules get either with [`crate::sources::load_volume`]`("ct-head", None)`,
 //! or [`load_dataset`].
 
 use std::path::{Path, PathBuf};
 
 use indicatif::ProgressBar;
 
-use crate::formats::den::parse_den;
-use crate::formats::read_volume_with_progress;
+use crate::io::den::parse_den;
+use crate::io::read_volume_with_progress;
 use crate::volume::Volume;
 
 /// Environment variable that points at the CT head's `.inv3` file.
@@ -34,7 +34,7 @@ pub const CT_HEAD_SPACING: [f64; 3] = [0.957_031_2, 0.957_031_2, 1.5];
 pub const BRAINSMALL_DIMS: [usize; 3] = [128, 128, 84];
 
 /// `brainsmall.den`, gzip-compressed.
-pub const BRAINSMALL_DEN_GZ: &[u8] = include_bytes!("../tests/data/brainsmall.den.gz");
+pub const BRAINSMALL_DEN_GZ: &[u8] = include_bytes!("../../tests/data/brainsmall.den.gz");
 
 /// The names [`load_dataset`] knows, with a description each.
 pub const DATASETS: &[(&str, &str)] = &[

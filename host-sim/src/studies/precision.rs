@@ -21,10 +21,10 @@ use fvr_core::render::{aux_len, grid_len, render};
 use fvr_core::spectrum::{padded_size, prepare_scratch_len, DenseVolume, Spectrum};
 use half::f16;
 
-use crate::phantom::Phantom;
-use crate::pipeline::{choose_filter, choose_oversampling, KbDesign, PipelineError};
 use crate::reference::{exact_projection, snr_db};
-use crate::scene::{load_volume, phantom_by_name};
+use crate::render::spectrum::{choose_filter, choose_oversampling, KbDesign, PipelineError};
+use crate::sources::phantom::Phantom;
+use crate::sources::{load_volume, phantom_by_name};
 use crate::volume::Volume;
 
 /// A spectrum in storage format `S`, owned, with block exponents if any.
@@ -50,7 +50,7 @@ impl<S: Sample> StoredSpectrum<S> {
         rounding: Rounding,
     ) -> Result<Self, PipelineError> {
         let n = padded_size(volume.dims, filter.oversample())?;
-        crate::pipeline::check_memory(n, std::mem::size_of::<S>())?;
+        crate::render::spectrum::check_memory(n, std::mem::size_of::<S>())?;
         let source = DenseVolume::new(volume.dims, &volume.data)?;
         let mut data = vec![S::default(); n * n * n];
         let mut scratch = vec![T::ZERO; prepare_scratch_len(n)];
@@ -80,7 +80,7 @@ impl<S: Sample> StoredSpectrum<S> {
         rounding: Rounding,
     ) -> Result<Self, PipelineError> {
         let n = padded_size(volume.dims, filter.oversample())?;
-        crate::pipeline::check_memory(n, std::mem::size_of::<S>())?;
+        crate::render::spectrum::check_memory(n, std::mem::size_of::<S>())?;
         let source = DenseVolume::new(volume.dims, &volume.data)?;
         let mut data = vec![S::default(); n * n * n];
         let mut exps = vec![0i8; n * n];
@@ -235,7 +235,7 @@ pub struct Subject {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Oversampling {
     /// 2 when premultiplication would amplify storage noise by more than
-    /// [`crate::pipeline::CONDITIONING_LIMIT_DB`], else 1.
+    /// [`crate::render::spectrum::CONDITIONING_LIMIT_DB`], else 1.
     Auto,
     /// Fixed.
     Fixed(u32),
@@ -732,7 +732,7 @@ pub fn summary(cells: &[Cell]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::phantom::{sample, GaussianMixture};
+    use crate::sources::phantom::{sample, GaussianMixture};
 
     fn gaussians(n: usize) -> Volume {
         sample(&GaussianMixture::random(1, n, 8), [n, n, n])
@@ -801,7 +801,7 @@ pub struct ExtremeCase {
 /// full-range u16 volume, the Gaussian phantom scaled by 1e-6, and a
 /// Shepp–Logan head in Hounsfield units (air −1000).
 pub fn extreme_cases(n: usize) -> Vec<ExtremeCase> {
-    use crate::phantom::{sample, GaussianMixture, SheppLogan};
+    use crate::sources::phantom::{sample, GaussianMixture, SheppLogan};
     let dims = [n, n, n];
     let views = || VIEWS.iter().map(|&d| View::along(d)).collect::<Vec<_>>();
     let filled = |f: &dyn Fn(usize, usize, usize) -> f32| {
@@ -886,7 +886,7 @@ pub fn measure_extremes(
     formats: &[Format],
     oversample: Option<u32>,
 ) -> Result<Vec<ExtremeRow>, String> {
-    use crate::pipeline::premultiplication_gain_db;
+    use crate::render::spectrum::premultiplication_gain_db;
     let mut rows = Vec::new();
     for case in extreme_cases(n) {
         let kind = FilterKind::Kb4;

@@ -32,13 +32,13 @@ use fvr_core::render::{aux_len, finish_projection, placement, render};
 use fvr_core::spectrum::{prepare_scratch_len, Spectrum};
 use half::f16;
 
-use crate::adaptive::{parse_tolerance, AdaptiveMarks, AdaptiveSettings, Bound};
-use crate::phantom::{sample, GaussianMixture, Phantom};
-use crate::pipeline::{choose_filter, KbDesign};
-use crate::plot::{Canvas, Overlay, Point, Scatter};
-use crate::precision::{parse_format, StoredSpectrum};
+use crate::image::plot::{Canvas, Overlay, Point, Scatter};
 use crate::reference::snr_db;
-use crate::scene::{BLOB_COUNT, BLOB_SIGMA_FRACTION, DEFAULT_SEED, GAUSSIAN_COUNT};
+use crate::render::adaptive::{parse_tolerance, AdaptiveMarks, AdaptiveSettings, Bound};
+use crate::render::spectrum::{choose_filter, KbDesign};
+use crate::sources::phantom::{sample, GaussianMixture, Phantom};
+use crate::sources::{BLOB_COUNT, BLOB_SIGMA_FRACTION, DEFAULT_SEED, GAUSSIAN_COUNT};
+use crate::studies::precision::{parse_format, StoredSpectrum};
 use crate::volume::Volume;
 
 /// Largest volume side without `--large`.
@@ -1278,7 +1278,7 @@ pub fn run(args: &TradeArgs) -> Result<(), String> {
     let (available, source) = match &args.memory_limit {
         Some(text) => (parse_bytes(text)?, "--memory-limit"),
         None => (
-            crate::nrrd::memory_limit_bytes(),
+            crate::io::nrrd::memory_limit_bytes(),
             "MemAvailable in /proc/meminfo",
         ),
     };
@@ -1316,7 +1316,7 @@ pub fn run(args: &TradeArgs) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::phantom::SplitMix64;
+    use crate::sources::phantom::SplitMix64;
     use fvr_core::spectrum::padded_size;
 
     /// On a random cloud with ties, no front point is dominated by any

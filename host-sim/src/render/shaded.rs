@@ -1,7 +1,7 @@
 //! Depth-cued and shaded rendering on the host: the spectra a scene needs
 //! (the `|∇f|` spectrum only when a light needs it) and a reusable renderer.
 
-use crate::pipeline::{AnySpectrum, OwnedSpectrum, PipelineError, Precision};
+use crate::render::spectrum::{AnySpectrum, OwnedSpectrum, PipelineError, Precision};
 use crate::volume::Volume;
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::{DerivativeTable, Filter, KernelTable};
@@ -444,7 +444,7 @@ impl Image {
         } else {
             vec![self.channels, self.width, self.height]
         };
-        crate::nrrd::write_nrrd_f32(path, &sizes, &data).map_err(|e| e.to_string())
+        crate::io::nrrd::write_nrrd_f32(path, &sizes, &data).map_err(|e| e.to_string())
     }
 
     /// Write as an 8-bit PNG, grey or RGB, auto-windowed over all channels

@@ -1,5 +1,5 @@
 //! The error type of volume I/O: NRRD, raw, and the other formats of
-//! [`crate::formats`].
+//! [`crate::io`].
 
 use std::fmt;
 use std::io;

@@ -1,14 +1,18 @@
 //! Volumes by name: files on disk, named data sets or built-in phantoms.
 
+pub mod datasets;
+pub mod phantom;
+pub mod teapot;
+
 use std::path::Path;
 
 use indicatif::ProgressBar;
 
-use crate::datasets::{load_dataset_with_progress, DATASETS_HELP};
-use crate::formats::{read_volume_with_progress, FORMATS_HELP};
-use crate::nrrd::{read_raw, Endian, SampleType};
-use crate::phantom::{sample, GaussianMixture, Phantom, SheppLogan, Sphere};
-use crate::teapot::{voxelize_teapot, DEFAULT_TEAPOT_SIZE};
+use crate::io::nrrd::{read_raw, Endian, SampleType};
+use crate::io::{read_volume_with_progress, FORMATS_HELP};
+use crate::sources::datasets::{load_dataset_with_progress, DATASETS_HELP};
+use crate::sources::phantom::{sample, GaussianMixture, Phantom, SheppLogan, Sphere};
+use crate::sources::teapot::{voxelize_teapot, DEFAULT_TEAPOT_SIZE};
 use crate::volume::Volume;
 
 /// Default side of built-in phantoms.
@@ -101,7 +105,7 @@ fn build_phantom(
     Ok(PhantomVolume { phantom, volume })
 }
 
-/// Parse `teapot[@N]` into the voxelized Utah teapot ([`crate::teapot`]),
+/// Parse `teapot[@N]` into the voxelized Utah teapot ([`crate::sources::teapot`]),
 /// or `None` if `spec` names something else.
 ///
 /// # Errors
@@ -132,8 +136,8 @@ pub struct RawLayout {
 }
 
 /// Load a volume: a built-in phantom (`gaussians@64`), a named data set
-/// (`brainsmall`, `ct-head`: [`crate::datasets`]), a raw file when `raw` is
-/// given, or a volume file of any format [`crate::formats`] reads.
+/// (`brainsmall`, `ct-head`: [`crate::sources::datasets`]), a raw file when `raw` is
+/// given, or a volume file of any format [`crate::io`] reads.
 ///
 /// # Errors
 /// Unknown names, missing data sets, unreadable or malformed files, with

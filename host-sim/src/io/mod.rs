@@ -6,18 +6,18 @@
 //!
 //! | format | extensions | magic | spacing from |
 //! |---|---|---|---|
-//! | NRRD ([`crate::nrrd`]) | `.nrrd`, `.nhdr` | `NRRD000x` | `spacings` or `space directions` |
+//! | NRRD ([`crate::io::nrrd`]) | `.nrrd`, `.nhdr` | `NRRD000x` | `spacings` or `space directions` |
 //! | NIfTI-1 ([`nifti`]) | `.nii`, `.nii.gz`, `.hdr` + `.img` | `sizeof_hdr` 348 and `n+1`/`ni1` | `pixdim`, in `xyzt_units` |
 //! | VolPack density ([`den`]) | `.den`, `.den.gz` | version 1 (either byte order) | none (1 mm) |
 //! | InVesalius project ([`inv3`]) | `.inv3` | gzip of a tar holding `main.plist` | `spacing` in `main.plist` |
 //! | DICOM series ([`dicom`]) | a directory, or one `.dcm` file of the series | `DICM` at byte 128 | `PixelSpacing` and slice positions |
 //!
 //! Headerless raw files have no magic: read them with
-//! [`crate::nrrd::read_raw`] and an explicit layout.
+//! [`crate::io::nrrd::read_raw`] and an explicit layout.
 //!
 //! Every reader treats its input as untrusted: sizes are checked for zero
 //! and overflow, the memory needed is checked against
-//! [`crate::nrrd::memory_limit_bytes`] before allocating, gzip data is never
+//! [`crate::io::nrrd::memory_limit_bytes`] before allocating, gzip data is never
 //! decompressed far beyond what the header calls for, and every problem is
 //! an [`IoError`] that names the file and the field.
 
@@ -25,6 +25,7 @@ pub mod den;
 pub mod dicom;
 pub mod inv3;
 pub mod nifti;
+pub mod nrrd;
 mod plist;
 
 use std::fs::File;
@@ -34,8 +35,8 @@ use std::path::Path;
 use flate2::bufread::MultiGzDecoder;
 use indicatif::ProgressBar;
 
-use crate::nrrd::{self, IoError};
 use crate::volume::Volume;
+use nrrd::IoError;
 
 pub use plist::{parse_plist, PlistValue};
 

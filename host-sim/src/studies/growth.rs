@@ -14,10 +14,10 @@ use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
 use half::f16;
 
-use crate::phantom::{sample, GaussianMixture};
-use crate::pipeline::{OwnedSpectrum, ViewRenderer};
-use crate::plot::{Canvas, Rgb};
-use crate::raycast::RayCaster;
+use crate::image::plot::{Canvas, Rgb};
+use crate::reference::raycast::RayCaster;
+use crate::render::spectrum::{OwnedSpectrum, ViewRenderer};
+use crate::sources::phantom::{sample, GaussianMixture};
 use crate::timing::median_ms;
 
 /// Time per view at one size.

@@ -5,8 +5,11 @@
 //! 2. [`exact_projection`]: exact line integrals of analytic phantoms.
 //! 3. [`ideal_projection`]: the volume's DFT evaluated directly on the slice
 //!    points (the ideal interpolation filter), for small volumes.
-//! 4. The full pipeline in f64: [`crate::pipeline::Precision::F64`].
+//! 4. The full pipeline in f64: [`crate::render::spectrum::Precision::F64`].
 //! 5. [`spatial_projection`]: a spatial-domain ray integrator.
+
+pub mod raycast;
+pub mod shaded;
 
 use std::f64::consts::PI;
 
@@ -15,7 +18,7 @@ use fvr_core::geometry::{center, Sampling, View};
 use fvr_core::render::{check_image, finish_projection, placement, signed_index};
 use fvr_core::spectrum::padded_size;
 
-use crate::phantom::Phantom;
+use crate::sources::phantom::Phantom;
 use crate::volume::Volume;
 
 /// Agreement of `test` with `reference` in dB:

@@ -44,7 +44,7 @@ use dicom_object::{DefaultDicomObject, OpenFileOptions};
 use dicom_pixeldata::{ConvertOptions, ModalityLutOption, PixelDecoder};
 use indicatif::ProgressBar;
 
-use crate::nrrd::{excerpt, format_error, IoError};
+use crate::io::nrrd::{excerpt, format_error, IoError};
 use crate::volume::{check_spacing, Volume};
 
 /// Format name in error messages.
@@ -525,7 +525,7 @@ fn check_pixel_size(obj: &DefaultDicomObject) -> Result<(), IoError> {
             "the pixel data holds",
         ),
     };
-    let limit = crate::nrrd::memory_limit_bytes();
+    let limit = crate::io::nrrd::memory_limit_bytes();
     if needed > available || needed > limit {
         return Err(format_error(
             FORMAT,
@@ -742,7 +742,7 @@ pub fn read_dicom_with_progress(path: &Path, progress: &ProgressBar) -> Result<V
             let read_one = || -> Result<Option<Slice>, IoError> {
                 let mut head = [0u8; 132];
                 let mut f = fs::File::open(&file)?;
-                let got = crate::nrrd::read_full(&mut f, &mut head)?;
+                let got = crate::io::nrrd::read_full(&mut f, &mut head)?;
                 if !has_magic(&head[..got]) {
                     return Ok(None);
                 }

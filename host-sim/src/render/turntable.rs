@@ -10,7 +10,7 @@ use fvr_core::geometry::{Sampling, View};
 use fvr_core::real::{Real, Sample};
 use indicatif::ProgressBar;
 
-use crate::pipeline::{AnySpectrum, OwnedSpectrum, ViewRenderer};
+use crate::render::spectrum::{AnySpectrum, OwnedSpectrum, ViewRenderer};
 
 /// The `frames` view directions of a full turn of `start` about `axis`
 /// (right-handed, starting at `start`), each with `axis` as the up hint.

@@ -18,7 +18,7 @@ use indicatif::ProgressBar;
 
 use super::plist::{parse_plist, PlistValue};
 use super::{decode_samples, open_counted, MaybeGzip};
-use crate::nrrd::{excerpt, format_error, Endian, IoError, SampleType};
+use crate::io::nrrd::{excerpt, format_error, Endian, IoError, SampleType};
 use crate::volume::{check_spacing, Volume};
 
 /// Format name of the archive in error messages.
@@ -247,10 +247,10 @@ fn read_plist<R: Read>(entry: tar::Entry<'_, R>) -> Result<String, IoError> {
 /// A whole member, within the memory limit.
 fn read_member<R: Read>(entry: tar::Entry<'_, R>) -> Result<Vec<u8>, IoError> {
     let size = entry.size();
-    if size > crate::nrrd::memory_limit_bytes() {
+    if size > crate::io::nrrd::memory_limit_bytes() {
         return Err(IoError::TooLarge {
             needed: size,
-            limit: crate::nrrd::memory_limit_bytes(),
+            limit: crate::io::nrrd::memory_limit_bytes(),
         });
     }
     let mut bytes = Vec::new();

@@ -22,7 +22,7 @@ use std::path::Path;
 use indicatif::ProgressBar;
 
 use super::{decode_samples, open_counted, MaybeGzip};
-use crate::nrrd::{format_error, Endian, IoError, SampleType};
+use crate::io::nrrd::{format_error, Endian, IoError, SampleType};
 use crate::volume::Volume;
 
 /// Bytes of the header.

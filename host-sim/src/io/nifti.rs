@@ -36,7 +36,7 @@ use ::nifti::{NiftiHeader, NiftiType, Unit};
 use indicatif::ProgressBar;
 
 use super::{decode_samples, open_counted, MaybeGzip};
-use crate::nrrd::{format_error, Endian, IoError, SampleType};
+use crate::io::nrrd::{format_error, Endian, IoError, SampleType};
 use crate::volume::{check_spacing, Volume};
 
 /// Bytes of a NIfTI-1 header.

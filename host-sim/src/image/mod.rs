@@ -1,5 +1,8 @@
 //! Writing rendered images: float32 NRRD, or auto-windowed 8-bit PNG.
 
+pub mod output;
+pub mod plot;
+
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::Path;

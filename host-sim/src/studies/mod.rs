@@ -1,0 +1,8 @@
+//! The measuring commands: accuracy against exact line integrals, storage
+//! precision, growth with the volume's side and the speed–accuracy trade.
+
+pub mod accuracy;
+pub mod growth;
+pub mod precision;
+pub mod precision_cli;
+pub mod trade;
