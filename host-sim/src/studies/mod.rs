@@ -4,5 +4,5 @@
 pub mod accuracy;
 pub mod growth;
 pub mod precision;
-pub mod precision_cli;
+pub mod precision_plot;
 pub mod trade;

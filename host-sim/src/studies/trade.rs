@@ -17,10 +17,8 @@
 //! the memory available is refused before any work ([`Sweep::check_memory`]).
 
 use std::fmt::Write as _;
-use std::path::PathBuf;
 use std::time::Instant;
 
-use clap::Args;
 use fvr_core::adaptive::{extract_slice_adaptive, marks_words, AdaptiveLevel, Marks};
 use fvr_core::dht::{Rounding, Twiddles};
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
@@ -54,54 +52,30 @@ pub const MIN_PREVIEW_SIDE: usize = 8;
 /// The cheaper filter of adaptive points (the project's default chain).
 pub const ADAPTIVE_CHAIN: [FilterKind; 1] = [FilterKind::Nearest];
 
-/// Arguments of `fvr trade`.
-#[derive(Args, Debug, Clone)]
-pub struct TradeArgs {
-    /// Interpolation filters, comma-separated: nearest, linear, cubic, kb3,
-    /// kb4, kb5, kb6.
-    #[arg(long, default_value = "nearest,linear,cubic,kb3,kb4,kb5,kb6")]
+/// The axes of a sweep as given (comma-separated lists), before
+/// validation by [`Sweep::from_axes`].
+#[derive(Debug, Clone)]
+pub struct SweepAxes {
+    /// Interpolation filters.
     pub filters: String,
-    /// Oversampling factors: 1, 2 or both.
-    #[arg(long, default_value = "1,2")]
+    /// Oversampling factors.
     pub oversample: String,
-    /// Storage formats of the spectrum: f16, f32, bf16, a 16-bit minifloat
-    /// eEmM (e.g. e4m11), q15, q15-line.
-    #[arg(long, default_value = "f16,f32")]
+    /// Storage formats of the spectrum.
     pub formats: String,
-    /// Adaptive tolerances in dB, or `none` for the full filter everywhere.
-    /// Adaptive points need oversampling 2 and level 0, and a filter wider
-    /// than nearest (the cheaper filter).
-    #[arg(long, default_value = "none,40,60")]
+    /// Adaptive tolerances in dB, or `none`.
     pub adaptive: String,
-    /// Progressive levels: 0 is the full image (the volume's side); L is a
-    /// preview 2^L times smaller from the central 1/4^L of the slice.
-    #[arg(long, default_value = "0,1,2")]
+    /// Progressive levels.
     pub levels: String,
-    /// The Gaussian-mixture phantom: `gaussians` (8 Gaussians, sigma 1.5 to
-    /// 0.12 N voxels) or `blobs` (24 smaller ones, sigma 1.5 to 0.05 N:
-    /// more detail, so filters and previews differ more).
-    #[arg(long, default_value = "gaussians")]
+    /// `gaussians` or `blobs`.
     pub phantom: String,
-    /// Sides of the phantom (16 to 256; 512 with --large).
-    #[arg(long, default_value = "64,128")]
+    /// Sides of the phantom.
     pub sizes: String,
-    /// Allow sides up to 512 (a 512³ f16 spectrum at oversampling 2 holds 2 GiB).
-    #[arg(long)]
+    /// Allow sides up to [`MAX_LARGE_SIZE`].
     pub large: bool,
     /// View directions per point.
-    #[arg(long, default_value_t = 3)]
     pub views: usize,
-    /// Timed renders of each view per point (the median of views × repeats
-    /// is reported).
-    #[arg(long, default_value_t = 3)]
+    /// Timed renders of each view per point.
     pub repeats: usize,
-    /// Memory the sweep may use, in bytes with an optional K, M or G suffix
-    /// (powers of 1024). Default: MemAvailable from /proc/meminfo.
-    #[arg(long, value_name = "BYTES")]
-    pub memory_limit: Option<String>,
-    /// Directory for trade.csv, trade.png and trade.md.
-    #[arg(long, default_value = "fvr-trade")]
-    pub out_dir: PathBuf,
 }
 
 /// One point of the sweep: every setting that changes a view.
@@ -363,7 +337,7 @@ impl Sweep {
     /// too deep for a size, zero views or repeats, and conflicting options:
     /// adaptive tolerances with oversampling 1 only, with levels above 0
     /// only, or with the nearest filter only.
-    pub fn from_args(args: &TradeArgs) -> Result<Self, String> {
+    pub fn from_axes(args: &SweepAxes) -> Result<Self, String> {
         let filters = axis("filters", &args.filters, |s| {
             FilterKind::from_name(s)
                 .ok_or_else(|| format!("unknown filter `{s}`: valid are {}", filter_names()))
@@ -1262,57 +1236,6 @@ fn levels_table(rows: &[Row], sweep: &Sweep) -> String {
 }
 
 /// The command line as typed, with the program named `fvr`.
-fn command_line() -> String {
-    let mut args: Vec<String> = std::env::args().skip(1).collect();
-    args.insert(0, "fvr".into());
-    args.join(" ")
-}
-
-/// Run `fvr trade`.
-///
-/// # Errors
-/// Bad or conflicting arguments and a sweep beyond memory (both before any
-/// work), a pipeline failure, or output that cannot be written.
-pub fn run(args: &TradeArgs) -> Result<(), String> {
-    let sweep = Sweep::from_args(args)?;
-    let (available, source) = match &args.memory_limit {
-        Some(text) => (parse_bytes(text)?, "--memory-limit"),
-        None => (
-            crate::io::nrrd::memory_limit_bytes(),
-            "MemAvailable in /proc/meminfo",
-        ),
-    };
-    sweep.check_memory(available, source)?;
-    let dir = &args.out_dir;
-    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
-    let total = sweep.settings().len();
-    eprintln!("fvr trade: {total} points");
-    let mut done = 0;
-    let rows = measure(&sweep, |r| {
-        done += 1;
-        eprintln!(
-            "  [{done}/{total}] {}³ {:<40} {:9.3} ms {:7.1} dB  {}",
-            r.setting.size,
-            r.setting.describe(),
-            r.ms_per_view,
-            r.snr_db,
-            human_bytes(r.memory.held())
-        );
-    })?;
-    let write = |name: &str, text: &str| {
-        let p = dir.join(name);
-        std::fs::write(&p, text).map_err(|e| format!("cannot write `{}`: {e}", p.display()))
-    };
-    write("trade.csv", &csv(&rows, sweep.views, sweep.repeats))?;
-    write("trade.md", &summary(&rows, &sweep, &command_line()))?;
-    plot(&rows).write_png(&dir.join("trade.png"))?;
-    eprintln!(
-        "wrote trade.csv, trade.md and trade.png in {}",
-        dir.display()
-    );
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

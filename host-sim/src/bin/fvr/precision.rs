@@ -1,23 +1,23 @@
-//! `fvr precision`: arguments, the run, and its three outputs (Markdown,
-//! CSV, PNG plot).
+//! `fvr precision`: arguments, the run, and its outputs (Markdown, CSV,
+//! PNG plot).
 
 use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
 use fvr_core::filter::FilterKind;
-use fvr_core::format::{Arithmetic, Format, FormatName};
+use fvr_core::format::{Format, FormatName};
 
-use crate::image::plot::{Point, Scatter};
-use crate::sources::phantom_by_name;
-use crate::studies::precision::{
+use fvr_host::sources::phantom_by_name;
+use fvr_host::studies::precision::{
     csv, default_formats, markdown, parse_format, study_subject, summary, Cell, Oversampling,
     Subject,
 };
+use fvr_host::studies::precision_plot::plot;
 
 /// Arguments of `fvr precision`.
 #[derive(Args, Debug)]
-pub struct PrecisionArgs {
+pub(crate) struct PrecisionArgs {
     /// Volumes: built-in phantoms (`gaussians`, `shepp-logan`, `sphere`),
     /// which are measured at every `--sizes` unless given as `name@N`, or
     /// NRRD files.
@@ -54,7 +54,7 @@ pub struct PrecisionArgs {
 /// # Errors
 /// Bad arguments (named, before any work), unreadable volumes, or output
 /// that cannot be written.
-pub fn run(args: &PrecisionArgs) -> Result<(), String> {
+pub(crate) fn run(args: &PrecisionArgs) -> Result<(), String> {
     // Configuration first: every error here comes before any transform.
     let formats: Vec<Format> = if args.formats.is_empty() {
         default_formats()
@@ -87,10 +87,10 @@ pub fn run(args: &PrecisionArgs) -> Result<(), String> {
             ("Oversampling 1", Some(1)),
             ("Automatic oversampling", None),
         ] {
-            let rows = crate::studies::precision::measure_extremes(n, &formats, o)?;
+            let rows = fvr_host::studies::precision::measure_extremes(n, &formats, o)?;
             md += &format!(
                 "## {title}\n\n{}\n",
-                crate::studies::precision::extremes_markdown(&rows)
+                fvr_host::studies::precision::extremes_markdown(&rows)
             );
         }
         return match &args.out_dir {
@@ -127,7 +127,7 @@ pub fn run(args: &PrecisionArgs) -> Result<(), String> {
             fvr_core::spectrum::padded_size(subject.volume.dims, subject.filter.oversample())
                 .map_err(|e| e.to_string())?;
         for &f in &formats {
-            for a in crate::studies::precision::modes_for(f) {
+            for a in fvr_host::studies::precision::modes_for(f) {
                 f.check(a, grid)
                     .map_err(|e| format!("format {} on {spec}: {e}", FormatName(f)))?;
             }
@@ -205,74 +205,4 @@ fn report(cells: &[Cell], args: &PrecisionArgs) -> String {
     s += "\n## Every cell\n\n";
     s += &markdown(cells);
     s
-}
-
-/// SNR against f64 over bytes per voxel; formats that share a size are
-/// spread sideways and named under the axis.
-pub fn plot(cells: &[Cell]) -> crate::image::plot::Canvas {
-    let mut formats: Vec<(Format, f64)> = Vec::new();
-    for c in cells
-        .iter()
-        .filter(|c| c.error.is_none() && c.format != Format::F64)
-    {
-        if !formats.iter().any(|(f, _)| *f == c.format) {
-            formats.push((c.format, c.bytes_per_voxel));
-        }
-    }
-    // Spread formats of the same (rounded) size over ±0.35 octave.
-    let class = |b: f64| b.log2().round() as i64;
-    let mut xs: Vec<(Format, f64)> = Vec::new();
-    for (f, b) in &formats {
-        let peers: Vec<&(Format, f64)> = formats
-            .iter()
-            .filter(|(_, c)| class(*c) == class(*b))
-            .collect();
-        let i = peers.iter().position(|(g, _)| g == f).unwrap_or(0) as f64;
-        let m = peers.len() as f64;
-        let spread = (0.7 / m).min(0.12);
-        let x = 2f64.powf(class(*b) as f64 + (i - (m - 1.0) / 2.0) * spread);
-        xs.push((*f, x));
-    }
-    let series = [
-        ("per-pass", [31, 119, 180]),
-        ("per-stage", [214, 39, 40]),
-        ("host-once", [44, 160, 44]),
-    ];
-    let points: Vec<Point> = cells
-        .iter()
-        .filter(|c| c.error.is_none() && c.snr_f64.is_finite())
-        .filter_map(|c| {
-            let x = xs.iter().find(|(f, _)| *f == c.format)?.1;
-            let series = match c.arithmetic {
-                Arithmetic::PerPass => 0,
-                Arithmetic::PerStage => 1,
-                Arithmetic::HostOnce => 2,
-            };
-            // Modes side by side: per-pass left, per-stage centre, host-once right.
-            Some(Point {
-                x: x * 2f64.powf(0.012 * (series as f64 - 1.0)),
-                y: c.snr_f64,
-                series,
-            })
-        })
-        .collect();
-    let labels: Vec<(f64, String)> = xs
-        .iter()
-        .map(|(f, x)| (*x, FormatName(*f).to_string()))
-        .collect();
-    let top = points.iter().map(|p| p.y).fold(60.0f64, f64::max);
-    let scatter = Scatter {
-        title: "SNR VS THE F64 PIPELINE, EVERY VOLUME AND SIZE",
-        x_label: "SPECTRUM BYTES PER VOXEL (LOG SCALE)",
-        y_label: "SNR DB",
-        x_range: (0.6, 6.0),
-        y_range: (0.0, (top / 20.0).ceil() * 20.0),
-        x_ticks: &[1.0, 2.0, 4.0],
-        y_step: 20.0,
-        y_lines: &[(40.0, "40 DB"), (50.0, "50 DB (PAPER)"), (75.0, "75 DB")],
-        series: &series,
-        x_labels: &labels,
-        points: &points,
-    };
-    scatter.draw(1000, 700)
 }

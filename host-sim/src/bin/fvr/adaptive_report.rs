@@ -1,0 +1,153 @@
+//! What an adaptive render did (`fvr render --adaptive`), for --stats.
+
+use crate::render::{json_num, json_str};
+use std::time::Instant;
+
+use fvr_core::geometry::View;
+use fvr_host::reference::snr_db;
+use fvr_host::render::adaptive::AdaptiveSettings;
+use fvr_host::render::spectrum::AnySpectrum;
+
+/// An adaptive render with what it did.
+pub(crate) struct AdaptiveReport {
+    pub(crate) image: Vec<f64>,
+    pub(crate) marks: fvr_host::render::adaptive::AdaptiveMarks,
+    pub(crate) stats: fvr_core::adaptive::AdaptiveStats,
+    pub(crate) mark_time: std::time::Duration,
+    pub(crate) view_time: std::time::Duration,
+    pub(crate) full_view_time: std::time::Duration,
+    pub(crate) snr_vs_full: f64,
+}
+
+impl AdaptiveReport {
+    pub(crate) fn print_human(&self) {
+        let s = &self.stats;
+        let pct = |v: u64, of: u64| 100.0 * v as f64 / of.max(1) as f64;
+        println!(
+            "  adaptive      {} dB: {} of {} taps ({:.1}%), {:.2} ms per view against {:.2} ms \
+             with the full filter; image {:.1} dB from the full-filter image",
+            self.marks.tolerance_db,
+            s.taps,
+            s.full_taps,
+            pct(s.taps, s.full_taps),
+            self.view_time.as_secs_f64() * 1e3,
+            self.full_view_time.as_secs_f64() * 1e3,
+            self.snr_vs_full
+        );
+        println!(
+            "  samples       {:.1}% on the full filter",
+            pct(s.per_filter[0], s.samples)
+        );
+        for (i, l) in self.marks.levels.iter().enumerate() {
+            println!(
+                "  samples       {:.1}% on {} (h_d {:.3}, threshold {:.3e}, {} of {} spectrum samples marked)",
+                pct(s.per_filter[i + 1], s.samples),
+                l.filter.kind().name(),
+                l.h_d,
+                l.threshold,
+                l.marked,
+                l.words.len() * 32
+            );
+            if let Some(r) = l.error_ratio {
+                println!(
+                    "  error field   {:.1} dB below the volume (exact bound, eq. 15)",
+                    -10.0 * r.log10()
+                );
+            }
+        }
+        println!(
+            "  marks         {} bytes (1 bit per voxel per level), built in {:.1} ms",
+            self.marks.bytes(),
+            self.mark_time.as_secs_f64() * 1e3
+        );
+        if let Some(note) = self.marks.effect(s) {
+            println!("  note          {note}");
+        }
+    }
+
+    pub(crate) fn json(&self) -> String {
+        let s = &self.stats;
+        let levels: Vec<String> = self
+            .marks
+            .levels
+            .iter()
+            .enumerate()
+            .map(|(i, l)| {
+                format!(
+                    "{{\"filter\": {}, \"h_d\": {}, \"threshold\": {}, \"marked\": {}, \"samples\": {}, \"error_field_db\": {}}}",
+                    json_str(l.filter.kind().name()),
+                    json_num(l.h_d),
+                    json_num(l.threshold),
+                    l.marked,
+                    s.per_filter[i + 1],
+                    l.error_ratio.map_or("null".into(), |r| json_num(-10.0 * r.log10()))
+                )
+            })
+            .collect();
+        format!(
+            "{{\"tolerance_db\": {}, \"bound\": {}, \"taps\": {}, \"full_taps\": {}, \"taps_ratio\": {}, \
+             \"samples\": {}, \"full_filter_samples\": {}, \"levels\": [{}], \"marks_bytes\": {}, \
+             \"mark_ms\": {}, \"view_ms\": {}, \"full_view_ms\": {}, \"snr_vs_full_db\": {}, \
+             \"note\": {}}}",
+            json_num(self.marks.tolerance_db),
+            json_str(self.marks.bound.name()),
+            s.taps,
+            s.full_taps,
+            json_num(s.taps as f64 / s.full_taps.max(1) as f64),
+            s.samples,
+            s.per_filter[0],
+            levels.join(", "),
+            self.marks.bytes(),
+            json_num(self.mark_time.as_secs_f64() * 1e3),
+            json_num(self.view_time.as_secs_f64() * 1e3),
+            json_num(self.full_view_time.as_secs_f64() * 1e3),
+            json_num(self.snr_vs_full),
+            self.marks.effect(s).map_or("null".into(), |n| json_str(&n))
+        )
+    }
+}
+
+/// Mark the spectrum, render adaptively, and render with the full filter
+/// for comparison.
+pub(crate) fn adaptive_render(
+    spec: &AnySpectrum,
+    view: &View,
+    w: usize,
+    h: usize,
+    settings: &AdaptiveSettings,
+) -> Result<AdaptiveReport, String> {
+    pub(crate) fn go<S: fvr_core::real::Sample, T: fvr_core::real::Real>(
+        any: &AnySpectrum,
+        spec: &fvr_host::render::spectrum::OwnedSpectrum<S>,
+        view: &View,
+        w: usize,
+        h: usize,
+        settings: &AdaptiveSettings,
+    ) -> Result<AdaptiveReport, String> {
+        let t0 = Instant::now();
+        let marks = fvr_host::render::adaptive::AdaptiveMarks::build(spec, settings)?;
+        let mark_time = t0.elapsed();
+        let t1 = Instant::now();
+        let (image, stats) = marks
+            .render::<S, T>(spec, view, w, h)
+            .map_err(|e| e.to_string())?;
+        let view_time = t1.elapsed();
+        let t2 = Instant::now();
+        let full = any.render(view, w, h).map_err(|e| e.to_string())?;
+        let full_view_time = t2.elapsed();
+        Ok(AdaptiveReport {
+            snr_vs_full: snr_db(&full, &image),
+            image,
+            marks,
+            stats,
+            mark_time,
+            view_time,
+            full_view_time,
+        })
+    }
+    match spec {
+        AnySpectrum::F16(s) => go::<_, f32>(spec, s, view, w, h, settings),
+        AnySpectrum::F32(s) => go::<_, f32>(spec, s, view, w, h, settings),
+        AnySpectrum::F64(s) => go::<_, f64>(spec, s, view, w, h, settings),
+    }
+}

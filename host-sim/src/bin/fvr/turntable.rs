@@ -1,0 +1,135 @@
+//! `fvr turntable`: an APNG of X-ray views on a full turn.
+
+use crate::args::{
+    parse_size, parse_vec3, prepare_with_progress, volume_help, InputArgs, PngArgs, SpectrumArgs,
+    UnitArgs,
+};
+use crate::render::{json_num, json_str};
+use crate::scene::SCENE_HELP;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Args;
+use fvr_host::image::output::write_apng;
+use fvr_host::progress;
+use fvr_host::render::turntable;
+
+#[derive(Args)]
+pub(crate) struct TurntableArgs {
+    /// A volume file, a raw file with --raw-dims, a data set, or a built-in phantom.
+    #[arg(help = volume_help(), required_unless_present = "scene")]
+    pub(crate) volume: Option<String>,
+    /// Scene file (TOML): its volume, camera, spectrum, output window and
+    /// [turntable] settings; flags given on the command line override them.
+    #[arg(long, value_name = "FILE.toml", long_help = SCENE_HELP)]
+    pub(crate) scene: Option<PathBuf>,
+    /// Number of frames in the turn.
+    #[arg(long, default_value_t = 72, value_parser = clap::value_parser!(u32).range(1..=3600))]
+    pub(crate) frames: u32,
+    /// Frames per second of the animation.
+    #[arg(long, default_value_t = 24, value_parser = clap::value_parser!(u16).range(1..=1000))]
+    pub(crate) fps: u16,
+    /// View direction X,Y,Z of the first frame; later frames turn it about --up.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,-1,0")]
+    pub(crate) dir: [f64; 3],
+    /// Turntable axis and up hint X,Y,Z.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,1")]
+    pub(crate) up: [f64; 3],
+    /// Image size W or WxH in pixels (of --pixel-size mm, or of one voxel
+    /// with --ignore-spacing); at most the padded grid.
+    /// Default: the padded grid divided by the oversampling.
+    #[arg(long, value_parser = parse_size)]
+    pub(crate) size: Option<(usize, usize)>,
+    #[command(flatten)]
+    pub(crate) units: UnitArgs,
+    #[command(flatten)]
+    pub(crate) spectrum: SpectrumArgs,
+    /// Output file: .apng or .png (an animated PNG either way).
+    #[arg(long, default_value = "spin.apng")]
+    pub(crate) out: PathBuf,
+    /// Print the timings (load, preprocess, views, views per second) as one
+    /// JSON object instead of the summary line.
+    #[arg(long)]
+    pub(crate) stats_json: bool,
+    #[command(flatten)]
+    pub(crate) png: PngArgs,
+    #[command(flatten)]
+    pub(crate) input: InputArgs,
+}
+
+pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), String> {
+    let views = turntable::orbit(args.dir, args.up, args.frames as usize)?;
+    let style = args.png.style()?;
+    let t0 = Instant::now();
+    let volume_spec = args.volume.as_deref().ok_or_else(|| {
+        "no volume: give VOLUME, or `volume.path` or `volume.builtin` in the scene".to_string()
+    })?;
+    let volume = args.input.load(volume_spec)?;
+    let t_load = t0.elapsed();
+    let t1 = Instant::now();
+    let spec = prepare_with_progress(
+        &volume,
+        args.spectrum.filter,
+        args.spectrum.oversample,
+        args.spectrum.kb_design,
+        args.spectrum.precision,
+    )?;
+    let t_prep = t1.elapsed();
+    let n = spec.n();
+    let side = n / args.spectrum.oversample as usize;
+    let (w, h) = args.size.unwrap_or((side, side));
+    let sampling = args.units.sampling(&volume, n, side)?;
+    let bar = progress::count(views.len() as u64, "frames");
+    let t2 = Instant::now();
+    let frames = turntable::render_views(&spec, &views, &sampling, w, h, &bar);
+    let t_views = t2.elapsed();
+    bar.finish_and_clear();
+    let frames = frames.map_err(|e| e.to_string())?;
+    write_apng(&args.out, w, h, &frames, args.fps, &style)?;
+    let secs = t_views.as_secs_f64();
+    println!(
+        "wrote {} ({} frames, {w}x{h}, {} fps)",
+        args.out.display(),
+        frames.len(),
+        args.fps
+    );
+    let views_per_second = frames.len() as f64 / secs.max(1e-9);
+    if args.stats_json {
+        let fields = [
+            ("volume", json_str(volume_spec)),
+            ("dims", format!("{:?}", volume.dims)),
+            ("image", format!("[{w}, {h}]")),
+            ("frames", frames.len().to_string()),
+            ("fps", args.fps.to_string()),
+            ("spectrum_side", n.to_string()),
+            ("precision", json_str(args.spectrum.precision.name())),
+            ("spectrum_bytes", spec.bytes().to_string()),
+            ("filter", json_str(args.spectrum.filter.name())),
+            ("oversample", args.spectrum.oversample.to_string()),
+            ("load_ms", json_num(t_load.as_secs_f64() * 1e3)),
+            ("preprocess_ms", json_num(t_prep.as_secs_f64() * 1e3)),
+            ("views_ms", json_num(secs * 1e3)),
+            (
+                "ms_per_view",
+                json_num(secs * 1e3 / frames.len().max(1) as f64),
+            ),
+            ("views_per_second", json_num(views_per_second)),
+        ];
+        let body: Vec<String> = fields
+            .iter()
+            .map(|(k, v)| format!("{}: {v}", json_str(k)))
+            .collect();
+        println!("{{{}}}", body.join(", "));
+    } else {
+        println!(
+            "  load {:.1} ms, preprocess {:.1} ms ({n}^3 {}), {} views in {:.1} ms = {:.1} views/s",
+            t_load.as_secs_f64() * 1e3,
+            t_prep.as_secs_f64() * 1e3,
+            args.spectrum.precision,
+            frames.len(),
+            secs * 1e3,
+            views_per_second
+        );
+    }
+    Ok(())
+}
