@@ -4,5 +4,4 @@
 pub mod accuracy;
 pub mod growth;
 pub mod precision;
-pub mod precision_plot;
 pub mod trade;

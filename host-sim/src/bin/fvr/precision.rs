@@ -9,11 +9,11 @@ use fvr_core::filter::FilterKind;
 use fvr_core::format::{Format, FormatName};
 
 use fvr_host::sources::phantom_by_name;
+use fvr_host::studies::precision::plot::plot;
 use fvr_host::studies::precision::{
     csv, default_formats, markdown, parse_format, study_subject, summary, Cell, Oversampling,
     Subject,
 };
-use fvr_host::studies::precision_plot::plot;
 
 /// Arguments of `fvr precision`.
 #[derive(Args, Debug)]

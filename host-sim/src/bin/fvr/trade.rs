@@ -75,6 +75,7 @@ impl TradeArgs {
     }
 }
 
+/// The command line as typed, with the program named `fvr`.
 fn command_line() -> String {
     let mut args: Vec<String> = std::env::args().skip(1).collect();
     args.insert(0, "fvr".into());

@@ -2,8 +2,8 @@
 
 use fvr_core::format::{Arithmetic, Format, FormatName};
 
+use super::Cell;
 use crate::image::plot::{Canvas, Point, Scatter};
-use crate::studies::precision::Cell;
 
 /// SNR against f64 over bytes per voxel; formats that share a size are
 /// spread sideways and named under the axis.

@@ -7,212 +7,32 @@
 //! or per butterfly stage) or rounded once from a host f32 spectrum, with
 //! block exponents for block floating point.
 
+mod extremes;
+pub mod plot;
+mod stored;
+#[cfg(test)]
+mod tests;
+
+pub use extremes::{extreme_cases, extremes_markdown, measure_extremes, ExtremeCase, ExtremeRow};
+pub use stored::StoredSpectrum;
+
 use std::fmt::Write as _;
 
-use fvr_core::dht::{Rounding, Twiddles};
-use fvr_core::filter::{Filter, FilterKind, KernelTable};
+use fvr_core::dht::Rounding;
+use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::format::{
-    bf16, encode_blocks, encode_elements, Arithmetic, BlockExponents, BlockLayout, Blocking,
-    Format, FormatName, Minifloat16, Minifloat8, Q15, Q7,
+    bf16, Arithmetic, BlockLayout, Blocking, Format, FormatName, Minifloat16, Minifloat8, Q15, Q7,
 };
 use fvr_core::geometry::View;
 use fvr_core::real::{Real, Sample};
-use fvr_core::render::{aux_len, grid_len, render};
-use fvr_core::spectrum::{padded_size, prepare_scratch_len, DenseVolume, Spectrum};
+use fvr_core::spectrum::padded_size;
 use half::f16;
 
 use crate::reference::{exact_projection, snr_db};
-use crate::render::spectrum::{choose_filter, choose_oversampling, KbDesign, PipelineError};
+use crate::render::spectrum::{choose_filter, choose_oversampling, KbDesign};
 use crate::sources::phantom::Phantom;
 use crate::sources::{load_volume, phantom_by_name};
 use crate::volume::Volume;
-
-/// A spectrum in storage format `S`, owned, with block exponents if any.
-#[derive(Clone, Debug)]
-pub struct StoredSpectrum<S> {
-    data: Vec<S>,
-    blocks: Option<(BlockLayout, Vec<i8>)>,
-    n: usize,
-    scale: f64,
-    filter: Filter,
-    dims: [usize; 3],
-}
-
-impl<S: Sample> StoredSpectrum<S> {
-    /// Premultiply, pad and transform `volume` in place in format `S`, with
-    /// arithmetic `T` and the given rounding.
-    ///
-    /// # Errors
-    /// As [`Spectrum::prepare_rounding`], or a spectrum beyond memory.
-    pub fn prepare<T: Real>(
-        volume: &Volume,
-        filter: Filter,
-        rounding: Rounding,
-    ) -> Result<Self, PipelineError> {
-        let n = padded_size(volume.dims, filter.oversample())?;
-        crate::render::spectrum::check_memory(n, std::mem::size_of::<S>())?;
-        let source = DenseVolume::new(volume.dims, &volume.data)?;
-        let mut data = vec![S::default(); n * n * n];
-        let mut scratch = vec![T::ZERO; prepare_scratch_len(n)];
-        let mut tw_buf = vec![T::ZERO; Twiddles::<T>::buffer_len(n)];
-        let tw = Twiddles::new(&mut tw_buf, n)?;
-        let spec =
-            Spectrum::prepare_rounding(&source, filter, &mut data, &mut scratch, &tw, rounding)?;
-        let (scale, dims) = (spec.scale(), spec.dims());
-        Ok(Self {
-            data,
-            blocks: None,
-            n,
-            scale,
-            filter,
-            dims,
-        })
-    }
-
-    /// Premultiply, pad and transform `volume` in place into block floating
-    /// point with per-line exponents ([`Spectrum::prepare_line_blocks`]).
-    ///
-    /// # Errors
-    /// As [`Spectrum::prepare_line_blocks`], or a spectrum beyond memory.
-    pub fn prepare_line_blocks<T: Real>(
-        volume: &Volume,
-        filter: Filter,
-        rounding: Rounding,
-    ) -> Result<Self, PipelineError> {
-        let n = padded_size(volume.dims, filter.oversample())?;
-        crate::render::spectrum::check_memory(n, std::mem::size_of::<S>())?;
-        let source = DenseVolume::new(volume.dims, &volume.data)?;
-        let mut data = vec![S::default(); n * n * n];
-        let mut exps = vec![0i8; n * n];
-        let mut exps_scratch = vec![0i8; n * n];
-        let mut scratch = vec![T::ZERO; prepare_scratch_len(n)];
-        let mut tw_buf = vec![T::ZERO; Twiddles::<T>::buffer_len(n)];
-        let tw = Twiddles::new(&mut tw_buf, n)?;
-        let spec = Spectrum::prepare_line_blocks(
-            &source,
-            filter,
-            &mut data,
-            &mut exps,
-            &mut exps_scratch,
-            &mut scratch,
-            &tw,
-            rounding,
-        )?;
-        let (scale, dims) = (spec.scale(), spec.dims());
-        Ok(Self {
-            data,
-            blocks: Some((BlockLayout::Line, exps)),
-            n,
-            scale,
-            filter,
-            dims,
-        })
-    }
-
-    /// Round a finished spectrum `src` to `S` once: element by element
-    /// (rescaled by a power of two to `S`'s scaling exponent), or with block
-    /// exponents.
-    ///
-    /// # Errors
-    /// An overflow, or a block layout that does not fit.
-    pub fn encode<U: Sample>(
-        src: &StoredSpectrum<U>,
-        blocking: Blocking,
-    ) -> Result<Self, fvr_core::Error> {
-        let n = src.n;
-        let mut data = vec![S::default(); n * n * n];
-        let values: Vec<f64> = src.data.iter().map(|v| v.to_f64()).collect();
-        let (blocks, scale) = match blocking {
-            Blocking::Volume => {
-                let factor = 2f64.powi(S::SCALE_LOG2 - U::SCALE_LOG2);
-                encode_elements(&values, factor, &mut data)?;
-                (None, src.scale * factor)
-            }
-            Blocking::Blocks(layout) => {
-                let mut exps = vec![0i8; layout.exponent_count(n)?];
-                encode_blocks(&values, n, layout, &mut data, &mut exps)?;
-                (Some((layout, exps)), src.scale)
-            }
-        };
-        Ok(Self {
-            data,
-            blocks,
-            n,
-            scale,
-            filter: src.filter,
-            dims: src.dims,
-        })
-    }
-
-    /// Borrow as a core spectrum.
-    pub fn view(&self) -> Spectrum<'_, S> {
-        let parts = match &self.blocks {
-            None => Spectrum::from_parts(&self.data, self.n, self.scale, self.filter, self.dims),
-            Some((layout, exps)) => BlockExponents::new(*layout, exps, self.n).and_then(|b| {
-                Spectrum::from_blocks(&self.data, b, self.n, self.scale, self.filter, self.dims)
-            }),
-        };
-        parts.expect("parts come from a prepared spectrum")
-    }
-
-    /// Side of the padded cube.
-    pub fn n(&self) -> usize {
-        self.n
-    }
-
-    /// Bytes held, block exponents included.
-    pub fn bytes(&self) -> usize {
-        self.view().bytes()
-    }
-
-    /// `(Σ stored², count of non-finite)`, the stored values times their
-    /// block's power of two.
-    pub fn stored_stats(&self) -> (f64, usize) {
-        let spec = self.view();
-        let mut sum = 0.0;
-        let mut bad = 0;
-        for i in 0..self.data.len() {
-            let v = spec.value(i);
-            if v.is_finite() {
-                sum += v * v;
-            } else {
-                bad += 1;
-            }
-        }
-        (sum, bad)
-    }
-
-    /// Render one view with arithmetic `T`; the image comes back in f64.
-    ///
-    /// # Errors
-    /// As [`fvr_core::render::render`].
-    pub fn render<T: Real>(
-        &self,
-        view: &View,
-        width: usize,
-        height: usize,
-    ) -> Result<Vec<f64>, fvr_core::Error> {
-        let n = self.n;
-        let kernel = KernelTable::<T>::new(self.filter);
-        let mut tw_buf = vec![T::ZERO; Twiddles::<T>::buffer_len(n)];
-        let tw = Twiddles::new(&mut tw_buf, n)?;
-        let mut grid = vec![T::ZERO; grid_len(n)];
-        let mut aux = vec![T::ZERO; aux_len(n)];
-        let mut out = vec![T::ZERO; width * height];
-        render(
-            &self.view(),
-            &kernel,
-            view,
-            width,
-            height,
-            &tw,
-            &mut grid,
-            &mut aux,
-            &mut out,
-        )?;
-        Ok(out.into_iter().map(T::to_f64).collect())
-    }
-}
 
 /// Everything a cell of the study needs about one volume at one size.
 pub struct Subject {
@@ -526,7 +346,7 @@ pub fn modes_for(format: Format) -> Vec<Arithmetic> {
 }
 
 /// Largest `|a − b|` relative to the largest `|a|`.
-fn relative_max_error(reference: &[f64], test: &[f64]) -> f64 {
+pub(crate) fn relative_max_error(reference: &[f64], test: &[f64]) -> f64 {
     let peak = reference.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let err = reference
         .iter()
@@ -614,7 +434,7 @@ pub fn study_subject(
     Ok(cells)
 }
 
-fn db(v: f64) -> String {
+pub(crate) fn db(v: f64) -> String {
     if v.is_nan() {
         "—".into()
     } else if v == f64::INFINITY {
@@ -725,247 +545,6 @@ pub fn summary(cells: &[Cell]) -> String {
             let _ = write!(s, " {text} |");
         }
         s.push('\n');
-    }
-    s
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::sources::phantom::{sample, GaussianMixture};
-
-    fn gaussians(n: usize) -> Volume {
-        sample(&GaussianMixture::random(1, n, 8), [n, n, n])
-    }
-
-    /// Block encoding rounds every coefficient once: the error is at most
-    /// half a mantissa step of its block, `2^(e−16)` for Q15 (`2^(e−8)` for
-    /// Q7), and the exponent is the smallest that holds the block's maximum.
-    #[test]
-    fn block_encoding_errs_by_at_most_half_a_step_of_the_block() {
-        let volume = gaussians(16);
-        let filter = Filter::new(FilterKind::Kb4, 1).unwrap();
-        let src =
-            StoredSpectrum::<f32>::prepare::<f32>(&volume, filter, Rounding::PerPass).unwrap();
-        for layout in [
-            BlockLayout::Line,
-            BlockLayout::Brick(2),
-            BlockLayout::Brick(4),
-        ] {
-            let q = StoredSpectrum::<Q15>::encode(&src, Blocking::Blocks(layout)).unwrap();
-            let q7 = StoredSpectrum::<Q7>::encode(&src, Blocking::Blocks(layout)).unwrap();
-            let (spec, spec7) = (q.view(), q7.view());
-            let exps = spec.blocks().unwrap().exponents();
-            let mut block_max = vec![0.0f64; exps.len()];
-            for i in 0..src.data.len() {
-                let (x, y, z) = (i % 16, (i / 16) % 16, i / 256);
-                let b = layout.block_of(16, x, y, z);
-                let v = src.data[i] as f64;
-                block_max[b] = block_max[b].max(v.abs());
-                let e = exps[b] as i32;
-                assert!(
-                    (spec.value(i) - v).abs() <= 2f64.powi(e - 16),
-                    "{layout:?} {i}"
-                );
-                let e7 = spec7.blocks().unwrap().exponents()[b] as i32;
-                assert!(
-                    (spec7.value(i) - v).abs() <= 2f64.powi(e7 - 8),
-                    "{layout:?} {i}"
-                );
-            }
-            for (b, &e) in exps.iter().enumerate() {
-                let m = block_max[b];
-                if m > 0.0 {
-                    // Smallest exponent: one less would not hold the maximum.
-                    assert!(m * 2f64.powi(-(e as i32)) <= 32767.5 / 32768.0);
-                    assert!(m * 2f64.powi(1 - e as i32) > 32767.5 / 32768.0);
-                }
-            }
-        }
-    }
-}
-
-/// A stability case: a volume at an extreme, with the views it is rendered
-/// along.
-pub struct ExtremeCase {
-    /// Short name (used in the docs table).
-    pub name: &'static str,
-    /// The volume.
-    pub volume: Volume,
-    /// Views.
-    pub views: Vec<View>,
-}
-
-/// The stability cases of the docs, at side `n` (even): a constant volume,
-/// a single-voxel impulse at the centre, a Nyquist checkerboard, a constant
-/// full-range u16 volume, the Gaussian phantom scaled by 1e-6, and a
-/// Shepp–Logan head in Hounsfield units (air −1000).
-pub fn extreme_cases(n: usize) -> Vec<ExtremeCase> {
-    use crate::sources::phantom::{sample, GaussianMixture, SheppLogan};
-    let dims = [n, n, n];
-    let views = || VIEWS.iter().map(|&d| View::along(d)).collect::<Vec<_>>();
-    let filled = |f: &dyn Fn(usize, usize, usize) -> f32| {
-        let mut v = Volume::zeros(dims);
-        for k in 0..n {
-            for j in 0..n {
-                for i in 0..n {
-                    let idx = v.index(i, j, k);
-                    v.data[idx] = f(i, j, k);
-                }
-            }
-        }
-        v
-    };
-    let gauss = sample(&GaussianMixture::random(1, n, 8), dims);
-    let sl = sample(&SheppLogan::new(dims), dims);
-    vec![
-        ExtremeCase {
-            name: "constant 1",
-            volume: filled(&|_, _, _| 1.0),
-            views: views(),
-        },
-        ExtremeCase {
-            name: "impulse",
-            volume: filled(&|i, j, k| if [i, j, k] == [n / 2; 3] { 1.0 } else { 0.0 }),
-            views: views(),
-        },
-        ExtremeCase {
-            name: "nyquist checkerboard",
-            volume: filled(&|i, j, k| if (i + j + k) % 2 == 0 { 1.0 } else { -1.0 }),
-            views: views(),
-        },
-        ExtremeCase {
-            name: "u16 65535",
-            volume: filled(&|_, _, _| 65535.0),
-            views: views(),
-        },
-        ExtremeCase {
-            name: "gaussians x 1e-6",
-            volume: Volume::new(dims, gauss.data.iter().map(|v| v * 1e-6).collect()),
-            views: views(),
-        },
-        ExtremeCase {
-            name: "shepp-logan in HU",
-            volume: Volume::new(dims, sl.data.iter().map(|v| 1000.0 * v - 1000.0).collect()),
-            views: views(),
-        },
-    ]
-}
-
-/// One stability measurement.
-#[derive(Clone, Debug)]
-pub struct ExtremeRow {
-    /// The case.
-    pub case: &'static str,
-    /// Premultiplication gain at oversampling 1, dB.
-    pub gain_db: f64,
-    /// Oversampling chosen.
-    pub oversample: u32,
-    /// The format.
-    pub format: Format,
-    /// Its arithmetic.
-    pub arithmetic: Arithmetic,
-    /// Worst SNR over the views against the f64 pipeline (dB), or the error.
-    pub snr_f64: Result<f64, String>,
-    /// `n·max|voxel|`, the largest line integral the volume could give.
-    pub line_scale: f64,
-    /// Largest `|pixel − f64 pixel|` over all views.
-    pub max_error: f64,
-    /// NaN or infinite pixels.
-    pub non_finite: usize,
-}
-
-/// Measure every case of [`extreme_cases`] with `formats` (each with
-/// [`modes_for`]), at the oversampling [`choose_oversampling`] picks for kb4
-/// unless `oversample` fixes it.
-///
-/// # Errors
-/// The f64 reference fails.
-pub fn measure_extremes(
-    n: usize,
-    formats: &[Format],
-    oversample: Option<u32>,
-) -> Result<Vec<ExtremeRow>, String> {
-    use crate::render::spectrum::premultiplication_gain_db;
-    let mut rows = Vec::new();
-    for case in extreme_cases(n) {
-        let kind = FilterKind::Kb4;
-        let f1 = choose_filter(&case.volume, kind, 1, KbDesign::Auto).map_err(|e| e.to_string())?;
-        let gain_db = premultiplication_gain_db(&case.volume, f1).map_err(|e| e.to_string())?;
-        let o = match oversample {
-            Some(o) => o,
-            None => choose_oversampling(&case.volume, kind, KbDesign::Auto)
-                .map_err(|e| e.to_string())?,
-        };
-        let filter =
-            choose_filter(&case.volume, kind, o, KbDesign::Auto).map_err(|e| e.to_string())?;
-        let mut subject = Subject::new(case.name, case.volume, None, filter, case.views);
-        let (reference, _) = subject.render_format(Format::F64, Arithmetic::PerPass)?;
-        let vmax = subject
-            .volume
-            .data
-            .iter()
-            .fold(0.0f64, |m, v| m.max(v.abs() as f64));
-        let line_scale = subject.size as f64 * vmax;
-        for &format in formats {
-            for arithmetic in modes_for(format) {
-                let got = subject.render_format(format, arithmetic);
-                let (snr_f64, max_error, non_finite) = match got {
-                    Ok((images, _)) => (
-                        Ok(images
-                            .iter()
-                            .zip(&reference)
-                            .map(|(i, r)| snr_db(r, i))
-                            .fold(f64::INFINITY, f64::min)),
-                        images
-                            .iter()
-                            .flatten()
-                            .zip(reference.iter().flatten())
-                            .fold(0.0f64, |m, (i, r)| m.max((i - r).abs())),
-                        images.iter().flatten().filter(|v| !v.is_finite()).count(),
-                    ),
-                    Err(e) => (Err(e), f64::NAN, 0),
-                };
-                rows.push(ExtremeRow {
-                    case: case.name,
-                    gain_db,
-                    oversample: o,
-                    format,
-                    arithmetic,
-                    snr_f64,
-                    line_scale,
-                    max_error,
-                    non_finite,
-                });
-            }
-        }
-    }
-    Ok(rows)
-}
-
-/// The stability rows as a Markdown table.
-pub fn extremes_markdown(rows: &[ExtremeRow]) -> String {
-    let mut s = String::from(
-        "| case | gain at σ=1 | oversample | format | arithmetic | SNR vs f64 | max error / (n·max\\|v\\|) | NaN/Inf |\n\
-         |---|---|---|---|---|---|---|---|\n",
-    );
-    for r in rows {
-        let snr = match &r.snr_f64 {
-            Ok(v) => db(*v),
-            Err(e) => format!("error: {e}"),
-        };
-        let _ = writeln!(
-            s,
-            "| {} | {:.1} dB | {} | {} | {} | {} | {:.1e} | {} |",
-            r.case,
-            r.gain_db,
-            r.oversample,
-            FormatName(r.format),
-            r.arithmetic.name(),
-            snr,
-            r.max_error / r.line_scale,
-            r.non_finite
-        );
     }
     s
 }
