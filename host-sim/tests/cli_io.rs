@@ -315,16 +315,17 @@ fn renders_a_dicom_series_directory() {
     let orientation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
     for k in 0..6u32 {
         let pixels: Vec<i16> = (0..64).map(|i| ((i * 7 + k * 13) % 50) as i16).collect();
-        let bytes = fvr_host::io::dicom::encode_ct_slice(
-            "1.2.3.4",
-            k + 1,
-            [8, 8],
-            [0.5, 0.5],
-            [0.0, 0.0, 1.25 * k as f64],
+        let bytes = fvr_host::io::dicom::CtSlice {
+            series: "1.2.3.4",
+            instance: k + 1,
+            size: [8, 8],
+            pixel_spacing: [0.5, 0.5],
+            position: [0.0, 0.0, 1.25 * k as f64],
             orientation,
-            -10.0,
-            &pixels,
-        );
+            intercept: -10.0,
+            pixels: &pixels,
+        }
+        .encode();
         std::fs::write(series.join(format!("IM{k:04}")), bytes).unwrap();
     }
     let out = fvr(

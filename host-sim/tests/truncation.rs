@@ -5,7 +5,7 @@
 use std::io::Write;
 
 use fvr_host::io::den::{encode_den, parse_den};
-use fvr_host::io::dicom::{encode_ct_slice, parse_slice};
+use fvr_host::io::dicom::{parse_slice, CtSlice};
 use fvr_host::io::inv3::{encode_inv3_i16, parse_inv3};
 use fvr_host::io::nifti::{encode_nifti_f32, parse_nifti};
 use fvr_host::io::nrrd::IoError;
@@ -72,16 +72,17 @@ fn prefixes_of_every_format_are_errors() {
 #[test]
 fn prefixes_of_a_dicom_slice_are_errors() {
     let orientation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
-    let bytes = encode_ct_slice(
-        "1.2",
-        1,
-        [3, 2],
-        [0.5, 0.5],
-        [0.0; 3],
+    let bytes = CtSlice {
+        series: "1.2",
+        instance: 1,
+        size: [3, 2],
+        pixel_spacing: [0.5, 0.5],
+        position: [0.0; 3],
         orientation,
-        -1024.0,
-        &[1, 2, 3, 4, 5, 6],
-    );
+        intercept: -1024.0,
+        pixels: &[1, 2, 3, 4, 5, 6],
+    }
+    .encode();
     let slice = parse_slice(&bytes).expect("whole slice");
     assert_eq!(
         slice.pixels,

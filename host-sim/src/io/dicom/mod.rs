@@ -34,6 +34,12 @@
 //! VR files) a declared length of up to 4 GiB can still be allocated, and
 //! fail, before the error is returned: memory and time, not a crash.
 
+mod encode;
+mod lengths;
+
+pub use encode::CtSlice;
+use lengths::check_lengths;
+
 use std::fs;
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -48,14 +54,14 @@ use crate::io::nrrd::{excerpt, format_error, IoError};
 use crate::volume::{check_spacing, Volume};
 
 /// Format name in error messages.
-const FORMAT: &str = "DICOM";
+pub(crate) const FORMAT: &str = "DICOM";
 /// Format name of the series in error messages.
-const SERIES: &str = "DICOM series";
+pub(crate) const SERIES: &str = "DICOM series";
 
 /// Relative tolerance on the slice step.
-const STEP_TOLERANCE: f64 = 0.01;
+pub(crate) const STEP_TOLERANCE: f64 = 0.01;
 /// Tolerance on direction cosines.
-const COSINE_TOLERANCE: f64 = 1e-4;
+pub(crate) const COSINE_TOLERANCE: f64 = 1e-4;
 
 /// Whether `head` is the start of a DICOM Part 10 file: `DICM` at 128.
 pub fn has_magic(head: &[u8]) -> bool {
@@ -92,251 +98,23 @@ pub fn parse_slice(bytes: &[u8]) -> Result<Slice, IoError> {
 }
 
 /// Parse a whole file held in memory, after [`check_lengths`].
-fn open_bytes(bytes: &[u8]) -> Result<DefaultDicomObject, IoError> {
+pub(crate) fn open_bytes(bytes: &[u8]) -> Result<DefaultDicomObject, IoError> {
     check_lengths(bytes)?;
     open(bytes)
 }
 
-fn open<R: Read>(reader: R) -> Result<DefaultDicomObject, IoError> {
+pub(crate) fn open<R: Read>(reader: R) -> Result<DefaultDicomObject, IoError> {
     OpenFileOptions::new()
         .read_preamble(ReadPreamble::Auto)
         .from_reader(reader)
         .map_err(|e| format_error(FORMAT, "file meta", format!("cannot parse the file: {e}")))
 }
 
-/// Transfer syntaxes whose data set is not explicit VR little endian.
-const IMPLICIT_VR_LITTLE_ENDIAN: &str = "1.2.840.10008.1.2";
-const EXPLICIT_VR_BIG_ENDIAN: &str = "1.2.840.10008.1.2.2";
-const DEFLATED_EXPLICIT_VR_LITTLE_ENDIAN: &str = "1.2.840.10008.1.2.1.99";
-
-/// Refuse a file in which an element declares more bytes than the file
-/// holds after it.
-///
-/// `dicom-object` allocates (and zero-fills) each value's declared length
-/// before reading it, so without this check a 1 kB file could make it
-/// allocate 4 GiB. The walk follows the element headers of the file meta
-/// group and of the data set (explicit or implicit VR, either byte order;
-/// a deflated data set is left to the decoder, whose output is bounded by
-/// the compressed size), descending into sequences and items, and skipping
-/// encapsulated pixel data fragments.
-fn check_lengths(bytes: &[u8]) -> Result<(), IoError> {
-    let start = if bytes.get(128..132) == Some(b"DICM") {
-        132
-    } else if bytes.starts_with(b"DICM") {
-        4
-    } else {
-        return Ok(()); // Not Part 10: the parser reports it.
-    };
-    let mut walk = Walk {
-        bytes,
-        pos: start,
-        explicit: true,
-        big_endian: false,
-        fragments: false,
-    };
-    // File meta group: explicit VR little endian, starting with its group
-    // length (0002,0000); like `dicom-object`, read elements until that many
-    // bytes have been read.
-    let mut syntax = String::new();
-    let group_length = match walk.element()? {
-        Some(((0x0002, 0x0000), v)) if v.len() == 4 => {
-            u32::from_le_bytes([v[0], v[1], v[2], v[3]]) as usize
-        }
-        _ => return Ok(()), // The parser reports the malformed meta group.
-    };
-    let meta_start = walk.pos;
-    while walk.pos - meta_start < group_length {
-        match walk.element()? {
-            Some(((0x0002, 0x0010), value)) => {
-                syntax = String::from_utf8_lossy(value)
-                    .trim_end_matches(['\0', ' '])
-                    .to_owned();
-            }
-            Some(_) => {}
-            None => return Ok(()),
-        }
-    }
-    match syntax.as_str() {
-        DEFLATED_EXPLICIT_VR_LITTLE_ENDIAN => return Ok(()),
-        IMPLICIT_VR_LITTLE_ENDIAN => walk.explicit = false,
-        EXPLICIT_VR_BIG_ENDIAN => walk.big_endian = true,
-        _ => {}
-    }
-    while walk.element()?.is_some() {}
-    Ok(())
-}
-
-/// A cursor over DICOM element headers (see [`check_lengths`]).
-struct Walk<'a> {
-    bytes: &'a [u8],
-    pos: usize,
-    explicit: bool,
-    big_endian: bool,
-    /// Inside encapsulated pixel data: items are raw fragments.
-    fragments: bool,
-}
-
-impl<'a> Walk<'a> {
-    fn u16_at(&self, at: usize) -> Option<u16> {
-        let b = self.bytes.get(at..at + 2)?;
-        Some(if self.big_endian {
-            u16::from_be_bytes([b[0], b[1]])
-        } else {
-            u16::from_le_bytes([b[0], b[1]])
-        })
-    }
-
-    fn u32_at(&self, at: usize) -> Option<u32> {
-        let b = self.bytes.get(at..at + 4)?;
-        let a = [b[0], b[1], b[2], b[3]];
-        Some(if self.big_endian {
-            u32::from_be_bytes(a)
-        } else {
-            u32::from_le_bytes(a)
-        })
-    }
-
-    /// Step over one element header (and its value when it has a defined
-    /// length and is not a sequence or item); the tag and value, or `None`
-    /// at the end of the input or of what can be walked.
-    #[allow(clippy::type_complexity)]
-    fn element(&mut self) -> Result<Option<((u16, u16), &'a [u8])>, IoError> {
-        let at = self.pos;
-        let (Some(group), Some(elem)) = (self.u16_at(at), self.u16_at(at + 2)) else {
-            return Ok(None);
-        };
-        let tag = (group, elem);
-        const UNDEFINED: u32 = u32::MAX;
-        // Items and delimiters have no VR, in every transfer syntax.
-        if group == 0xFFFE {
-            let Some(len) = self.u32_at(at + 4) else {
-                return Ok(None);
-            };
-            self.pos = at + 8;
-            match elem {
-                0xE000 if self.fragments && len != UNDEFINED => self.skip(tag, len)?,
-                0xE0DD => self.fragments = false,
-                // An item of elements: walk into it.
-                _ => {}
-            }
-            return Ok(Some((tag, &[])));
-        }
-        let (vr, len, header) = if self.explicit {
-            let Some(vr) = self.bytes.get(at + 4..at + 6) else {
-                return Ok(None);
-            };
-            // The VRs with a 2-byte length (PS3.5 7.1.2); any other code,
-            // unknown ones included (read as UN, as `dicom-encoding` does),
-            // has 2 reserved bytes and a 4-byte length.
-            let long = !matches!(
-                vr,
-                b"AE"
-                    | b"AS"
-                    | b"AT"
-                    | b"CS"
-                    | b"DA"
-                    | b"DS"
-                    | b"DT"
-                    | b"FL"
-                    | b"FD"
-                    | b"IS"
-                    | b"LO"
-                    | b"LT"
-                    | b"PN"
-                    | b"SH"
-                    | b"SL"
-                    | b"SS"
-                    | b"ST"
-                    | b"TM"
-                    | b"UI"
-                    | b"UL"
-                    | b"US"
-            );
-            let len = if long {
-                self.u32_at(at + 8)
-            } else {
-                self.u16_at(at + 6).map(u32::from)
-            };
-            let Some(len) = len else {
-                return Ok(None);
-            };
-            (Some(vr), len, if long { 12 } else { 8 })
-        } else {
-            let Some(len) = self.u32_at(at + 4) else {
-                return Ok(None);
-            };
-            (None, len, 8)
-        };
-        self.pos = at + header;
-        if len == UNDEFINED {
-            if tag == (0x7FE0, 0x0010) {
-                self.fragments = true;
-            } else if vr.is_some_and(|v| v != b"SQ" && v != b"UN") {
-                return Err(format_error(
-                    FORMAT,
-                    "element length",
-                    format!(
-                        "element ({group:04X},{elem:04X}) has an undefined length but is not a sequence or pixel data"
-                    ),
-                ));
-            }
-            // A sequence of undefined length: walk into its items.
-            return Ok(Some((tag, &[])));
-        }
-        // Binary numbers: `dicom-parser` reads whole values, so a length
-        // that is not a multiple of the value size would put it out of step
-        // with the element boundaries (and with this walk).
-        let size = match vr {
-            Some(b"SS" | b"US") => 2,
-            Some(b"FL" | b"SL" | b"UL" | b"AT" | b"OF" | b"OL") => 4,
-            Some(b"FD" | b"SV" | b"UV" | b"OD" | b"OV") => 8,
-            _ => 1,
-        };
-        if len % size != 0 {
-            return Err(format_error(
-                FORMAT,
-                "element length",
-                format!(
-                    "element ({group:04X},{elem:04X}) of {}-byte values has length {len}, not a multiple of {size}",
-                    size
-                ),
-            ));
-        }
-        if vr == Some(b"SQ") {
-            self.check(tag, len)?;
-            return Ok(Some((tag, &[])));
-        }
-        let value_at = self.pos;
-        self.skip(tag, len)?;
-        Ok(Some((tag, &self.bytes[value_at..self.pos])))
-    }
-
-    fn check(&self, (group, elem): (u16, u16), len: u32) -> Result<(), IoError> {
-        let left = self.bytes.len().saturating_sub(self.pos);
-        if len as usize > left {
-            return Err(format_error(
-                FORMAT,
-                "element length",
-                format!(
-                    "element ({group:04X},{elem:04X}) declares {len} bytes but the file has only {left} after it: truncated or corrupt"
-                ),
-            ));
-        }
-        Ok(())
-    }
-
-    fn skip(&mut self, tag: (u16, u16), len: u32) -> Result<(), IoError> {
-        self.check(tag, len)?;
-        self.pos += len as usize;
-        Ok(())
-    }
-}
-
-fn has_pixel_data(obj: &DefaultDicomObject) -> bool {
+pub(crate) fn has_pixel_data(obj: &DefaultDicomObject) -> bool {
     obj.get(tags::PIXEL_DATA).is_some()
 }
 
-fn slice_from(obj: &DefaultDicomObject) -> Result<Slice, IoError> {
+pub(crate) fn slice_from(obj: &DefaultDicomObject) -> Result<Slice, IoError> {
     if !has_pixel_data(obj) {
         return Err(format_error(
             FORMAT,
@@ -433,7 +211,7 @@ fn slice_from(obj: &DefaultDicomObject) -> Result<Slice, IoError> {
 
 /// `BitsAllocated` 8 or 16, and `1 <= BitsStored <= BitsAllocated`, the
 /// greyscale layouts decoded here.
-fn check_bits(obj: &DefaultDicomObject) -> Result<(), IoError> {
+pub(crate) fn check_bits(obj: &DefaultDicomObject) -> Result<(), IoError> {
     let int = |tag, name: &'static str| -> Result<Option<i64>, IoError> {
         match obj.get(tag) {
             None => Ok(None),
@@ -465,7 +243,7 @@ fn check_bits(obj: &DefaultDicomObject) -> Result<(), IoError> {
 
 /// Largest ratio accepted between decoded and encapsulated (compressed)
 /// pixel bytes; deflate's limit is about 1032.
-const MAX_COMPRESSION_RATIO: u64 = 1024;
+pub(crate) const MAX_COMPRESSION_RATIO: u64 = 1024;
 
 /// Refuse `Rows × Columns × NumberOfFrames × SamplesPerPixel ×
 /// BitsAllocated/8` bytes that the pixel data cannot hold: more than its
@@ -473,7 +251,7 @@ const MAX_COMPRESSION_RATIO: u64 = 1024;
 /// bytes when encapsulated, or more than the memory limit. The decoder
 /// allocates the decoded size up front, so a 1 kB file could otherwise
 /// claim gigabytes.
-fn check_pixel_size(obj: &DefaultDicomObject) -> Result<(), IoError> {
+pub(crate) fn check_pixel_size(obj: &DefaultDicomObject) -> Result<(), IoError> {
     let int = |tag, name: &'static str, default: i64| -> Result<i64, IoError> {
         match obj.get(tag) {
             None => Ok(default),
@@ -538,7 +316,7 @@ fn check_pixel_size(obj: &DefaultDicomObject) -> Result<(), IoError> {
     Ok(())
 }
 
-fn text(
+pub(crate) fn text(
     obj: &DefaultDicomObject,
     tag: dicom_object::Tag,
     name: &'static str,
@@ -553,7 +331,7 @@ fn text(
 }
 
 /// `count` finite numbers of a decimal-string attribute, or `None` if absent.
-fn floats(
+pub(crate) fn floats(
     obj: &DefaultDicomObject,
     tag: dicom_object::Tag,
     name: &'static str,
@@ -575,7 +353,7 @@ fn floats(
     Ok(Some(v))
 }
 
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -583,7 +361,7 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     ]
 }
 
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
@@ -767,156 +545,4 @@ pub fn read_dicom_with_progress(path: &Path, progress: &ProgressBar) -> Result<V
         assemble(slices)
     };
     go().map_err(|e| e.in_file(path))
-}
-
-/// Encode one CT slice as a DICOM Part 10 file (explicit VR little endian,
-/// 16-bit signed samples, rescale slope 1 and the given intercept). A test
-/// and fixture helper.
-///
-/// # Panics
-/// If `pixels.len()` is not `columns × rows`.
-#[allow(clippy::too_many_arguments)]
-pub fn encode_ct_slice(
-    series: &str,
-    instance: u32,
-    size: [u16; 2],
-    pixel_spacing: [f64; 2],
-    position: [f64; 3],
-    orientation: [f64; 6],
-    intercept: f64,
-    pixels: &[i16],
-) -> Vec<u8> {
-    use dicom_core::{PrimitiveValue, VR};
-    use dicom_object::mem::InMemElement;
-    use dicom_object::{FileMetaTableBuilder, InMemDicomObject};
-    assert_eq!(
-        pixels.len(),
-        size[0] as usize * size[1] as usize,
-        "encode_ct_slice"
-    );
-    let ds = |v: &[f64]| {
-        v.iter()
-            .map(|x| format!("{x}"))
-            .collect::<Vec<_>>()
-            .join("\\")
-    };
-    let mut obj = InMemDicomObject::new_empty();
-    let sop = format!("1.2.826.0.1.3680043.2.1125.{instance}");
-    let put = |obj: &mut InMemDicomObject, tag, vr, value: PrimitiveValue| {
-        obj.put(InMemElement::new(tag, vr, value));
-    };
-    put(
-        &mut obj,
-        tags::SOP_CLASS_UID,
-        VR::UI,
-        PrimitiveValue::from(dicom_dictionary_std::uids::CT_IMAGE_STORAGE),
-    );
-    put(
-        &mut obj,
-        tags::SOP_INSTANCE_UID,
-        VR::UI,
-        PrimitiveValue::from(sop.as_str()),
-    );
-    put(&mut obj, tags::MODALITY, VR::CS, PrimitiveValue::from("CT"));
-    put(
-        &mut obj,
-        tags::SERIES_INSTANCE_UID,
-        VR::UI,
-        PrimitiveValue::from(series),
-    );
-    put(
-        &mut obj,
-        tags::INSTANCE_NUMBER,
-        VR::IS,
-        PrimitiveValue::from(instance.to_string()),
-    );
-    put(
-        &mut obj,
-        tags::IMAGE_POSITION_PATIENT,
-        VR::DS,
-        PrimitiveValue::from(ds(&position)),
-    );
-    put(
-        &mut obj,
-        tags::IMAGE_ORIENTATION_PATIENT,
-        VR::DS,
-        PrimitiveValue::from(ds(&orientation)),
-    );
-    put(
-        &mut obj,
-        tags::PIXEL_SPACING,
-        VR::DS,
-        PrimitiveValue::from(ds(&pixel_spacing)),
-    );
-    put(
-        &mut obj,
-        tags::SAMPLES_PER_PIXEL,
-        VR::US,
-        PrimitiveValue::from(1u16),
-    );
-    put(
-        &mut obj,
-        tags::PHOTOMETRIC_INTERPRETATION,
-        VR::CS,
-        PrimitiveValue::from("MONOCHROME2"),
-    );
-    put(&mut obj, tags::ROWS, VR::US, PrimitiveValue::from(size[1]));
-    put(
-        &mut obj,
-        tags::COLUMNS,
-        VR::US,
-        PrimitiveValue::from(size[0]),
-    );
-    put(
-        &mut obj,
-        tags::BITS_ALLOCATED,
-        VR::US,
-        PrimitiveValue::from(16u16),
-    );
-    put(
-        &mut obj,
-        tags::BITS_STORED,
-        VR::US,
-        PrimitiveValue::from(16u16),
-    );
-    put(
-        &mut obj,
-        tags::HIGH_BIT,
-        VR::US,
-        PrimitiveValue::from(15u16),
-    );
-    put(
-        &mut obj,
-        tags::PIXEL_REPRESENTATION,
-        VR::US,
-        PrimitiveValue::from(1u16),
-    );
-    put(
-        &mut obj,
-        tags::RESCALE_INTERCEPT,
-        VR::DS,
-        PrimitiveValue::from(format!("{intercept}")),
-    );
-    put(
-        &mut obj,
-        tags::RESCALE_SLOPE,
-        VR::DS,
-        PrimitiveValue::from("1"),
-    );
-    let bytes: Vec<u8> = pixels.iter().flat_map(|v| v.to_le_bytes()).collect();
-    put(
-        &mut obj,
-        tags::PIXEL_DATA,
-        VR::OW,
-        PrimitiveValue::from(bytes),
-    );
-    let file = obj
-        .with_meta(
-            FileMetaTableBuilder::new()
-                .transfer_syntax(dicom_dictionary_std::uids::EXPLICIT_VR_LITTLE_ENDIAN),
-        )
-        .expect("a complete file meta table");
-    let mut out = Vec::new();
-    file.write_all(&mut out).expect("writing DICOM into a Vec");
-    out
 }
