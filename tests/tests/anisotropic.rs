@@ -324,7 +324,7 @@ fn cubic_voxels_render_cued_and_lit_scenes_in_mm() {
             .render_sampled(&scene, &view, &sampling, 64, 64)
             .unwrap();
         let exact =
-            exact_scene_projection_sampled(&object, dims, &sampling, &scene, &view, 64, 64, 0.05)
+            exact_scene_projection_sampled(&object, dims, &sampling, &scene, &view, (64, 64), 0.05)
                 .unwrap();
         let snr = snr_db(&exact.data, &image.data);
         println!(

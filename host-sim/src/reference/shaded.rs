@@ -152,8 +152,7 @@ pub fn exact_scene_projection(
         &Sampling::UNIT,
         scene,
         view,
-        width,
-        height,
+        (width, height),
         step,
     )
 }
@@ -162,8 +161,8 @@ pub fn exact_scene_projection(
 /// and a volume of `dims` sampled at `sampling.spacing()`: pixels at
 /// `sampling.pixel_position`, depth `t = d·(x − C)` in mm with the cue's `R`
 /// half the longest physical side `max_a n_a·Δ_a`, gradients per mm, and
-/// `∫ … dt` with `t` in mm. `step` is in mm. [`Sampling::UNIT`] gives
-/// [`exact_scene_projection`].
+/// `∫ … dt` with `t` in mm, on an image of `(width, height)` pixels. `step`
+/// is in mm. [`Sampling::UNIT`] gives [`exact_scene_projection`].
 ///
 /// # Errors
 /// As [`exact_scene_projection`].
@@ -173,8 +172,7 @@ pub fn exact_scene_projection_sampled(
     sampling: &Sampling,
     scene: &Scene,
     view: &View,
-    width: usize,
-    height: usize,
+    (width, height): (usize, usize),
     step: f64,
 ) -> Result<Image, fvr_core::Error> {
     scene.validate()?;

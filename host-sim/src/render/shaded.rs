@@ -58,6 +58,16 @@ pub fn gradient_volume(volume: &Volume) -> Result<Volume, fvr_core::Error> {
     })
 }
 
+/// The spectra a scene reads, in one storage type `S`: the density and,
+/// for lights, `|∇f|`.
+#[derive(Clone, Copy, Debug)]
+pub struct TypedSpectra<'a, S> {
+    /// The density spectrum.
+    pub density: &'a OwnedSpectrum<S>,
+    /// The `|∇f|` spectrum, if a light needs it.
+    pub gradient: Option<&'a OwnedSpectrum<S>>,
+}
+
 /// The spectra of one volume prepared for a scene.
 #[derive(Clone, Debug)]
 pub struct SceneSpectra {
@@ -179,7 +189,11 @@ impl SceneSpectra {
         ) -> Result<Image, fvr_core::Error> {
             let mut r = SceneRenderer::<T>::new(d.n(), d.filter(), scene)?;
             let mut out = vec![T::ZERO; scene.channels() * w * h];
-            let channels = r.render_into(d, g, scene, view, w, h, &mut out)?;
+            let spectra = TypedSpectra {
+                density: d,
+                gradient: g,
+            };
+            let channels = r.render_into(spectra, scene, view, w, h, &mut out)?;
             Ok(Image {
                 channels,
                 width: w,
@@ -262,17 +276,16 @@ impl<T: Real> SceneRenderer<T> {
     /// # Errors
     /// As [`render_scene`]; a scene with more fields than this renderer was
     /// built for.
-    #[allow(clippy::too_many_arguments)]
     pub fn render_into<S: Sample>(
         &mut self,
-        density: &OwnedSpectrum<S>,
-        gradient: Option<&OwnedSpectrum<S>>,
+        spectra: TypedSpectra<'_, S>,
         scene: &Scene,
         view: &View,
         width: usize,
         height: usize,
         out: &mut [T],
     ) -> Result<usize, fvr_core::Error> {
+        let TypedSpectra { density, gradient } = spectra;
         if self.derivative.is_none() && scene.needs_kernel_derivative() {
             self.derivative = Some(DerivativeTable::new(density.filter())?);
         }

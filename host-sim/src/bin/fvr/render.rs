@@ -436,8 +436,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), String> {
                         &sampling,
                         &scene,
                         &view,
-                        w,
-                        h,
+                        (w, h),
                         0.05,
                     )
                     .map_err(|e| e.to_string())?;

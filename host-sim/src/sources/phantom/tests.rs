@@ -230,9 +230,7 @@ fn sampled_sum_equals_integral() {
         .components
         .iter()
         .map(|g| {
-            g.amplitude
-                * (2.0 * std::f64::consts::PI).powf(1.5)
-                * g.sigmas.iter().product::<f64>()
+            g.amplitude * (2.0 * std::f64::consts::PI).powf(1.5) * g.sigmas.iter().product::<f64>()
         })
         .sum();
     assert!((want - mixture.integral()).abs() < 1e-12 * want);
@@ -273,9 +271,8 @@ fn shepp_logan_matches_table() {
             let got = sl.density(p);
             assert!((got - table_density(x)).abs() < 1e-12, "at {x:?}");
             let outer = MODIFIED_SHEPP_LOGAN_3D[0];
-            let q = (x[0] / outer[1]).powi(2)
-                + (x[1] / outer[2]).powi(2)
-                + (x[2] / outer[3]).powi(2);
+            let q =
+                (x[0] / outer[1]).powi(2) + (x[1] / outer[2]).powi(2) + (x[2] / outer[3]).powi(2);
             if q > 1.0 {
                 outside += 1;
                 assert_eq!(got, 0.0, "nonzero outside the skull at {x:?}");
