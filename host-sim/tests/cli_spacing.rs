@@ -3,7 +3,7 @@
 //! on anisotropic voxels.
 
 mod common;
-use common::{assert_error, assert_ok, fvr, temp_dir};
+use common::{assert_error, assert_ok, fvr, fvr_line, temp_dir};
 
 use std::path::Path;
 
@@ -52,16 +52,8 @@ fn write_volume_of(path: &Path, dims: [usize; 3], spacing: Option<[f64; 3]>) {
 fn render_uses_the_files_spacing_and_matches_exact_in_mm() {
     let dir = temp_dir("spacing-default");
     write_volume(&dir.join("v.nrrd"), Some(SPACING));
-    let stdout = assert_ok(&fvr(
-        &[
-            "render",
-            "v.nrrd",
-            "--dir",
-            "1,0.3,0.2",
-            "--out",
-            "a.nrrd",
-            "--stats",
-        ],
+    let stdout = assert_ok(&fvr_line(
+        "render v.nrrd --dir 1,0.3,0.2 --out a.nrrd --stats",
         &dir,
     ));
     assert!(
@@ -79,19 +71,8 @@ fn render_uses_the_files_spacing_and_matches_exact_in_mm() {
     assert!(snr >= 50.0, "{snr:.2} dB");
 
     // A coarser --pixel-size halves the pixel count across the same extent.
-    assert_ok(&fvr(
-        &[
-            "render",
-            "v.nrrd",
-            "--dir",
-            "1,0.3,0.2",
-            "--pixel-size",
-            "1.6",
-            "--size",
-            "32",
-            "--out",
-            "b.nrrd",
-        ],
+    assert_ok(&fvr_line(
+        "render v.nrrd --dir 1,0.3,0.2 --pixel-size 1.6 --size 32 --out b.nrrd",
         &dir,
     ));
     let coarse = read_nrrd(&dir.join("b.nrrd")).unwrap();
@@ -109,24 +90,13 @@ fn render_uses_the_files_spacing_and_matches_exact_in_mm() {
 fn default_pixel_size_fits_the_longest_side() {
     let dir = temp_dir("spacing-fit");
     write_volume_of(&dir.join("v.nrrd"), [64, 63, 35], Some(SPACING));
-    let stdout = assert_ok(&fvr(
-        &[
-            "render", "v.nrrd", "--dir", "0,1,0", "--out", "a.nrrd", "--stats",
-        ],
+    let stdout = assert_ok(&fvr_line(
+        "render v.nrrd --dir 0,1,0 --out a.nrrd --stats",
         &dir,
     ));
     assert!(stdout.contains("pixel size    0.8203125 mm"), "{stdout}");
-    let out = fvr(
-        &[
-            "render",
-            "v.nrrd",
-            "--dir",
-            "0,1,0",
-            "--out",
-            "b.nrrd",
-            "--pixel-size",
-            "0.5",
-        ],
+    let out = fvr_line(
+        "render v.nrrd --dir 0,1,0 --out b.nrrd --pixel-size 0.5",
         &dir,
     );
     assert_ok(&out);
@@ -153,15 +123,8 @@ fn ignore_spacing_is_the_voxel_unit_render() {
     let b = std::fs::read(dir.join("plain-out.nrrd")).unwrap();
     assert_eq!(a, b);
     let spaced = {
-        assert_ok(&fvr(
-            &[
-                "render",
-                "spaced.nrrd",
-                "--dir",
-                "1,0.3,0.2",
-                "--out",
-                "mm.nrrd",
-            ],
+        assert_ok(&fvr_line(
+            "render spaced.nrrd --dir 1,0.3,0.2 --out mm.nrrd",
             &dir,
         ));
         std::fs::read(dir.join("mm.nrrd")).unwrap()
@@ -271,19 +234,8 @@ fn adaptive_renders_cubic_voxels_in_mm_and_refuses_anisotropic_ones() {
 
     write_volume(&dir.join("a.nrrd"), Some(SPACING));
     assert_error(
-        &fvr(
-            &[
-                "render",
-                "a.nrrd",
-                "--dir",
-                "1,0.3,0.2",
-                "--oversample",
-                "2",
-                "--adaptive",
-                "40",
-                "--out",
-                "x.png",
-            ],
+        &fvr_line(
+            "render a.nrrd --dir 1,0.3,0.2 --oversample 2 --adaptive 40 --out x.png",
             &dir,
         ),
         &["cubic voxels", "--resample", "--ignore-spacing"],

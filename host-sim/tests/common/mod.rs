@@ -39,3 +39,8 @@ pub fn assert_ok(out: &Output) -> String {
     );
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
+
+/// Run `fvr` with the words of `command` (split at white space) in `dir`.
+pub fn fvr_line(command: &str, dir: &Path) -> Output {
+    fvr(&command.split_whitespace().collect::<Vec<_>>(), dir)
+}
