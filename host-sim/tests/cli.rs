@@ -1,7 +1,7 @@
 //! The `fvr` program end to end: outputs, and clear errors on bad input.
 
 mod common;
-use common::{assert_error, assert_ok, fvr, fvr_line, temp_dir};
+use common::{assert_error, assert_ok, fvr, fvr_in, fvr_line, temp_dir};
 
 use fvr_host::io::nrrd::{encode_nrrd, Encoding, Endian, SampleType};
 
@@ -57,8 +57,7 @@ fn render_to_nrrd_and_compare_precisions() {
 
 #[test]
 fn zero_and_parallel_view_vectors_are_named() {
-    let dir = temp_dir("view");
-    let out = fvr_line("render sphere@16 --dir 0,0,0 --out x.png", &dir);
+    let (dir, out) = fvr_in("view", "render sphere@16 --dir 0,0,0 --out x.png");
     assert_error(&out, &["zero view vector", "(0, 0, 0)", "(0, 0, 1)"]);
     let out = fvr_line("render sphere@16 --dir 0,0,-2 --out x.png", &dir);
     assert_error(&out, &["parallel", "(0, 0, -2)", "(0, 0, 1)"]);
@@ -69,8 +68,10 @@ fn zero_and_parallel_view_vectors_are_named() {
 
 #[test]
 fn oversized_image_unknown_filter_and_bad_output_are_errors() {
-    let dir = temp_dir("args");
-    let out = fvr_line("render sphere@16 --dir 1,0,0 --size 40x8 --out x.png", &dir);
+    let (dir, out) = fvr_in(
+        "args",
+        "render sphere@16 --dir 1,0,0 --size 40x8 --out x.png",
+    );
     assert_error(&out, &["40x8", "padded grid size 16"]);
     let out = fvr_line(
         "render sphere@16 --dir 1,0,0 --filter kb9 --out x.png",
@@ -130,8 +131,7 @@ fn nan_voxels_truncated_and_malformed_files_are_named() {
 
 #[test]
 fn help_documents_the_geometry_contract_and_every_option() {
-    let dir = temp_dir("help");
-    let out = fvr_line("render --help", &dir);
+    let (_, out) = fvr_in("help", "render --help");
     let text = String::from_utf8_lossy(&out.stdout);
     for needle in [
         "GEOMETRY CONTRACT",
@@ -152,8 +152,7 @@ fn help_documents_the_geometry_contract_and_every_option() {
 
 #[test]
 fn precision_study_writes_markdown_csv_and_png_with_no_non_finite_pixel() {
-    let dir = temp_dir("precision");
-    let out = fvr_line("precision --volumes gaussians@16,shepp-logan@16 --formats f16,bf16,e4m11,q15-line,q7-brick2,e4m3,f32 --out-dir out", &dir);
+    let (dir, out) = fvr_in("precision", "precision --volumes gaussians@16,shepp-logan@16 --formats f16,bf16,e4m11,q15-line,q7-brick2,e4m3,f32 --out-dir out");
     assert_ok(&out);
     let csv = std::fs::read_to_string(dir.join("out/precision.csv")).unwrap();
     let lines: Vec<&str> = csv.lines().collect();
@@ -175,8 +174,7 @@ fn precision_study_writes_markdown_csv_and_png_with_no_non_finite_pixel() {
 
 #[test]
 fn precision_bad_formats_are_named_before_any_work() {
-    let dir = temp_dir("precision-bad");
-    let out = fvr_line("precision --formats e5m11", &dir);
+    let (dir, out) = fvr_in("precision-bad", "precision --formats e5m11");
     assert_error(&out, &["e5m11", "17 bits", "16"]);
     let out = fvr_line("precision --formats e9m6", &dir);
     assert_error(&out, &["e9m6", "f32"]);
@@ -193,8 +191,10 @@ fn precision_bad_formats_are_named_before_any_work() {
 
 #[test]
 fn precision_extremes_table_reports_every_case() {
-    let dir = temp_dir("precision-extremes");
-    let out = fvr_line("precision --extremes 8 --formats f16,q15-line", &dir);
+    let (_, out) = fvr_in(
+        "precision-extremes",
+        "precision --extremes 8 --formats f16,q15-line",
+    );
     assert_ok(&out);
     let md = String::from_utf8_lossy(&out.stdout);
     for case in [

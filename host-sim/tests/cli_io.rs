@@ -2,7 +2,7 @@
 //! options, turntables, help, version, exit codes and progress output.
 
 mod common;
-use common::{assert_error, fvr, fvr_line, temp_dir};
+use common::{assert_error, fvr, fvr_in, fvr_line, temp_dir};
 
 use std::path::Path;
 use std::process::Output;
@@ -168,10 +168,9 @@ fn renders_nifti_den_and_named_volumes_to_styled_pngs() {
 
 #[test]
 fn the_ct_head_renders_by_name() {
-    let dir = temp_dir("io-ct");
-    let out = fvr_line(
+    let (dir, out) = fvr_in(
+        "io-ct",
         "render ct-head --dir 0,1,0 --out ct.png --size 128 --quiet --stats",
-        &dir,
     );
     assert_ok(&out);
     assert!(stdout(&out).contains("256x256x108"), "{}", stdout(&out));
@@ -180,10 +179,9 @@ fn the_ct_head_renders_by_name() {
 
 #[test]
 fn turntable_writes_an_apng_and_reports_views_per_second() {
-    let dir = temp_dir("io-spin");
-    let out = fvr_line(
+    let (dir, out) = fvr_in(
+        "io-spin",
         "turntable gaussians@32 --frames 8 --out spin.apng --colormap hot",
-        &dir,
     );
     assert_ok(&out);
     let text = stdout(&out);

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{assert_error, assert_ok, fvr, fvr_line, temp_dir};
+use common::{assert_error, assert_ok, fvr, fvr_in, temp_dir};
 
 /// The header `fvr trade` writes, as documented in docs/trade/README.md.
 const HEADER: &str = "size,grid,filter,oversample,format,adaptive_db,level,image_side,views,\
@@ -12,8 +12,7 @@ held_bytes,prepare_ms,adaptive_taps_fraction,peak_rss_bytes,pareto";
 
 #[test]
 fn tiny_sweep_writes_csv_png_and_summary_with_one_row_per_point() {
-    let dir = temp_dir("trade");
-    let out = fvr_line("trade --sizes 32 --filters linear,kb3 --oversample 1,2 --formats f16,q15-line --adaptive none,40 --levels 0,1 --views 2 --repeats 1 --out-dir out", &dir);
+    let (dir, out) = fvr_in("trade", "trade --sizes 32 --filters linear,kb3 --oversample 1,2 --formats f16,q15-line --adaptive none,40 --levels 0,1 --views 2 --repeats 1 --out-dir out");
     assert_ok(&out);
     let csv = std::fs::read_to_string(dir.join("out/trade.csv")).unwrap();
     let lines: Vec<&str> = csv.lines().collect();
@@ -77,10 +76,9 @@ fn every_csv_column_is_documented() {
 
 #[test]
 fn a_sweep_beyond_memory_is_refused_before_any_work() {
-    let dir = temp_dir("trade-memory");
-    let out = fvr_line(
+    let (dir, out) = fvr_in(
+        "trade-memory",
         "trade --sizes 32,64 --filters kb6 --formats f32 --memory-limit 2M --out-dir out",
-        &dir,
     );
     // 64³ at oversampling 2 in f32: a 128³ spectrum of 8 MiB alone.
     assert_error(
@@ -145,8 +143,7 @@ fn conflicting_and_bad_options_are_named_before_any_work() {
 /// refuses sizes it cannot do before any work.
 #[test]
 fn growth_writes_csv_markdown_and_plot_and_refuses_bad_sizes() {
-    let dir = temp_dir("growth");
-    let out = fvr_line("growth --sizes 16,32 --runs 1 --out-dir g", &dir);
+    let (dir, out) = fvr_in("growth", "growth --sizes 16,32 --runs 1 --out-dir g");
     let stdout = assert_ok(&out);
     assert!(stdout.contains("| 32³ |"), "{stdout}");
     let csv = std::fs::read_to_string(dir.join("g/growth.csv")).unwrap();

@@ -4,7 +4,7 @@
 //! file and the key.
 
 mod common;
-use common::{assert_error, assert_ok, fvr, fvr_line, temp_dir};
+use common::{assert_error, assert_ok, fvr, fvr_in, fvr_line, temp_dir};
 
 const SCENE: &str = r#"
 [volume]
@@ -116,8 +116,7 @@ fn wrong_type_names_the_key_and_the_type() {
 
 #[test]
 fn missing_scene_file_and_missing_settings_are_errors() {
-    let dir = temp_dir("scenefile-missing");
-    let out = fvr_line("render --scene nowhere.toml", &dir);
+    let (dir, out) = fvr_in("scenefile-missing", "render --scene nowhere.toml");
     assert_error(&out, &["cannot read scene file `nowhere.toml`"]);
     std::fs::write(dir.join("novolume.toml"), "[camera]\ndir = [1, 0, 0]\n").unwrap();
     let out = fvr_line("render --scene novolume.toml --out a.png", &dir);
@@ -231,10 +230,9 @@ fn teapot_names_are_checked() {
 
 #[test]
 fn turntable_stats_json_is_one_object_with_views_per_second() {
-    let dir = temp_dir("scenefile-turntable-json");
-    let out = fvr_line(
+    let (_, out) = fvr_in(
+        "scenefile-turntable-json",
         "turntable sphere@16 --frames 4 --stats-json --out s.apng",
-        &dir,
     );
     let stdout = assert_ok(&out);
     let json = stdout

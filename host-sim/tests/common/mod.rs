@@ -44,3 +44,11 @@ pub fn assert_ok(out: &Output) -> String {
 pub fn fvr_line(command: &str, dir: &Path) -> Output {
     fvr(&command.split_whitespace().collect::<Vec<_>>(), dir)
 }
+
+/// Run `command` (as [`fvr_line`]) in a fresh directory named `name` (as
+/// [`temp_dir`]); returns the directory and the output.
+pub fn fvr_in(name: &str, command: &str) -> (PathBuf, Output) {
+    let dir = temp_dir(name);
+    let out = fvr_line(command, &dir);
+    (dir, out)
+}
