@@ -785,3 +785,20 @@ fn nifti_with_dims(
     edit(&mut bytes);
     bytes
 }
+
+/// A `main.plist` nested deeper than the limit is refused before the value
+/// is built, not a stack overflow; the limit itself is accepted.
+#[test]
+fn deep_plist_nesting_is_refused_not_a_stack_overflow() {
+    use fvr_host::io::inv3::{parse_plist, MAX_PLIST_DEPTH};
+    let deep = "<array>".repeat(100_000);
+    let e = parse_plist(&format!("<plist>{deep}")).unwrap_err();
+    assert!(e.contains("nested deeper than 64"), "{e}");
+    let n = MAX_PLIST_DEPTH;
+    let ok = format!(
+        "<plist>{}{}</plist>",
+        "<array>".repeat(n),
+        "</array>".repeat(n)
+    );
+    assert!(parse_plist(&ok).is_ok());
+}

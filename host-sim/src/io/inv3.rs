@@ -16,7 +16,8 @@ use std::path::Path;
 
 use indicatif::ProgressBar;
 
-use super::plist::{parse_plist, PlistValue};
+use plist::{Dictionary, Value};
+
 use super::{decode_samples, open_counted, MaybeGzip};
 use crate::io::nrrd::{excerpt, format_error, Endian, IoError, SampleType};
 use crate::volume::{check_spacing, Volume};
@@ -51,22 +52,22 @@ pub struct MatrixInfo {
 /// Malformed XML, or a missing or malformed `matrix.dtype`,
 /// `matrix.filename`, `matrix.shape` or `spacing`.
 pub fn parse_main_plist(text: &str) -> Result<MatrixInfo, IoError> {
-    let root = parse_plist(text).map_err(|e| format_error(PLIST, "xml", e.to_string()))?;
-    let matrix = root.get("matrix").ok_or_else(|| missing("matrix"))?;
-    let dtype = matrix
-        .get("dtype")
+    let root = parse_plist(text).map_err(|e| format_error(PLIST, "xml", e))?;
+    let root = root.as_dictionary();
+    let matrix = get(root, "matrix").ok_or_else(|| missing("matrix"))?;
+    let matrix = matrix.as_dictionary();
+    let dtype = get(matrix, "dtype")
         .ok_or_else(|| missing("matrix.dtype"))?
-        .as_str()
+        .as_string()
         .ok_or_else(|| format_error(PLIST, "matrix.dtype", "is not a string"))?;
     let ty = numpy_type(dtype)?;
-    let filename = matrix
-        .get("filename")
+    let filename = get(matrix, "filename")
         .ok_or_else(|| missing("matrix.filename"))?
-        .as_str()
+        .as_string()
         .filter(|s| !s.is_empty())
         .ok_or_else(|| format_error(PLIST, "matrix.filename", "is not a non-empty string"))?
         .to_owned();
-    let shape = numbers(matrix.get("shape"), "matrix.shape")?;
+    let shape = numbers(get(matrix, "shape"), "matrix.shape")?;
     let mut dims = [0usize; 3];
     for (axis, &n) in shape.iter().rev().enumerate() {
         if !(n >= 1.0 && n.fract() == 0.0 && n <= i64::MAX as f64) {
@@ -78,7 +79,7 @@ pub fn parse_main_plist(text: &str) -> Result<MatrixInfo, IoError> {
         }
         dims[axis] = n as usize;
     }
-    let spacing = numbers(root.get("spacing"), "spacing")?;
+    let spacing = numbers(get(root, "spacing"), "spacing")?;
     let spacing =
         check_spacing(spacing).map_err(|e| format_error(PLIST, "spacing", e.to_string()))?;
     Ok(MatrixInfo {
@@ -89,18 +90,64 @@ pub fn parse_main_plist(text: &str) -> Result<MatrixInfo, IoError> {
     })
 }
 
+/// Collections nested deeper than this are refused before the value is
+/// built (building recurses once per level).
+pub const MAX_PLIST_DEPTH: usize = 64;
+
+/// Parse an XML property list with the `plist` crate, refusing nesting
+/// deeper than [`MAX_PLIST_DEPTH`] first.
+///
+/// # Errors
+/// Malformed XML or property list, or nesting too deep, as text.
+pub fn parse_plist(text: &str) -> Result<Value, String> {
+    // Text cannot hold a raw `<`, so every `<` opens markup; a comment that
+    // mentions a collection can only make this count stricter.
+    let mut depth = 0usize;
+    for (i, _) in text.match_indices('<') {
+        let tag = &text[i + 1..];
+        let end = tag.find('>').map_or(tag.len(), |e| e);
+        let self_closing = tag[..end].ends_with('/');
+        if (tag.starts_with("array") || tag.starts_with("dict")) && !self_closing {
+            depth += 1;
+            if depth > MAX_PLIST_DEPTH {
+                return Err(format!("nested deeper than {MAX_PLIST_DEPTH}"));
+            }
+        } else if tag.starts_with("/array") || tag.starts_with("/dict") {
+            depth = depth.saturating_sub(1);
+        }
+    }
+    Value::from_reader_xml(text.as_bytes()).map_err(|e| e.to_string())
+}
+
+/// `key` of a dictionary value, if it is one.
+fn get<'a>(dict: Option<&'a Dictionary>, key: &str) -> Option<&'a Value> {
+    dict.and_then(|d| d.get(key))
+}
+
+/// An integer or real as `f64`.
+fn as_f64(v: &Value) -> Option<f64> {
+    match v {
+        Value::Integer(i) => i
+            .as_signed()
+            .map(|i| i as f64)
+            .or_else(|| i.as_unsigned().map(|u| u as f64)),
+        Value::Real(r) => Some(*r),
+        _ => None,
+    }
+}
+
 #[cold]
 fn missing(field: &'static str) -> IoError {
     format_error(PLIST, field, "is missing")
 }
 
 /// Three numbers from an array value.
-fn numbers(value: Option<&PlistValue>, field: &'static str) -> Result<[f64; 3], IoError> {
+fn numbers(value: Option<&Value>, field: &'static str) -> Result<[f64; 3], IoError> {
     let items = value
         .ok_or_else(|| missing(field))?
         .as_array()
         .ok_or_else(|| format_error(PLIST, field, "is not an array"))?;
-    let values: Option<Vec<f64>> = items.iter().map(PlistValue::as_f64).collect();
+    let values: Option<Vec<f64>> = items.iter().map(as_f64).collect();
     match values.as_deref() {
         Some(&[a, b, c]) => Ok([a, b, c]),
         _ => Err(format_error(

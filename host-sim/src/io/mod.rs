@@ -26,7 +26,6 @@ pub mod dicom;
 pub mod inv3;
 pub mod nifti;
 pub mod nrrd;
-mod plist;
 
 use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read};
@@ -37,8 +36,6 @@ use indicatif::ProgressBar;
 
 use crate::volume::Volume;
 use nrrd::IoError;
-
-pub use plist::{parse_plist, PlistValue};
 
 /// Read buffer for files.
 const FILE_BUFFER_BYTES: usize = 1 << 16;
