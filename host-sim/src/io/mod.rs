@@ -22,6 +22,7 @@
 //! an [`IoError`] that names the file and the field.
 
 pub mod den;
+mod error;
 pub mod dicom;
 pub mod inv3;
 pub mod nifti;
@@ -35,7 +36,7 @@ use flate2::bufread::MultiGzDecoder;
 use indicatif::ProgressBar;
 
 use crate::volume::Volume;
-use nrrd::IoError;
+pub use error::IoError;
 
 /// Read buffer for files.
 const FILE_BUFFER_BYTES: usize = 1 << 16;

@@ -29,7 +29,7 @@
 //!   read is decompressed to its end (within the margin) so that its CRC is
 //!   verified.
 
-mod error;
+use super::error;
 mod header;
 mod samples;
 #[cfg(test)]

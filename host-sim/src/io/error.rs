@@ -9,23 +9,27 @@ use std::path::PathBuf;
 ///
 /// `Display` names the header field or the problem, e.g.
 /// ``NRRD field `sizes`: expected 3 positive integers, got `12 x` ``, and the
-/// file path when the error came from [`read_nrrd`](super::read_nrrd),
-/// [`read_raw`](super::read_raw) or [`write_nrrd_f32`](super::write_nrrd_f32).
-#[derive(Debug)]
+/// file path when the error came from [`read_nrrd`](crate::io::nrrd::read_nrrd),
+/// [`read_raw`](crate::io::nrrd::read_raw) or [`write_nrrd_f32`](crate::io::nrrd::write_nrrd_f32).
+#[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum IoError {
     /// An operating-system error while opening, reading or writing.
+    #[error("I/O error: {source}")]
     Io {
         /// The underlying error.
+        #[from]
         source: io::Error,
     },
     /// The first line is not a NRRD magic `NRRD0001` to `NRRD0005`.
+    #[error("{}", bad_magic(found))]
     BadMagic {
         /// The start of the first line (control characters escaped).
         found: String,
     },
     /// A header line that is not a comment, field or key/value pair, or a
     /// header that is too long or not terminated by a blank line.
+    #[error("NRRD header line {line}: {problem}")]
     Header {
         /// 1-based line number.
         line: usize,
@@ -33,11 +37,13 @@ pub enum IoError {
         problem: String,
     },
     /// A required header field is absent.
+    #[error("NRRD field `{field}`: required field is missing")]
     MissingField {
         /// The canonical field name, e.g. `sizes`.
         field: &'static str,
     },
     /// A header field has a malformed or unsupported value.
+    #[error("NRRD field `{field}`: {problem}")]
     Field {
         /// The canonical field name, e.g. `sizes`.
         field: &'static str,
@@ -46,11 +52,15 @@ pub enum IoError {
     },
     /// The header refers to a detached data file, but was parsed from memory
     /// without a path to resolve it against.
+    #[error(
+        "NRRD field `data file`: the samples are in the separate file `{file}`, which can only be found from the header's path (read the header as a file)"
+    )]
     DetachedData {
         /// The value of the `data file` field.
         file: String,
     },
     /// Fewer data bytes than the sizes and sample type call for.
+    #[error("truncated data: expected {expected} bytes of samples{}, found {found}", if *gzip { " after gzip decompression" } else { "" })]
     Truncated {
         /// Bytes of sample data needed.
         expected: u64,
@@ -60,6 +70,7 @@ pub enum IoError {
         gzip: bool,
     },
     /// Decoding would need more memory than allowed.
+    #[error("volume too large: decoding would need {needed} bytes ({}) of memory, the limit is {limit} bytes ({})", Gib(*needed), Gib(*limit))]
     TooLarge {
         /// Bytes the decoded volume (plus its raw samples) would need.
         needed: u64,
@@ -67,11 +78,13 @@ pub enum IoError {
         limit: u64,
     },
     /// The gzip-encoded data could not be decompressed.
+    #[error("corrupt or truncated gzip stream: {source}")]
     Gzip {
         /// The decompressor's error.
         source: io::Error,
     },
     /// A NaN or infinite sample, or a double too large for `f32`.
+    #[error("{}", non_finite(*voxel, *value))]
     NonFinite {
         /// Voxel index `(i, j, k)` of the first offending sample.
         voxel: [usize; 3],
@@ -79,11 +92,13 @@ pub enum IoError {
         value: f64,
     },
     /// Invalid arguments: raw dimensions, sizes for writing, type names.
+    #[error("{problem}")]
     InvalidArgument {
         /// What is wrong.
         problem: String,
     },
     /// A malformed or unsupported field of a format other than NRRD.
+    #[error("{format} field `{field}`: {problem}")]
     Format {
         /// The format and the part of the file, e.g. `NIfTI-1 header`.
         format: &'static str,
@@ -93,11 +108,13 @@ pub enum IoError {
         problem: String,
     },
     /// A file whose format could not be recognised.
+    #[error("{problem}")]
     UnknownFormat {
         /// What was seen, and what is supported.
         problem: String,
     },
     /// Another error, while reading or writing the file at `path`.
+    #[error("{}: {source}", path.display())]
     File {
         /// The file.
         path: PathBuf,
@@ -124,74 +141,25 @@ impl IoError {
     }
 }
 
-impl From<io::Error> for IoError {
-    fn from(source: io::Error) -> Self {
-        IoError::Io { source }
+/// The message of [`IoError::BadMagic`].
+fn bad_magic(found: &str) -> String {
+    if found.is_empty() {
+        "not a NRRD file: empty first line (expected magic `NRRD0001` to `NRRD0005`)".into()
+    } else {
+        format!("not a NRRD file: magic line `{found}` (expected `NRRD0001` to `NRRD0005`)")
     }
 }
 
-impl fmt::Display for IoError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            IoError::Io { source } => write!(f, "I/O error: {source}"),
-            IoError::BadMagic { found } if found.is_empty() => {
-                f.write_str("not a NRRD file: empty first line (expected magic `NRRD0001` to `NRRD0005`)")
-            }
-            IoError::BadMagic { found } => write!(
-                f,
-                "not a NRRD file: magic line `{found}` (expected `NRRD0001` to `NRRD0005`)"
-            ),
-            IoError::Header { line, problem } => write!(f, "NRRD header line {line}: {problem}"),
-            IoError::MissingField { field } => {
-                write!(f, "NRRD field `{field}`: required field is missing")
-            }
-            IoError::Field { field, problem } => write!(f, "NRRD field `{field}`: {problem}"),
-            IoError::DetachedData { file } => write!(
-                f,
-                "NRRD field `data file`: the samples are in the separate file `{file}`, which can only be found from the header's path (read the header as a file)"
-            ),
-            IoError::Truncated { expected, found, gzip } => {
-                let after = if *gzip { " after gzip decompression" } else { "" };
-                write!(f, "truncated data: expected {expected} bytes of samples{after}, found {found}")
-            }
-            IoError::TooLarge { needed, limit } => write!(
-                f,
-                "volume too large: decoding would need {needed} bytes ({}) of memory, the limit is {limit} bytes ({})",
-                Gib(*needed),
-                Gib(*limit)
-            ),
-            IoError::Gzip { source } => {
-                write!(f, "corrupt or truncated gzip stream: {source}")
-            }
-            IoError::NonFinite { voxel: [i, j, k], value } if value.is_finite() => write!(
-                f,
-                "sample {value:e} at voxel ({i}, {j}, {k}) does not fit in f32 (it would become infinite)"
-            ),
-            IoError::NonFinite { voxel: [i, j, k], value } => write!(
-                f,
-                "non-finite sample {value} at voxel ({i}, {j}, {k}); NaN/Inf data would corrupt the rendering"
-            ),
-            IoError::InvalidArgument { problem } => f.write_str(problem),
-            IoError::Format { format, field, problem } => {
-                write!(f, "{format} field `{field}`: {problem}")
-            }
-            IoError::UnknownFormat { problem } => f.write_str(problem),
-            IoError::File { path, source } => write!(f, "{}: {source}", path.display()),
-        }
+/// The message of [`IoError::NonFinite`]: a double too large for `f32`, or
+/// NaN/Inf.
+fn non_finite([i, j, k]: [usize; 3], value: f64) -> String {
+    if value.is_finite() {
+        format!("sample {value:e} at voxel ({i}, {j}, {k}) does not fit in f32 (it would become infinite)")
+    } else {
+        format!("non-finite sample {value} at voxel ({i}, {j}, {k}); NaN/Inf data would corrupt the rendering")
     }
 }
 
-impl std::error::Error for IoError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            IoError::Io { source } | IoError::Gzip { source } => Some(source),
-            IoError::File { source, .. } => source.source(),
-            _ => None,
-        }
-    }
-}
-
-/// A byte count shown in GiB.
 struct Gib(u64);
 
 impl fmt::Display for Gib {
@@ -235,7 +203,7 @@ pub(crate) fn format_error(
 
 /// A malformed or unsupported field value.
 #[cold]
-pub(super) fn field_error(field: &'static str, problem: impl Into<String>) -> IoError {
+pub(crate) fn field_error(field: &'static str, problem: impl Into<String>) -> IoError {
     IoError::Field {
         field,
         problem: problem.into(),
@@ -244,7 +212,7 @@ pub(super) fn field_error(field: &'static str, problem: impl Into<String>) -> Io
 
 /// A malformed header line.
 #[cold]
-pub(super) fn header_error(line: usize, problem: impl Into<String>) -> IoError {
+pub(crate) fn header_error(line: usize, problem: impl Into<String>) -> IoError {
     IoError::Header {
         line,
         problem: problem.into(),
@@ -253,7 +221,7 @@ pub(super) fn header_error(line: usize, problem: impl Into<String>) -> IoError {
 
 /// Invalid caller-supplied arguments.
 #[cold]
-pub(super) fn invalid_argument(problem: impl Into<String>) -> IoError {
+pub(crate) fn invalid_argument(problem: impl Into<String>) -> IoError {
     IoError::InvalidArgument {
         problem: problem.into(),
     }
