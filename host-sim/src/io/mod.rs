@@ -22,8 +22,8 @@
 //! an [`IoError`] that names the file and the field.
 
 pub mod den;
-mod error;
 pub mod dicom;
+mod error;
 pub mod inv3;
 pub mod nifti;
 pub mod nrrd;

@@ -1,6 +1,6 @@
 //! What an adaptive render did (`fvr render --adaptive`), for --stats.
 
-use crate::render::{json_num, json_str};
+use serde::Serialize;
 use std::time::Instant;
 
 use fvr_core::geometry::View;
@@ -65,45 +65,38 @@ impl AdaptiveReport {
         }
     }
 
-    pub(crate) fn json(&self) -> String {
+    pub(crate) fn json(&self) -> AdaptiveJson {
         let s = &self.stats;
-        let levels: Vec<String> = self
+        let levels = self
             .marks
             .levels
             .iter()
             .enumerate()
-            .map(|(i, l)| {
-                format!(
-                    "{{\"filter\": {}, \"h_d\": {}, \"threshold\": {}, \"marked\": {}, \"samples\": {}, \"error_field_db\": {}}}",
-                    json_str(l.filter.kind().name()),
-                    json_num(l.h_d),
-                    json_num(l.threshold),
-                    l.marked,
-                    s.per_filter[i + 1],
-                    l.error_ratio.map_or("null".into(), |r| json_num(-10.0 * r.log10()))
-                )
+            .map(|(i, l)| LevelJson {
+                filter: l.filter.kind().name(),
+                h_d: l.h_d,
+                threshold: l.threshold,
+                marked: l.marked,
+                samples: s.per_filter[i + 1],
+                error_field_db: l.error_ratio.map(|r| -10.0 * r.log10()),
             })
             .collect();
-        format!(
-            "{{\"tolerance_db\": {}, \"bound\": {}, \"taps\": {}, \"full_taps\": {}, \"taps_ratio\": {}, \
-             \"samples\": {}, \"full_filter_samples\": {}, \"levels\": [{}], \"marks_bytes\": {}, \
-             \"mark_ms\": {}, \"view_ms\": {}, \"full_view_ms\": {}, \"snr_vs_full_db\": {}, \
-             \"note\": {}}}",
-            json_num(self.marks.tolerance_db),
-            json_str(self.marks.bound.name()),
-            s.taps,
-            s.full_taps,
-            json_num(s.taps as f64 / s.full_taps.max(1) as f64),
-            s.samples,
-            s.per_filter[0],
-            levels.join(", "),
-            self.marks.bytes(),
-            json_num(self.mark_time.as_secs_f64() * 1e3),
-            json_num(self.view_time.as_secs_f64() * 1e3),
-            json_num(self.full_view_time.as_secs_f64() * 1e3),
-            json_num(self.snr_vs_full),
-            self.marks.effect(s).map_or("null".into(), |n| json_str(&n))
-        )
+        AdaptiveJson {
+            tolerance_db: self.marks.tolerance_db,
+            bound: self.marks.bound.name(),
+            taps: s.taps,
+            full_taps: s.full_taps,
+            taps_ratio: s.taps as f64 / s.full_taps.max(1) as f64,
+            samples: s.samples,
+            full_filter_samples: s.per_filter[0],
+            levels,
+            marks_bytes: self.marks.bytes(),
+            mark_ms: self.mark_time.as_secs_f64() * 1e3,
+            view_ms: self.view_time.as_secs_f64() * 1e3,
+            full_view_ms: self.full_view_time.as_secs_f64() * 1e3,
+            snr_vs_full_db: self.snr_vs_full,
+            note: self.marks.effect(s),
+        }
     }
 }
 
@@ -150,4 +143,34 @@ pub(crate) fn adaptive_render(
         AnySpectrum::F32(s) => go::<_, f32>(spec, s, view, w, h, settings),
         AnySpectrum::F64(s) => go::<_, f64>(spec, s, view, w, h, settings),
     }
+}
+
+/// The `adaptive` member of `fvr render --stats-json`.
+#[derive(Serialize)]
+pub(crate) struct AdaptiveJson {
+    tolerance_db: f64,
+    bound: &'static str,
+    taps: u64,
+    full_taps: u64,
+    taps_ratio: f64,
+    samples: u64,
+    full_filter_samples: u64,
+    levels: Vec<LevelJson>,
+    marks_bytes: usize,
+    mark_ms: f64,
+    view_ms: f64,
+    full_view_ms: f64,
+    snr_vs_full_db: f64,
+    note: Option<String>,
+}
+
+/// One cheaper filter of [`AdaptiveJson`].
+#[derive(Serialize)]
+struct LevelJson {
+    filter: &'static str,
+    h_d: f64,
+    threshold: f64,
+    marked: usize,
+    samples: u64,
+    error_field_db: Option<f64>,
 }

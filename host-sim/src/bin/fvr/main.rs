@@ -6,6 +6,7 @@ mod adaptive_table;
 mod args;
 mod compare;
 mod growth;
+mod json;
 mod precision;
 mod render;
 mod scene;

@@ -9,6 +9,12 @@ use crate::scene::SCENE_HELP;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use serde::Serialize;
+use serde_json::value::RawValue;
+
+use crate::adaptive_report::{AdaptiveJson, AdaptiveReport};
+use crate::json::{debug_triple, one_line};
+
 use clap::Args;
 use fvr_core::geometry::{Sampling, View};
 use fvr_core::scene::{Light, Scene, MAX_LIGHTS};
@@ -377,39 +383,27 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), String> {
         }
     }
     if args.stats_json {
-        let mut fields = vec![
-            ("volume", json_str(volume_spec)),
-            ("dims", format!("{:?}", volume.dims)),
-            ("spacing_mm", format!("{:?}", volume.spacing)),
-            ("pixel_size", json_num(sampling.pixel_size())),
-            ("ignore_spacing", args.units.ignore_spacing.to_string()),
-            ("image", format!("[{w}, {h}, {}]", image.channels)),
-            ("spectrum_side", n.to_string()),
-            ("precision", json_str(args.spectrum.precision.name())),
-            ("spectrum_bytes", spectra.density.bytes().to_string()),
-            (
-                "gradient_spectrum_bytes",
-                spectra
-                    .gradient
-                    .as_ref()
-                    .map_or("null".into(), |g| g.bytes().to_string()),
-            ),
-            ("filter", json_str(filter.kind().name())),
-            ("oversample", filter.oversample().to_string()),
-            ("storage_snr_db", json_num(storage_snr)),
-            ("load_ms", json_num(t_load.as_secs_f64() * 1e3)),
-            ("preprocess_ms", json_num(t_prep.as_secs_f64() * 1e3)),
-            ("view_ms", json_num(t_view.as_secs_f64() * 1e3)),
-            ("preview_level", args.preview_level.to_string()),
-        ];
-        if let Some(r) = &adaptive_report {
-            fields.push(("adaptive", r.json()));
-        }
-        let body: Vec<String> = fields
-            .iter()
-            .map(|(k, v)| format!("{}: {v}", json_str(k)))
-            .collect();
-        println!("{{{}}}", body.join(", "));
+        let stats = RenderStats {
+            volume: volume_spec,
+            dims: volume.dims,
+            spacing_mm: debug_triple(volume.spacing),
+            pixel_size: sampling.pixel_size(),
+            ignore_spacing: args.units.ignore_spacing,
+            image: [w, h, image.channels],
+            spectrum_side: n,
+            precision: args.spectrum.precision.name(),
+            spectrum_bytes: spectra.density.bytes(),
+            gradient_spectrum_bytes: spectra.gradient.as_ref().map(|g| g.bytes()),
+            filter: filter.kind().name(),
+            oversample: filter.oversample(),
+            storage_snr_db: storage_snr,
+            load_ms: t_load.as_secs_f64() * 1e3,
+            preprocess_ms: t_prep.as_secs_f64() * 1e3,
+            view_ms: t_view.as_secs_f64() * 1e3,
+            preview_level: args.preview_level,
+            adaptive: adaptive_report.as_ref().map(AdaptiveReport::json),
+        };
+        println!("{}", one_line(&stats));
     }
     if args.exact {
         let plain = scene.channels() == 1 && !scene.has_partner_terms();
@@ -483,24 +477,26 @@ pub(crate) fn build_scene(args: &RenderArgs) -> Result<Scene, String> {
     Ok(scene)
 }
 
-pub(crate) fn json_str(s: &str) -> String {
-    let mut out = String::from("\"");
-    for c in s.chars() {
-        match c {
-            '"' => out.push_str("\\\""),
-            '\\' => out.push_str("\\\\"),
-            c if (c as u32) < 0x20 => out.push_str(&format!("\\u{:04x}", c as u32)),
-            c => out.push(c),
-        }
-    }
-    out.push('"');
-    out
-}
-
-pub(crate) fn json_num(v: f64) -> String {
-    if v.is_finite() {
-        format!("{v}")
-    } else {
-        "null".into()
-    }
+/// `fvr render --stats-json`, in the order printed.
+#[derive(Serialize)]
+struct RenderStats<'a> {
+    volume: &'a str,
+    dims: [usize; 3],
+    spacing_mm: Box<RawValue>,
+    pixel_size: f64,
+    ignore_spacing: bool,
+    image: [usize; 3],
+    spectrum_side: usize,
+    precision: &'a str,
+    spectrum_bytes: usize,
+    gradient_spectrum_bytes: Option<usize>,
+    filter: &'a str,
+    oversample: u32,
+    storage_snr_db: f64,
+    load_ms: f64,
+    preprocess_ms: f64,
+    view_ms: f64,
+    preview_level: u32,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    adaptive: Option<AdaptiveJson>,
 }

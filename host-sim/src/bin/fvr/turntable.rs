@@ -4,8 +4,10 @@ use crate::args::{
     parse_size, parse_vec3, prepare_with_progress, volume_help, InputArgs, PngArgs, SpectrumArgs,
     UnitArgs,
 };
-use crate::render::{json_num, json_str};
+use crate::json::one_line;
+
 use crate::scene::SCENE_HELP;
+use serde::Serialize;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -95,31 +97,24 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), String> {
     );
     let views_per_second = frames.len() as f64 / secs.max(1e-9);
     if args.stats_json {
-        let fields = [
-            ("volume", json_str(volume_spec)),
-            ("dims", format!("{:?}", volume.dims)),
-            ("image", format!("[{w}, {h}]")),
-            ("frames", frames.len().to_string()),
-            ("fps", args.fps.to_string()),
-            ("spectrum_side", n.to_string()),
-            ("precision", json_str(args.spectrum.precision.name())),
-            ("spectrum_bytes", spec.bytes().to_string()),
-            ("filter", json_str(args.spectrum.filter.name())),
-            ("oversample", args.spectrum.oversample.to_string()),
-            ("load_ms", json_num(t_load.as_secs_f64() * 1e3)),
-            ("preprocess_ms", json_num(t_prep.as_secs_f64() * 1e3)),
-            ("views_ms", json_num(secs * 1e3)),
-            (
-                "ms_per_view",
-                json_num(secs * 1e3 / frames.len().max(1) as f64),
-            ),
-            ("views_per_second", json_num(views_per_second)),
-        ];
-        let body: Vec<String> = fields
-            .iter()
-            .map(|(k, v)| format!("{}: {v}", json_str(k)))
-            .collect();
-        println!("{{{}}}", body.join(", "));
+        let stats = TurntableStats {
+            volume: volume_spec,
+            dims: volume.dims,
+            image: [w, h],
+            frames: frames.len(),
+            fps: args.fps,
+            spectrum_side: n,
+            precision: args.spectrum.precision.name(),
+            spectrum_bytes: spec.bytes(),
+            filter: args.spectrum.filter.name(),
+            oversample: args.spectrum.oversample,
+            load_ms: t_load.as_secs_f64() * 1e3,
+            preprocess_ms: t_prep.as_secs_f64() * 1e3,
+            views_ms: secs * 1e3,
+            ms_per_view: secs * 1e3 / frames.len().max(1) as f64,
+            views_per_second,
+        };
+        println!("{}", one_line(&stats));
     } else {
         println!(
             "  load {:.1} ms, preprocess {:.1} ms ({n}^3 {}), {} views in {:.1} ms = {:.1} views/s",
@@ -132,4 +127,24 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), String> {
         );
     }
     Ok(())
+}
+
+/// `fvr turntable --stats-json`, in the order printed.
+#[derive(Serialize)]
+struct TurntableStats<'a> {
+    volume: &'a str,
+    dims: [usize; 3],
+    image: [usize; 2],
+    frames: usize,
+    fps: u16,
+    spectrum_side: usize,
+    precision: &'a str,
+    spectrum_bytes: usize,
+    filter: &'a str,
+    oversample: u32,
+    load_ms: f64,
+    preprocess_ms: f64,
+    views_ms: f64,
+    ms_per_view: f64,
+    views_per_second: f64,
 }
