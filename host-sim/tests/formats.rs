@@ -448,33 +448,24 @@ fn nrrd_detached_headers_find_their_data_file() {
         read_nrrd(&dir.join("c.nhdr")).expect("absolute").data.len(),
         24
     );
-    std::fs::write(
-        dir.join("d.nhdr"),
-        nrrd_header(&format!("{fields}encoding: raw\ndata file: gone.raw\n")),
-    )
-    .unwrap();
-    let e = read_nrrd(&dir.join("d.nhdr")).unwrap_err().to_string();
+    // The error of a header `name` whose samples are in `data_file`.
+    let detached_error = |name: &str, data_file: &str| {
+        let text = format!("{fields}encoding: raw\ndata file: {data_file}\n");
+        std::fs::write(dir.join(name), nrrd_header(&text)).unwrap();
+        read_nrrd(&dir.join(name)).unwrap_err().to_string()
+    };
+    let e = detached_error("d.nhdr", "gone.raw");
     assert!(
         e.contains("d.nhdr") && e.contains("gone.raw") && e.contains("No such file"),
         "{e}"
     );
-    std::fs::write(
-        dir.join("e.nhdr"),
-        nrrd_header(&format!("{fields}encoding: raw\ndata file: LIST\n")),
-    )
-    .unwrap();
-    let e = read_nrrd(&dir.join("e.nhdr")).unwrap_err().to_string();
+    let e = detached_error("e.nhdr", "LIST");
     assert!(
         e.contains("`data file`") && e.contains("several data files"),
         "{e}"
     );
     std::fs::write(dir.join("short.raw"), &data[..20]).unwrap();
-    std::fs::write(
-        dir.join("f.nhdr"),
-        nrrd_header(&format!("{fields}encoding: raw\ndata file: short.raw\n")),
-    )
-    .unwrap();
-    let e = read_nrrd(&dir.join("f.nhdr")).unwrap_err().to_string();
+    let e = detached_error("f.nhdr", "short.raw");
     assert!(
         e.contains("short.raw") && e.contains("expected 24") && e.contains("found 20"),
         "{e}"

@@ -5,6 +5,8 @@
 
 mod common;
 use common::{assert_error, assert_ok, fvr, fvr_in, fvr_line, temp_dir};
+use std::path::PathBuf;
+use std::process::Output;
 
 const SCENE: &str = r#"
 [volume]
@@ -88,10 +90,7 @@ fn flags_override_the_scene() {
 
 #[test]
 fn unknown_key_is_named_with_the_closest_valid_key() {
-    let dir = temp_dir("scenefile-unknown");
-    let bad = SCENE.replace("color = 0.5", "colr = 0.5");
-    std::fs::write(dir.join("bad.toml"), bad).unwrap();
-    let out = fvr_line("render --scene bad.toml", &dir);
+    let (dir, out) = render_edited_scene("scenefile-unknown", "color = 0.5", "colr = 0.5");
     assert_error(
         &out,
         &[
@@ -104,10 +103,7 @@ fn unknown_key_is_named_with_the_closest_valid_key() {
 
 #[test]
 fn wrong_type_names_the_key_and_the_type() {
-    let dir = temp_dir("scenefile-type");
-    let bad = SCENE.replace("oversample = 2", "oversample = \"two\"");
-    std::fs::write(dir.join("bad.toml"), bad).unwrap();
-    let out = fvr_line("render --scene bad.toml", &dir);
+    let (_, out) = render_edited_scene("scenefile-type", "oversample = 2", "oversample = \"two\"");
     assert_error(
         &out,
         &["bad.toml: `spectrum.oversample` must be an integer from 1 to 2, got string \"two\""],
@@ -256,4 +252,13 @@ fn turntable_stats_json_is_one_object_with_views_per_second() {
         "{json}"
     );
     assert!(json.contains("\"volume\": \"sphere@16\""), "{json}");
+}
+
+/// Render [`SCENE`] with `from` replaced by `to`, as `bad.toml` in a fresh
+/// directory `name`.
+fn render_edited_scene(name: &str, from: &str, to: &str) -> (PathBuf, Output) {
+    let dir = temp_dir(name);
+    std::fs::write(dir.join("bad.toml"), SCENE.replace(from, to)).unwrap();
+    let out = fvr_line("render --scene bad.toml", &dir);
+    (dir, out)
 }
