@@ -20,7 +20,7 @@ use crate::adaptive_table::adaptive_table;
 use crate::args::{InputArgs, PngArgs, SpectrumArgs, UnitArgs};
 use crate::compare::compare;
 use crate::render::{render, RenderArgs};
-use crate::scene::{apply_scene_to_render, apply_scene_to_turntable, given_on_command_line};
+use crate::scene::{apply_scene_to_render, given_on_command_line, merge_scene};
 use crate::turntable::{turntable, TurntableArgs};
 
 use std::path::Path;
@@ -127,24 +127,12 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         None => default_scene(),
-        Some(Command::Render(mut args)) => args
-            .scene
-            .clone()
-            .map_or(Ok(()), |path| {
-                SceneFile::load(&path).map(|scene| {
-                    apply_scene_to_render(&mut args, &scene, &|id| given("render", id))
-                })
-            })
-            .and_then(|()| render(&args)),
-        Some(Command::Turntable(mut args)) => args
-            .scene
-            .clone()
-            .map_or(Ok(()), |path| {
-                SceneFile::load(&path).map(|scene| {
-                    apply_scene_to_turntable(&mut args, &scene, &|id| given("turntable", id))
-                })
-            })
-            .and_then(|()| turntable(&args)),
+        Some(Command::Render(mut args)) => {
+            merge_scene(&mut *args, &|id| given("render", id)).and_then(|()| render(&args))
+        }
+        Some(Command::Turntable(mut args)) => {
+            merge_scene(&mut args, &|id| given("turntable", id)).and_then(|()| turntable(&args))
+        }
         Some(Command::Compare(args)) => compare(&args),
         Some(Command::Accuracy(args)) => accuracy(&args),
         Some(Command::AdaptiveTable(args)) => adaptive_table(&args),

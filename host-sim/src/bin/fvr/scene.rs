@@ -5,6 +5,8 @@ use crate::args::{InputArgs, PngArgs, SpectrumArgs, UnitArgs};
 use crate::render::RenderArgs;
 use crate::turntable::TurntableArgs;
 
+use std::path::Path;
+
 use clap::parser::ValueSource;
 use clap::ArgMatches;
 use fvr_host::render::scene_file::SceneFile;
@@ -221,3 +223,44 @@ turntable.path, profile:@FILE) are relative to the scene file's directory.
 
 Unknown keys and wrong types are errors naming the file, the key and the closest
 valid key. Examples: the examples/ directory of the repository.";
+
+/// A subcommand whose settings a scene file can fill.
+pub(crate) trait FromScene {
+    /// The `--scene` file given, if any.
+    fn scene_file(&self) -> Option<&Path>;
+    /// Fill the settings the command line did not give (`given`) from `scene`.
+    fn apply_scene(&mut self, scene: &SceneFile, given: &dyn Fn(&str) -> bool);
+}
+
+impl FromScene for RenderArgs {
+    fn scene_file(&self) -> Option<&Path> {
+        self.scene.as_deref()
+    }
+
+    fn apply_scene(&mut self, scene: &SceneFile, given: &dyn Fn(&str) -> bool) {
+        apply_scene_to_render(self, scene, given);
+    }
+}
+
+impl FromScene for TurntableArgs {
+    fn scene_file(&self) -> Option<&Path> {
+        self.scene.as_deref()
+    }
+
+    fn apply_scene(&mut self, scene: &SceneFile, given: &dyn Fn(&str) -> bool) {
+        apply_scene_to_turntable(self, scene, given);
+    }
+}
+
+/// Load the `--scene` file of `args`, if any, and fill `args` from it.
+pub(crate) fn merge_scene(
+    args: &mut impl FromScene,
+    given: &dyn Fn(&str) -> bool,
+) -> Result<(), String> {
+    let Some(path) = args.scene_file().map(Path::to_path_buf) else {
+        return Ok(());
+    };
+    let scene = SceneFile::load(&path)?;
+    args.apply_scene(&scene, given);
+    Ok(())
+}

@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::render::RenderArgs;
-use crate::scene::{apply_scene_to_render, apply_scene_to_turntable, given_on_command_line};
+use crate::scene::{given_on_command_line, FromScene};
 use clap::ArgMatches;
 use fvr_core::filter::FilterKind;
 use fvr_core::scene::Light;
@@ -59,17 +59,29 @@ fn parse_cli(argv: &[&str]) -> (Cli, ArgMatches) {
     (Cli::from_arg_matches(&m).expect("arguments convert"), m)
 }
 
-fn merged_render(scene: &str, flags: &[&str]) -> RenderArgs {
-    let mut argv = vec!["fvr", "render", "--scene", "s.toml"];
+/// Parse `fvr SUB --scene s.toml FLAGS`, pick the subcommand's arguments
+/// and fill them from the scene `text` (read from `/s`).
+fn merged<A: FromScene>(
+    sub: &str,
+    text: &str,
+    flags: &[&str],
+    pick: impl FnOnce(Command) -> Option<A>,
+) -> A {
+    let mut argv = vec!["fvr", sub, "--scene", "s.toml"];
     argv.extend(flags);
     let (cli, m) = parse_cli(&argv);
-    let Some(Command::Render(mut args)) = cli.command else {
-        panic!("not a render")
-    };
-    let sub = m.subcommand_matches("render").expect("render matches");
-    let scene = SceneFile::parse(scene, "s.toml", Path::new("/s")).expect("scene parses");
-    apply_scene_to_render(&mut args, &scene, &|id| given_on_command_line(sub, id));
-    *args
+    let mut args = cli.command.and_then(pick).expect("the subcommand");
+    let matches = m.subcommand_matches(sub).expect("subcommand matches");
+    let scene = SceneFile::parse(text, "s.toml", Path::new("/s")).expect("scene parses");
+    args.apply_scene(&scene, &|id| given_on_command_line(matches, id));
+    args
+}
+
+fn merged_render(scene: &str, flags: &[&str]) -> RenderArgs {
+    merged("render", scene, flags, |c| match c {
+        Command::Render(args) => Some(*args),
+        _ => None,
+    })
 }
 
 #[test]
@@ -187,16 +199,10 @@ fn each_flag_overrides_its_scene_key() {
 #[test]
 fn turntable_takes_scene_values_and_flags_win() {
     let run = |flags: &[&str]| {
-        let mut argv = vec!["fvr", "turntable", "--scene", "s.toml"];
-        argv.extend(flags);
-        let (cli, m) = parse_cli(&argv);
-        let Some(Command::Turntable(mut args)) = cli.command else {
-            panic!("not a turntable")
-        };
-        let sub = m.subcommand_matches("turntable").expect("matches");
-        let scene = SceneFile::parse(FULL_SCENE, "s.toml", Path::new("/s")).expect("parses");
-        apply_scene_to_turntable(&mut args, &scene, &|id| given_on_command_line(sub, id));
-        args
+        merged("turntable", FULL_SCENE, flags, |c| match c {
+            Command::Turntable(args) => Some(args),
+            _ => None,
+        })
     };
     let a = run(&[]);
     assert_eq!((a.frames, a.fps), (12, 6));
