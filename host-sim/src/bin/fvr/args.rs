@@ -50,6 +50,20 @@ impl PngArgs {
     }
 }
 
+/// The image and the spectrum it is read from (render and turntable).
+#[derive(Args, Clone, Copy, Default)]
+pub(crate) struct FrameArgs {
+    /// Image size W or WxH in pixels (of --pixel-size mm, or of one voxel
+    /// with --ignore-spacing); at most the padded grid.
+    /// Default: the padded grid divided by the oversampling.
+    #[arg(long, value_parser = parse_size)]
+    pub(crate) size: Option<(usize, usize)>,
+    #[command(flatten)]
+    pub(crate) units: UnitArgs,
+    #[command(flatten)]
+    pub(crate) spectrum: SpectrumArgs,
+}
+
 /// Physical units (render and turntable).
 #[derive(Args, Clone, Copy, Default)]
 pub(crate) struct UnitArgs {

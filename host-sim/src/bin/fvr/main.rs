@@ -17,7 +17,7 @@ mod turntable;
 
 use crate::accuracy::accuracy;
 use crate::adaptive_table::adaptive_table;
-use crate::args::{InputArgs, PngArgs, SpectrumArgs, UnitArgs};
+use crate::args::{FrameArgs, InputArgs, PngArgs};
 use crate::compare::compare;
 use crate::render::{render, RenderArgs};
 use crate::scene::{apply_scene_to_render, given_on_command_line, merge_scene};
@@ -159,9 +159,7 @@ fn default_scene() -> Result<(), String> {
         scene: None,
         dir: None,
         up: DEFAULT_UP,
-        size: None,
-        units: UnitArgs::default(),
-        spectrum: SpectrumArgs::default(),
+        frame: FrameArgs::default(),
         depth_cue: "none".into(),
         cue_harmonics: DEFAULT_PROFILE_HARMONICS,
         ambient: None,

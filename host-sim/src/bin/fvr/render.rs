@@ -2,8 +2,7 @@
 
 use crate::adaptive_report::adaptive_render;
 use crate::args::{
-    parse_size, parse_vec3, prepare_scene_with_progress, volume_help, InputArgs, PngArgs,
-    SpectrumArgs, UnitArgs,
+    parse_vec3, prepare_scene_with_progress, volume_help, FrameArgs, InputArgs, PngArgs,
 };
 use crate::scene::SCENE_HELP;
 use std::path::{Path, PathBuf};
@@ -52,15 +51,8 @@ pub(crate) struct RenderArgs {
     /// Up hint X,Y,Z.
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,1")]
     pub(crate) up: [f64; 3],
-    /// Image size W or WxH in pixels (of --pixel-size mm, or of one voxel
-    /// with --ignore-spacing); at most the padded grid.
-    /// Default: the padded grid divided by the oversampling.
-    #[arg(long, value_parser = parse_size)]
-    pub(crate) size: Option<(usize, usize)>,
     #[command(flatten)]
-    pub(crate) units: UnitArgs,
-    #[command(flatten)]
-    pub(crate) spectrum: SpectrumArgs,
+    pub(crate) frame: FrameArgs,
     /// Depth cue: none, linear:FRONT,BACK, sine:FRONT,BACK, profile:W0,W1,...,
     /// profile:@FILE or profile:gauss:C,S (details with --help).
     #[arg(long, default_value = "none", long_help = DEPTH_CUE_HELP)]
@@ -185,10 +177,10 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), String> {
     let t1 = Instant::now();
     let (spectra, filter) = prepare_scene_with_progress(
         &volume,
-        args.spectrum.filter,
-        args.spectrum.oversample,
-        args.spectrum.kb_design,
-        args.spectrum.precision,
+        args.frame.spectrum.filter,
+        args.frame.spectrum.oversample,
+        args.frame.spectrum.kb_design,
+        args.frame.spectrum.precision,
         &scene,
     )?;
     let t_prep = t1.elapsed();
@@ -199,9 +191,9 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), String> {
             "fvr: warning: premultiplying for {} at oversample {} amplifies this volume's edges; \
              the {} spectrum is estimated to hold only {storage_snr:.1} dB. \
              Use --oversample 2, --filter cubic, or --precision f32.",
-            args.spectrum.filter.name(),
-            args.spectrum.oversample,
-            args.spectrum.precision
+            args.frame.spectrum.filter.name(),
+            args.frame.spectrum.oversample,
+            args.frame.spectrum.precision
         );
     }
     let (lowest, share) = negative_cue_share(&volume, &scene, &view).map_err(|e| e.to_string())?;
@@ -214,9 +206,9 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), String> {
         );
     }
     let n = spectra.density.n();
-    let default_side = n / args.spectrum.oversample as usize;
-    let (w, h) = args.size.unwrap_or((default_side, default_side));
-    let sampling = args.units.sampling(&volume, n, default_side)?;
+    let default_side = n / args.frame.spectrum.oversample as usize;
+    let (w, h) = args.frame.size.unwrap_or((default_side, default_side));
+    let sampling = args.frame.units.sampling(&volume, n, default_side)?;
     let plain_view = scene.channels() == 1 && !scene.has_partner_terms();
     if (args.preview_level > 0 || args.adaptive.is_some()) && !plain_view {
         return Err(
@@ -308,7 +300,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), String> {
         let [dx, dy, dz] = volume.spacing;
         println!(
             "  spacing       {dx} x {dy} x {dz} mm{}",
-            if args.units.ignore_spacing {
+            if args.frame.units.ignore_spacing {
                 " (ignored: --ignore-spacing, voxel units)"
             } else {
                 ""
@@ -317,7 +309,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), String> {
         println!(
             "  pixel size    {} {}",
             sampling.pixel_size(),
-            if args.units.ignore_spacing {
+            if args.frame.units.ignore_spacing {
                 "voxel"
             } else {
                 "mm (values in mm x volume units)"
@@ -325,9 +317,9 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), String> {
         );
         println!(
             "  spectrum      {n}^3 {} = {} bytes ({} bytes/voxel)",
-            args.spectrum.precision,
+            args.frame.spectrum.precision,
             spectra.density.bytes(),
-            args.spectrum.precision.bytes()
+            args.frame.spectrum.precision.bytes()
         );
         match &spectra.gradient {
             Some(g) => println!(
@@ -336,7 +328,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), String> {
             ),
             None => println!("  |grad f|      not built (no light needs it)"),
         }
-        let working = match args.spectrum.precision {
+        let working = match args.frame.spectrum.precision {
             Precision::F64 => SceneRenderer::<f64>::new(n, filter, &scene).map(|r| r.bytes()),
             _ => SceneRenderer::<f32>::new(n, filter, &scene).map(|r| r.bytes()),
         }
@@ -388,10 +380,10 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), String> {
             dims: volume.dims,
             spacing_mm: debug_triple(volume.spacing),
             pixel_size: sampling.pixel_size(),
-            ignore_spacing: args.units.ignore_spacing,
+            ignore_spacing: args.frame.units.ignore_spacing,
             image: [w, h, image.channels],
             spectrum_side: n,
-            precision: args.spectrum.precision.name(),
+            precision: args.frame.spectrum.precision.name(),
             spectrum_bytes: spectra.density.bytes(),
             gradient_spectrum_bytes: spectra.gradient.as_ref().map(|g| g.bytes()),
             filter: filter.kind().name(),

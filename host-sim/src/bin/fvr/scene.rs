@@ -119,9 +119,9 @@ pub(crate) fn apply_scene_to_render(
     let c = &scene.camera;
     fill(given, "dir", &mut args.dir, c.dir.map(Some));
     fill(given, "up", &mut args.up, c.up);
-    fill(given, "size", &mut args.size, c.size.map(Some));
-    apply_scene_to_units(&mut args.units, scene, given);
-    apply_scene_to_spectrum(&mut args.spectrum, scene, given);
+    fill(given, "size", &mut args.frame.size, c.size.map(Some));
+    apply_scene_to_units(&mut args.frame.units, scene, given);
+    apply_scene_to_spectrum(&mut args.frame.spectrum, scene, given);
     let sh = &scene.shading;
     fill(
         given,
@@ -170,9 +170,9 @@ pub(crate) fn apply_scene_to_turntable(
     let c = &scene.camera;
     fill(given, "dir", &mut args.dir, c.dir);
     fill(given, "up", &mut args.up, c.up);
-    fill(given, "size", &mut args.size, c.size.map(Some));
-    apply_scene_to_units(&mut args.units, scene, given);
-    apply_scene_to_spectrum(&mut args.spectrum, scene, given);
+    fill(given, "size", &mut args.frame.size, c.size.map(Some));
+    apply_scene_to_units(&mut args.frame.units, scene, given);
+    apply_scene_to_spectrum(&mut args.frame.spectrum, scene, given);
     apply_scene_to_png(&mut args.png, scene, given);
     let t = &scene.turntable;
     fill(given, "frames", &mut args.frames, t.frames);

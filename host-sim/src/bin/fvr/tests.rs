@@ -95,13 +95,13 @@ fn scene_fills_every_render_setting() {
     assert_eq!(a.resample, Some(96));
     assert_eq!(a.dir, Some([1.0, 0.5, -0.25]));
     assert_eq!(a.up, [0.0, 1.0, 0.0]);
-    assert_eq!(a.size, Some((64, 32)));
-    assert_eq!(a.units.pixel_size, Some(0.5));
-    assert!(!a.units.ignore_spacing);
-    assert_eq!(a.spectrum.filter, FilterKind::Cubic);
-    assert_eq!(a.spectrum.oversample, 2);
-    assert_eq!(a.spectrum.precision, Precision::F32);
-    assert_eq!(a.spectrum.kb_design, KbDesign::Sigma(1.5));
+    assert_eq!(a.frame.size, Some((64, 32)));
+    assert_eq!(a.frame.units.pixel_size, Some(0.5));
+    assert!(!a.frame.units.ignore_spacing);
+    assert_eq!(a.frame.spectrum.filter, FilterKind::Cubic);
+    assert_eq!(a.frame.spectrum.oversample, 2);
+    assert_eq!(a.frame.spectrum.precision, Precision::F32);
+    assert_eq!(a.frame.spectrum.kb_design, KbDesign::Sigma(1.5));
     assert_eq!(a.ambient, Some([0.1; 3]));
     assert_eq!(a.depth_cue, "linear:1,0.3");
     assert_eq!(a.cue_harmonics, 6);
@@ -120,7 +120,7 @@ fn scene_fills_every_render_setting() {
     assert_eq!(a.png.colormap, Colormap::Bone);
     // An empty scene leaves the flags' defaults.
     let d = merged_render("", &["v.nrrd", "--dir", "0,1,0", "--out", "o.png"]);
-    assert_eq!(d.spectrum.filter, FilterKind::Kb4);
+    assert_eq!(d.frame.spectrum.filter, FilterKind::Kb4);
     assert_eq!(d.up, DEFAULT_UP);
     assert_eq!(d.depth_cue, "none");
     assert!(!d.no_cue_correction && d.lights.is_empty() && d.light_ring.is_none());
@@ -146,20 +146,22 @@ fn each_flag_overrides_its_scene_key() {
         (&["--resample", "64"], |a| a.resample == Some(64)),
         (&["--dir", "0,0,1"], |a| a.dir == Some([0.0, 0.0, 1.0])),
         (&["--up", "1,0,0"], |a| a.up == [1.0, 0.0, 0.0]),
-        (&["--size", "8"], |a| a.size == Some((8, 8))),
-        (&["--pixel-size", "2"], |a| a.units.pixel_size == Some(2.0)),
+        (&["--size", "8"], |a| a.frame.size == Some((8, 8))),
+        (&["--pixel-size", "2"], |a| {
+            a.frame.units.pixel_size == Some(2.0)
+        }),
         (&["--ignore-spacing"], |a| {
-            a.units.ignore_spacing && a.units.pixel_size.is_none()
+            a.frame.units.ignore_spacing && a.frame.units.pixel_size.is_none()
         }),
         (&["--filter", "kb3"], |a| {
-            a.spectrum.filter == FilterKind::Kb3
+            a.frame.spectrum.filter == FilterKind::Kb3
         }),
-        (&["--oversample", "1"], |a| a.spectrum.oversample == 1),
+        (&["--oversample", "1"], |a| a.frame.spectrum.oversample == 1),
         (&["--precision", "f16"], |a| {
-            a.spectrum.precision == Precision::F16
+            a.frame.spectrum.precision == Precision::F16
         }),
         (&["--kb-design", "auto"], |a| {
-            a.spectrum.kb_design == KbDesign::Auto
+            a.frame.spectrum.kb_design == KbDesign::Auto
         }),
         (&["--ambient", "0.5"], |a| a.ambient == Some([0.5; 3])),
         (&["--depth-cue", "none"], |a| a.depth_cue == "none"),
@@ -208,7 +210,7 @@ fn turntable_takes_scene_values_and_flags_win() {
     assert_eq!((a.frames, a.fps), (12, 6));
     assert_eq!(a.out, PathBuf::from("/s/spin.apng"));
     assert_eq!(a.dir, [1.0, 0.5, -0.25]);
-    assert_eq!(a.spectrum.filter, FilterKind::Cubic);
+    assert_eq!(a.frame.spectrum.filter, FilterKind::Cubic);
     let b = run(&[
         "--frames", "3", "--fps", "30", "--out", "t.apng", "--dir", "0,1,0",
     ]);

@@ -1,9 +1,6 @@
 //! `fvr turntable`: an APNG of X-ray views on a full turn.
 
-use crate::args::{
-    parse_size, parse_vec3, prepare_with_progress, volume_help, InputArgs, PngArgs, SpectrumArgs,
-    UnitArgs,
-};
+use crate::args::{parse_vec3, prepare_with_progress, volume_help, FrameArgs, InputArgs, PngArgs};
 use crate::json::one_line;
 
 use crate::scene::SCENE_HELP;
@@ -37,15 +34,8 @@ pub(crate) struct TurntableArgs {
     /// Turntable axis and up hint X,Y,Z.
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,1")]
     pub(crate) up: [f64; 3],
-    /// Image size W or WxH in pixels (of --pixel-size mm, or of one voxel
-    /// with --ignore-spacing); at most the padded grid.
-    /// Default: the padded grid divided by the oversampling.
-    #[arg(long, value_parser = parse_size)]
-    pub(crate) size: Option<(usize, usize)>,
     #[command(flatten)]
-    pub(crate) units: UnitArgs,
-    #[command(flatten)]
-    pub(crate) spectrum: SpectrumArgs,
+    pub(crate) frame: FrameArgs,
     /// Output file: .apng or .png (an animated PNG either way).
     #[arg(long, default_value = "spin.apng")]
     pub(crate) out: PathBuf,
@@ -71,16 +61,16 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), String> {
     let t1 = Instant::now();
     let spec = prepare_with_progress(
         &volume,
-        args.spectrum.filter,
-        args.spectrum.oversample,
-        args.spectrum.kb_design,
-        args.spectrum.precision,
+        args.frame.spectrum.filter,
+        args.frame.spectrum.oversample,
+        args.frame.spectrum.kb_design,
+        args.frame.spectrum.precision,
     )?;
     let t_prep = t1.elapsed();
     let n = spec.n();
-    let side = n / args.spectrum.oversample as usize;
-    let (w, h) = args.size.unwrap_or((side, side));
-    let sampling = args.units.sampling(&volume, n, side)?;
+    let side = n / args.frame.spectrum.oversample as usize;
+    let (w, h) = args.frame.size.unwrap_or((side, side));
+    let sampling = args.frame.units.sampling(&volume, n, side)?;
     let bar = progress::count(views.len() as u64, "frames");
     let t2 = Instant::now();
     let frames = turntable::render_views(&spec, &views, &sampling, w, h, &bar);
@@ -104,10 +94,10 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), String> {
             frames: frames.len(),
             fps: args.fps,
             spectrum_side: n,
-            precision: args.spectrum.precision.name(),
+            precision: args.frame.spectrum.precision.name(),
             spectrum_bytes: spec.bytes(),
-            filter: args.spectrum.filter.name(),
-            oversample: args.spectrum.oversample,
+            filter: args.frame.spectrum.filter.name(),
+            oversample: args.frame.spectrum.oversample,
             load_ms: t_load.as_secs_f64() * 1e3,
             preprocess_ms: t_prep.as_secs_f64() * 1e3,
             views_ms: secs * 1e3,
@@ -120,7 +110,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), String> {
             "  load {:.1} ms, preprocess {:.1} ms ({n}^3 {}), {} views in {:.1} ms = {:.1} views/s",
             t_load.as_secs_f64() * 1e3,
             t_prep.as_secs_f64() * 1e3,
-            args.spectrum.precision,
+            args.frame.spectrum.precision,
             frames.len(),
             secs * 1e3,
             views_per_second
