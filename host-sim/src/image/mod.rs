@@ -1,31 +1,15 @@
-//! Writing rendered images: float32 NRRD, or auto-windowed 8-bit PNG.
+//! Pictures: the rendered [`Image`] (grey or RGB) with its NRRD and PNG
+//! output, windowing, colormaps and APNG ([`output`]), and study plots
+//! ([`plot`]).
 
 pub mod output;
 pub mod plot;
+mod png;
 
-use std::fs::File;
-use std::io::BufWriter;
-use std::path::Path;
+use output::percentile_range;
 
 /// Lower and upper percentile of the automatic PNG window.
 pub const AUTO_WINDOW_PERCENTILES: (f64, f64) = (0.5, 99.5);
-
-/// The automatic window `(low, high)`: the 0.5th and 99.5th percentiles of
-/// the finite pixel values, widened to a non-empty interval.
-pub fn auto_window(pixels: &[f64]) -> (f64, f64) {
-    let mut v: Vec<f64> = pixels.iter().copied().filter(|x| x.is_finite()).collect();
-    if v.is_empty() {
-        return (0.0, 1.0);
-    }
-    v.sort_by(f64::total_cmp);
-    let at = |p: f64| v[((p / 100.0) * (v.len() - 1) as f64).round() as usize];
-    let (lo, hi) = (at(AUTO_WINDOW_PERCENTILES.0), at(AUTO_WINDOW_PERCENTILES.1));
-    if hi > lo {
-        (lo, hi)
-    } else {
-        (lo, lo + 1.0)
-    }
-}
 
 /// Map pixels to 8-bit grey through `window`, clamping outside it.
 pub fn to_gray8(pixels: &[f64], window: (f64, f64)) -> Vec<u8> {
@@ -43,19 +27,66 @@ pub fn to_gray8(pixels: &[f64], window: (f64, f64)) -> Vec<u8> {
         .collect()
 }
 
-/// Write a `width × height` grey image (row 0 at the top) as an 8-bit PNG,
-/// auto-windowed ([`auto_window`]).
-///
-/// # Errors
-/// File creation or encoding failure, with the path in the message.
-pub fn write_png(path: &Path, width: usize, height: usize, pixels: &[f64]) -> Result<(), String> {
-    let gray = to_gray8(pixels, auto_window(pixels));
-    let fail = |e: &dyn std::fmt::Display| format!("cannot write PNG `{}`: {e}", path.display());
-    let file = File::create(path).map_err(|e| fail(&e))?;
-    let mut enc = png::Encoder::new(BufWriter::new(file), width as u32, height as u32);
-    enc.set_color(png::ColorType::Grayscale);
-    enc.set_depth(png::BitDepth::Eight);
-    let mut writer = enc.write_header().map_err(|e| fail(&e))?;
-    writer.write_image_data(&gray).map_err(|e| fail(&e))?;
-    writer.finish().map_err(|e| fail(&e))
+/// An image of 1 (grey) or 3 (RGB) interleaved channels, row 0 at the top.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    /// Channels per pixel.
+    pub channels: usize,
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// `data[(row·width + col)·channels + c]`.
+    pub data: Vec<f64>,
+}
+
+impl Image {
+    /// Channel `c` as its own `width × height` image.
+    pub fn channel(&self, c: usize) -> Vec<f64> {
+        self.data
+            .iter()
+            .skip(c)
+            .step_by(self.channels)
+            .copied()
+            .collect()
+    }
+}
+
+impl Image {
+    /// Write as a float32 NRRD: `sizes: W H` for grey, `sizes: 3 W H`
+    /// (channel fastest) for RGB.
+    ///
+    /// # Errors
+    /// File errors, with the path.
+    pub fn write_nrrd(&self, path: &std::path::Path) -> Result<(), String> {
+        let data: Vec<f32> = self.data.iter().map(|&v| v as f32).collect();
+        let sizes: Vec<usize> = if self.channels == 1 {
+            vec![self.width, self.height]
+        } else {
+            vec![self.channels, self.width, self.height]
+        };
+        crate::io::nrrd::write_nrrd_f32(path, &sizes, &data).map_err(|e| e.to_string())
+    }
+
+    /// Write as an 8-bit PNG, grey or RGB, auto-windowed over all channels
+    /// together (one window keeps the lights' colour balance).
+    ///
+    /// # Errors
+    /// File or encoding errors, with the path.
+    pub fn write_png(&self, path: &std::path::Path) -> Result<(), String> {
+        let (lo, hi) = AUTO_WINDOW_PERCENTILES;
+        let bytes = to_gray8(&self.data, percentile_range(&self.data, lo, hi));
+        let color = if self.channels == 1 {
+            ::png::ColorType::Grayscale
+        } else {
+            ::png::ColorType::Rgb
+        };
+        png::write(
+            path,
+            (self.width, self.height),
+            color,
+            ::png::BitDepth::Eight,
+            &bytes,
+        )
+    }
 }

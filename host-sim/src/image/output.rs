@@ -22,7 +22,7 @@
 //!   regions.
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::BufWriter;
 use std::path::Path;
 use std::str::FromStr;
 
@@ -272,26 +272,6 @@ impl Style {
     }
 }
 
-fn png_encoder<W: Write>(
-    w: W,
-    width: usize,
-    height: usize,
-    style: &Style,
-) -> Result<png::Encoder<'static, W>, String> {
-    let (w32, h32) = match (u32::try_from(width), u32::try_from(height)) {
-        (Ok(a), Ok(b)) if a > 0 && b > 0 => (a, b),
-        _ => {
-            return Err(format!(
-                "image size {width}x{height} cannot be stored in a PNG"
-            ))
-        }
-    };
-    let mut enc = png::Encoder::new(w, w32, h32);
-    enc.set_color(style.png_color());
-    enc.set_depth(style.png_depth());
-    Ok(enc)
-}
-
 /// Write a `width × height` image (row 0 at the top) as a PNG in `style`.
 ///
 /// # Errors
@@ -304,7 +284,7 @@ pub fn write_png(
     pixels: &[f64],
     style: &Style,
 ) -> Result<(), String> {
-    let fail = |e: &dyn std::fmt::Display| format!("cannot write PNG `{}`: {e}", path.display());
+    let fail = |e: &dyn std::fmt::Display| super::png::png_error(path, e);
     if pixels.len() != width.saturating_mul(height) {
         return Err(fail(&format!(
             "{} pixels for a {width}x{height} image",
@@ -312,11 +292,13 @@ pub fn write_png(
         )));
     }
     let data = style.encode(pixels, style.window.resolve(pixels));
-    let file = File::create(path).map_err(|e| fail(&e))?;
-    let enc = png_encoder(BufWriter::new(file), width, height, style).map_err(|e| fail(&e))?;
-    let mut writer = enc.write_header().map_err(|e| fail(&e))?;
-    writer.write_image_data(&data).map_err(|e| fail(&e))?;
-    writer.finish().map_err(|e| fail(&e))
+    super::png::write(
+        path,
+        (width, height),
+        style.png_color(),
+        style.png_depth(),
+        &data,
+    )
 }
 
 /// Write `frames` (each `width × height`, row 0 at the top) as an animated
@@ -358,7 +340,14 @@ pub fn write_apng(
         Window::Percentiles(..) => style.window.resolve(&frames.concat()),
     };
     let file = File::create(path).map_err(|e| fail(&e))?;
-    let mut enc = png_encoder(BufWriter::new(file), width, height, style).map_err(|e| fail(&e))?;
+    let mut enc = super::png::encoder(
+        BufWriter::new(file),
+        width,
+        height,
+        style.png_color(),
+        style.png_depth(),
+    )
+    .map_err(|e| fail(&e))?;
     let count = u32::try_from(frames.len()).map_err(|e| fail(&e))?;
     enc.set_animated(count, 0).map_err(|e| fail(&e))?;
     enc.set_frame_delay(1, fps).map_err(|e| fail(&e))?;

@@ -3,8 +3,6 @@
 //! fronts for the speed–accuracy trade. Text uses a built-in 3×5 pixel font (upper-case
 //! letters, digits and a few signs), drawn at twice its size.
 
-use std::fs::File;
-use std::io::BufWriter;
 use std::path::Path;
 
 /// An RGB image being drawn.
@@ -108,16 +106,13 @@ impl Canvas {
     /// # Errors
     /// File creation or encoding failure, with the path.
     pub fn write_png(&self, path: &Path) -> Result<(), String> {
-        let fail =
-            |e: &dyn std::fmt::Display| format!("cannot write PNG `{}`: {e}", path.display());
-        let file = File::create(path).map_err(|e| fail(&e))?;
-        let mut enc =
-            png::Encoder::new(BufWriter::new(file), self.width as u32, self.height as u32);
-        enc.set_color(png::ColorType::Rgb);
-        enc.set_depth(png::BitDepth::Eight);
-        let mut writer = enc.write_header().map_err(|e| fail(&e))?;
-        writer.write_image_data(&self.rgb).map_err(|e| fail(&e))?;
-        writer.finish().map_err(|e| fail(&e))
+        super::png::write(
+            path,
+            (self.width, self.height),
+            png::ColorType::Rgb,
+            png::BitDepth::Eight,
+            &self.rgb,
+        )
     }
 }
 

@@ -16,8 +16,8 @@
 //!   derivatives and of `|∇f|` (the same samples the frequency-domain path
 //!   transforms).
 
+use crate::image::Image;
 use crate::reference::trilinear;
-use crate::render::shaded::Image;
 use crate::sources::phantom::{Gaussian, GaussianMixture};
 use crate::volume::Volume;
 use fvr_core::dht::Twiddles;

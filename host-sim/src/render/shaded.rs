@@ -1,6 +1,7 @@
 //! Depth-cued and shaded rendering on the host: the spectra a scene needs
 //! (the `|∇f|` spectrum only when a light needs it) and a reusable renderer.
 
+use crate::image::Image;
 use crate::render::spectrum::{AnySpectrum, OwnedSpectrum, PipelineError, Precision};
 use crate::volume::Volume;
 use fvr_core::dht::Twiddles;
@@ -12,31 +13,6 @@ use fvr_core::render::aux_len;
 use fvr_core::scene::{DepthCue, Light, Scene, MAX_PROFILE_POINTS};
 use fvr_core::scene_render::{fields_len, render_scene};
 use fvr_core::spectrum::DenseVolume;
-
-/// An image of 1 (grey) or 3 (RGB) interleaved channels, row 0 at the top.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Image {
-    /// Channels per pixel.
-    pub channels: usize,
-    /// Width in pixels.
-    pub width: usize,
-    /// Height in pixels.
-    pub height: usize,
-    /// `data[(row·width + col)·channels + c]`.
-    pub data: Vec<f64>,
-}
-
-impl Image {
-    /// Channel `c` as its own `width × height` image.
-    pub fn channel(&self, c: usize) -> Vec<f64> {
-        self.data
-            .iter()
-            .skip(c)
-            .step_by(self.channels)
-            .copied()
-            .collect()
-    }
-}
 
 /// `|∇f|` at every voxel (spectral gradient, [`fvr_core::gradient`]),
 /// computed in f64.
@@ -442,49 +418,6 @@ pub fn parse_light(s: &str) -> Result<Light, String> {
         towards,
         color: parse_rgb(color)?,
     })
-}
-
-impl Image {
-    /// Write as a float32 NRRD: `sizes: W H` for grey, `sizes: 3 W H`
-    /// (channel fastest) for RGB.
-    ///
-    /// # Errors
-    /// File errors, with the path.
-    pub fn write_nrrd(&self, path: &std::path::Path) -> Result<(), String> {
-        let data: Vec<f32> = self.data.iter().map(|&v| v as f32).collect();
-        let sizes: Vec<usize> = if self.channels == 1 {
-            vec![self.width, self.height]
-        } else {
-            vec![self.channels, self.width, self.height]
-        };
-        crate::io::nrrd::write_nrrd_f32(path, &sizes, &data).map_err(|e| e.to_string())
-    }
-
-    /// Write as an 8-bit PNG, grey or RGB, auto-windowed over all channels
-    /// together (one window keeps the lights' colour balance).
-    ///
-    /// # Errors
-    /// File or encoding errors, with the path.
-    pub fn write_png(&self, path: &std::path::Path) -> Result<(), String> {
-        if self.channels == 1 {
-            return crate::image::write_png(path, self.width, self.height, &self.data);
-        }
-        let window = crate::image::auto_window(&self.data);
-        let bytes = crate::image::to_gray8(&self.data, window);
-        let fail =
-            |e: &dyn std::fmt::Display| format!("cannot write PNG `{}`: {e}", path.display());
-        let file = std::fs::File::create(path).map_err(|e| fail(&e))?;
-        let mut enc = png::Encoder::new(
-            std::io::BufWriter::new(file),
-            self.width as u32,
-            self.height as u32,
-        );
-        enc.set_color(png::ColorType::Rgb);
-        enc.set_depth(png::BitDepth::Eight);
-        let mut writer = enc.write_header().map_err(|e| fail(&e))?;
-        writer.write_image_data(&bytes).map_err(|e| fail(&e))?;
-        writer.finish().map_err(|e| fail(&e))
-    }
 }
 
 /// How much of the image a depth cue weights negatively on `view`: the

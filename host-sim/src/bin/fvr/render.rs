@@ -240,7 +240,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), String> {
             .render_level_sampled(&view, &sampling, pw, ph, args.preview_level)
             .map_err(|e| e.to_string())?;
         (
-            fvr_host::render::shaded::Image {
+            fvr_host::image::Image {
                 channels: 1,
                 width: pw,
                 height: ph,
@@ -264,7 +264,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), String> {
         let data = report.image.iter().map(|v| v * gain).collect();
         adaptive_report = Some(report);
         (
-            fvr_host::render::shaded::Image {
+            fvr_host::image::Image {
                 channels: 1,
                 width: w,
                 height: h,
