@@ -2,7 +2,9 @@
 //! renderer, shaded renders, adaptive filtering, turntables and scene files.
 
 pub mod adaptive;
+pub mod filter;
 pub mod scene_file;
 pub mod shaded;
 pub mod spectrum;
 pub mod turntable;
+pub mod view;

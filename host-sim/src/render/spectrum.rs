@@ -1,4 +1,6 @@
-//! The core pipeline with owned buffers, for the host.
+//! The owned spectrum: the core pipeline's spectrum with its buffers, for
+//! the host ([`ViewRenderer`] renders views of it, [`super::filter`] chooses
+//! its filter).
 //!
 //! Three precisions share the one generic core:
 //! - `f16`: spectrum stored as IEEE binary16 (2 bytes a voxel), f32 arithmetic;
@@ -9,17 +11,19 @@ use std::fmt;
 use std::str::FromStr;
 
 use fvr_core::dht::Twiddles;
-use fvr_core::filter::{Filter, FilterKind, KernelTable};
+use fvr_core::filter::{Filter, KernelTable};
 use fvr_core::geometry::{Sampling, View};
 use fvr_core::real::{Real, Sample};
-use fvr_core::render::{
-    aux_len, check_image, extract_slice_rows, finish_projection, grid_len, placement_on_axes,
-    render_sampled,
-};
+use fvr_core::render::aux_len;
 use fvr_core::spectrum::{padded_size, prepare_scratch_len, DenseVolume, Spectrum};
 use half::f16;
 
 use crate::volume::Volume;
+
+pub use super::filter::{
+    choose_filter, choose_oversampling, premultiplication_gain_db, KbDesign, CONDITIONING_LIMIT_DB,
+};
+pub use super::view::ViewRenderer;
 
 /// Storage and arithmetic of a pipeline.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -165,137 +169,14 @@ impl<S: Sample> OwnedSpectrum<S> {
     }
 }
 
-/// Reusable per-view buffers and tables for arithmetic `T`.
-#[derive(Debug)]
-pub struct ViewRenderer<T> {
-    kernel: KernelTable<T>,
-    tw: Vec<T>,
-    grid: Vec<T>,
-    aux: Vec<T>,
-    n: usize,
-    threads: usize,
-}
-
-impl<T: Real> ViewRenderer<T> {
-    /// Buffers for spectra of side `n` and `filter`.
-    pub fn new(n: usize, filter: Filter) -> Self {
-        let mut tw = vec![T::ZERO; Twiddles::<T>::buffer_len(n)];
-        Twiddles::new(&mut tw, n).expect("n is a power of two");
-        Self {
-            kernel: KernelTable::new(filter),
-            tw,
-            grid: vec![T::ZERO; grid_len(n)],
-            aux: vec![T::ZERO; aux_len(n)],
-            n,
-            threads: 0,
-        }
-    }
-
-    /// Extract the slice on `threads` threads (0, the default: one per
-    /// core). The image is the same bit for bit whatever the count.
-    pub fn with_threads(mut self, threads: usize) -> Self {
-        self.threads = threads;
-        self
-    }
-
-    /// Render one view into `out` (`width × height`, row 0 at the top).
-    ///
-    /// The slice is extracted in blocks of rows on the renderer's threads
-    /// ([`fvr_core::render::extract_slice_rows`]; the core stays
-    /// single-threaded), then inverse-transformed on this one.
-    ///
-    /// # Errors
-    /// As [`fvr_core::render::render`].
-    pub fn render_into<S: Sample>(
-        &mut self,
-        spec: &OwnedSpectrum<S>,
-        view: &View,
-        width: usize,
-        height: usize,
-        out: &mut [T],
-    ) -> Result<(), fvr_core::Error> {
-        self.render_sampled_into(spec, view, &Sampling::UNIT, width, height, out)
-    }
-
-    /// [`ViewRenderer::render_into`] in physical units
-    /// ([`fvr_core::render::render_sampled`]).
-    ///
-    /// # Errors
-    /// As [`fvr_core::render::render_sampled`].
-    pub fn render_sampled_into<S: Sample>(
-        &mut self,
-        spec: &OwnedSpectrum<S>,
-        view: &View,
-        sampling: &Sampling,
-        width: usize,
-        height: usize,
-        out: &mut [T],
-    ) -> Result<(), fvr_core::Error> {
-        let tw = Twiddles::from_table(&self.tw, self.n)?;
-        let spec = spec.view();
-        let n = spec.n();
-        let threads = match self.threads {
-            0 => std::thread::available_parallelism().map_or(1, |t| t.get()),
-            t => t,
-        };
-        // Blocks of at least 16 rows: below that a thread costs more than it saves.
-        let blocks = threads.min(n / 16).max(1);
-        if blocks == 1 || self.grid.len() != grid_len(n) || self.kernel.filter() != spec.filter() {
-            return render_sampled(
-                &spec,
-                &self.kernel,
-                view,
-                sampling,
-                width,
-                height,
-                &tw,
-                &mut self.grid,
-                &mut self.aux,
-                out,
-            );
-        }
-        let axes = sampling.slice_axes(&view.frame()?);
-        check_image(width, height, n)?;
-        let rows_per_block = n.div_ceil(blocks);
-        let kernel = &self.kernel;
-        let spec_ref = &spec;
-        let axes_ref = &axes;
-        std::thread::scope(|scope| {
-            let workers: Vec<_> = self
-                .grid
-                .chunks_mut(rows_per_block * n)
-                .enumerate()
-                .map(|(block, rows)| {
-                    scope.spawn(move || {
-                        extract_slice_rows(spec_ref, kernel, axes_ref, block * rows_per_block, rows)
-                    })
-                })
-                .collect();
-            workers
-                .into_iter()
-                .try_for_each(|w| w.join().expect("an extraction thread panicked"))
-        })?;
-        let place = placement_on_axes(spec.dims(), &axes, width, height, 1.0);
-        finish_projection(
-            &mut self.grid,
-            n,
-            &place,
-            sampling.gain() / spec.scale(),
-            width,
-            height,
-            &tw,
-            &mut self.aux,
-            out,
-        )
-    }
-}
-
 /// Why a host pipeline could not run.
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
 pub enum PipelineError {
     /// The core refused (bad view, bad size, non-finite voxel, ...).
-    Core(fvr_core::Error),
+    #[error(transparent)]
+    Core(#[from] fvr_core::Error),
     /// The padded spectrum would need more memory than is available.
+    #[error("a {n}^3 spectrum needs {needed} bytes, more than the {limit} bytes available")]
     OutOfMemory {
         /// Bytes the spectrum would need.
         needed: u64,
@@ -304,26 +185,6 @@ pub enum PipelineError {
         /// Side of the padded cube.
         n: usize,
     },
-}
-
-impl fmt::Display for PipelineError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            PipelineError::Core(e) => e.fmt(f),
-            PipelineError::OutOfMemory { needed, limit, n } => write!(
-                f,
-                "a {n}^3 spectrum needs {needed} bytes, more than the {limit} bytes available"
-            ),
-        }
-    }
-}
-
-impl std::error::Error for PipelineError {}
-
-impl From<fvr_core::Error> for PipelineError {
-    fn from(e: fvr_core::Error) -> Self {
-        PipelineError::Core(e)
-    }
 }
 
 /// Refuse a spectrum of side `n` whose storage and f32 working buffers would
@@ -338,127 +199,6 @@ pub(crate) fn check_memory(n: usize, bytes_per_sample: usize) -> Result<(), Pipe
         return Err(PipelineError::OutOfMemory { needed, limit, n });
     }
     Ok(())
-}
-
-/// How the Kaiser–Bessel shape parameter is chosen.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum KbDesign {
-    /// Fitted to the volume's energy distribution ([`Filter::fit`]).
-    Auto,
-    /// Beatty's β for this design oversampling.
-    Sigma(f64),
-}
-
-impl FromStr for KbDesign {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        if s == "auto" {
-            return Ok(KbDesign::Auto);
-        }
-        match s.parse::<f64>() {
-            Ok(v) if v.is_finite() && v >= 1.0 => Ok(KbDesign::Sigma(v)),
-            _ => Err(format!(
-                "kb design `{s}` must be `auto` or an oversampling factor >= 1"
-            )),
-        }
-    }
-}
-
-/// Choose the filter for `volume`.
-///
-/// # Errors
-/// As [`Filter::fit`].
-pub fn choose_filter(
-    volume: &Volume,
-    kind: FilterKind,
-    oversample: u32,
-    design: KbDesign,
-) -> Result<Filter, fvr_core::Error> {
-    match design {
-        KbDesign::Auto => {
-            let src = DenseVolume::new(volume.dims, &volume.data)?;
-            Ok(Filter::fit(kind, oversample, &src)?.0)
-        }
-        KbDesign::Sigma(s) => Filter::with_design_oversampling(kind, oversample, s),
-    }
-}
-
-/// Above this [`premultiplication_gain_db`], [`choose_oversampling`] pads the
-/// grid to oversampling 2.
-///
-/// Why 20 dB: the f16 spectrum of compact data sits 75–84 dB from f64
-/// (README); a gain of 20 dB would leave about 55–64 dB, the most the
-/// default format can give away and still stay above the paper's 50 dB.
-pub const CONDITIONING_LIMIT_DB: f64 = 20.0;
-
-/// How much premultiplication amplifies storage rounding noise relative to
-/// the image, in dB: `10·log10(Σg² / (p₀⁶·Σf²))`, where `g = f·p(x)p(y)p(z)`
-/// is the premultiplied volume, `p` the per-axis factor `1/ĥ` on the padded
-/// grid and `p₀ = p(0)` its value at the centre.
-///
-/// Rounding adds noise proportional to each stored coefficient, so the noise
-/// energy of an image is proportional to `Σg²` (Parseval), while its signal
-/// is that of `p₀³·f`. A volume confined to the middle of its grid has a gain
-/// near 0 dB. One that fills the grid at oversampling 1 has its faces and
-/// corners multiplied by `p(n/2)/p₀` per axis (about 200 for kb4, so up to
-/// 10⁷ at a corner), which no 16-bit format can absorb: the gain is then
-/// 60–90 dB. Returns 0 for an all-zero volume.
-///
-/// # Errors
-/// A NaN or infinite voxel, or an empty volume.
-pub fn premultiplication_gain_db(volume: &Volume, filter: Filter) -> Result<f64, fvr_core::Error> {
-    let n = padded_size(volume.dims, filter.oversample())?;
-    let mut table = vec![0.0f64; n];
-    fvr_core::spectrum::premultiplier_table(&filter, n, &mut table);
-    let p0 = table[0];
-    let dims = volume.dims;
-    let factor = |i: usize, a: usize| table[(i + n - dims[a] / 2) & (n - 1)] / p0;
-    let (mut g2, mut f2) = (0.0f64, 0.0f64);
-    for k in 0..dims[2] {
-        for j in 0..dims[1] {
-            let pyz = factor(j, 1) * factor(k, 2);
-            for i in 0..dims[0] {
-                let v = volume.get(i, j, k) as f64;
-                if !v.is_finite() {
-                    return Err(fvr_core::Error::NonFiniteVoxel {
-                        index: [i, j, k],
-                        value: v,
-                    });
-                }
-                let g = v * factor(i, 0) * pyz;
-                g2 += g * g;
-                f2 += v * v;
-            }
-        }
-    }
-    Ok(if f2 > 0.0 {
-        10.0 * (g2 / f2).log10()
-    } else {
-        0.0
-    })
-}
-
-/// The oversampling for `volume`: 1, unless premultiplying for `kind` at
-/// oversampling 1 would amplify storage noise by more than
-/// [`CONDITIONING_LIMIT_DB`] ([`premultiplication_gain_db`]); then 2, where
-/// the data fills only the middle half of each axis and the gain is a few dB.
-///
-/// This is the remedy for the ill-conditioning of Kaiser–Bessel
-/// premultiplication on data that fills its grid (a constant volume, or CT
-/// in Hounsfield units, whose air is −1000): the f64 image there is itself
-/// wrong at the faces (the kernel's first alias is as strong as its main
-/// lobe at ν = ½), and the amplified faces swamp every 16-bit format.
-///
-/// # Errors
-/// As [`choose_filter`] and [`premultiplication_gain_db`].
-pub fn choose_oversampling(
-    volume: &Volume,
-    kind: FilterKind,
-    design: KbDesign,
-) -> Result<u32, fvr_core::Error> {
-    let filter = choose_filter(volume, kind, 1, design)?;
-    let gain = premultiplication_gain_db(volume, filter)?;
-    Ok(if gain > CONDITIONING_LIMIT_DB { 2 } else { 1 })
 }
 
 /// A prepared spectrum in any of the three precisions.
