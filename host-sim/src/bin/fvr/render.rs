@@ -6,8 +6,12 @@ use crate::args::{
 };
 use crate::scene::SCENE_HELP;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
+use fvr_core::filter::Filter;
+use fvr_host::image::Image;
+use fvr_host::render::shaded::SceneSpectra;
+use fvr_host::volume::Volume;
 use serde::Serialize;
 use serde_json::value::RawValue;
 
@@ -291,149 +295,33 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), String> {
     }
     let kind = if image.channels == 1 { "grey" } else { "RGB" };
     println!("wrote {} ({w}x{h} {kind})", out.display());
+    let rendered = Rendered {
+        args,
+        volume_spec,
+        volume,
+        view,
+        scene,
+        sampling,
+        spectra,
+        filter,
+        storage_snr,
+        image,
+        w,
+        h,
+        n,
+        t_load,
+        t_prep,
+        t_view,
+        adaptive_report,
+    };
     if args.stats && !args.stats_json {
-        let d = volume.dims;
-        println!(
-            "  volume        {}x{}x{} ({})",
-            d[0], d[1], d[2], volume_spec
-        );
-        let [dx, dy, dz] = volume.spacing;
-        println!(
-            "  spacing       {dx} x {dy} x {dz} mm{}",
-            if args.frame.units.ignore_spacing {
-                " (ignored: --ignore-spacing, voxel units)"
-            } else {
-                ""
-            }
-        );
-        println!(
-            "  pixel size    {} {}",
-            sampling.pixel_size(),
-            if args.frame.units.ignore_spacing {
-                "voxel"
-            } else {
-                "mm (values in mm x volume units)"
-            }
-        );
-        println!(
-            "  spectrum      {n}^3 {} = {} bytes ({} bytes/voxel)",
-            args.frame.spectrum.precision,
-            spectra.density.bytes(),
-            args.frame.spectrum.precision.bytes()
-        );
-        match &spectra.gradient {
-            Some(g) => println!(
-                "  |grad f|      {} bytes (second spectrum, for the lights)",
-                g.bytes()
-            ),
-            None => println!("  |grad f|      not built (no light needs it)"),
-        }
-        let working = match args.frame.spectrum.precision {
-            Precision::F64 => SceneRenderer::<f64>::new(n, filter, &scene).map(|r| r.bytes()),
-            _ => SceneRenderer::<f32>::new(n, filter, &scene).map(|r| r.bytes()),
-        }
-        .map_err(|e| e.to_string())?;
-        println!(
-            "  per view      {working} bytes ({} slice fields, tables, twiddles)",
-            scene.field_count()
-        );
-        println!("  held          {} bytes in all", spectra.bytes() + working);
-        let f = spectra.density.filter();
-        if f.kind().is_kaiser_bessel() {
-            println!(
-                "  filter        {} (oversample {}, beta {:.3})",
-                f.kind().name(),
-                f.oversample(),
-                f.beta()
-            );
-        } else {
-            println!(
-                "  filter        {} (oversample {})",
-                f.kind().name(),
-                f.oversample()
-            );
-        }
-        println!("  storage SNR   {storage_snr:.1} dB (estimate, against the f64 pipeline)");
-        println!("  load          {:.1} ms", t_load.as_secs_f64() * 1e3);
-        println!("  preprocess    {:.1} ms", t_prep.as_secs_f64() * 1e3);
-        println!("  view          {:.2} ms", t_view.as_secs_f64() * 1e3);
-        if args.preview_level > 0 {
-            println!(
-                "  level         {} ({w}x{h} at pitch {} {}, central 1/{} of the slice)",
-                args.preview_level,
-                (1u64 << args.preview_level) as f64 * sampling.pixel_size(),
-                if sampling == Sampling::UNIT {
-                    "voxels"
-                } else {
-                    "mm"
-                },
-                1u64 << (2 * args.preview_level)
-            );
-        }
-        if let Some(r) = &adaptive_report {
-            r.print_human();
-        }
+        rendered.print_human()?;
     }
     if args.stats_json {
-        let stats = RenderStats {
-            volume: volume_spec,
-            dims: volume.dims,
-            spacing_mm: debug_triple(volume.spacing),
-            pixel_size: sampling.pixel_size(),
-            ignore_spacing: args.frame.units.ignore_spacing,
-            image: [w, h, image.channels],
-            spectrum_side: n,
-            precision: args.frame.spectrum.precision.name(),
-            spectrum_bytes: spectra.density.bytes(),
-            gradient_spectrum_bytes: spectra.gradient.as_ref().map(|g| g.bytes()),
-            filter: filter.kind().name(),
-            oversample: filter.oversample(),
-            storage_snr_db: storage_snr,
-            load_ms: t_load.as_secs_f64() * 1e3,
-            preprocess_ms: t_prep.as_secs_f64() * 1e3,
-            view_ms: t_view.as_secs_f64() * 1e3,
-            preview_level: args.preview_level,
-            adaptive: adaptive_report.as_ref().map(AdaptiveReport::json),
-        };
-        println!("{}", one_line(&stats));
+        rendered.print_json();
     }
     if args.exact {
-        let plain = scene.channels() == 1 && !scene.has_partner_terms();
-        match phantom_by_name(volume_spec) {
-            Some(Ok(p)) if plain => {
-                let exact = exact_projection_sampled(
-                    p.phantom.as_ref(),
-                    volume.dims,
-                    &view,
-                    &sampling,
-                    w,
-                    h,
-                )
-                .map_err(|e| e.to_string())?;
-                let ambient = scene.ambient[0];
-                let exact: Vec<f64> = exact.iter().map(|v| v * ambient).collect();
-                println!("  SNR vs exact  {:.2} dB", snr_db(&exact, &image.data));
-            }
-            Some(Ok(p)) => match p.phantom.as_gaussian_mixture() {
-                Some(mixture) => {
-                    let exact = exact_scene_projection_sampled(
-                        mixture,
-                        volume.dims,
-                        &sampling,
-                        &scene,
-                        &view,
-                        (w, h),
-                        0.05,
-                    )
-                    .map_err(|e| e.to_string())?;
-                    println!("  SNR vs exact  {:.2} dB", snr_db(&exact.data, &image.data));
-                }
-                None => println!(
-                    "  SNR vs exact  n/a (cued or shaded references exist for gaussians only)"
-                ),
-            },
-            _ => println!("  SNR vs exact  n/a (not a built-in phantom)"),
-        }
+        rendered.print_exact()?;
     }
     Ok(())
 }
@@ -491,4 +379,221 @@ struct RenderStats<'a> {
     preview_level: u32,
     #[serde(skip_serializing_if = "Option::is_none")]
     adaptive: Option<AdaptiveJson>,
+}
+
+/// A finished render and what `--stats`, `--stats-json` and `--exact`
+/// report of it.
+struct Rendered<'a> {
+    args: &'a RenderArgs,
+    volume_spec: &'a str,
+    volume: Volume,
+    view: View,
+    scene: Scene,
+    sampling: Sampling,
+    spectra: SceneSpectra,
+    filter: Filter,
+    storage_snr: f64,
+    image: Image,
+    w: usize,
+    h: usize,
+    n: usize,
+    t_load: Duration,
+    t_prep: Duration,
+    t_view: Duration,
+    adaptive_report: Option<AdaptiveReport>,
+}
+
+impl Rendered<'_> {
+    /// `--stats`: sizes, memory, filter and timings, one per line.
+    fn print_human(&self) -> Result<(), String> {
+        let &Rendered {
+            args,
+            volume_spec,
+            ref volume,
+            ref scene,
+            ref sampling,
+            ref spectra,
+            filter,
+            storage_snr,
+            w,
+            h,
+            n,
+            t_load,
+            t_prep,
+            t_view,
+            ref adaptive_report,
+            ..
+        } = self;
+        let d = volume.dims;
+        println!(
+            "  volume        {}x{}x{} ({})",
+            d[0], d[1], d[2], volume_spec
+        );
+        let [dx, dy, dz] = volume.spacing;
+        println!(
+            "  spacing       {dx} x {dy} x {dz} mm{}",
+            if args.frame.units.ignore_spacing {
+                " (ignored: --ignore-spacing, voxel units)"
+            } else {
+                ""
+            }
+        );
+        println!(
+            "  pixel size    {} {}",
+            sampling.pixel_size(),
+            if args.frame.units.ignore_spacing {
+                "voxel"
+            } else {
+                "mm (values in mm x volume units)"
+            }
+        );
+        println!(
+            "  spectrum      {n}^3 {} = {} bytes ({} bytes/voxel)",
+            args.frame.spectrum.precision,
+            spectra.density.bytes(),
+            args.frame.spectrum.precision.bytes()
+        );
+        match &spectra.gradient {
+            Some(g) => println!(
+                "  |grad f|      {} bytes (second spectrum, for the lights)",
+                g.bytes()
+            ),
+            None => println!("  |grad f|      not built (no light needs it)"),
+        }
+        let working = match args.frame.spectrum.precision {
+            Precision::F64 => SceneRenderer::<f64>::new(n, filter, scene).map(|r| r.bytes()),
+            _ => SceneRenderer::<f32>::new(n, filter, scene).map(|r| r.bytes()),
+        }
+        .map_err(|e| e.to_string())?;
+        println!(
+            "  per view      {working} bytes ({} slice fields, tables, twiddles)",
+            scene.field_count()
+        );
+        println!("  held          {} bytes in all", spectra.bytes() + working);
+        let f = spectra.density.filter();
+        if f.kind().is_kaiser_bessel() {
+            println!(
+                "  filter        {} (oversample {}, beta {:.3})",
+                f.kind().name(),
+                f.oversample(),
+                f.beta()
+            );
+        } else {
+            println!(
+                "  filter        {} (oversample {})",
+                f.kind().name(),
+                f.oversample()
+            );
+        }
+        println!("  storage SNR   {storage_snr:.1} dB (estimate, against the f64 pipeline)");
+        println!("  load          {:.1} ms", t_load.as_secs_f64() * 1e3);
+        println!("  preprocess    {:.1} ms", t_prep.as_secs_f64() * 1e3);
+        println!("  view          {:.2} ms", t_view.as_secs_f64() * 1e3);
+        if args.preview_level > 0 {
+            println!(
+                "  level         {} ({w}x{h} at pitch {} {}, central 1/{} of the slice)",
+                args.preview_level,
+                (1u64 << args.preview_level) as f64 * sampling.pixel_size(),
+                if *sampling == Sampling::UNIT {
+                    "voxels"
+                } else {
+                    "mm"
+                },
+                1u64 << (2 * args.preview_level)
+            );
+        }
+        if let Some(r) = &adaptive_report {
+            r.print_human();
+        }
+        Ok(())
+    }
+
+    /// `--stats-json`: the same as one JSON object.
+    fn print_json(&self) {
+        let &Rendered {
+            args,
+            volume_spec,
+            ref volume,
+            ref sampling,
+            ref spectra,
+            filter,
+            storage_snr,
+            ref image,
+            w,
+            h,
+            n,
+            t_load,
+            t_prep,
+            t_view,
+            ref adaptive_report,
+            ..
+        } = self;
+        let stats = RenderStats {
+            volume: volume_spec,
+            dims: volume.dims,
+            spacing_mm: debug_triple(volume.spacing),
+            pixel_size: sampling.pixel_size(),
+            ignore_spacing: args.frame.units.ignore_spacing,
+            image: [w, h, image.channels],
+            spectrum_side: n,
+            precision: args.frame.spectrum.precision.name(),
+            spectrum_bytes: spectra.density.bytes(),
+            gradient_spectrum_bytes: spectra.gradient.as_ref().map(|g| g.bytes()),
+            filter: filter.kind().name(),
+            oversample: filter.oversample(),
+            storage_snr_db: storage_snr,
+            load_ms: t_load.as_secs_f64() * 1e3,
+            preprocess_ms: t_prep.as_secs_f64() * 1e3,
+            view_ms: t_view.as_secs_f64() * 1e3,
+            preview_level: args.preview_level,
+            adaptive: adaptive_report.as_ref().map(AdaptiveReport::json),
+        };
+        println!("{}", one_line(&stats));
+    }
+
+    /// `--exact`: the SNR against the phantom's exact image, where there is one.
+    fn print_exact(&self) -> Result<(), String> {
+        let &Rendered {
+            volume_spec,
+            ref volume,
+            ref view,
+            ref scene,
+            ref sampling,
+            ref image,
+            w,
+            h,
+            ..
+        } = self;
+        let plain = scene.channels() == 1 && !scene.has_partner_terms();
+        match phantom_by_name(volume_spec) {
+            Some(Ok(p)) if plain => {
+                let exact =
+                    exact_projection_sampled(p.phantom.as_ref(), volume.dims, view, sampling, w, h)
+                        .map_err(|e| e.to_string())?;
+                let ambient = scene.ambient[0];
+                let exact: Vec<f64> = exact.iter().map(|v| v * ambient).collect();
+                println!("  SNR vs exact  {:.2} dB", snr_db(&exact, &image.data));
+            }
+            Some(Ok(p)) => match p.phantom.as_gaussian_mixture() {
+                Some(mixture) => {
+                    let exact = exact_scene_projection_sampled(
+                        mixture,
+                        volume.dims,
+                        sampling,
+                        scene,
+                        view,
+                        (w, h),
+                        0.05,
+                    )
+                    .map_err(|e| e.to_string())?;
+                    println!("  SNR vs exact  {:.2} dB", snr_db(&exact.data, &image.data));
+                }
+                None => println!(
+                    "  SNR vs exact  n/a (cued or shaded references exist for gaussians only)"
+                ),
+            },
+            _ => println!("  SNR vs exact  n/a (not a built-in phantom)"),
+        }
+        Ok(())
+    }
 }
