@@ -1,5 +1,6 @@
 //! `fvr accuracy`: the README's accuracy table.
 
+use crate::Error;
 use clap::Args;
 
 #[derive(Args)]
@@ -9,9 +10,8 @@ pub(crate) struct AccuracyArgs {
     pub(crate) sizes: Vec<usize>,
 }
 
-pub(crate) fn accuracy(args: &AccuracyArgs) -> Result<(), String> {
-    let rows =
-        fvr_host::studies::accuracy::accuracy_table(&args.sizes).map_err(|e| e.to_string())?;
+pub(crate) fn accuracy(args: &AccuracyArgs) -> Result<(), Error> {
+    let rows = fvr_host::studies::accuracy::accuracy_table(&args.sizes)?;
     print!("{}", fvr_host::studies::accuracy::markdown(&rows));
     Ok(())
 }

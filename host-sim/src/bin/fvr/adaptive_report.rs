@@ -1,5 +1,6 @@
 //! What an adaptive render did (`fvr render --adaptive`), for --stats.
 
+use crate::Error;
 use serde::Serialize;
 use std::time::Instant;
 
@@ -108,7 +109,7 @@ pub(crate) fn adaptive_render(
     w: usize,
     h: usize,
     settings: &AdaptiveSettings,
-) -> Result<AdaptiveReport, String> {
+) -> Result<AdaptiveReport, Error> {
     pub(crate) fn go<S: fvr_core::real::Sample, T: fvr_core::real::Real>(
         any: &AnySpectrum,
         spec: &fvr_host::render::spectrum::OwnedSpectrum<S>,
@@ -116,17 +117,15 @@ pub(crate) fn adaptive_render(
         w: usize,
         h: usize,
         settings: &AdaptiveSettings,
-    ) -> Result<AdaptiveReport, String> {
+    ) -> Result<AdaptiveReport, Error> {
         let t0 = Instant::now();
         let marks = fvr_host::render::adaptive::AdaptiveMarks::build(spec, settings)?;
         let mark_time = t0.elapsed();
         let t1 = Instant::now();
-        let (image, stats) = marks
-            .render::<S, T>(spec, view, w, h)
-            .map_err(|e| e.to_string())?;
+        let (image, stats) = marks.render::<S, T>(spec, view, w, h)?;
         let view_time = t1.elapsed();
         let t2 = Instant::now();
-        let full = any.render(view, w, h).map_err(|e| e.to_string())?;
+        let full = any.render(view, w, h)?;
         let full_view_time = t2.elapsed();
         Ok(AdaptiveReport {
             snr_vs_full: snr_db(&full, &image),

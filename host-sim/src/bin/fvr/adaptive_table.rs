@@ -1,6 +1,7 @@
 //! `fvr adaptive-table`: the paper's Table 1 measured here.
 
 use crate::args::{load_with_progress, parse_filter};
+use crate::Error;
 
 use clap::Args;
 use fvr_host::render::adaptive::parse_tolerance;
@@ -31,7 +32,7 @@ pub(crate) struct AdaptiveTableArgs {
     pub(crate) runs: usize,
 }
 
-pub(crate) fn adaptive_table(args: &AdaptiveTableArgs) -> Result<(), String> {
+pub(crate) fn adaptive_table(args: &AdaptiveTableArgs) -> Result<(), Error> {
     let AdaptiveTableArgs {
         tolerance,
         bound,
@@ -40,7 +41,7 @@ pub(crate) fn adaptive_table(args: &AdaptiveTableArgs) -> Result<(), String> {
         ref volumes,
         runs,
     } = *args;
-    let filter = fvr_core::filter::Filter::new(kind, oversample).map_err(|e| e.to_string())?;
+    let filter = fvr_core::filter::Filter::new(kind, oversample)?;
     let view = View::along([1.0, 0.3, 0.2]);
     let mut rows = Vec::new();
     for name in volumes {

@@ -1,5 +1,6 @@
 //! Argument groups render and turntable share, and their value parsers.
 
+use crate::Error;
 use clap::Args;
 use fvr_core::filter::FilterKind;
 use fvr_core::geometry::Sampling;
@@ -37,7 +38,7 @@ pub(crate) struct PngArgs {
 }
 
 impl PngArgs {
-    pub(crate) fn style(&self) -> Result<Style, String> {
+    pub(crate) fn style(&self) -> Result<Style, Error> {
         let window = match (self.window, self.level) {
             (Some(w), Some(l)) => Window::from_width_level(w, l)?,
             _ => Window::from_percentiles(self.percentiles.0, self.percentiles.1)?,
@@ -94,7 +95,7 @@ impl UnitArgs {
         volume: &fvr_host::volume::Volume,
         n: usize,
         default_side: usize,
-    ) -> Result<Sampling, String> {
+    ) -> Result<Sampling, Error> {
         if self.ignore_spacing {
             return Ok(Sampling::UNIT);
         }
@@ -183,7 +184,7 @@ impl Default for InputArgs {
 
 impl InputArgs {
     /// Load `spec` with a progress bar, then subtract the background.
-    pub(crate) fn load(&self, spec: &str) -> Result<fvr_host::volume::Volume, String> {
+    pub(crate) fn load(&self, spec: &str) -> Result<fvr_host::volume::Volume, Error> {
         let raw = self.raw_dims.map(|dims| RawLayout {
             dims,
             ty: self.raw_type,
@@ -258,11 +259,11 @@ pub(crate) fn parse_filter(s: &str) -> Result<FilterKind, String> {
 pub(crate) fn load_with_progress(
     spec: &str,
     raw: Option<RawLayout>,
-) -> Result<fvr_host::volume::Volume, String> {
+) -> Result<fvr_host::volume::Volume, Error> {
     let bar = progress::bytes("loading");
     let volume = load_volume_with_progress(spec, raw, &bar);
     bar.finish_and_clear();
-    volume
+    Ok(volume?)
 }
 
 /// Fit the filter and prepare the scene's spectra, with a spinner.
@@ -273,20 +274,20 @@ pub(crate) fn prepare_scene_with_progress(
     design: KbDesign,
     precision: Precision,
     scene: &Scene,
-) -> Result<(SceneSpectra, fvr_core::filter::Filter), String> {
+) -> Result<(SceneSpectra, fvr_core::filter::Filter), Error> {
     let bar = progress::spinner("fitting filter");
-    let result = choose_filter(volume, kind, oversample, design)
-        .map_err(|e| e.to_string())
-        .and_then(|filter| {
-            bar.set_message(if scene.needs_gradient_spectrum() {
-                "preprocess (density and |grad f| spectra)"
-            } else {
-                "preprocess"
-            });
-            SceneSpectra::prepare(volume, filter, precision, scene)
-                .map(|s| (s, filter))
-                .map_err(|e| e.to_string())
+    let result = (|| -> Result<_, Error> {
+        let filter = choose_filter(volume, kind, oversample, design)?;
+        bar.set_message(if scene.needs_gradient_spectrum() {
+            "preprocess (density and |grad f| spectra)"
+        } else {
+            "preprocess"
         });
+        Ok((
+            SceneSpectra::prepare(volume, filter, precision, scene)?,
+            filter,
+        ))
+    })();
     bar.finish_and_clear();
     result
 }
@@ -299,14 +300,13 @@ pub(crate) fn prepare_with_progress(
     oversample: u32,
     design: KbDesign,
     precision: Precision,
-) -> Result<AnySpectrum, String> {
+) -> Result<AnySpectrum, Error> {
     let bar = progress::spinner("fitting filter");
-    let result = choose_filter(volume, kind, oversample, design)
-        .map_err(|e| e.to_string())
-        .and_then(|filter| {
-            bar.set_message("preprocess");
-            AnySpectrum::prepare(volume, filter, precision).map_err(|e| e.to_string())
-        });
+    let result = (|| -> Result<_, Error> {
+        let filter = choose_filter(volume, kind, oversample, design)?;
+        bar.set_message("preprocess");
+        Ok(AnySpectrum::prepare(volume, filter, precision)?)
+    })();
     bar.finish_and_clear();
     result
 }

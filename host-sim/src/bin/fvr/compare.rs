@@ -1,5 +1,6 @@
 //! `fvr compare`: the SNR of one NRRD image against another.
 
+use crate::Error;
 use std::path::PathBuf;
 
 use clap::Args;
@@ -15,15 +16,12 @@ pub(crate) struct CompareArgs {
     pub(crate) b: PathBuf,
 }
 
-pub(crate) fn compare(args: &CompareArgs) -> Result<(), String> {
+pub(crate) fn compare(args: &CompareArgs) -> Result<(), Error> {
     let (a, b) = (&args.a, &args.b);
-    let ia = read_nrrd(a).map_err(|e| e.to_string())?;
-    let ib = read_nrrd(b).map_err(|e| e.to_string())?;
+    let ia = read_nrrd(a)?;
+    let ib = read_nrrd(b)?;
     if ia.dims != ib.dims {
-        return Err(format!(
-            "images differ in size: {:?} against {:?}",
-            ia.dims, ib.dims
-        ));
+        return Err(format!("images differ in size: {:?} against {:?}", ia.dims, ib.dims).into());
     }
     let ra: Vec<f64> = ia.data.iter().map(|&v| v as f64).collect();
     let rb: Vec<f64> = ib.data.iter().map(|&v| v as f64).collect();

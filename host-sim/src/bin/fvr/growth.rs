@@ -1,5 +1,6 @@
 //! `fvr growth`: time per view against the volume's side, both methods.
 
+use crate::Error;
 use std::path::PathBuf;
 
 use clap::Args;
@@ -20,12 +21,13 @@ pub(crate) struct GrowthArgs {
     pub(crate) out_dir: PathBuf,
 }
 
-pub(crate) fn run(args: &GrowthArgs) -> Result<(), String> {
+pub(crate) fn run(args: &GrowthArgs) -> Result<(), Error> {
     fvr_host::studies::growth::run(&args.sizes, args.runs, args.large, &args.out_dir, |r| {
         eprintln!(
             "fvr: {}³: {:.3} ms against {:.2} ms",
             r.n, r.frequency_ms, r.raycast_ms
         )
     })
-    .map(|md| print!("{md}"))
+    .map(|md| print!("{md}"))?;
+    Ok(())
 }

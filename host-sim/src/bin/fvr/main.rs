@@ -26,6 +26,9 @@ use crate::turntable::{turntable, TurntableArgs};
 use std::path::Path;
 use std::process::ExitCode;
 
+/// Any error of a subcommand; `main` prints it as one line and exits 2.
+pub(crate) type Error = Box<dyn std::error::Error>;
+
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use fvr_core::geometry::DEFAULT_UP;
 use fvr_host::image::output::{Bits, Colormap};
@@ -153,7 +156,7 @@ fn main() -> ExitCode {
 /// working directory).
 pub(crate) const DEFAULT_SCENE: &str = include_str!("../../default-scene.toml");
 
-fn default_scene() -> Result<(), String> {
+fn default_scene() -> Result<(), Error> {
     let mut args = RenderArgs {
         volume: None,
         scene: None,

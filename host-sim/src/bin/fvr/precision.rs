@@ -1,6 +1,7 @@
 //! `fvr precision`: arguments, the run, and its outputs (Markdown, CSV,
 //! PNG plot).
 
+use crate::Error;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -54,7 +55,7 @@ pub(crate) struct PrecisionArgs {
 /// # Errors
 /// Bad arguments (named, before any work), unreadable volumes, or output
 /// that cannot be written.
-pub(crate) fn run(args: &PrecisionArgs) -> Result<(), String> {
+pub(crate) fn run(args: &PrecisionArgs) -> Result<(), Error> {
     // Configuration first: every error here comes before any transform.
     let formats: Vec<Format> = if args.formats.is_empty() {
         default_formats()
@@ -70,13 +71,11 @@ pub(crate) fn run(args: &PrecisionArgs) -> Result<(), String> {
         "auto" => Oversampling::Auto,
         "1" => Oversampling::Fixed(1),
         "2" => Oversampling::Fixed(2),
-        o => return Err(format!("oversampling `{o}` must be auto, 1 or 2")),
+        o => return Err(format!("oversampling `{o}` must be auto, 1 or 2").into()),
     };
     if let Some(n) = args.extremes {
         if n < 2 || n % 2 != 0 || n > 128 {
-            return Err(format!(
-                "--extremes {n}: the side must be even, from 2 to 128"
-            ));
+            return Err(format!("--extremes {n}: the side must be even, from 2 to 128").into());
         }
         let mut md = format!(
             "# Stability at the extremes: measured\n\n\
@@ -102,7 +101,9 @@ pub(crate) fn run(args: &PrecisionArgs) -> Result<(), String> {
                 std::fs::create_dir_all(dir)
                     .map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
                 let p = dir.join("extremes.md");
-                std::fs::write(&p, md).map_err(|e| format!("cannot write `{}`: {e}", p.display()))
+                std::fs::write(&p, md)
+                    .map_err(|e| format!("cannot write `{}`: {e}", p.display()))?;
+                Ok(())
             }
         };
     }
@@ -124,8 +125,7 @@ pub(crate) fn run(args: &PrecisionArgs) -> Result<(), String> {
         // Formats this grid cannot hold (a brick that does not divide it) are
         // configuration errors, reported before any transform.
         let grid =
-            fvr_core::spectrum::padded_size(subject.volume.dims, subject.filter.oversample())
-                .map_err(|e| e.to_string())?;
+            fvr_core::spectrum::padded_size(subject.volume.dims, subject.filter.oversample())?;
         for &f in &formats {
             for a in fvr_host::studies::precision::modes_for(f) {
                 f.check(a, grid)

@@ -5,6 +5,7 @@ use crate::args::{
     parse_vec3, prepare_scene_with_progress, volume_help, FrameArgs, InputArgs, PngArgs,
 };
 use crate::scene::SCENE_HELP;
+use crate::Error;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -138,38 +139,35 @@ pub(crate) struct RenderArgs {
 }
 
 impl RenderArgs {
-    pub(crate) fn volume_spec(&self) -> Result<&str, String> {
+    pub(crate) fn volume_spec(&self) -> Result<&str, Error> {
         self.volume.as_deref().ok_or_else(|| {
             "no volume: give VOLUME, or `volume.path` or `volume.builtin` in the scene".into()
         })
     }
 
-    pub(crate) fn view(&self) -> Result<View, String> {
+    pub(crate) fn view(&self) -> Result<View, Error> {
         let dir = self.dir.ok_or_else(|| {
             "no view direction: give --dir, or `camera.dir` in the scene".to_string()
         })?;
         Ok(View { dir, up: self.up })
     }
 
-    pub(crate) fn out_path(&self) -> Result<&Path, String> {
+    pub(crate) fn out_path(&self) -> Result<&Path, Error> {
         self.out
             .as_deref()
             .ok_or_else(|| "no output file: give --out, or `output.path` in the scene".into())
     }
 }
 
-pub(crate) fn render(args: &RenderArgs) -> Result<(), String> {
+pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     let out = args.out_path()?;
     let volume_spec = args.volume_spec()?;
     let ext = out.extension().and_then(|e| e.to_str()).unwrap_or("");
     if ext != "png" && ext != "nrrd" {
-        return Err(format!(
-            "output `{}` must end in .png or .nrrd",
-            out.display()
-        ));
+        return Err(format!("output `{}` must end in .png or .nrrd", out.display()).into());
     }
     let view = args.view()?;
-    view.frame().map_err(|e| e.to_string())?;
+    view.frame()?;
     let style = args.png.style()?;
     let t0 = Instant::now();
     let mut volume = args.input.load(volume_spec)?;
@@ -200,7 +198,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), String> {
             args.frame.spectrum.precision
         );
     }
-    let (lowest, share) = negative_cue_share(&volume, &scene, &view).map_err(|e| e.to_string())?;
+    let (lowest, share) = negative_cue_share(&volume, &scene, &view)?;
     if share > NEGATIVE_CUE_WARNING_SHARE {
         eprintln!(
             "fvr: warning: the depth cue is given between t = -R and +R; extrapolated beyond, \
@@ -233,16 +231,17 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), String> {
              or add --ignore-spacing",
             fmt_spacing(sampling.spacing()),
             sampling.pixel_size()
-        ));
+        )
+        .into());
     }
     let mut adaptive_report = None;
     let t2 = Instant::now();
     let (image, w, h) = if args.preview_level > 0 {
         let (pw, ph) = fvr_core::progressive::preview_size(w, h, args.preview_level);
-        let data = spectra
-            .density
-            .render_level_sampled(&view, &sampling, pw, ph, args.preview_level)
-            .map_err(|e| e.to_string())?;
+        let data =
+            spectra
+                .density
+                .render_level_sampled(&view, &sampling, pw, ph, args.preview_level)?;
         (
             fvr_host::image::Image {
                 channels: 1,
@@ -331,11 +330,11 @@ pub(crate) fn fmt_spacing(s: [f64; 3]) -> String {
 }
 
 /// The scene from the command line: cue, ambient, lights.
-pub(crate) fn build_scene(args: &RenderArgs) -> Result<Scene, String> {
+pub(crate) fn build_scene(args: &RenderArgs) -> Result<Scene, Error> {
     let cue = parse_depth_cue(&args.depth_cue, args.cue_harmonics)?;
     let mut lights = args.lights.clone();
     if let Some((count, tilt)) = args.light_ring {
-        lights.extend(light_ring(&args.view()?, count, tilt).map_err(|e| e.to_string())?);
+        lights.extend(light_ring(&args.view()?, count, tilt)?);
     }
     let default_ambient = if lights.is_empty() { 1.0 } else { 0.2 };
     let mut scene = Scene {
@@ -348,12 +347,13 @@ pub(crate) fn build_scene(args: &RenderArgs) -> Result<Scene, String> {
         return Err(format!(
             "{} lights given, but a scene holds at most {MAX_LIGHTS}",
             lights.len()
-        ));
+        )
+        .into());
     }
     for light in &lights {
-        scene.add_light(*light).map_err(|e| e.to_string())?;
+        scene.add_light(*light)?;
     }
-    scene.validate().map_err(|e| e.to_string())?;
+    scene.validate()?;
     Ok(scene)
 }
 
@@ -405,7 +405,7 @@ struct Rendered<'a> {
 
 impl Rendered<'_> {
     /// `--stats`: sizes, memory, filter and timings, one per line.
-    fn print_human(&self) -> Result<(), String> {
+    fn print_human(&self) -> Result<(), Error> {
         let &Rendered {
             args,
             volume_spec,
@@ -463,8 +463,7 @@ impl Rendered<'_> {
         let working = match args.frame.spectrum.precision {
             Precision::F64 => SceneRenderer::<f64>::new(n, filter, scene).map(|r| r.bytes()),
             _ => SceneRenderer::<f32>::new(n, filter, scene).map(|r| r.bytes()),
-        }
-        .map_err(|e| e.to_string())?;
+        }?;
         println!(
             "  per view      {working} bytes ({} slice fields, tables, twiddles)",
             scene.field_count()
@@ -552,7 +551,7 @@ impl Rendered<'_> {
     }
 
     /// `--exact`: the SNR against the phantom's exact image, where there is one.
-    fn print_exact(&self) -> Result<(), String> {
+    fn print_exact(&self) -> Result<(), Error> {
         let &Rendered {
             volume_spec,
             ref volume,
@@ -567,9 +566,14 @@ impl Rendered<'_> {
         let plain = scene.channels() == 1 && !scene.has_partner_terms();
         match phantom_by_name(volume_spec) {
             Some(Ok(p)) if plain => {
-                let exact =
-                    exact_projection_sampled(p.phantom.as_ref(), volume.dims, view, sampling, w, h)
-                        .map_err(|e| e.to_string())?;
+                let exact = exact_projection_sampled(
+                    p.phantom.as_ref(),
+                    volume.dims,
+                    view,
+                    sampling,
+                    w,
+                    h,
+                )?;
                 let ambient = scene.ambient[0];
                 let exact: Vec<f64> = exact.iter().map(|v| v * ambient).collect();
                 println!("  SNR vs exact  {:.2} dB", snr_db(&exact, &image.data));
@@ -584,8 +588,7 @@ impl Rendered<'_> {
                         view,
                         (w, h),
                         0.05,
-                    )
-                    .map_err(|e| e.to_string())?;
+                    )?;
                     println!("  SNR vs exact  {:.2} dB", snr_db(&exact.data, &image.data));
                 }
                 None => println!(

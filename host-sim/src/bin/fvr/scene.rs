@@ -4,6 +4,7 @@
 use crate::args::{InputArgs, PngArgs, SpectrumArgs, UnitArgs};
 use crate::render::RenderArgs;
 use crate::turntable::TurntableArgs;
+use crate::Error;
 
 use std::path::Path;
 
@@ -256,7 +257,7 @@ impl FromScene for TurntableArgs {
 pub(crate) fn merge_scene(
     args: &mut impl FromScene,
     given: &dyn Fn(&str) -> bool,
-) -> Result<(), String> {
+) -> Result<(), Error> {
     let Some(path) = args.scene_file().map(Path::to_path_buf) else {
         return Ok(());
     };

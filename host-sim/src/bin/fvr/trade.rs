@@ -1,6 +1,7 @@
 //! `fvr trade`: the speed–accuracy map, written to trade.csv, trade.md and
 //! trade.png.
 
+use crate::Error;
 use std::path::PathBuf;
 
 use clap::Args;
@@ -87,7 +88,7 @@ fn command_line() -> String {
 /// # Errors
 /// Bad or conflicting arguments and a sweep beyond memory (both before any
 /// work), a pipeline failure, or output that cannot be written.
-pub(crate) fn run(args: &TradeArgs) -> Result<(), String> {
+pub(crate) fn run(args: &TradeArgs) -> Result<(), Error> {
     let sweep = Sweep::from_axes(&args.axes())?;
     let (available, source) = match &args.memory_limit {
         Some(text) => (parse_bytes(text)?, "--memory-limit"),

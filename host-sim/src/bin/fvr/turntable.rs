@@ -2,6 +2,7 @@
 
 use crate::args::{parse_vec3, prepare_with_progress, volume_help, FrameArgs, InputArgs, PngArgs};
 use crate::json::one_line;
+use crate::Error;
 
 use crate::scene::SCENE_HELP;
 use serde::Serialize;
@@ -49,7 +50,7 @@ pub(crate) struct TurntableArgs {
     pub(crate) input: InputArgs,
 }
 
-pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), String> {
+pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     let views = turntable::orbit(args.dir, args.up, args.frames as usize)?;
     let style = args.png.style()?;
     let t0 = Instant::now();
@@ -76,7 +77,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), String> {
     let frames = turntable::render_views(&spec, &views, &sampling, w, h, &bar);
     let t_views = t2.elapsed();
     bar.finish_and_clear();
-    let frames = frames.map_err(|e| e.to_string())?;
+    let frames = frames?;
     write_apng(&args.out, w, h, &frames, args.fps, &style)?;
     let secs = t_views.as_secs_f64();
     println!(
