@@ -1,7 +1,7 @@
 //! The `fvr` program end to end: outputs, and clear errors on bad input.
 
 mod common;
-use common::{assert_error, assert_ok, fvr, fvr_in, fvr_line, temp_dir};
+use common::{assert_error, assert_ok, fvr, fvr_in, fvr_line, read, temp_dir};
 
 use fvr_host::io::nrrd::{encode_nrrd, Encoding, Endian, SampleType};
 
@@ -154,7 +154,7 @@ fn help_documents_the_geometry_contract_and_every_option() {
 fn precision_study_writes_markdown_csv_and_png_with_no_non_finite_pixel() {
     let (dir, out) = fvr_in("precision", "precision --volumes gaussians@16,shepp-logan@16 --formats f16,bf16,e4m11,q15-line,q7-brick2,e4m3,f32 --out-dir out");
     assert_ok(&out);
-    let csv = std::fs::read_to_string(dir.join("out/precision.csv")).unwrap();
+    let csv = read(&dir, "out/precision.csv");
     let lines: Vec<&str> = csv.lines().collect();
     assert!(lines[0].starts_with("volume,size,grid,format,arithmetic,bytes_per_voxel"));
     // 2 volumes × (f16×3 + bf16×3 + e4m11×3 + q15-line×3 + q7-brick2 + e4m3×3 + f32×2).
@@ -166,7 +166,7 @@ fn precision_study_writes_markdown_csv_and_png_with_no_non_finite_pixel() {
         let snr: f64 = cols[6].parse().unwrap();
         assert!(snr > 0.0 || cols[3] == "e4m11", "{line}");
     }
-    let md = std::fs::read_to_string(dir.join("out/precision.md")).unwrap();
+    let md = read(&dir, "out/precision.md");
     assert!(md.contains("| q15-line | host-once |"), "{md}");
     let png = std::fs::read(dir.join("out/precision.png")).unwrap();
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");

@@ -18,23 +18,35 @@ fn gzip(bytes: &[u8]) -> Vec<u8> {
     e.finish().unwrap()
 }
 
-/// `parse` accepts `whole` and refuses every strict prefix of it.
+/// `parse` accepts `whole` and refuses every strict prefix of it; returns
+/// what `whole` gave. `what` names an accepted value in the failure message.
+fn refuse_every_prefix<T>(
+    name: &str,
+    whole: &[u8],
+    parse: impl Fn(&[u8]) -> Result<T, IoError>,
+    what: impl Fn(&T) -> String,
+) -> T {
+    let full = parse(whole).unwrap_or_else(|e| panic!("{name}: the whole file fails: {e}"));
+    for len in 0..whole.len() {
+        if let Ok(v) = parse(&whole[..len]) {
+            panic!(
+                "{name}: a prefix of {len} of {} bytes gave {}",
+                whole.len(),
+                what(&v)
+            );
+        }
+    }
+    full
+}
+
+/// [`refuse_every_prefix`] for a volume reader; the whole file has samples.
 fn every_prefix_is_refused(
     name: &str,
     whole: &[u8],
     parse: impl Fn(&[u8]) -> Result<Volume, IoError>,
 ) {
-    let full = parse(whole).unwrap_or_else(|e| panic!("{name}: the whole file fails: {e}"));
+    let full = refuse_every_prefix(name, whole, parse, |v| format!("a volume of {:?}", v.dims));
     assert!(!full.data.is_empty());
-    for len in 0..whole.len() {
-        if let Ok(v) = parse(&whole[..len]) {
-            panic!(
-                "{name}: a prefix of {len} of {} bytes gave a volume of {:?}",
-                whole.len(),
-                v.dims
-            );
-        }
-    }
 }
 
 #[test]
@@ -83,18 +95,11 @@ fn prefixes_of_a_dicom_slice_are_errors() {
         pixels: &[1, 2, 3, 4, 5, 6],
     }
     .encode();
-    let slice = parse_slice(&bytes).expect("whole slice");
+    let slice = refuse_every_prefix("dicom", &bytes, parse_slice, |s| {
+        format!("a slice of {:?}", s.size)
+    });
     assert_eq!(
         slice.pixels,
         vec![-1023.0, -1022.0, -1021.0, -1020.0, -1019.0, -1018.0]
     );
-    for len in 0..bytes.len() {
-        if let Ok(s) = parse_slice(&bytes[..len]) {
-            panic!(
-                "a prefix of {len} of {} bytes gave a slice of {:?}",
-                bytes.len(),
-                s.size
-            );
-        }
-    }
 }

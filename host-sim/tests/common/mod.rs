@@ -52,3 +52,8 @@ pub fn fvr_in(name: &str, command: &str) -> (PathBuf, Output) {
     let out = fvr_line(command, &dir);
     (dir, out)
 }
+
+/// The text of the file `name` in `dir` (an output a test checks).
+pub fn read(dir: &Path, name: &str) -> String {
+    std::fs::read_to_string(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
