@@ -34,12 +34,8 @@ impl<S: Sample> StoredSpectrum<S> {
         filter: Filter,
         rounding: Rounding,
     ) -> Result<Self, PipelineError> {
-        let n = padded_size(volume.dims, filter.oversample())?;
-        crate::render::spectrum::check_memory(n, std::mem::size_of::<S>())?;
+        let (n, mut data, mut scratch, mut tw_buf) = buffers::<S, T>(volume, filter)?;
         let source = DenseVolume::new(volume.dims, &volume.data)?;
-        let mut data = vec![S::default(); n * n * n];
-        let mut scratch = vec![T::ZERO; prepare_scratch_len(n)];
-        let mut tw_buf = vec![T::ZERO; Twiddles::<T>::buffer_len(n)];
         let tw = Twiddles::new(&mut tw_buf, n)?;
         let spec =
             Spectrum::prepare_rounding(&source, filter, &mut data, &mut scratch, &tw, rounding)?;
@@ -64,14 +60,10 @@ impl<S: Sample> StoredSpectrum<S> {
         filter: Filter,
         rounding: Rounding,
     ) -> Result<Self, PipelineError> {
-        let n = padded_size(volume.dims, filter.oversample())?;
-        crate::render::spectrum::check_memory(n, std::mem::size_of::<S>())?;
+        let (n, mut data, mut scratch, mut tw_buf) = buffers::<S, T>(volume, filter)?;
         let source = DenseVolume::new(volume.dims, &volume.data)?;
-        let mut data = vec![S::default(); n * n * n];
         let mut exps = vec![0i8; n * n];
         let mut exps_scratch = vec![0i8; n * n];
-        let mut scratch = vec![T::ZERO; prepare_scratch_len(n)];
-        let mut tw_buf = vec![T::ZERO; Twiddles::<T>::buffer_len(n)];
         let tw = Twiddles::new(&mut tw_buf, n)?;
         let spec = Spectrum::prepare_line_blocks(
             &source,
@@ -197,4 +189,23 @@ impl<S: Sample> StoredSpectrum<S> {
         )?;
         Ok(out.into_iter().map(T::to_f64).collect())
     }
+}
+
+/// The side of a padded spectrum and the buffers of its in-place
+/// preparation in `S` with arithmetic `T`: spectrum, scratch, twiddles.
+type Buffers<S, T> = (usize, Vec<S>, Vec<T>, Vec<T>);
+
+/// [`Buffers`] for `volume`, refusing a spectrum beyond memory first.
+fn buffers<S: Sample, T: Real>(
+    volume: &Volume,
+    filter: Filter,
+) -> Result<Buffers<S, T>, PipelineError> {
+    let n = padded_size(volume.dims, filter.oversample())?;
+    crate::render::spectrum::check_memory(n, std::mem::size_of::<S>())?;
+    Ok((
+        n,
+        vec![S::default(); n * n * n],
+        vec![T::ZERO; prepare_scratch_len(n)],
+        vec![T::ZERO; Twiddles::<T>::buffer_len(n)],
+    ))
 }
