@@ -6,9 +6,9 @@ use crate::io::nrrd::{format_error, IoError};
 use super::FORMAT;
 
 /// Transfer syntaxes whose data set is not explicit VR little endian.
-pub(crate) const IMPLICIT_VR_LITTLE_ENDIAN: &str = "1.2.840.10008.1.2";
-pub(crate) const EXPLICIT_VR_BIG_ENDIAN: &str = "1.2.840.10008.1.2.2";
-pub(crate) const DEFLATED_EXPLICIT_VR_LITTLE_ENDIAN: &str = "1.2.840.10008.1.2.1.99";
+const IMPLICIT_VR_LITTLE_ENDIAN: &str = "1.2.840.10008.1.2";
+const EXPLICIT_VR_BIG_ENDIAN: &str = "1.2.840.10008.1.2.2";
+const DEFLATED_EXPLICIT_VR_LITTLE_ENDIAN: &str = "1.2.840.10008.1.2.1.99";
 
 /// Refuse a file in which an element declares more bytes than the file
 /// holds after it.
@@ -68,7 +68,7 @@ pub(crate) fn check_lengths(bytes: &[u8]) -> Result<(), IoError> {
 }
 
 /// A cursor over DICOM element headers (see [`check_lengths`]).
-pub(crate) struct Walk<'a> {
+struct Walk<'a> {
     bytes: &'a [u8],
     pos: usize,
     explicit: bool,

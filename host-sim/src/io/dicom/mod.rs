@@ -56,12 +56,12 @@ use crate::volume::{check_spacing, Volume};
 /// Format name in error messages.
 pub(crate) const FORMAT: &str = "DICOM";
 /// Format name of the series in error messages.
-pub(crate) const SERIES: &str = "DICOM series";
+const SERIES: &str = "DICOM series";
 
 /// Relative tolerance on the slice step.
-pub(crate) const STEP_TOLERANCE: f64 = 0.01;
+const STEP_TOLERANCE: f64 = 0.01;
 /// Tolerance on direction cosines.
-pub(crate) const COSINE_TOLERANCE: f64 = 1e-4;
+const COSINE_TOLERANCE: f64 = 1e-4;
 
 /// Whether `head` is the start of a DICOM Part 10 file: `DICM` at 128.
 pub fn has_magic(head: &[u8]) -> bool {
@@ -98,7 +98,7 @@ pub fn parse_slice(bytes: &[u8]) -> Result<Slice, IoError> {
 }
 
 /// Parse a whole file held in memory, after [`check_lengths`].
-pub(crate) fn open_bytes(bytes: &[u8]) -> Result<DefaultDicomObject, IoError> {
+fn open_bytes(bytes: &[u8]) -> Result<DefaultDicomObject, IoError> {
     check_lengths(bytes)?;
     open(bytes)
 }
@@ -110,11 +110,11 @@ pub(crate) fn open<R: Read>(reader: R) -> Result<DefaultDicomObject, IoError> {
         .map_err(|e| format_error(FORMAT, "file meta", format!("cannot parse the file: {e}")))
 }
 
-pub(crate) fn has_pixel_data(obj: &DefaultDicomObject) -> bool {
+fn has_pixel_data(obj: &DefaultDicomObject) -> bool {
     obj.get(tags::PIXEL_DATA).is_some()
 }
 
-pub(crate) fn slice_from(obj: &DefaultDicomObject) -> Result<Slice, IoError> {
+fn slice_from(obj: &DefaultDicomObject) -> Result<Slice, IoError> {
     if !has_pixel_data(obj) {
         return Err(format_error(
             FORMAT,
@@ -211,7 +211,7 @@ pub(crate) fn slice_from(obj: &DefaultDicomObject) -> Result<Slice, IoError> {
 
 /// `BitsAllocated` 8 or 16, and `1 <= BitsStored <= BitsAllocated`, the
 /// greyscale layouts decoded here.
-pub(crate) fn check_bits(obj: &DefaultDicomObject) -> Result<(), IoError> {
+fn check_bits(obj: &DefaultDicomObject) -> Result<(), IoError> {
     let int = |tag, name: &'static str| -> Result<Option<i64>, IoError> {
         match obj.get(tag) {
             None => Ok(None),
@@ -243,7 +243,7 @@ pub(crate) fn check_bits(obj: &DefaultDicomObject) -> Result<(), IoError> {
 
 /// Largest ratio accepted between decoded and encapsulated (compressed)
 /// pixel bytes; deflate's limit is about 1032.
-pub(crate) const MAX_COMPRESSION_RATIO: u64 = 1024;
+const MAX_COMPRESSION_RATIO: u64 = 1024;
 
 /// Refuse `Rows × Columns × NumberOfFrames × SamplesPerPixel ×
 /// BitsAllocated/8` bytes that the pixel data cannot hold: more than its
@@ -251,7 +251,7 @@ pub(crate) const MAX_COMPRESSION_RATIO: u64 = 1024;
 /// bytes when encapsulated, or more than the memory limit. The decoder
 /// allocates the decoded size up front, so a 1 kB file could otherwise
 /// claim gigabytes.
-pub(crate) fn check_pixel_size(obj: &DefaultDicomObject) -> Result<(), IoError> {
+fn check_pixel_size(obj: &DefaultDicomObject) -> Result<(), IoError> {
     let int = |tag, name: &'static str, default: i64| -> Result<i64, IoError> {
         match obj.get(tag) {
             None => Ok(default),

@@ -123,7 +123,7 @@ impl Subject {
 }
 
 /// Reusable buffers for one point's renders.
-pub(crate) struct Renderer<'s, 'm, S> {
+struct Renderer<'s, 'm, S> {
     spec: &'s Spectrum<'s, S>,
     kernel: KernelTable<f32>,
     small: Vec<KernelTable<f32>>,
@@ -245,7 +245,7 @@ pub(crate) fn median(mut v: Vec<f64>) -> f64 {
 
 /// Measure every setting of `group` (one size, filter, oversampling and
 /// format) on the prepared `spec`.
-pub(crate) fn measure_group<S: Sample>(
+fn measure_group<S: Sample>(
     spec: &Spectrum<'_, S>,
     subject: &Subject,
     group: &[Setting],
@@ -319,7 +319,7 @@ pub(crate) fn measure_group<S: Sample>(
 
 /// Prepare the spectrum of `subject` for the group's filter and format,
 /// then measure the group.
-pub(crate) fn prepare_and_measure(
+fn prepare_and_measure(
     subject: &Subject,
     group: &[Setting],
     repeats: usize,

@@ -266,7 +266,7 @@ pub(crate) fn axis<T: PartialEq>(
     Ok(out)
 }
 
-pub(crate) fn filter_names() -> String {
+fn filter_names() -> String {
     FilterKind::ALL.map(FilterKind::name).join(", ")
 }
 
@@ -274,7 +274,7 @@ pub(crate) fn filter_names() -> String {
 pub(crate) const FORMATS_HELP: &str =
     "f16, bf16, f32, a 16-bit minifloat eEmM (e.g. e4m11), q15, q15-line";
 
-pub(crate) fn parse_trade_format(s: &str) -> Result<Format, String> {
+fn parse_trade_format(s: &str) -> Result<Format, String> {
     let f = parse_format(s)?;
     match f {
         Format::F16
@@ -493,6 +493,6 @@ impl Sweep {
     }
 }
 
-pub(crate) fn adaptive_allowed(s: &Setting) -> bool {
+fn adaptive_allowed(s: &Setting) -> bool {
     s.oversample == 2 && s.level == 0 && s.filter.width() > ADAPTIVE_CHAIN[0].width()
 }

@@ -95,7 +95,7 @@ pub fn csv(rows: &[Row], views: usize, repeats: usize) -> String {
 
 /// `v` as the CSV prints it: ms to the nanosecond, dB to 0.01, so that
 /// the CSV's `pareto` flags are the front of the CSV's own figures.
-pub(crate) fn as_printed(v: f64, decimals: usize) -> f64 {
+fn as_printed(v: f64, decimals: usize) -> f64 {
     format!("{v:.decimals$}").parse().unwrap_or(v)
 }
 
@@ -124,7 +124,7 @@ pub fn mark_fronts(rows: &mut [Row]) {
     }
 }
 
-pub(crate) const FILTER_COLOURS: [[u8; 3]; 7] = [
+const FILTER_COLOURS: [[u8; 3]; 7] = [
     [127, 127, 127],
     [140, 86, 75],
     [148, 103, 189],
@@ -134,12 +134,12 @@ pub(crate) const FILTER_COLOURS: [[u8; 3]; 7] = [
     [214, 39, 40],
 ];
 
-pub(crate) fn filter_index(f: FilterKind) -> usize {
+fn filter_index(f: FilterKind) -> usize {
     FilterKind::ALL.iter().position(|&k| k == f).unwrap_or(0)
 }
 
 /// 1-2-5 ticks covering `[lo, hi]`.
-pub(crate) fn ticks_125(lo: f64, hi: f64) -> Vec<f64> {
+fn ticks_125(lo: f64, hi: f64) -> Vec<f64> {
     let mut out = Vec::new();
     let mut decade = 10f64.powf(lo.log10().floor());
     while decade <= hi {
@@ -232,7 +232,7 @@ pub fn plot(rows: &[Row]) -> Canvas {
 }
 
 /// The CPU model from /proc/cpuinfo, if readable.
-pub(crate) fn cpu_model() -> Option<String> {
+fn cpu_model() -> Option<String> {
     let s = std::fs::read_to_string("/proc/cpuinfo").ok()?;
     s.lines()
         .find_map(|l| l.strip_prefix("model name"))
@@ -240,7 +240,7 @@ pub(crate) fn cpu_model() -> Option<String> {
         .map(|(_, m)| m.trim().to_string())
 }
 
-pub(crate) fn setting_cells(st: &Setting) -> String {
+fn setting_cells(st: &Setting) -> String {
     format!(
         "{} | {} | {} | {} | {} | {}²",
         st.filter.name(),
@@ -326,7 +326,7 @@ pub fn summary(rows: &[Row], sweep: &Sweep, command: &str) -> String {
 
 /// Each size and level: its fastest point at ≥ 50 dB, and its most
 /// accurate point, so every level's time and dB can be read off.
-pub(crate) fn levels_table(rows: &[Row], sweep: &Sweep) -> String {
+fn levels_table(rows: &[Row], sweep: &Sweep) -> String {
     let mut s = String::from(
         "## Each level: fastest at ≥ 50 dB, and most accurate\n\n\
          | size | level | image | fastest at ≥ 50 dB | ms/view | dB | most accurate | ms/view | dB |\n\
