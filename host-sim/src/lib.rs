@@ -7,7 +7,8 @@
 //! - [`render`]: the core with owned buffers: spectra, views, shaded
 //!   renders, adaptive filtering, turntables, scene files;
 //! - [`reference`]: f64 references and the agreement metric;
-//! - [`studies`]: the measuring commands (accuracy, precision, growth, trade).
+//! - [`studies`]: the measuring commands (accuracy, adaptive table,
+//!   precision, growth, trade) and their timing.
 
 pub mod image;
 pub mod io;
@@ -16,5 +17,4 @@ pub mod reference;
 pub mod render;
 pub mod sources;
 pub mod studies;
-pub mod timing;
 pub mod volume;

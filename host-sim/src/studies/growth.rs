@@ -18,7 +18,7 @@ use crate::image::plot::{Canvas, Rgb};
 use crate::reference::raycast::RayCaster;
 use crate::render::spectrum::{OwnedSpectrum, ViewRenderer};
 use crate::sources::phantom::{sample, GaussianMixture};
-use crate::timing::median_ms;
+use crate::studies::timing::median_ms;
 
 /// Time per view at one size.
 #[derive(Clone, Debug, PartialEq)]

@@ -54,7 +54,7 @@ pub(crate) fn adaptive_table(args: &AdaptiveTableArgs) -> Result<(), Error> {
             bound,
             ..AdaptiveSettings::new(tolerance)
         };
-        rows.push(fvr_host::render::adaptive::table1_row(
+        rows.push(fvr_host::studies::adaptive_table::table1_row(
             name,
             &volume,
             filter,
@@ -66,7 +66,7 @@ pub(crate) fn adaptive_table(args: &AdaptiveTableArgs) -> Result<(), Error> {
     }
     print!(
         "{}",
-        fvr_host::render::adaptive::table1_markdown(&rows, tolerance)
+        fvr_host::studies::adaptive_table::table1_markdown(&rows, tolerance)
     );
     Ok(())
 }
