@@ -138,21 +138,13 @@ fn ignore_spacing_is_the_voxel_unit_render() {
 fn cued_or_lit_anisotropic_renders_are_refused_until_resampled() {
     let dir = temp_dir("spacing-scene");
     write_volume(&dir.join("v.nrrd"), Some(SPACING));
-    let base = ["render", "v.nrrd", "--dir", "1,0.3,0.2", "--out", "s.png"];
-    for extra in [
-        &["--light-ring", "3"][..],
-        &["--depth-cue", "linear:1,0.2"][..],
-    ] {
-        let mut args = base.to_vec();
-        args.extend(extra);
+    let base = "render v.nrrd --dir 1,0.3,0.2 --out s.png";
+    for extra in ["--light-ring 3", "--depth-cue linear:1,0.2"] {
         assert_error(
-            &fvr(&args, &dir),
+            &fvr_line(&format!("{base} {extra}"), &dir),
             &["0.8 x 0.8 x 1.5 mm", "--resample", "--ignore-spacing"],
         );
-        let mut args = base.to_vec();
-        args.extend(extra);
-        args.extend(["--resample", "48"]);
-        assert_ok(&fvr(&args, &dir));
+        assert_ok(&fvr_line(&format!("{base} {extra} --resample 48"), &dir));
     }
 }
 
@@ -160,15 +152,13 @@ fn cued_or_lit_anisotropic_renders_are_refused_until_resampled() {
 #[test]
 fn bad_pixel_size_is_an_error() {
     let dir = temp_dir("spacing-bad");
-    let base = ["render", "gaussians@16", "--dir", "1,0,0", "--out", "x.png"];
+    let base = "render gaussians@16 --dir 1,0,0 --out x.png";
     for bad in ["0", "-1", "nan", "inf"] {
-        let mut args = base.to_vec();
-        args.extend(["--pixel-size", bad]);
-        assert_error(&fvr(&args, &dir), &["pixel size"]);
+        let out = fvr_line(&format!("{base} --pixel-size {bad}"), &dir);
+        assert_error(&out, &["pixel size"]);
     }
-    let mut args = base.to_vec();
-    args.extend(["--pixel-size", "1", "--ignore-spacing"]);
-    assert_error(&fvr(&args, &dir), &["--ignore-spacing"]);
+    let out = fvr_line(&format!("{base} --pixel-size 1 --ignore-spacing"), &dir);
+    assert_error(&out, &["--ignore-spacing"]);
 }
 
 /// `fvr turntable` takes the same units: the spacing by default,
@@ -177,21 +167,13 @@ fn bad_pixel_size_is_an_error() {
 fn turntable_uses_the_spacing_too() {
     let dir = temp_dir("spacing-turntable");
     write_volume(&dir.join("v.nrrd"), Some(SPACING));
-    let base = ["turntable", "v.nrrd", "--frames", "2", "--size", "32"];
-    for extra in [
-        &[][..],
-        &["--ignore-spacing"][..],
-        &["--pixel-size", "1.6"][..],
-    ] {
-        let mut args = base.to_vec();
-        args.extend(extra);
-        args.extend(["--out", "s.apng"]);
-        assert_ok(&fvr(&args, &dir));
+    let base = "turntable v.nrrd --frames 2 --size 32";
+    for extra in ["", "--ignore-spacing", "--pixel-size 1.6"] {
+        assert_ok(&fvr_line(&format!("{base} {extra} --out s.apng"), &dir));
         assert!(dir.join("s.apng").exists());
     }
-    let mut args = base.to_vec();
-    args.extend(["--pixel-size", "0", "--out", "t.apng"]);
-    assert_error(&fvr(&args, &dir), &["pixel size"]);
+    let out = fvr_line(&format!("{base} --pixel-size 0 --out t.apng"), &dir);
+    assert_error(&out, &["pixel size"]);
 }
 
 /// `--adaptive` on cubic voxels imaged at their own size renders in mm (the
