@@ -16,7 +16,7 @@ use common::{exact_image, host_image, snr_db};
 use fvr_firmware::capture::decode_frame;
 use fvr_firmware::display::{rgb565, rgb565_gray, Window};
 use fvr_firmware::scene::{IMAGE_SIDE, PROGRAMS};
-use fvr_host::nrrd::parse_nrrd;
+use fvr_host::io::nrrd::parse_nrrd;
 
 #[test]
 #[ignore = "needs the firmware's QEMU outputs: bash scripts/firmware.sh"]

@@ -26,8 +26,8 @@ use fvr_firmware::stored::{
     all, all_derivatives, twiddles, DENSITY_KB3, DENSITY_KB4, DENSITY_KB6, DERIVATIVE_KB3,
     GRADIENT_KB3,
 };
-use fvr_host::pipeline::{AnySpectrum, Precision};
-use fvr_host::shaded::{gradient_volume, SceneSpectra};
+use fvr_host::render::shaded::{gradient_volume, SceneSpectra};
+use fvr_host::render::spectrum::{AnySpectrum, Precision};
 use fvr_host::volume::Volume;
 use std::cell::Cell;
 
@@ -420,7 +420,7 @@ fn nrrd_images_parse_on_the_host_grey_and_rgb() {
             Ok::<(), ()>(())
         })
         .unwrap();
-        let parsed = fvr_host::nrrd::parse_nrrd(&bytes).unwrap();
+        let parsed = fvr_host::io::nrrd::parse_nrrd(&bytes).unwrap();
         assert_eq!(parsed.dims, dims);
         assert_eq!(parsed.data, values);
     }

@@ -11,9 +11,9 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
 use fvr_core::shading::{DepthCue, Scene};
-use fvr_host::phantom::{sample, GaussianMixture};
-use fvr_host::pipeline::OwnedSpectrum;
-use fvr_host::shaded::{gradient_volume, light_ring, SceneRenderer};
+use fvr_host::render::shaded::{gradient_volume, light_ring, SceneRenderer, TypedSpectra};
+use fvr_host::render::spectrum::OwnedSpectrum;
+use fvr_host::sources::phantom::{sample, GaussianMixture};
 use half::f16;
 
 fn scenes(view: &View) -> Vec<(&'static str, Scene)> {
@@ -74,7 +74,17 @@ fn benches(c: &mut Criterion) {
         group.bench_function(BenchmarkId::from_parameter(name), |b| {
             b.iter(|| {
                 renderer
-                    .render_into(&density, g, &scene, black_box(&view), n, n, &mut out)
+                    .render_into(
+                        TypedSpectra {
+                            density: &density,
+                            gradient: g,
+                        },
+                        &scene,
+                        black_box(&view),
+                        n,
+                        n,
+                        &mut out,
+                    )
                     .unwrap()
             })
         });

@@ -1,28 +1,20 @@
 //! Host simulator for `fvr-core`: volume I/O, analytic phantoms, f64
 //! references, agreement in dB and the `fvr` command-line program.
+//!
+//! - [`io`]: volume and image files (NRRD, NIfTI, den, inv3, DICOM, raw);
+//! - [`image`]: windowing, colormaps, PNG/APNG output and plots;
+//! - [`sources`]: volumes by name: phantoms, the teapot, data sets;
+//! - [`render`]: the core with owned buffers: spectra, views, shaded
+//!   renders, adaptive filtering, turntables, scene files;
+//! - [`reference`]: f64 references and the agreement metric;
+//! - [`studies`]: the measuring commands (accuracy, adaptive table,
+//!   precision, growth, trade) and their timing.
 
-pub mod accuracy;
-pub mod adaptive;
-pub mod datasets;
-pub mod formats;
-pub mod growth;
 pub mod image;
-pub mod nrrd;
-pub mod output;
-pub mod phantom;
-pub mod pipeline;
-pub mod plot;
-pub mod precision;
-pub mod precision_cli;
+pub mod io;
 pub mod progress;
-pub mod raycast;
 pub mod reference;
-pub mod scene;
-pub mod scene_file;
-pub mod scene_reference;
-pub mod shaded;
-pub mod teapot;
-pub mod timing;
-pub mod trade;
-pub mod turntable;
+pub mod render;
+pub mod sources;
+pub mod studies;
 pub mod volume;

@@ -1,9 +1,9 @@
 //! The `fvr` program end to end: outputs, and clear errors on bad input.
 
 mod common;
-use common::{assert_error, assert_ok, fvr, temp_dir};
+use common::{assert_error, assert_ok, fvr, fvr_in, fvr_line, read, temp_dir};
 
-use fvr_host::nrrd::{encode_nrrd, Encoding, Endian, SampleType};
+use fvr_host::io::nrrd::{encode_nrrd, Encoding, Endian, SampleType};
 
 #[test]
 fn no_arguments_renders_the_default_scene_and_says_where() {
@@ -37,7 +37,7 @@ fn render_to_nrrd_and_compare_precisions() {
         );
         assert_ok(&out);
     }
-    let out = fvr(&["compare", "f64.nrrd", "f16.nrrd"], &dir);
+    let out = fvr_line("compare f64.nrrd f16.nrrd", &dir);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{stdout}");
     let db: f64 = stdout
@@ -57,74 +57,36 @@ fn render_to_nrrd_and_compare_precisions() {
 
 #[test]
 fn zero_and_parallel_view_vectors_are_named() {
-    let dir = temp_dir("view");
-    let out = fvr(
-        &["render", "sphere@16", "--dir", "0,0,0", "--out", "x.png"],
-        &dir,
-    );
+    let (dir, out) = fvr_in("view", "render sphere@16 --dir 0,0,0 --out x.png");
     assert_error(&out, &["zero view vector", "(0, 0, 0)", "(0, 0, 1)"]);
-    let out = fvr(
-        &["render", "sphere@16", "--dir", "0,0,-2", "--out", "x.png"],
-        &dir,
-    );
+    let out = fvr_line("render sphere@16 --dir 0,0,-2 --out x.png", &dir);
     assert_error(&out, &["parallel", "(0, 0, -2)", "(0, 0, 1)"]);
-    let out = fvr(
-        &["render", "sphere@16", "--dir", "1,nan,0", "--out", "x.png"],
-        &dir,
-    );
+    let out = fvr_line("render sphere@16 --dir 1,nan,0 --out x.png", &dir);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("finite"));
 }
 
 #[test]
 fn oversized_image_unknown_filter_and_bad_output_are_errors() {
-    let dir = temp_dir("args");
-    let out = fvr(
-        &[
-            "render",
-            "sphere@16",
-            "--dir",
-            "1,0,0",
-            "--size",
-            "40x8",
-            "--out",
-            "x.png",
-        ],
-        &dir,
+    let (dir, out) = fvr_in(
+        "args",
+        "render sphere@16 --dir 1,0,0 --size 40x8 --out x.png",
     );
     assert_error(&out, &["40x8", "padded grid size 16"]);
-    let out = fvr(
-        &[
-            "render",
-            "sphere@16",
-            "--dir",
-            "1,0,0",
-            "--filter",
-            "kb9",
-            "--out",
-            "x.png",
-        ],
+    let out = fvr_line(
+        "render sphere@16 --dir 1,0,0 --filter kb9 --out x.png",
         &dir,
     );
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("unknown filter `kb9`"));
-    let out = fvr(
-        &["render", "sphere@16", "--dir", "1,0,0", "--out", "x.bmp"],
-        &dir,
-    );
+    let out = fvr_line("render sphere@16 --dir 1,0,0 --out x.bmp", &dir);
     assert_error(&out, &["x.bmp", ".png or .nrrd"]);
-    let out = fvr(
-        &["render", "nosuchthing", "--dir", "1,0,0", "--out", "x.png"],
-        &dir,
-    );
+    let out = fvr_line("render nosuchthing --dir 1,0,0 --out x.png", &dir);
     assert_error(
         &out,
         &["nosuchthing", "neither a file nor a built-in phantom"],
     );
-    let out = fvr(
-        &["render", "sphere@99999", "--dir", "1,0,0", "--out", "x.png"],
-        &dir,
-    );
+    let out = fvr_line("render sphere@99999 --dir 1,0,0 --out x.png", &dir);
     assert_error(&out, &["phantom size `99999`"]);
 }
 
@@ -141,10 +103,7 @@ fn nan_voxels_truncated_and_malformed_files_are_named() {
         &values,
     );
     std::fs::write(dir.join("nan.nrrd"), &nan).unwrap();
-    let out = fvr(
-        &["render", "nan.nrrd", "--dir", "1,0,0", "--out", "x.png"],
-        &dir,
-    );
+    let out = fvr_line("render nan.nrrd --dir 1,0,0 --out x.png", &dir);
     assert_error(&out, &["NaN", "(1, 2, 3)"]);
 
     let good = encode_nrrd(
@@ -155,34 +114,24 @@ fn nan_voxels_truncated_and_malformed_files_are_named() {
         &[7.0; 64],
     );
     std::fs::write(dir.join("short.nrrd"), &good[..good.len() - 20]).unwrap();
-    let out = fvr(
-        &["render", "short.nrrd", "--dir", "1,0,0", "--out", "x.png"],
-        &dir,
-    );
+    let out = fvr_line("render short.nrrd --dir 1,0,0 --out x.png", &dir);
     assert_eq!(out.status.code(), Some(2));
     assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
 
     let bad = b"NRRD0004\ntype: complex\ndimension: 3\nsizes: 4 4 4\nencoding: raw\n\n";
     std::fs::write(dir.join("bad.nrrd"), bad).unwrap();
-    let out = fvr(
-        &["render", "bad.nrrd", "--dir", "1,0,0", "--out", "x.png"],
-        &dir,
-    );
+    let out = fvr_line("render bad.nrrd --dir 1,0,0 --out x.png", &dir);
     assert_error(&out, &["type", "complex"]);
 
     let huge = b"NRRD0004\ntype: float\ndimension: 3\nsizes: 100000 100000 100000\nencoding: raw\nendian: little\n\n";
     std::fs::write(dir.join("huge.nrrd"), huge).unwrap();
-    let out = fvr(
-        &["render", "huge.nrrd", "--dir", "1,0,0", "--out", "x.png"],
-        &dir,
-    );
+    let out = fvr_line("render huge.nrrd --dir 1,0,0 --out x.png", &dir);
     assert_error(&out, &["bytes"]);
 }
 
 #[test]
 fn help_documents_the_geometry_contract_and_every_option() {
-    let dir = temp_dir("help");
-    let out = fvr(&["render", "--help"], &dir);
+    let (_, out) = fvr_in("help", "render --help");
     let text = String::from_utf8_lossy(&out.stdout);
     for needle in [
         "GEOMETRY CONTRACT",
@@ -203,21 +152,9 @@ fn help_documents_the_geometry_contract_and_every_option() {
 
 #[test]
 fn precision_study_writes_markdown_csv_and_png_with_no_non_finite_pixel() {
-    let dir = temp_dir("precision");
-    let out = fvr(
-        &[
-            "precision",
-            "--volumes",
-            "gaussians@16,shepp-logan@16",
-            "--formats",
-            "f16,bf16,e4m11,q15-line,q7-brick2,e4m3,f32",
-            "--out-dir",
-            "out",
-        ],
-        &dir,
-    );
+    let (dir, out) = fvr_in("precision", "precision --volumes gaussians@16,shepp-logan@16 --formats f16,bf16,e4m11,q15-line,q7-brick2,e4m3,f32 --out-dir out");
     assert_ok(&out);
-    let csv = std::fs::read_to_string(dir.join("out/precision.csv")).unwrap();
+    let csv = read(&dir, "out/precision.csv");
     let lines: Vec<&str> = csv.lines().collect();
     assert!(lines[0].starts_with("volume,size,grid,format,arithmetic,bytes_per_voxel"));
     // 2 volumes × (f16×3 + bf16×3 + e4m11×3 + q15-line×3 + q7-brick2 + e4m3×3 + f32×2).
@@ -229,7 +166,7 @@ fn precision_study_writes_markdown_csv_and_png_with_no_non_finite_pixel() {
         let snr: f64 = cols[6].parse().unwrap();
         assert!(snr > 0.0 || cols[3] == "e4m11", "{line}");
     }
-    let md = std::fs::read_to_string(dir.join("out/precision.md")).unwrap();
+    let md = read(&dir, "out/precision.md");
     assert!(md.contains("| q15-line | host-once |"), "{md}");
     let png = std::fs::read(dir.join("out/precision.png")).unwrap();
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
@@ -237,34 +174,26 @@ fn precision_study_writes_markdown_csv_and_png_with_no_non_finite_pixel() {
 
 #[test]
 fn precision_bad_formats_are_named_before_any_work() {
-    let dir = temp_dir("precision-bad");
-    let out = fvr(&["precision", "--formats", "e5m11"], &dir);
+    let (dir, out) = fvr_in("precision-bad", "precision --formats e5m11");
     assert_error(&out, &["e5m11", "17 bits", "16"]);
-    let out = fvr(&["precision", "--formats", "e9m6"], &dir);
+    let out = fvr_line("precision --formats e9m6", &dir);
     assert_error(&out, &["e9m6", "f32"]);
-    let out = fvr(&["precision", "--formats", "f24"], &dir);
+    let out = fvr_line("precision --formats f24", &dir);
     assert_error(&out, &["unknown format `f24`"]);
-    let out = fvr(
-        &[
-            "precision",
-            "--volumes",
-            "gaussians@16",
-            "--formats",
-            "q15-brick6",
-        ],
+    let out = fvr_line(
+        "precision --volumes gaussians@16 --formats q15-brick6",
         &dir,
     );
     assert_error(&out, &["q15-brick6", "block size 6 does not divide", "16"]);
-    let out = fvr(&["precision", "--formats", "e4m11-line"], &dir);
+    let out = fvr_line("precision --formats e4m11-line", &dir);
     assert_error(&out, &["only q15 and q7 take block exponents"]);
 }
 
 #[test]
 fn precision_extremes_table_reports_every_case() {
-    let dir = temp_dir("precision-extremes");
-    let out = fvr(
-        &["precision", "--extremes", "8", "--formats", "f16,q15-line"],
-        &dir,
+    let (_, out) = fvr_in(
+        "precision-extremes",
+        "precision --extremes 8 --formats f16,q15-line",
     );
     assert_ok(&out);
     let md = String::from_utf8_lossy(&out.stdout);

@@ -2,14 +2,14 @@
 //! options, turntables, help, version, exit codes and progress output.
 
 mod common;
-use common::{assert_error, fvr, temp_dir};
+use common::{assert_error, fvr, fvr_in, fvr_line, temp_dir};
 
 use std::path::Path;
 use std::process::Output;
 
-use fvr_host::formats::den::encode_den;
-use fvr_host::formats::nifti::encode_nifti_f32;
-use fvr_host::nrrd::Endian;
+use fvr_host::io::den::encode_den;
+use fvr_host::io::nifti::encode_nifti_f32;
+use fvr_host::io::nrrd::Endian;
 
 fn stdout(out: &Output) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
@@ -50,7 +50,7 @@ fn version_and_help_document_the_exit_status() {
     ] {
         assert!(help.contains(needle), "`{needle}` not in --help:\n{help}");
     }
-    let out = fvr(&["render", "--help"], &dir);
+    let out = fvr_line("render --help", &dir);
     let help = stdout(&out);
     for needle in [
         "NIfTI-1",
@@ -97,8 +97,8 @@ fn option_defaults(help: &str) -> Vec<(String, String)> {
 #[test]
 fn turntable_options_match_render_options() {
     let dir = temp_dir("io-options");
-    let render = option_defaults(&stdout(&fvr(&["render", "--help"], &dir)));
-    let spin = option_defaults(&stdout(&fvr(&["turntable", "--help"], &dir)));
+    let render = option_defaults(&stdout(&fvr_line("render --help", &dir)));
+    let spin = option_defaults(&stdout(&fvr_line("turntable --help", &dir)));
     let shared = [
         "size",
         "filter",
@@ -142,57 +142,20 @@ fn renders_nifti_den_and_named_volumes_to_styled_pngs() {
     std::fs::write(dir.join("v.nii"), nii).unwrap();
     let den = encode_den([8, 8, 8], &[7; 512], Endian::Big);
     std::fs::write(dir.join("v.den"), den).unwrap();
-    let out = fvr(
-        &[
-            "render",
-            "v.nii",
-            "--dir",
-            "1,0.2,0.1",
-            "--out",
-            "n.png",
-            "--bits",
-            "16",
-        ],
-        &dir,
-    );
+    let out = fvr_line("render v.nii --dir 1,0.2,0.1 --out n.png --bits 16", &dir);
     assert_ok(&out);
     let info = png_info(&dir.join("n.png"));
     assert_eq!(
         (info.width, info.height, info.bit_depth),
         (16, 16, png::BitDepth::Sixteen)
     );
-    let out = fvr(
-        &[
-            "render",
-            "v.den",
-            "--dir",
-            "0,1,0",
-            "--out",
-            "d.png",
-            "--colormap",
-            "bone",
-            "--window",
-            "20",
-            "--level",
-            "40",
-        ],
+    let out = fvr_line(
+        "render v.den --dir 0,1,0 --out d.png --colormap bone --window 20 --level 40",
         &dir,
     );
     assert_ok(&out);
     assert_eq!(png_info(&dir.join("d.png")).color_type, png::ColorType::Rgb);
-    let out = fvr(
-        &[
-            "render",
-            "brainsmall",
-            "--dir",
-            "1,0,0",
-            "--out",
-            "b.png",
-            "--size",
-            "64",
-        ],
-        &dir,
-    );
+    let out = fvr_line("render brainsmall --dir 1,0,0 --out b.png --size 64", &dir);
     assert_ok(&out);
     assert_eq!(png_info(&dir.join("b.png")).width, 64);
     // Piped stderr is not a terminal: no progress bars, no control codes.
@@ -205,13 +168,9 @@ fn renders_nifti_den_and_named_volumes_to_styled_pngs() {
 
 #[test]
 fn the_ct_head_renders_by_name() {
-    let dir = temp_dir("io-ct");
-    let out = fvr(
-        &[
-            "render", "ct-head", "--dir", "0,1,0", "--out", "ct.png", "--size", "128", "--quiet",
-            "--stats",
-        ],
-        &dir,
+    let (dir, out) = fvr_in(
+        "io-ct",
+        "render ct-head --dir 0,1,0 --out ct.png --size 128 --quiet --stats",
     );
     assert_ok(&out);
     assert!(stdout(&out).contains("256x256x108"), "{}", stdout(&out));
@@ -220,19 +179,9 @@ fn the_ct_head_renders_by_name() {
 
 #[test]
 fn turntable_writes_an_apng_and_reports_views_per_second() {
-    let dir = temp_dir("io-spin");
-    let out = fvr(
-        &[
-            "turntable",
-            "gaussians@32",
-            "--frames",
-            "8",
-            "--out",
-            "spin.apng",
-            "--colormap",
-            "hot",
-        ],
-        &dir,
+    let (dir, out) = fvr_in(
+        "io-spin",
+        "turntable gaussians@32 --frames 8 --out spin.apng --colormap hot",
     );
     assert_ok(&out);
     let text = stdout(&out);
@@ -244,19 +193,9 @@ fn turntable_writes_an_apng_and_reports_views_per_second() {
     let actl = info.animation_control.expect("animated");
     assert_eq!((actl.num_frames, actl.num_plays), (8, 0));
     assert_eq!((info.width, info.color_type), (32, png::ColorType::Rgb));
-    let out = fvr(
-        &[
-            "turntable",
-            "gaussians@16",
-            "--dir",
-            "0,0,1",
-            "--up",
-            "0,0,3",
-        ],
-        &dir,
-    );
+    let out = fvr_line("turntable gaussians@16 --dir 0,0,1 --up 0,0,3", &dir);
     assert_error(&out, &["parallel"]);
-    let out = fvr(&["turntable", "gaussians@16", "--frames", "0"], &dir);
+    let out = fvr_line("turntable gaussians@16 --frames 0", &dir);
     assert_eq!(out.status.code(), Some(2));
 }
 
@@ -272,24 +211,15 @@ fn bad_inputs_and_options_exit_2_with_the_file_and_field() {
     };
     gz.truncate(gz.len() - 10);
     std::fs::write(dir.join("cut.nii.gz"), &gz).unwrap();
-    let out = fvr(
-        &["render", "cut.nii.gz", "--dir", "1,0,0", "--out", "x.png"],
-        &dir,
-    );
+    let out = fvr_line("render cut.nii.gz --dir 1,0,0 --out x.png", &dir);
     assert_error(&out, &["fvr: error:", "cut.nii.gz", "gzip"]);
     let mut zero_pixdim = good.clone();
     zero_pixdim[80..84].copy_from_slice(&0f32.to_le_bytes());
     std::fs::write(dir.join("flat.nii"), &zero_pixdim).unwrap();
-    let out = fvr(
-        &["render", "flat.nii", "--dir", "1,0,0", "--out", "x.png"],
-        &dir,
-    );
+    let out = fvr_line("render flat.nii --dir 1,0,0 --out x.png", &dir);
     assert_error(&out, &["flat.nii", "`pixdim`", "zero"]);
     std::fs::write(dir.join("junk.vol"), b"not a volume").unwrap();
-    let out = fvr(
-        &["render", "junk.vol", "--dir", "1,0,0", "--out", "x.png"],
-        &dir,
-    );
+    let out = fvr_line("render junk.vol --dir 1,0,0 --out x.png", &dir);
     assert_error(&out, &["junk.vol", "unknown volume format", "--raw-dims"]);
     let png_cases: [(&[&str], &[&str]); 4] = [
         (&["--window", "10"], &["--level"]),
@@ -315,36 +245,23 @@ fn renders_a_dicom_series_directory() {
     let orientation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
     for k in 0..6u32 {
         let pixels: Vec<i16> = (0..64).map(|i| ((i * 7 + k * 13) % 50) as i16).collect();
-        let bytes = fvr_host::formats::dicom::encode_ct_slice(
-            "1.2.3.4",
-            k + 1,
-            [8, 8],
-            [0.5, 0.5],
-            [0.0, 0.0, 1.25 * k as f64],
+        let bytes = fvr_host::io::dicom::CtSlice {
+            series: "1.2.3.4",
+            instance: k + 1,
+            size: [8, 8],
+            pixel_spacing: [0.5, 0.5],
+            position: [0.0, 0.0, 1.25 * k as f64],
             orientation,
-            -10.0,
-            &pixels,
-        );
+            intercept: -10.0,
+            pixels: &pixels,
+        }
+        .encode();
         std::fs::write(series.join(format!("IM{k:04}")), bytes).unwrap();
     }
-    let out = fvr(
-        &[
-            "render",
-            "series",
-            "--dir",
-            "1,0.3,0.2",
-            "--out",
-            "s.png",
-            "--stats",
-        ],
-        &dir,
-    );
+    let out = fvr_line("render series --dir 1,0.3,0.2 --out s.png --stats", &dir);
     assert_ok(&out);
     assert!(stdout(&out).contains("8x8x6"), "{}", stdout(&out));
     std::fs::write(series.join("IM0002"), b"broken").unwrap();
-    let out = fvr(
-        &["render", "series", "--dir", "1,0,0", "--out", "s.png"],
-        &dir,
-    );
+    let out = fvr_line("render series --dir 1,0,0 --out s.png", &dir);
     assert_error(&out, &["series", "missing slices"]);
 }

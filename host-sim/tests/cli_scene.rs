@@ -4,7 +4,7 @@
 mod common;
 use common::{assert_error, assert_ok, fvr, temp_dir};
 
-use fvr_host::nrrd::read_nrrd;
+use fvr_host::io::nrrd::read_nrrd;
 
 const BASE: [&str; 5] = ["render", "gaussians@32", "--dir", "1,0.4,-0.3", "--stats"];
 

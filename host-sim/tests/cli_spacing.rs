@@ -3,14 +3,14 @@
 //! on anisotropic voxels.
 
 mod common;
-use common::{assert_error, assert_ok, fvr, temp_dir};
+use common::{assert_error, assert_ok, fvr, fvr_line, temp_dir};
 
 use std::path::Path;
 
 use fvr_core::geometry::{Sampling, View};
-use fvr_host::nrrd::read_nrrd;
-use fvr_host::phantom::{sample_spaced, GaussianMixture};
+use fvr_host::io::nrrd::read_nrrd;
 use fvr_host::reference::{exact_projection_sampled, snr_db};
+use fvr_host::sources::phantom::{sample_spaced, GaussianMixture};
 
 const SPACING: [f64; 3] = [0.8, 0.8, 1.5];
 /// 33 × 1.5 = 49.5 mm ≤ 64 × 0.8: the default pixel size is the smallest
@@ -52,16 +52,8 @@ fn write_volume_of(path: &Path, dims: [usize; 3], spacing: Option<[f64; 3]>) {
 fn render_uses_the_files_spacing_and_matches_exact_in_mm() {
     let dir = temp_dir("spacing-default");
     write_volume(&dir.join("v.nrrd"), Some(SPACING));
-    let stdout = assert_ok(&fvr(
-        &[
-            "render",
-            "v.nrrd",
-            "--dir",
-            "1,0.3,0.2",
-            "--out",
-            "a.nrrd",
-            "--stats",
-        ],
+    let stdout = assert_ok(&fvr_line(
+        "render v.nrrd --dir 1,0.3,0.2 --out a.nrrd --stats",
         &dir,
     ));
     assert!(
@@ -79,19 +71,8 @@ fn render_uses_the_files_spacing_and_matches_exact_in_mm() {
     assert!(snr >= 50.0, "{snr:.2} dB");
 
     // A coarser --pixel-size halves the pixel count across the same extent.
-    assert_ok(&fvr(
-        &[
-            "render",
-            "v.nrrd",
-            "--dir",
-            "1,0.3,0.2",
-            "--pixel-size",
-            "1.6",
-            "--size",
-            "32",
-            "--out",
-            "b.nrrd",
-        ],
+    assert_ok(&fvr_line(
+        "render v.nrrd --dir 1,0.3,0.2 --pixel-size 1.6 --size 32 --out b.nrrd",
         &dir,
     ));
     let coarse = read_nrrd(&dir.join("b.nrrd")).unwrap();
@@ -109,24 +90,13 @@ fn render_uses_the_files_spacing_and_matches_exact_in_mm() {
 fn default_pixel_size_fits_the_longest_side() {
     let dir = temp_dir("spacing-fit");
     write_volume_of(&dir.join("v.nrrd"), [64, 63, 35], Some(SPACING));
-    let stdout = assert_ok(&fvr(
-        &[
-            "render", "v.nrrd", "--dir", "0,1,0", "--out", "a.nrrd", "--stats",
-        ],
+    let stdout = assert_ok(&fvr_line(
+        "render v.nrrd --dir 0,1,0 --out a.nrrd --stats",
         &dir,
     ));
     assert!(stdout.contains("pixel size    0.8203125 mm"), "{stdout}");
-    let out = fvr(
-        &[
-            "render",
-            "v.nrrd",
-            "--dir",
-            "0,1,0",
-            "--out",
-            "b.nrrd",
-            "--pixel-size",
-            "0.5",
-        ],
+    let out = fvr_line(
+        "render v.nrrd --dir 0,1,0 --out b.nrrd --pixel-size 0.5",
         &dir,
     );
     assert_ok(&out);
@@ -153,15 +123,8 @@ fn ignore_spacing_is_the_voxel_unit_render() {
     let b = std::fs::read(dir.join("plain-out.nrrd")).unwrap();
     assert_eq!(a, b);
     let spaced = {
-        assert_ok(&fvr(
-            &[
-                "render",
-                "spaced.nrrd",
-                "--dir",
-                "1,0.3,0.2",
-                "--out",
-                "mm.nrrd",
-            ],
+        assert_ok(&fvr_line(
+            "render spaced.nrrd --dir 1,0.3,0.2 --out mm.nrrd",
             &dir,
         ));
         std::fs::read(dir.join("mm.nrrd")).unwrap()
@@ -175,21 +138,13 @@ fn ignore_spacing_is_the_voxel_unit_render() {
 fn cued_or_lit_anisotropic_renders_are_refused_until_resampled() {
     let dir = temp_dir("spacing-scene");
     write_volume(&dir.join("v.nrrd"), Some(SPACING));
-    let base = ["render", "v.nrrd", "--dir", "1,0.3,0.2", "--out", "s.png"];
-    for extra in [
-        &["--light-ring", "3"][..],
-        &["--depth-cue", "linear:1,0.2"][..],
-    ] {
-        let mut args = base.to_vec();
-        args.extend(extra);
+    let base = "render v.nrrd --dir 1,0.3,0.2 --out s.png";
+    for extra in ["--light-ring 3", "--depth-cue linear:1,0.2"] {
         assert_error(
-            &fvr(&args, &dir),
+            &fvr_line(&format!("{base} {extra}"), &dir),
             &["0.8 x 0.8 x 1.5 mm", "--resample", "--ignore-spacing"],
         );
-        let mut args = base.to_vec();
-        args.extend(extra);
-        args.extend(["--resample", "48"]);
-        assert_ok(&fvr(&args, &dir));
+        assert_ok(&fvr_line(&format!("{base} {extra} --resample 48"), &dir));
     }
 }
 
@@ -197,15 +152,13 @@ fn cued_or_lit_anisotropic_renders_are_refused_until_resampled() {
 #[test]
 fn bad_pixel_size_is_an_error() {
     let dir = temp_dir("spacing-bad");
-    let base = ["render", "gaussians@16", "--dir", "1,0,0", "--out", "x.png"];
+    let base = "render gaussians@16 --dir 1,0,0 --out x.png";
     for bad in ["0", "-1", "nan", "inf"] {
-        let mut args = base.to_vec();
-        args.extend(["--pixel-size", bad]);
-        assert_error(&fvr(&args, &dir), &["pixel size"]);
+        let out = fvr_line(&format!("{base} --pixel-size {bad}"), &dir);
+        assert_error(&out, &["pixel size"]);
     }
-    let mut args = base.to_vec();
-    args.extend(["--pixel-size", "1", "--ignore-spacing"]);
-    assert_error(&fvr(&args, &dir), &["--ignore-spacing"]);
+    let out = fvr_line(&format!("{base} --pixel-size 1 --ignore-spacing"), &dir);
+    assert_error(&out, &["--ignore-spacing"]);
 }
 
 /// `fvr turntable` takes the same units: the spacing by default,
@@ -214,21 +167,13 @@ fn bad_pixel_size_is_an_error() {
 fn turntable_uses_the_spacing_too() {
     let dir = temp_dir("spacing-turntable");
     write_volume(&dir.join("v.nrrd"), Some(SPACING));
-    let base = ["turntable", "v.nrrd", "--frames", "2", "--size", "32"];
-    for extra in [
-        &[][..],
-        &["--ignore-spacing"][..],
-        &["--pixel-size", "1.6"][..],
-    ] {
-        let mut args = base.to_vec();
-        args.extend(extra);
-        args.extend(["--out", "s.apng"]);
-        assert_ok(&fvr(&args, &dir));
+    let base = "turntable v.nrrd --frames 2 --size 32";
+    for extra in ["", "--ignore-spacing", "--pixel-size 1.6"] {
+        assert_ok(&fvr_line(&format!("{base} {extra} --out s.apng"), &dir));
         assert!(dir.join("s.apng").exists());
     }
-    let mut args = base.to_vec();
-    args.extend(["--pixel-size", "0", "--out", "t.apng"]);
-    assert_error(&fvr(&args, &dir), &["pixel size"]);
+    let out = fvr_line(&format!("{base} --pixel-size 0 --out t.apng"), &dir);
+    assert_error(&out, &["pixel size"]);
 }
 
 /// `--adaptive` on cubic voxels imaged at their own size renders in mm (the
@@ -271,19 +216,8 @@ fn adaptive_renders_cubic_voxels_in_mm_and_refuses_anisotropic_ones() {
 
     write_volume(&dir.join("a.nrrd"), Some(SPACING));
     assert_error(
-        &fvr(
-            &[
-                "render",
-                "a.nrrd",
-                "--dir",
-                "1,0.3,0.2",
-                "--oversample",
-                "2",
-                "--adaptive",
-                "40",
-                "--out",
-                "x.png",
-            ],
+        &fvr_line(
+            "render a.nrrd --dir 1,0.3,0.2 --oversample 2 --adaptive 40 --out x.png",
             &dir,
         ),
         &["cubic voxels", "--resample", "--ignore-spacing"],

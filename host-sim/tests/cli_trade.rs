@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{assert_error, assert_ok, fvr, temp_dir};
+use common::{assert_error, assert_ok, fvr, fvr_in, read, temp_dir};
 
 /// The header `fvr trade` writes, as documented in docs/trade/README.md.
 const HEADER: &str = "size,grid,filter,oversample,format,adaptive_db,level,image_side,views,\
@@ -12,33 +12,9 @@ held_bytes,prepare_ms,adaptive_taps_fraction,peak_rss_bytes,pareto";
 
 #[test]
 fn tiny_sweep_writes_csv_png_and_summary_with_one_row_per_point() {
-    let dir = temp_dir("trade");
-    let out = fvr(
-        &[
-            "trade",
-            "--sizes",
-            "32",
-            "--filters",
-            "linear,kb3",
-            "--oversample",
-            "1,2",
-            "--formats",
-            "f16,q15-line",
-            "--adaptive",
-            "none,40",
-            "--levels",
-            "0,1",
-            "--views",
-            "2",
-            "--repeats",
-            "1",
-            "--out-dir",
-            "out",
-        ],
-        &dir,
-    );
+    let (dir, out) = fvr_in("trade", "trade --sizes 32 --filters linear,kb3 --oversample 1,2 --formats f16,q15-line --adaptive none,40 --levels 0,1 --views 2 --repeats 1 --out-dir out");
     assert_ok(&out);
-    let csv = std::fs::read_to_string(dir.join("out/trade.csv")).unwrap();
+    let csv = read(&dir, "out/trade.csv");
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines[0], HEADER);
     // Per filter and format: oversampling 1 at levels 0 and 1 (2 points),
@@ -77,7 +53,7 @@ fn tiny_sweep_writes_csv_png_and_summary_with_one_row_per_point() {
         });
         assert_eq!(r[front] == "1", !dominated, "{r:?}");
     }
-    let md = std::fs::read_to_string(dir.join("out/trade.md")).unwrap();
+    let md = read(&dir, "out/trade.md");
     assert!(md.contains("## 32³: the Pareto front"), "{md}");
     assert!(md.contains("fvr trade --sizes 32"), "{md}");
     let png = std::fs::read(dir.join("out/trade.png")).unwrap();
@@ -100,22 +76,9 @@ fn every_csv_column_is_documented() {
 
 #[test]
 fn a_sweep_beyond_memory_is_refused_before_any_work() {
-    let dir = temp_dir("trade-memory");
-    let out = fvr(
-        &[
-            "trade",
-            "--sizes",
-            "32,64",
-            "--filters",
-            "kb6",
-            "--formats",
-            "f32",
-            "--memory-limit",
-            "2M",
-            "--out-dir",
-            "out",
-        ],
-        &dir,
+    let (dir, out) = fvr_in(
+        "trade-memory",
+        "trade --sizes 32,64 --filters kb6 --formats f32 --memory-limit 2M --out-dir out",
     );
     // 64³ at oversampling 2 in f32: a 128³ spectrum of 8 MiB alone.
     assert_error(
@@ -180,22 +143,10 @@ fn conflicting_and_bad_options_are_named_before_any_work() {
 /// refuses sizes it cannot do before any work.
 #[test]
 fn growth_writes_csv_markdown_and_plot_and_refuses_bad_sizes() {
-    let dir = temp_dir("growth");
-    let out = fvr(
-        &[
-            "growth",
-            "--sizes",
-            "16,32",
-            "--runs",
-            "1",
-            "--out-dir",
-            "g",
-        ],
-        &dir,
-    );
+    let (dir, out) = fvr_in("growth", "growth --sizes 16,32 --runs 1 --out-dir g");
     let stdout = assert_ok(&out);
     assert!(stdout.contains("| 32³ |"), "{stdout}");
-    let csv = std::fs::read_to_string(dir.join("g/growth.csv")).unwrap();
+    let csv = read(&dir, "g/growth.csv");
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines[0], "n,frequency_ms,raycast_ms,ratio");
     assert_eq!(lines.len(), 3, "{csv}");

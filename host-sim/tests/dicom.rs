@@ -1,10 +1,10 @@
 //! DICOM series: slice sorting, spacing, rescale, series selection and bad
-//! input, on series written by `encode_ct_slice`.
+//! input, on series written by `CtSlice::encode`.
 
 use std::path::{Path, PathBuf};
 
-use fvr_host::formats::dicom::{encode_ct_slice, parse_slice, read_dicom};
-use fvr_host::formats::{detect, read_volume, Format};
+use fvr_host::io::dicom::{parse_slice, read_dicom, CtSlice};
+use fvr_host::io::{detect, read_volume, Format};
 
 const AXIAL: [f64; 6] = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
 
@@ -36,16 +36,17 @@ fn write_series(dir: &Path, series: &str, depths: &[f64], orientation: [f64; 6],
             -20.0 + d * normal[1],
             5.0 + d * normal[2],
         ];
-        let bytes = encode_ct_slice(
+        let bytes = CtSlice {
             series,
-            k as u32 + 1,
-            [5, 3],
-            [0.7, 0.6],
+            instance: k as u32 + 1,
+            size: [5, 3],
+            pixel_spacing: [0.7, 0.6],
             position,
             orientation,
-            -1024.0,
-            &pixels(k, 15),
-        );
+            intercept: -1024.0,
+            pixels: &pixels(k, 15),
+        }
+        .encode();
         std::fs::write(dir.join(names[k]), bytes).unwrap();
     }
 }
@@ -139,20 +140,31 @@ fn gaps_duplicates_and_mismatches_are_refused() {
     assert!(err_of(&dup).contains("share a position"));
     let size = temp_dir("size");
     write_series(&size, "1", &[0.0, 1.0], AXIAL, &["1", "2"]);
-    let other = encode_ct_slice(
-        "1",
-        3,
-        [4, 3],
-        [0.7, 0.6],
-        [10.0, -20.0, 7.0],
-        AXIAL,
-        0.0,
-        &[0; 12],
-    );
+    let other = CtSlice {
+        series: "1",
+        instance: 3,
+        size: [4, 3],
+        pixel_spacing: [0.7, 0.6],
+        position: [10.0, -20.0, 7.0],
+        orientation: AXIAL,
+        intercept: 0.0,
+        pixels: &[0; 12],
+    }
+    .encode();
     std::fs::write(size.join("3"), other).unwrap();
     assert!(err_of(&size).contains("Rows"), "{}", err_of(&size));
     let zero = temp_dir("zero-spacing");
-    let flat = encode_ct_slice("1", 1, [2, 2], [0.0, 0.5], [0.0; 3], AXIAL, 0.0, &[0; 4]);
+    let flat = CtSlice {
+        series: "1",
+        instance: 1,
+        size: [2, 2],
+        pixel_spacing: [0.0, 0.5],
+        position: [0.0; 3],
+        orientation: AXIAL,
+        intercept: 0.0,
+        pixels: &[0; 4],
+    }
+    .encode();
     std::fs::write(zero.join("1"), flat).unwrap();
     let msg = err_of(&zero);
     assert!(
@@ -255,14 +267,15 @@ fn sizes_beyond_the_pixel_data_are_refused_before_decoding() {
 /// A valid 2×2 axial CT slice of pixels 1..=4 with `intercept`.
 fn tiny_slice(intercept: f64) -> Vec<u8> {
     let orientation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
-    encode_ct_slice(
-        "1",
-        1,
-        [2, 2],
-        [1.0, 1.0],
-        [0.0; 3],
+    CtSlice {
+        series: "1",
+        instance: 1,
+        size: [2, 2],
+        pixel_spacing: [1.0, 1.0],
+        position: [0.0; 3],
         orientation,
         intercept,
-        &[1, 2, 3, 4],
-    )
+        pixels: &[1, 2, 3, 4],
+    }
+    .encode()
 }

@@ -4,12 +4,14 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use fvr_host::datasets::{BRAINSMALL_DEN_GZ, BRAINSMALL_DIMS};
-use fvr_host::formats::den::{encode_den, parse_den, read_den, HEADER_BYTES as DEN_HEADER};
-use fvr_host::formats::inv3::{encode_archive, encode_inv3_i16, main_plist_text, parse_inv3};
-use fvr_host::formats::nifti::{encode_nifti_f32, offsets, parse_nifti, read_nifti};
-use fvr_host::formats::{detect, read_volume, Format};
-use fvr_host::nrrd::{encode_nrrd, parse_nrrd, read_nrrd, Encoding, Endian, IoError, SampleType};
+use fvr_host::io::den::{encode_den, parse_den, read_den, HEADER_BYTES as DEN_HEADER};
+use fvr_host::io::inv3::{encode_archive, encode_inv3_i16, main_plist_text, parse_inv3};
+use fvr_host::io::nifti::{encode_nifti_f32, offsets, parse_nifti, read_nifti};
+use fvr_host::io::nrrd::{
+    encode_nrrd, parse_nrrd, read_nrrd, Encoding, Endian, IoError, SampleType,
+};
+use fvr_host::io::{detect, read_volume, Format};
+use fvr_host::sources::datasets::{BRAINSMALL_DEN_GZ, BRAINSMALL_DIMS};
 use fvr_host::volume::{check_spacing, Volume, DEFAULT_SPACING};
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -446,33 +448,24 @@ fn nrrd_detached_headers_find_their_data_file() {
         read_nrrd(&dir.join("c.nhdr")).expect("absolute").data.len(),
         24
     );
-    std::fs::write(
-        dir.join("d.nhdr"),
-        nrrd_header(&format!("{fields}encoding: raw\ndata file: gone.raw\n")),
-    )
-    .unwrap();
-    let e = read_nrrd(&dir.join("d.nhdr")).unwrap_err().to_string();
+    // The error of a header `name` whose samples are in `data_file`.
+    let detached_error = |name: &str, data_file: &str| {
+        let text = format!("{fields}encoding: raw\ndata file: {data_file}\n");
+        std::fs::write(dir.join(name), nrrd_header(&text)).unwrap();
+        read_nrrd(&dir.join(name)).unwrap_err().to_string()
+    };
+    let e = detached_error("d.nhdr", "gone.raw");
     assert!(
         e.contains("d.nhdr") && e.contains("gone.raw") && e.contains("No such file"),
         "{e}"
     );
-    std::fs::write(
-        dir.join("e.nhdr"),
-        nrrd_header(&format!("{fields}encoding: raw\ndata file: LIST\n")),
-    )
-    .unwrap();
-    let e = read_nrrd(&dir.join("e.nhdr")).unwrap_err().to_string();
+    let e = detached_error("e.nhdr", "LIST");
     assert!(
         e.contains("`data file`") && e.contains("several data files"),
         "{e}"
     );
     std::fs::write(dir.join("short.raw"), &data[..20]).unwrap();
-    std::fs::write(
-        dir.join("f.nhdr"),
-        nrrd_header(&format!("{fields}encoding: raw\ndata file: short.raw\n")),
-    )
-    .unwrap();
-    let e = read_nrrd(&dir.join("f.nhdr")).unwrap_err().to_string();
+    let e = detached_error("f.nhdr", "short.raw");
     assert!(
         e.contains("short.raw") && e.contains("expected 24") && e.contains("found 20"),
         "{e}"
@@ -533,7 +526,7 @@ fn sizes_whose_product_overflows_are_refused_before_allocating() {
         msg.contains("`sizes`") && msg.contains("overflows"),
         "{msg}"
     );
-    let raw = fvr_host::nrrd::parse_raw(&[0; 8], [big, 3, 1], SampleType::U8, Endian::Little);
+    let raw = fvr_host::io::nrrd::parse_raw(&[0; 8], [big, 3, 1], SampleType::U8, Endian::Little);
     assert!(raw.unwrap_err().to_string().contains("overflows"));
     // A header that claims a large volume but holds a few bytes fails on
     // the missing bytes, not on memory.
@@ -607,9 +600,9 @@ fn formats_are_detected_by_magic_before_extension() {
 
 #[test]
 fn named_volumes_load_through_the_scene() {
-    let brain = fvr_host::scene::load_volume("brainsmall", None).expect("embedded");
+    let brain = fvr_host::sources::load_volume("brainsmall", None).expect("embedded");
     assert_eq!(brain.dims, BRAINSMALL_DIMS);
-    let msg = fvr_host::scene::load_volume("no-such-thing", None).unwrap_err();
+    let msg = fvr_host::sources::load_volume("no-such-thing", None).unwrap_err();
     assert!(
         msg.contains("ct-head") && msg.contains("NIfTI-1") && msg.contains("shepp-logan"),
         "{msg}"
@@ -638,17 +631,17 @@ fn spacing_checks_reject_zero_negative_and_non_finite() {
 /// it first, so this test fails rather than skips when it is missing.
 #[test]
 fn ct_head_reads_with_its_shape_spacing_and_hounsfield_range() {
-    let path = fvr_host::datasets::ct_head_path()
+    let path = fvr_host::sources::datasets::ct_head_path()
         .unwrap_or_else(|e| panic!("{e} (scripts/test-all.sh installs it)"));
     let vol = read_volume(Path::new(&path)).expect("CT head");
-    assert_eq!(vol.dims, fvr_host::datasets::CT_HEAD_DIMS);
-    assert_eq!(vol.spacing, fvr_host::datasets::CT_HEAD_SPACING);
+    assert_eq!(vol.dims, fvr_host::sources::datasets::CT_HEAD_DIMS);
+    assert_eq!(vol.spacing, fvr_host::sources::datasets::CT_HEAD_SPACING);
     let min = vol.data.iter().cloned().fold(f32::INFINITY, f32::min);
     let max = vol.data.iter().cloned().fold(f32::NEG_INFINITY, f32::max);
     // main.plist's scalar_range is [-1024, 3033]; air is -1024 HU.
     assert_eq!(min, -1024.0);
     assert!((1000.0..=3033.0).contains(&max), "max {max}");
-    let loaded = fvr_host::scene::load_volume("ct-head", None).expect("by name");
+    let loaded = fvr_host::sources::load_volume("ct-head", None).expect("by name");
     assert_eq!(loaded.data, vol.data);
 }
 
@@ -782,4 +775,21 @@ fn nifti_with_dims(
     let mut bytes = encode_nifti_f32(dims, spacing, (1.0, 0.0), data, Endian::Little);
     edit(&mut bytes);
     bytes
+}
+
+/// A `main.plist` nested deeper than the limit is refused before the value
+/// is built, not a stack overflow; the limit itself is accepted.
+#[test]
+fn deep_plist_nesting_is_refused_not_a_stack_overflow() {
+    use fvr_host::io::inv3::{parse_plist, MAX_PLIST_DEPTH};
+    let deep = "<array>".repeat(100_000);
+    let e = parse_plist(&format!("<plist>{deep}")).unwrap_err();
+    assert!(e.contains("nested deeper than 64"), "{e}");
+    let n = MAX_PLIST_DEPTH;
+    let ok = format!(
+        "<plist>{}{}</plist>",
+        "<array>".repeat(n),
+        "</array>".repeat(n)
+    );
+    assert!(parse_plist(&ok).is_ok());
 }

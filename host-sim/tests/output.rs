@@ -4,10 +4,12 @@ use std::path::{Path, PathBuf};
 
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::Sampling;
-use fvr_host::output::{percentile_range, write_apng, write_png, Bits, Colormap, Style, Window};
-use fvr_host::phantom::{sample, GaussianMixture};
-use fvr_host::pipeline::{AnySpectrum, Precision};
-use fvr_host::turntable::{orbit, render_views};
+use fvr_host::image::output::{
+    percentile_range, write_apng, write_png, Bits, Colormap, Style, Window,
+};
+use fvr_host::render::spectrum::{AnySpectrum, Precision};
+use fvr_host::render::turntable::{orbit, render_views};
+use fvr_host::sources::phantom::{sample, GaussianMixture};
 use indicatif::ProgressBar;
 
 fn temp_dir(name: &str) -> PathBuf {

@@ -4,7 +4,9 @@
 //! file and the key.
 
 mod common;
-use common::{assert_error, assert_ok, fvr, temp_dir};
+use common::{assert_error, assert_ok, fvr, fvr_in, fvr_line, temp_dir};
+use std::path::PathBuf;
+use std::process::Output;
 
 const SCENE: &str = r#"
 [volume]
@@ -55,7 +57,7 @@ fn scene_and_equivalent_flags_write_identical_nrrd_bytes() {
     std::fs::create_dir_all(dir.join("scenes/out")).unwrap();
     std::fs::write(dir.join("scenes/lit.toml"), SCENE).unwrap();
     // Run from elsewhere: the output lands next to the scene file.
-    assert_ok(&fvr(&["render", "--scene", "scenes/lit.toml"], &dir));
+    assert_ok(&fvr_line("render --scene scenes/lit.toml", &dir));
     let mut flags = EQUIVALENT_FLAGS.to_vec();
     flags.extend(["--out", "flags.nrrd"]);
     assert_ok(&fvr(&flags, &dir));
@@ -72,39 +74,23 @@ fn flags_override_the_scene() {
     std::fs::write(dir.join("lit.toml"), SCENE).unwrap();
     // Size, output (relative to the working directory) and lights replaced:
     // one grey light makes an RGB image with equal channels.
-    let stdout = assert_ok(&fvr(
-        &[
-            "render",
-            "--scene",
-            "lit.toml",
-            "--size",
-            "16",
-            "--light",
-            "0,1,0:1",
-            "--out",
-            "over.nrrd",
-        ],
+    let stdout = assert_ok(&fvr_line(
+        "render --scene lit.toml --size 16 --light 0,1,0:1 --out over.nrrd",
         &dir,
     ));
     assert!(stdout.contains("wrote over.nrrd (16x16 RGB)"), "{stdout}");
-    let image = fvr_host::nrrd::read_nrrd(&dir.join("over.nrrd")).unwrap();
+    let image = fvr_host::io::nrrd::read_nrrd(&dir.join("over.nrrd")).unwrap();
     assert_eq!(image.dims, [3, 16, 16]);
     assert!(image.data.chunks(3).all(|p| p[0] == p[1] && p[1] == p[2]));
     assert!(image.data.iter().any(|&v| v > 0.0));
     // The volume on the command line replaces the scene's.
-    let stdout = assert_ok(&fvr(
-        &["render", "sphere@16", "--scene", "lit.toml", "--stats"],
-        &dir,
-    ));
+    let stdout = assert_ok(&fvr_line("render sphere@16 --scene lit.toml --stats", &dir));
     assert!(stdout.contains("16x16x16 (sphere@16)"), "{stdout}");
 }
 
 #[test]
 fn unknown_key_is_named_with_the_closest_valid_key() {
-    let dir = temp_dir("scenefile-unknown");
-    let bad = SCENE.replace("color = 0.5", "colr = 0.5");
-    std::fs::write(dir.join("bad.toml"), bad).unwrap();
-    let out = fvr(&["render", "--scene", "bad.toml"], &dir);
+    let (dir, out) = render_edited_scene("scenefile-unknown", "color = 0.5", "colr = 0.5");
     assert_error(
         &out,
         &[
@@ -117,10 +103,7 @@ fn unknown_key_is_named_with_the_closest_valid_key() {
 
 #[test]
 fn wrong_type_names_the_key_and_the_type() {
-    let dir = temp_dir("scenefile-type");
-    let bad = SCENE.replace("oversample = 2", "oversample = \"two\"");
-    std::fs::write(dir.join("bad.toml"), bad).unwrap();
-    let out = fvr(&["render", "--scene", "bad.toml"], &dir);
+    let (_, out) = render_edited_scene("scenefile-type", "oversample = 2", "oversample = \"two\"");
     assert_error(
         &out,
         &["bad.toml: `spectrum.oversample` must be an integer from 1 to 2, got string \"two\""],
@@ -129,20 +112,16 @@ fn wrong_type_names_the_key_and_the_type() {
 
 #[test]
 fn missing_scene_file_and_missing_settings_are_errors() {
-    let dir = temp_dir("scenefile-missing");
-    let out = fvr(&["render", "--scene", "nowhere.toml"], &dir);
+    let (dir, out) = fvr_in("scenefile-missing", "render --scene nowhere.toml");
     assert_error(&out, &["cannot read scene file `nowhere.toml`"]);
     std::fs::write(dir.join("novolume.toml"), "[camera]\ndir = [1, 0, 0]\n").unwrap();
-    let out = fvr(
-        &["render", "--scene", "novolume.toml", "--out", "a.png"],
-        &dir,
-    );
+    let out = fvr_line("render --scene novolume.toml --out a.png", &dir);
     assert_error(&out, &["no volume", "volume.builtin"]);
-    let out = fvr(&["render", "--scene", "novolume.toml", "sphere@8"], &dir);
+    let out = fvr_line("render --scene novolume.toml sphere@8", &dir);
     assert_error(&out, &["no output file", "output.path"]);
-    let out = fvr(&["render", "--scene", "novolume.toml"], &dir);
+    let out = fvr_line("render --scene novolume.toml", &dir);
     assert_eq!(out.status.code(), Some(2));
-    let out = fvr(&["render", "sphere@8", "--out", "a.png"], &dir);
+    let out = fvr_line("render sphere@8 --out a.png", &dir);
     assert_error(&out, &["--dir"]);
 }
 
@@ -155,7 +134,7 @@ fn turntable_reads_the_scene() {
          [turntable]\nframes = 3\nfps = 5\npath = \"spin.apng\"\n",
     )
     .unwrap();
-    let out = fvr(&["turntable", "--scene", "spin.toml"], &dir);
+    let out = fvr_line("turntable --scene spin.toml", &dir);
     let stdout = assert_ok(&out);
     assert!(stdout.contains("(3 frames, 12x12, 5 fps)"), "{stdout}");
     assert!(String::from_utf8_lossy(&out.stderr).contains("does not use the scene's [shading]"));
@@ -177,7 +156,7 @@ fn example_scenes_parse_and_render() {
     scenes.sort();
     assert!(scenes.len() >= 4, "{scenes:?}");
     for path in &scenes {
-        let scene = fvr_host::scene_file::SceneFile::load(path)
+        let scene = fvr_host::render::scene_file::SceneFile::load(path)
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let spec = scene
             .volume
@@ -247,18 +226,9 @@ fn teapot_names_are_checked() {
 
 #[test]
 fn turntable_stats_json_is_one_object_with_views_per_second() {
-    let dir = temp_dir("scenefile-turntable-json");
-    let out = fvr(
-        &[
-            "turntable",
-            "sphere@16",
-            "--frames",
-            "4",
-            "--stats-json",
-            "--out",
-            "s.apng",
-        ],
-        &dir,
+    let (_, out) = fvr_in(
+        "scenefile-turntable-json",
+        "turntable sphere@16 --frames 4 --stats-json --out s.apng",
     );
     let stdout = assert_ok(&out);
     let json = stdout
@@ -282,4 +252,13 @@ fn turntable_stats_json_is_one_object_with_views_per_second() {
         "{json}"
     );
     assert!(json.contains("\"volume\": \"sphere@16\""), "{json}");
+}
+
+/// Render [`SCENE`] with `from` replaced by `to`, as `bad.toml` in a fresh
+/// directory `name`.
+fn render_edited_scene(name: &str, from: &str, to: &str) -> (PathBuf, Output) {
+    let dir = temp_dir(name);
+    std::fs::write(dir.join("bad.toml"), SCENE.replace(from, to)).unwrap();
+    let out = fvr_line("render --scene bad.toml", &dir);
+    (dir, out)
 }

@@ -4,12 +4,12 @@
 
 use std::io::Write;
 
-use fvr_host::formats::den::{encode_den, parse_den};
-use fvr_host::formats::dicom::{encode_ct_slice, parse_slice};
-use fvr_host::formats::inv3::{encode_inv3_i16, parse_inv3};
-use fvr_host::formats::nifti::{encode_nifti_f32, parse_nifti};
-use fvr_host::nrrd::IoError;
-use fvr_host::nrrd::{encode_nrrd, parse_nrrd, Encoding, Endian, SampleType};
+use fvr_host::io::den::{encode_den, parse_den};
+use fvr_host::io::dicom::{parse_slice, CtSlice};
+use fvr_host::io::inv3::{encode_inv3_i16, parse_inv3};
+use fvr_host::io::nifti::{encode_nifti_f32, parse_nifti};
+use fvr_host::io::nrrd::IoError;
+use fvr_host::io::nrrd::{encode_nrrd, parse_nrrd, Encoding, Endian, SampleType};
 use fvr_host::volume::Volume;
 
 fn gzip(bytes: &[u8]) -> Vec<u8> {
@@ -18,23 +18,35 @@ fn gzip(bytes: &[u8]) -> Vec<u8> {
     e.finish().unwrap()
 }
 
-/// `parse` accepts `whole` and refuses every strict prefix of it.
+/// `parse` accepts `whole` and refuses every strict prefix of it; returns
+/// what `whole` gave. `what` names an accepted value in the failure message.
+fn refuse_every_prefix<T>(
+    name: &str,
+    whole: &[u8],
+    parse: impl Fn(&[u8]) -> Result<T, IoError>,
+    what: impl Fn(&T) -> String,
+) -> T {
+    let full = parse(whole).unwrap_or_else(|e| panic!("{name}: the whole file fails: {e}"));
+    for len in 0..whole.len() {
+        if let Ok(v) = parse(&whole[..len]) {
+            panic!(
+                "{name}: a prefix of {len} of {} bytes gave {}",
+                whole.len(),
+                what(&v)
+            );
+        }
+    }
+    full
+}
+
+/// [`refuse_every_prefix`] for a volume reader; the whole file has samples.
 fn every_prefix_is_refused(
     name: &str,
     whole: &[u8],
     parse: impl Fn(&[u8]) -> Result<Volume, IoError>,
 ) {
-    let full = parse(whole).unwrap_or_else(|e| panic!("{name}: the whole file fails: {e}"));
+    let full = refuse_every_prefix(name, whole, parse, |v| format!("a volume of {:?}", v.dims));
     assert!(!full.data.is_empty());
-    for len in 0..whole.len() {
-        if let Ok(v) = parse(&whole[..len]) {
-            panic!(
-                "{name}: a prefix of {len} of {} bytes gave a volume of {:?}",
-                whole.len(),
-                v.dims
-            );
-        }
-    }
 }
 
 #[test]
@@ -72,28 +84,22 @@ fn prefixes_of_every_format_are_errors() {
 #[test]
 fn prefixes_of_a_dicom_slice_are_errors() {
     let orientation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
-    let bytes = encode_ct_slice(
-        "1.2",
-        1,
-        [3, 2],
-        [0.5, 0.5],
-        [0.0; 3],
+    let bytes = CtSlice {
+        series: "1.2",
+        instance: 1,
+        size: [3, 2],
+        pixel_spacing: [0.5, 0.5],
+        position: [0.0; 3],
         orientation,
-        -1024.0,
-        &[1, 2, 3, 4, 5, 6],
-    );
-    let slice = parse_slice(&bytes).expect("whole slice");
+        intercept: -1024.0,
+        pixels: &[1, 2, 3, 4, 5, 6],
+    }
+    .encode();
+    let slice = refuse_every_prefix("dicom", &bytes, parse_slice, |s| {
+        format!("a slice of {:?}", s.size)
+    });
     assert_eq!(
         slice.pixels,
         vec![-1023.0, -1022.0, -1021.0, -1020.0, -1019.0, -1018.0]
     );
-    for len in 0..bytes.len() {
-        if let Ok(s) = parse_slice(&bytes[..len]) {
-            panic!(
-                "a prefix of {len} of {} bytes gave a slice of {:?}",
-                bytes.len(),
-                s.size
-            );
-        }
-    }
 }

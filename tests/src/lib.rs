@@ -3,8 +3,8 @@
 
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::num::{Real, Sample};
-use fvr_host::phantom::{sample, GaussianMixture};
-use fvr_host::pipeline::OwnedSpectrum;
+use fvr_host::render::spectrum::OwnedSpectrum;
+use fvr_host::sources::phantom::{sample, GaussianMixture};
 
 /// A random Gaussian mixture (`GaussianMixture::random(seed, n, count)`)
 /// sampled on `dims`, prepared for `kind` at `oversample` in storage `S`

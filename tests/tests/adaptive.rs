@@ -4,10 +4,12 @@
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
 use fvr_core::slice::adaptive::{mark, marks_words, threshold_for, Marks};
-use fvr_host::adaptive::{parse_chain, parse_tolerance, AdaptiveMarks, AdaptiveSettings, Bound};
-use fvr_host::phantom::{sample, GaussianMixture, SheppLogan};
-use fvr_host::pipeline::{AnySpectrum, OwnedSpectrum};
 use fvr_host::reference::snr_db;
+use fvr_host::render::adaptive::{
+    parse_chain, parse_tolerance, AdaptiveMarks, AdaptiveSettings, Bound,
+};
+use fvr_host::render::spectrum::{AnySpectrum, OwnedSpectrum};
+use fvr_host::sources::phantom::{sample, GaussianMixture, SheppLogan};
 use fvr_tests::mixture_spectrum;
 use half::f16;
 

@@ -19,12 +19,12 @@ use fvr_core::image::{aux_len, grid_len};
 use fvr_core::render::{render, Buffers, Request, Source};
 use fvr_core::shading::{DepthCue, Light, Scene};
 use fvr_core::Error;
-use fvr_host::accuracy::{CONFIGS, VIEWS};
-use fvr_host::phantom::{sample_spaced, GaussianMixture};
-use fvr_host::pipeline::{choose_filter, AnySpectrum, KbDesign, Precision};
+use fvr_host::reference::shaded::exact_scene_projection_sampled;
 use fvr_host::reference::{exact_projection_sampled, snr_db};
-use fvr_host::scene_reference::exact_scene_projection_sampled;
-use fvr_host::shaded::SceneSpectra;
+use fvr_host::render::shaded::SceneSpectra;
+use fvr_host::render::spectrum::{choose_filter, AnySpectrum, KbDesign, Precision};
+use fvr_host::sources::phantom::{sample_spaced, GaussianMixture};
+use fvr_host::studies::accuracy::{CONFIGS, VIEWS};
 use fvr_tests::mixture_spectrum;
 use half::f16;
 
@@ -289,7 +289,7 @@ fn cubic_voxels_render_cued_and_lit_scenes_in_mm() {
             .render_sampled(&scene, &view, &sampling, 64, 64)
             .unwrap();
         let exact =
-            exact_scene_projection_sampled(&object, dims, &sampling, &scene, &view, 64, 64, 0.05)
+            exact_scene_projection_sampled(&object, dims, &sampling, &scene, &view, (64, 64), 0.05)
                 .unwrap();
         let snr = snr_db(&exact.data, &image.data);
         println!(

@@ -15,11 +15,11 @@ use fvr_core::geometry::View;
 use fvr_core::num::Sample;
 use fvr_core::num::{Arithmetic, BlockLayout, Blocking, Format, FormatName};
 use fvr_core::spectrum::{premultiplier_table, scale_for_target};
-use fvr_host::pipeline::{
+use fvr_host::reference::snr_db;
+use fvr_host::render::spectrum::{
     choose_filter, choose_oversampling, premultiplication_gain_db, KbDesign, CONDITIONING_LIMIT_DB,
 };
-use fvr_host::precision::{measure_extremes, ExtremeRow, Subject};
-use fvr_host::reference::snr_db;
+use fvr_host::studies::precision::{measure_extremes, ExtremeRow, Subject};
 use fvr_host::volume::Volume;
 
 const N: usize = 32;
@@ -179,7 +179,7 @@ fn constant_volume_projects_to_c_times_n_along_an_axis_up_to_kb4_aliasing_in_f64
 fn impulse_spectrum_is_exactly_flat_in_every_format_and_images_reach_their_floor() {
     use fvr_core::dht::Rounding;
     use fvr_core::num::{bf16, Minifloat16, Minifloat8};
-    use fvr_host::precision::StoredSpectrum;
+    use fvr_host::studies::precision::StoredSpectrum;
     use half::f16;
     let mut volume = Volume::zeros([16; 3]);
     let centre = volume.index(8, 8, 8);
@@ -292,10 +292,10 @@ fn full_range_u16_volume_at_512_cubed_cannot_overflow_any_format_by_the_scaling_
 #[test]
 fn volume_scaled_by_2_pow_minus_20_is_bit_identical_and_by_1e_minus_6_or_1e_minus_30_keeps_its_floor(
 ) {
-    use fvr_host::phantom::{sample, GaussianMixture};
+    use fvr_host::sources::phantom::{sample, GaussianMixture};
     let base = sample(&GaussianMixture::random(1, N, 8), [N; 3]);
     let filter = choose_filter(&base, FilterKind::Kb4, 1, KbDesign::Auto).unwrap();
-    let views: Vec<View> = fvr_host::precision::VIEWS
+    let views: Vec<View> = fvr_host::studies::precision::VIEWS
         .iter()
         .map(|&d| View::along(d))
         .collect();
@@ -359,7 +359,7 @@ fn hounsfield_units_fill_the_box_and_need_oversampling_2_mixed_sign_gaussians_do
         .all(|r| r.gain_db > CONDITIONING_LIMIT_DB && r.oversample == 2));
     assert_floors(&hu);
 
-    use fvr_host::phantom::{sample, GaussianMixture};
+    use fvr_host::sources::phantom::{sample, GaussianMixture};
     let mut mix = GaussianMixture::random(3, N, 8);
     for (i, g) in mix.components.iter_mut().enumerate() {
         if i % 2 == 1 {
@@ -374,7 +374,7 @@ fn hounsfield_units_fill_the_box_and_need_oversampling_2_mixed_sign_gaussians_do
     );
     let filter = choose_filter(&volume, FilterKind::Kb4, 1, KbDesign::Auto).unwrap();
     assert!(premultiplication_gain_db(&volume, filter).unwrap() < 6.0);
-    let views = fvr_host::precision::VIEWS
+    let views = fvr_host::studies::precision::VIEWS
         .iter()
         .map(|&d| View::along(d))
         .collect();
@@ -410,7 +410,7 @@ fn hounsfield_units_fill_the_box_and_need_oversampling_2_mixed_sign_gaussians_do
 /// the f32 rounding of the weights).
 #[test]
 fn views_1e_minus_7_rad_off_an_axis_or_diagonal_are_continuous_in_every_format() {
-    use fvr_host::phantom::{sample, GaussianMixture};
+    use fvr_host::sources::phantom::{sample, GaussianMixture};
     let phantom = GaussianMixture::random(1, N, 8);
     let volume = sample(&phantom, [N; 3]);
     let filter = choose_filter(&volume, FilterKind::Kb4, 1, KbDesign::Auto).unwrap();
@@ -429,7 +429,7 @@ fn views_1e_minus_7_rad_off_an_axis_or_diagonal_are_continuous_in_every_format()
         let views = vec![View { dir: exact, up }, View { dir: off, up }];
         let mut s = Subject::new("continuity", volume.clone(), None, filter, views);
         for format in formats() {
-            for arithmetic in fvr_host::precision::modes_for(format) {
+            for arithmetic in fvr_host::studies::precision::modes_for(format) {
                 let (images, _) = s.render_format(format, arithmetic).unwrap();
                 assert!(images.iter().flatten().all(|v| v.is_finite()));
                 let snr = snr_db(&images[0], &images[1]);
@@ -452,7 +452,7 @@ fn views_1e_minus_7_rad_off_an_axis_or_diagonal_are_continuous_in_every_format()
 /// f64), and auto picks 2.
 #[test]
 fn sizes_1_2_and_4_work_in_every_format() {
-    use fvr_host::phantom::SplitMix64;
+    use fvr_host::sources::phantom::SplitMix64;
     let mut rng = SplitMix64::new(11);
     for n in [1usize, 2, 4] {
         let volume = Volume {
@@ -464,7 +464,7 @@ fn sizes_1_2_and_4_work_in_every_format() {
         };
         for o in [1u32, 2] {
             let filter = choose_filter(&volume, FilterKind::Kb4, o, KbDesign::Auto).unwrap();
-            let views = fvr_host::precision::VIEWS
+            let views = fvr_host::studies::precision::VIEWS
                 .iter()
                 .map(|&d| View::along(d))
                 .collect();
@@ -472,8 +472,8 @@ fn sizes_1_2_and_4_work_in_every_format() {
             let (reference, _) = s.render_format(Format::F64, Arithmetic::PerPass).unwrap();
             assert!(reference.iter().flatten().all(|v| v.is_finite()));
             let grid = fvr_core::volume::padded_size([n; 3], o).unwrap();
-            for format in fvr_host::precision::default_formats() {
-                for arithmetic in fvr_host::precision::modes_for(format) {
+            for format in fvr_host::studies::precision::default_formats() {
+                for arithmetic in fvr_host::studies::precision::modes_for(format) {
                     if let Format::Q15(Blocking::Blocks(BlockLayout::Brick(b)))
                     | Format::Q7(Blocking::Blocks(BlockLayout::Brick(b))) = format
                     {

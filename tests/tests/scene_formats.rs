@@ -11,10 +11,10 @@ use fvr_core::render::{render, Buffers, Request, Source};
 use fvr_core::shading::fields_len;
 use fvr_core::shading::{DepthCue, Light, Scene};
 use fvr_core::spectrum::Spectrum;
-use fvr_host::phantom::{sample, GaussianMixture};
-use fvr_host::precision::StoredSpectrum;
 use fvr_host::reference::snr_db;
-use fvr_host::shaded::gradient_volume;
+use fvr_host::render::shaded::gradient_volume;
+use fvr_host::sources::phantom::{sample, GaussianMixture};
+use fvr_host::studies::precision::StoredSpectrum;
 
 fn render_scene<S: fvr_core::num::Sample>(
     density: &Spectrum<'_, S>,

@@ -8,8 +8,8 @@ use fvr_core::shading::fields_len;
 use fvr_firmware::frame::{tables_for, FrameTables};
 use fvr_firmware::scene::{Blob, FrameSpec, Shading, BLOBS, DIMS, IMAGE_SIDE};
 use fvr_firmware::stored::{all, all_derivatives, twiddles};
-use fvr_host::phantom::{Gaussian, GaussianMixture, Phantom};
-use fvr_host::scene_reference::exact_scene_projection;
+use fvr_host::reference::shaded::exact_scene_projection;
+use fvr_host::sources::phantom::{Gaussian, GaussianMixture, Phantom};
 
 /// Simpson step (voxels) of the exact references' numerically integrated
 /// `|∇f|` term, as in tests/tests/shading.rs: for Gaussians of σ ≥ 1.8

@@ -39,3 +39,21 @@ pub fn assert_ok(out: &Output) -> String {
     );
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
+
+/// Run `fvr` with the words of `command` (split at white space) in `dir`.
+pub fn fvr_line(command: &str, dir: &Path) -> Output {
+    fvr(&command.split_whitespace().collect::<Vec<_>>(), dir)
+}
+
+/// Run `command` (as [`fvr_line`]) in a fresh directory named `name` (as
+/// [`temp_dir`]); returns the directory and the output.
+pub fn fvr_in(name: &str, command: &str) -> (PathBuf, Output) {
+    let dir = temp_dir(name);
+    let out = fvr_line(command, &dir);
+    (dir, out)
+}
+
+/// The text of the file `name` in `dir` (an output a test checks).
+pub fn read(dir: &Path, name: &str) -> String {
+    std::fs::read_to_string(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
+}

@@ -1,0 +1,175 @@
+//! What an adaptive render did (`fvr render --adaptive`), for --stats.
+
+use crate::Error;
+use serde::Serialize;
+use std::time::Instant;
+
+use fvr_core::geometry::View;
+use fvr_host::reference::snr_db;
+use fvr_host::render::adaptive::AdaptiveSettings;
+use fvr_host::render::spectrum::AnySpectrum;
+
+/// An adaptive render with what it did.
+pub(crate) struct AdaptiveReport {
+    pub(crate) image: Vec<f64>,
+    pub(crate) marks: fvr_host::render::adaptive::AdaptiveMarks,
+    pub(crate) stats: fvr_core::slice::adaptive::AdaptiveStats,
+    pub(crate) mark_time: std::time::Duration,
+    pub(crate) view_time: std::time::Duration,
+    pub(crate) full_view_time: std::time::Duration,
+    pub(crate) snr_vs_full: f64,
+}
+
+impl AdaptiveReport {
+    pub(crate) fn print_human(&self) {
+        let s = &self.stats;
+        let pct = |v: u64, of: u64| 100.0 * v as f64 / of.max(1) as f64;
+        println!(
+            "  adaptive      {} dB: {} of {} taps ({:.1}%), {:.2} ms per view against {:.2} ms \
+             with the full filter; image {:.1} dB from the full-filter image",
+            self.marks.tolerance_db,
+            s.taps,
+            s.full_taps,
+            pct(s.taps, s.full_taps),
+            self.view_time.as_secs_f64() * 1e3,
+            self.full_view_time.as_secs_f64() * 1e3,
+            self.snr_vs_full
+        );
+        println!(
+            "  samples       {:.1}% on the full filter",
+            pct(s.per_filter[0], s.samples)
+        );
+        for (i, l) in self.marks.levels.iter().enumerate() {
+            println!(
+                "  samples       {:.1}% on {} (h_d {:.3}, threshold {:.3e}, {} of {} spectrum samples marked)",
+                pct(s.per_filter[i + 1], s.samples),
+                l.filter.kind().name(),
+                l.h_d,
+                l.threshold,
+                l.marked,
+                l.words.len() * 32
+            );
+            if let Some(r) = l.error_ratio {
+                println!(
+                    "  error field   {:.1} dB below the volume (exact bound, eq. 15)",
+                    -10.0 * r.log10()
+                );
+            }
+        }
+        println!(
+            "  marks         {} bytes (1 bit per voxel per level), built in {:.1} ms",
+            self.marks.bytes(),
+            self.mark_time.as_secs_f64() * 1e3
+        );
+        if let Some(note) = self.marks.effect(s) {
+            println!("  note          {note}");
+        }
+    }
+
+    pub(crate) fn json(&self) -> AdaptiveJson {
+        let s = &self.stats;
+        let levels = self
+            .marks
+            .levels
+            .iter()
+            .enumerate()
+            .map(|(i, l)| LevelJson {
+                filter: l.filter.kind().name(),
+                h_d: l.h_d,
+                threshold: l.threshold,
+                marked: l.marked,
+                samples: s.per_filter[i + 1],
+                error_field_db: l.error_ratio.map(|r| -10.0 * r.log10()),
+            })
+            .collect();
+        AdaptiveJson {
+            tolerance_db: self.marks.tolerance_db,
+            bound: self.marks.bound.name(),
+            taps: s.taps,
+            full_taps: s.full_taps,
+            taps_ratio: s.taps as f64 / s.full_taps.max(1) as f64,
+            samples: s.samples,
+            full_filter_samples: s.per_filter[0],
+            levels,
+            marks_bytes: self.marks.bytes(),
+            mark_ms: self.mark_time.as_secs_f64() * 1e3,
+            view_ms: self.view_time.as_secs_f64() * 1e3,
+            full_view_ms: self.full_view_time.as_secs_f64() * 1e3,
+            snr_vs_full_db: self.snr_vs_full,
+            note: self.marks.effect(s),
+        }
+    }
+}
+
+/// Mark the spectrum, render adaptively, and render with the full filter
+/// for comparison.
+pub(crate) fn adaptive_render(
+    spec: &AnySpectrum,
+    view: &View,
+    w: usize,
+    h: usize,
+    settings: &AdaptiveSettings,
+) -> Result<AdaptiveReport, Error> {
+    pub(crate) fn go<S: fvr_core::num::Sample, T: fvr_core::num::Real>(
+        any: &AnySpectrum,
+        spec: &fvr_host::render::spectrum::OwnedSpectrum<S>,
+        view: &View,
+        w: usize,
+        h: usize,
+        settings: &AdaptiveSettings,
+    ) -> Result<AdaptiveReport, Error> {
+        let t0 = Instant::now();
+        let marks = fvr_host::render::adaptive::AdaptiveMarks::build(spec, settings)?;
+        let mark_time = t0.elapsed();
+        let t1 = Instant::now();
+        let (image, stats) = marks.render::<S, T>(spec, view, w, h)?;
+        let view_time = t1.elapsed();
+        let t2 = Instant::now();
+        let full = any.render(view, w, h)?;
+        let full_view_time = t2.elapsed();
+        Ok(AdaptiveReport {
+            snr_vs_full: snr_db(&full, &image),
+            image,
+            marks,
+            stats,
+            mark_time,
+            view_time,
+            full_view_time,
+        })
+    }
+    match spec {
+        AnySpectrum::F16(s) => go::<_, f32>(spec, s, view, w, h, settings),
+        AnySpectrum::F32(s) => go::<_, f32>(spec, s, view, w, h, settings),
+        AnySpectrum::F64(s) => go::<_, f64>(spec, s, view, w, h, settings),
+    }
+}
+
+/// The `adaptive` member of `fvr render --stats-json`.
+#[derive(Serialize)]
+pub(crate) struct AdaptiveJson {
+    tolerance_db: f64,
+    bound: &'static str,
+    taps: u64,
+    full_taps: u64,
+    taps_ratio: f64,
+    samples: u64,
+    full_filter_samples: u64,
+    levels: Vec<LevelJson>,
+    marks_bytes: usize,
+    mark_ms: f64,
+    view_ms: f64,
+    full_view_ms: f64,
+    snr_vs_full_db: f64,
+    note: Option<String>,
+}
+
+/// One cheaper filter of [`AdaptiveJson`].
+#[derive(Serialize)]
+struct LevelJson {
+    filter: &'static str,
+    h_d: f64,
+    threshold: f64,
+    marked: usize,
+    samples: u64,
+    error_field_db: Option<f64>,
+}

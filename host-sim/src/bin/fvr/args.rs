@@ -1,0 +1,318 @@
+//! Argument groups render and turntable share, and their value parsers.
+
+use crate::Error;
+use clap::Args;
+use fvr_core::filter::FilterKind;
+use fvr_core::geometry::Sampling;
+use fvr_core::shading::Scene;
+use fvr_host::image::output::{Bits, Colormap, Style, Window};
+use fvr_host::io::nrrd::{Endian, SampleType};
+use fvr_host::io::FORMATS_HELP;
+use fvr_host::progress;
+use fvr_host::render::scene_file::parse_endian;
+use fvr_host::render::shaded::SceneSpectra;
+use fvr_host::render::spectrum::{choose_filter, AnySpectrum, KbDesign, Precision};
+use fvr_host::sources::datasets::DATASETS_HELP;
+use fvr_host::sources::{load_volume_with_progress, RawLayout, PHANTOM_HELP};
+
+/// How a PNG is made from the rendered values (render and turntable).
+#[derive(Args, Clone)]
+pub(crate) struct PngArgs {
+    /// PNG bits per channel: 8 or 16.
+    #[arg(long, default_value = "8")]
+    pub(crate) bits: Bits,
+    /// Window width W: values in [L - W/2, L + W/2] span black to white
+    /// (needs --level). Default: automatic, from --percentiles.
+    #[arg(long, requires = "level", allow_hyphen_values = true)]
+    pub(crate) window: Option<f64>,
+    /// Window level (centre) L; needs --window.
+    #[arg(long, requires = "window", allow_hyphen_values = true)]
+    pub(crate) level: Option<f64>,
+    /// Automatic window: the LOW,HIGH percentiles of the pixel values.
+    #[arg(long, value_parser = parse_percentiles, default_value = "0.5,99.5", conflicts_with = "window")]
+    pub(crate) percentiles: (f64, f64),
+    /// Colormap for the X-ray image: gray, bone or hot (MATLAB's maps, as
+    /// tabulated in matplotlib).
+    #[arg(long, default_value = "gray")]
+    pub(crate) colormap: Colormap,
+}
+
+impl PngArgs {
+    pub(crate) fn style(&self) -> Result<Style, Error> {
+        let window = match (self.window, self.level) {
+            (Some(w), Some(l)) => Window::from_width_level(w, l)?,
+            _ => Window::from_percentiles(self.percentiles.0, self.percentiles.1)?,
+        };
+        Ok(Style {
+            bits: self.bits,
+            window,
+            colormap: self.colormap,
+        })
+    }
+}
+
+/// The image and the spectrum it is read from (render and turntable).
+#[derive(Args, Clone, Copy, Default)]
+pub(crate) struct FrameArgs {
+    /// Image size W or WxH in pixels (of --pixel-size mm, or of one voxel
+    /// with --ignore-spacing); at most the padded grid.
+    /// Default: the padded grid divided by the oversampling.
+    #[arg(long, value_parser = parse_size)]
+    pub(crate) size: Option<(usize, usize)>,
+    #[command(flatten)]
+    pub(crate) units: UnitArgs,
+    #[command(flatten)]
+    pub(crate) spectrum: SpectrumArgs,
+}
+
+/// Physical units (render and turntable).
+#[derive(Args, Clone, Copy, Default)]
+pub(crate) struct UnitArgs {
+    /// Pixel size in mm. Default: the smallest voxel spacing, or, if the
+    /// volume's longest physical side would not fit the default image at
+    /// that size, the size that fits it (longest side / default width).
+    #[arg(
+        long,
+        value_name = "MM",
+        conflicts_with = "ignore_spacing",
+        allow_hyphen_values = true
+    )]
+    pub(crate) pixel_size: Option<f64>,
+    /// Render in voxel units, as if the voxels were 1 mm cubes, ignoring the
+    /// volume's spacing (the behaviour before spacing was used).
+    #[arg(long)]
+    pub(crate) ignore_spacing: bool,
+}
+
+impl UnitArgs {
+    /// The voxel spacing and pixel size: the volume's spacing, or 1 mm
+    /// with `--ignore-spacing`; `--pixel-size`, or by default the smallest
+    /// spacing, raised if need be so that the longest physical side fits
+    /// `default_side` pixels (the default image). Warns when the longest
+    /// side exceeds the image grid's period `n·p`.
+    pub(crate) fn sampling(
+        &self,
+        volume: &fvr_host::volume::Volume,
+        n: usize,
+        default_side: usize,
+    ) -> Result<Sampling, Error> {
+        if self.ignore_spacing {
+            return Ok(Sampling::UNIT);
+        }
+        let spacing = volume.spacing;
+        let longest = (0..3)
+            .map(|a| volume.dims[a] as f64 * spacing[a])
+            .fold(0.0, f64::max);
+        let pixel_size = match self.pixel_size {
+            Some(p) => p,
+            None => {
+                let finest = spacing.iter().copied().fold(f64::INFINITY, f64::min);
+                finest.max(longest / default_side.max(1) as f64)
+            }
+        };
+        let sampling =
+            Sampling::new(spacing, pixel_size).map_err(|e| format!("--pixel-size: {e}"))?;
+        let period = n as f64 * pixel_size;
+        if longest > period {
+            eprintln!(
+                "fvr: warning: the volume's longest side ({longest:.1} mm) exceeds the image \
+                 grid's period ({n} pixels of {pixel_size} mm = {period:.1} mm): views across \
+                 it wrap around. Use a larger --pixel-size or --oversample 2."
+            );
+        }
+        Ok(sampling)
+    }
+}
+
+/// How the spectrum is made (render and turntable).
+#[derive(Args, Clone, Copy)]
+pub(crate) struct SpectrumArgs {
+    /// Interpolation filter: nearest, linear, cubic, kb3, kb4, kb5, kb6.
+    #[arg(long, value_parser = parse_filter, default_value = "kb4")]
+    pub(crate) filter: FilterKind,
+    /// Oversampling of the spectrum grid: 1 or 2.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=2))]
+    pub(crate) oversample: u32,
+    /// Spectrum storage and arithmetic: f16 (f32 arithmetic), f32 or f64.
+    #[arg(long, default_value = "f16")]
+    pub(crate) precision: Precision,
+    /// Kaiser-Bessel shape: `auto` fits beta to the volume's energy
+    /// distribution; a number is the design oversampling of Beatty's formula.
+    #[arg(long, default_value = "auto")]
+    pub(crate) kb_design: KbDesign,
+}
+
+impl Default for SpectrumArgs {
+    fn default() -> Self {
+        Self {
+            filter: FilterKind::Kb4,
+            oversample: 1,
+            precision: Precision::F16,
+            kb_design: KbDesign::Auto,
+        }
+    }
+}
+
+/// How the volume is read (render and turntable).
+#[derive(Args, Clone, Copy)]
+pub(crate) struct InputArgs {
+    /// Read VOLUME as a headerless raw file of these sizes X,Y,Z.
+    #[arg(long, value_parser = parse_dims)]
+    pub(crate) raw_dims: Option<[usize; 3]>,
+    /// Sample type of a raw file: u8, i8, u16, i16, u32, i32, f32, f64.
+    #[arg(long, default_value = "u8")]
+    pub(crate) raw_type: SampleType,
+    /// Byte order of a raw file: little or big.
+    #[arg(long, default_value = "little", value_parser = parse_endian)]
+    pub(crate) raw_endian: Endian,
+    /// Value of empty space: voxels become max(value - B, 0) before
+    /// rendering. Use -1024 for CT in Hounsfield units (air).
+    #[arg(long, allow_hyphen_values = true)]
+    pub(crate) background: Option<f64>,
+}
+
+impl Default for InputArgs {
+    fn default() -> Self {
+        Self {
+            raw_dims: None,
+            raw_type: SampleType::U8,
+            raw_endian: Endian::Little,
+            background: None,
+        }
+    }
+}
+
+impl InputArgs {
+    /// Load `spec` with a progress bar, then subtract the background.
+    pub(crate) fn load(&self, spec: &str) -> Result<fvr_host::volume::Volume, Error> {
+        let raw = self.raw_dims.map(|dims| RawLayout {
+            dims,
+            ty: self.raw_type,
+            endian: self.raw_endian,
+        });
+        let mut volume = load_with_progress(spec, raw)?;
+        if let Some(b) = self.background {
+            volume.subtract_background(b)?;
+        }
+        Ok(volume)
+    }
+}
+
+pub(crate) fn parse_percentiles(s: &str) -> Result<(f64, f64), String> {
+    let bad = || format!("expected percentiles LOW,HIGH with 0 <= LOW < HIGH <= 100, got `{s}`");
+    let (lo, hi) = s.split_once(',').ok_or_else(bad)?;
+    let lo = lo.trim().parse::<f64>().map_err(|_| bad())?;
+    let hi = hi.trim().parse::<f64>().map_err(|_| bad())?;
+    Window::from_percentiles(lo, hi).map_err(|_| bad())?;
+    Ok((lo, hi))
+}
+
+pub(crate) fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    let bad = || format!("expected three comma-separated numbers X,Y,Z, got `{s}`");
+    if parts.len() != 3 {
+        return Err(bad());
+    }
+    let mut v = [0.0; 3];
+    for (slot, p) in v.iter_mut().zip(parts) {
+        *slot = p.trim().parse::<f64>().map_err(|_| bad())?;
+        if !slot.is_finite() {
+            return Err(format!("vector components must be finite, got `{s}`"));
+        }
+    }
+    Ok(v)
+}
+
+pub(crate) fn parse_dims(s: &str) -> Result<[usize; 3], String> {
+    let v: Vec<usize> = s
+        .split(',')
+        .map(|p| p.trim().parse::<usize>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("expected sizes X,Y,Z, got `{s}`"))?;
+    match v.as_slice() {
+        [x, y, z] if *x > 0 && *y > 0 && *z > 0 => Ok([*x, *y, *z]),
+        _ => Err(format!("expected three positive sizes X,Y,Z, got `{s}`")),
+    }
+}
+
+pub(crate) fn parse_size(s: &str) -> Result<(usize, usize), String> {
+    let bad = || format!("expected W or WxH with positive integers, got `{s}`");
+    let (w, h) = match s.split_once(['x', 'X']) {
+        Some((w, h)) => (w, h),
+        None => (s, s),
+    };
+    let w = w.trim().parse::<usize>().map_err(|_| bad())?;
+    let h = h.trim().parse::<usize>().map_err(|_| bad())?;
+    if w == 0 || h == 0 {
+        return Err(bad());
+    }
+    Ok((w, h))
+}
+
+pub(crate) fn parse_filter(s: &str) -> Result<FilterKind, String> {
+    FilterKind::from_name(s).ok_or_else(|| {
+        format!("unknown filter `{s}`: expected nearest, linear, cubic, kb3, kb4, kb5 or kb6")
+    })
+}
+
+/// Load a volume with a progress bar on the bytes read.
+pub(crate) fn load_with_progress(
+    spec: &str,
+    raw: Option<RawLayout>,
+) -> Result<fvr_host::volume::Volume, Error> {
+    let bar = progress::bytes("loading");
+    let volume = load_volume_with_progress(spec, raw, &bar);
+    bar.finish_and_clear();
+    Ok(volume?)
+}
+
+/// Fit the filter and prepare the scene's spectra, with a spinner.
+pub(crate) fn prepare_scene_with_progress(
+    volume: &fvr_host::volume::Volume,
+    kind: FilterKind,
+    oversample: u32,
+    design: KbDesign,
+    precision: Precision,
+    scene: &Scene,
+) -> Result<(SceneSpectra, fvr_core::filter::Filter), Error> {
+    let bar = progress::spinner("fitting filter");
+    let result = (|| -> Result<_, Error> {
+        let filter = choose_filter(volume, kind, oversample, design)?;
+        bar.set_message(if scene.needs_gradient_spectrum() {
+            "preprocess (density and |grad f| spectra)"
+        } else {
+            "preprocess"
+        });
+        Ok((
+            SceneSpectra::prepare(volume, filter, precision, scene)?,
+            filter,
+        ))
+    })();
+    bar.finish_and_clear();
+    result
+}
+
+/// Fit the filter and prepare the spectrum, with a spinner (the core's
+/// preparation is one call with no progress of its own).
+pub(crate) fn prepare_with_progress(
+    volume: &fvr_host::volume::Volume,
+    kind: FilterKind,
+    oversample: u32,
+    design: KbDesign,
+    precision: Precision,
+) -> Result<AnySpectrum, Error> {
+    let bar = progress::spinner("fitting filter");
+    let result = (|| -> Result<_, Error> {
+        let filter = choose_filter(volume, kind, oversample, design)?;
+        bar.set_message("preprocess");
+        Ok(AnySpectrum::prepare(volume, filter, precision)?)
+    })();
+    bar.finish_and_clear();
+    result
+}
+
+pub(crate) fn volume_help() -> String {
+    format!(
+        "Volume: a file ({FORMATS_HELP}), a raw file (with --raw-dims), one of the {DATASETS_HELP}, or one of the {PHANTOM_HELP}"
+    )
+}

@@ -1,0 +1,198 @@
+//! `fvr`: frequency-domain volume rendering from the command line.
+
+mod accuracy;
+mod adaptive_report;
+mod adaptive_table;
+mod args;
+mod compare;
+mod growth;
+mod json;
+mod precision;
+mod render;
+mod scene;
+#[cfg(test)]
+mod tests;
+mod trade;
+mod turntable;
+
+use crate::accuracy::accuracy;
+use crate::adaptive_table::adaptive_table;
+use crate::args::{FrameArgs, InputArgs, PngArgs};
+use crate::compare::compare;
+use crate::render::{render, RenderArgs};
+use crate::scene::{apply_scene_to_render, given_on_command_line, merge_scene};
+use crate::turntable::{turntable, TurntableArgs};
+
+use std::path::Path;
+use std::process::ExitCode;
+
+/// Any error of a subcommand; `main` prints it as one line and exits 2.
+pub(crate) type Error = Box<dyn std::error::Error>;
+
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
+use fvr_core::geometry::DEFAULT_UP;
+use fvr_host::image::output::{Bits, Colormap};
+use fvr_host::progress;
+use fvr_host::render::scene_file::SceneFile;
+use fvr_host::render::shaded::DEFAULT_PROFILE_HARMONICS;
+
+const GEOMETRY: &str = "\
+GEOMETRY CONTRACT
+  Voxel (i,j,k) sits at (i,j,k); i is the fastest axis in files.
+  The rotation centre is c = (nx/2, ny/2, nz/2).
+  --dir d points from the eye into the scene; --up u0 defaults to 0,0,1.
+  right r = normalize(d x u0), up u = r x d.
+  Pixel (col,row), row 0 at the top, of a W x H image sits at
+  p = c + (col - W/2) r + (H/2 - row) u, and its value is the line integral
+  of the band-limited interpolant of the voxels along p + t d, in voxel units.
+  A zero d or u0, or u0 parallel to d, is an error.
+
+PHYSICAL UNITS (fvr render, fvr turntable)
+  By default fvr uses the volume's voxel spacing D (mm, from the
+  file; 1,1,1 when it gives none) and a pixel size P (--pixel-size, mm):
+  voxel (i,j,k) sits at (i Dx, j Dy, k Dz), the centre is C = (n/2) D, pixel
+  (col,row) sits at C + (col - W/2) P r + (H/2 - row) P u with r, u, d unit
+  vectors in mm, and its value is the line integral in mm (mm x volume
+  units). This is exact in the frequency domain: the slice is taken at index
+  frequencies k r_a D_a/P and scaled by Dx Dy Dz/P^2. --ignore-spacing gives
+  the voxel-unit contract above. Depth cues and lights need cubic voxels
+  imaged at their own size (--resample N makes them so).
+
+EXIT STATUS
+  0  success (also for --help and --version)
+  2  any error: bad arguments, unreadable or malformed input, a render that
+     cannot be done; the reason is printed on stderr as `fvr: error: ...`
+     (argument errors are explained by the parser, with a usage line).
+
+Progress bars go to stderr only when it is a terminal; --quiet turns them off.";
+
+/// Frequency-domain volume rendering (Totsuka & Levoy 1993): X-ray
+/// projections, depth cueing and shading from a 16-bit Hartley spectrum.
+/// With no subcommand, renders the built-in default scene to
+/// `fvr-default.png`: the Utah teapot lit by three coloured lights, as
+/// `fvr render teapot@128 --dir 0.3,1,-0.45 --light-ring 3 --ambient 0.1
+/// --out fvr-default.png --stats`.
+#[derive(Parser)]
+#[command(name = "fvr", version, after_help = GEOMETRY)]
+pub(crate) struct Cli {
+    /// No progress bars (they are shown only when stderr is a terminal anyway).
+    #[arg(long, global = true)]
+    quiet: bool,
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+pub(crate) enum Command {
+    /// Render the projection of a volume along a view direction.
+    #[command(after_help = GEOMETRY)]
+    Render(Box<RenderArgs>),
+    /// Render a turntable animation (APNG): one preprocessing pass, then
+    /// FRAMES X-ray views on a full turn about the up axis.
+    #[command(after_help = GEOMETRY)]
+    Turntable(TurntableArgs),
+    /// Print the SNR in dB of image B against reference image A (NRRD files).
+    Compare(crate::compare::CompareArgs),
+    /// Measure accuracy against exact line integrals of the Gaussian-mixture
+    /// phantom and print the Markdown table quoted in the README.
+    Accuracy(crate::accuracy::AccuracyArgs),
+    /// The precision study: SNR of every storage format and arithmetic
+    /// against the f64 pipeline and exact line integrals, with bytes per
+    /// voxel; writes a Markdown table, a CSV and a PNG plot.
+    Precision(crate::precision::PrecisionArgs),
+    /// The speed-accuracy map: time per view, SNR against exact line
+    /// integrals and memory held over filter, oversampling, storage format,
+    /// adaptive tolerance, progressive level and volume size, on the
+    /// Gaussian-mixture phantom; writes trade.csv, trade.png (dB against ms,
+    /// Pareto fronts) and trade.md (the settings on each front).
+    Trade(crate::trade::TradeArgs),
+    /// How the time per view grows with the volume's side: the kb3 f16
+    /// frequency-domain view against the f32 ray caster (both on all cores),
+    /// medians of RUNS views per size; writes growth.csv, growth.md and a
+    /// log-log growth.png, and prints the Markdown (with the growth per
+    /// doubling against the n² log n ratio).
+    Growth(crate::growth::GrowthArgs),
+    /// The paper's Table 1 measured here: filter taps and time per view with
+    /// and without adaptive filtering, and the spatial-domain ray caster, on
+    /// the CT head (resampled to 128 along its longest side), a 256³ volume
+    /// and a phantom. Prints Markdown.
+    AdaptiveTable(crate::adaptive_table::AdaptiveTableArgs),
+}
+
+fn main() -> ExitCode {
+    let matches = Cli::command().get_matches();
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    progress::set_quiet(cli.quiet);
+    let given = |sub: &str, id: &str| {
+        matches
+            .subcommand_matches(sub)
+            .is_some_and(|m| given_on_command_line(m, id))
+    };
+    let result = match cli.command {
+        None => default_scene(),
+        Some(Command::Render(mut args)) => {
+            merge_scene(&mut *args, &|id| given("render", id)).and_then(|()| render(&args))
+        }
+        Some(Command::Turntable(mut args)) => {
+            merge_scene(&mut args, &|id| given("turntable", id)).and_then(|()| turntable(&args))
+        }
+        Some(Command::Compare(args)) => compare(&args),
+        Some(Command::Accuracy(args)) => accuracy(&args),
+        Some(Command::AdaptiveTable(args)) => adaptive_table(&args),
+        Some(Command::Precision(args)) => crate::precision::run(&args),
+        Some(Command::Trade(args)) => crate::trade::run(&args),
+        Some(Command::Growth(args)) => crate::growth::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("fvr: error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// The scene `fvr` renders with no subcommand (output relative to the
+/// working directory).
+pub(crate) const DEFAULT_SCENE: &str = include_str!("../../default-scene.toml");
+
+fn default_scene() -> Result<(), Error> {
+    let mut args = RenderArgs {
+        volume: None,
+        scene: None,
+        dir: None,
+        up: DEFAULT_UP,
+        frame: FrameArgs::default(),
+        depth_cue: "none".into(),
+        cue_harmonics: DEFAULT_PROFILE_HARMONICS,
+        ambient: None,
+        lights: Vec::new(),
+        light_ring: None,
+        no_cue_correction: false,
+        out: None,
+        png: PngArgs {
+            bits: Bits::Eight,
+            window: None,
+            level: None,
+            percentiles: fvr_host::image::AUTO_WINDOW_PERCENTILES,
+            colormap: Colormap::Gray,
+        },
+        stats: true,
+        resample: None,
+        stats_json: false,
+        adaptive: None,
+        adaptive_chain: "nearest".into(),
+        adaptive_hd: None,
+        adaptive_bound: None,
+        preview_level: 0,
+        exact: false,
+        input: InputArgs::default(),
+    };
+    let scene = SceneFile::parse(DEFAULT_SCENE, "the default scene", Path::new(""))?;
+    apply_scene_to_render(&mut args, &scene, &|_| false);
+    println!(
+        "fvr: rendering the default scene: the Utah teapot lit by red, green and blue lights \
+         120 degrees apart, as in the paper's figure 8 (run `fvr --help` for options)"
+    );
+    render(&args)
+}

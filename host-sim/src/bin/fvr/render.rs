@@ -1,0 +1,602 @@
+//! `fvr render`: one view of a volume, X-ray, depth-cued or shaded.
+
+use crate::adaptive_report::adaptive_render;
+use crate::args::{
+    parse_vec3, prepare_scene_with_progress, volume_help, FrameArgs, InputArgs, PngArgs,
+};
+use crate::scene::SCENE_HELP;
+use crate::Error;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use fvr_core::filter::Filter;
+use fvr_host::image::Image;
+use fvr_host::render::shaded::SceneSpectra;
+use fvr_host::volume::Volume;
+use serde::Serialize;
+use serde_json::value::RawValue;
+
+use crate::adaptive_report::{AdaptiveJson, AdaptiveReport};
+use crate::json::{debug_triple, one_line};
+
+use clap::Args;
+use fvr_core::geometry::{Sampling, View};
+use fvr_core::shading::{Light, Scene, MAX_LIGHTS};
+use fvr_host::image::output::write_png;
+use fvr_host::reference::shaded::exact_scene_projection_sampled;
+use fvr_host::reference::{exact_projection_sampled, snr_db};
+use fvr_host::render::adaptive::{parse_chain, parse_tolerance, AdaptiveSettings, Bound};
+use fvr_host::render::shaded::{
+    light_ring, negative_cue_share, parse_depth_cue, parse_light, parse_light_ring, parse_rgb,
+    SceneRenderer, DEFAULT_PROFILE_HARMONICS, DEPTH_CUE_HELP,
+};
+use fvr_host::render::spectrum::Precision;
+use fvr_host::sources::phantom_by_name;
+
+/// Below this estimated storage SNR the renderer warns (see
+/// `OwnedSpectrum::storage_snr_estimate_db`).
+pub(crate) const STORAGE_SNR_WARNING_DB: f64 = 50.0;
+
+/// Above this share of negatively weighted density (−30 dB) a depth cue
+/// warns (see `negative_cue_share`).
+pub(crate) const NEGATIVE_CUE_WARNING_SHARE: f64 = 1e-3;
+
+#[derive(Args)]
+pub(crate) struct RenderArgs {
+    /// A volume file, a raw file with --raw-dims, a data set, or a built-in phantom.
+    #[arg(help = volume_help(), required_unless_present = "scene")]
+    pub(crate) volume: Option<String>,
+    /// Scene file (TOML) with any of the settings below; flags given on the
+    /// command line override the scene's values.
+    #[arg(long, value_name = "FILE.toml", long_help = SCENE_HELP)]
+    pub(crate) scene: Option<PathBuf>,
+    /// View direction X,Y,Z, from the eye into the scene.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, required_unless_present = "scene")]
+    pub(crate) dir: Option<[f64; 3]>,
+    /// Up hint X,Y,Z.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,1")]
+    pub(crate) up: [f64; 3],
+    #[command(flatten)]
+    pub(crate) frame: FrameArgs,
+    /// Depth cue: none, linear:FRONT,BACK, sine:FRONT,BACK, profile:W0,W1,...,
+    /// profile:@FILE or profile:gauss:C,S (details with --help).
+    #[arg(long, default_value = "none", long_help = DEPTH_CUE_HELP)]
+    pub(crate) depth_cue: String,
+    /// Cosine harmonics fitted to a profile depth cue (1 to 16).
+    #[arg(long, default_value_t = DEFAULT_PROFILE_HARMONICS)]
+    pub(crate) cue_harmonics: usize,
+    /// Ambient colour R,G,B or one grey value (paper eq. 7). Default: 1 without
+    /// lights, 0.2 with.
+    #[arg(long, value_parser = parse_rgb)]
+    pub(crate) ambient: Option<[f64; 3]>,
+    /// A directional light X,Y,Z:R,G,B: the direction towards the light and
+    /// its colour (or one grey value). Repeatable, up to 8. Surfaces of denser
+    /// structures that face a light are lit (hemispherical model, eq. 8-11).
+    #[arg(long = "light", value_parser = parse_light, allow_hyphen_values = true)]
+    pub(crate) lights: Vec<Light>,
+    /// N lights evenly spaced around the view axis (as in the paper's figure
+    /// 8), saturated colours evenly spaced in hue (3: red at the top, green,
+    /// blue), tilted TILT degrees towards the eye (default 30). Added to any
+    /// --light.
+    #[arg(long, value_name = "N[:TILT]", value_parser = parse_light_ring)]
+    pub(crate) light_ring: Option<(usize, f64)>,
+    /// Leave out the eq. 14 correction when depth cueing and shading are
+    /// combined (only to see what it fixes).
+    #[arg(long)]
+    pub(crate) no_cue_correction: bool,
+    /// Output file: .nrrd (float32; sizes W H, or 3 W H for RGB) or .png
+    /// (grey: windowed, see --bits, --window/--level, --percentiles and
+    /// --colormap; RGB: 8-bit, one percentile window over all channels).
+    #[arg(long, required_unless_present = "scene")]
+    pub(crate) out: Option<PathBuf>,
+    #[command(flatten)]
+    pub(crate) png: PngArgs,
+    /// Print timing, memory and filter details.
+    #[arg(long)]
+    pub(crate) stats: bool,
+    /// Resample to cubic voxels with N samples along the longest physical
+    /// side (trilinear) before rendering. X-ray views of anisotropic data
+    /// such as CT (0.957 x 0.957 x 1.5 mm) are exact without it; depth cues
+    /// and lights need it.
+    #[arg(long, value_name = "N")]
+    pub(crate) resample: Option<usize>,
+    /// Print the statistics as one JSON object instead (implies --stats).
+    #[arg(long)]
+    pub(crate) stats_json: bool,
+    /// Adaptive filtering (paper §4): use a cheaper filter wherever the
+    /// spectrum is weak, keeping the image within DB decibels of the
+    /// full-filter image (eq. 16). Plain X-ray views only.
+    #[arg(long, value_name = "DB", value_parser = parse_tolerance, allow_hyphen_values = true)]
+    pub(crate) adaptive: Option<f64>,
+    /// The cheaper filters of --adaptive, cheapest first (1 or 2 of nearest,
+    /// linear, cubic, kb3, ...; each narrower than --filter).
+    #[arg(long, default_value = "nearest")]
+    pub(crate) adaptive_chain: String,
+    /// Use this response difference h_d in eq. 16 instead of the one computed
+    /// for the filter pair (the paper used 0.3); implies --adaptive-bound
+    /// paper. A smaller value than the filters' own voids the guarantee;
+    /// --stats then shows the SNR reached.
+    #[arg(long, value_name = "H")]
+    pub(crate) adaptive_hd: Option<f64>,
+    /// How --adaptive turns decibels into a magnitude threshold: `exact`
+    /// measures the error field of eq. 15 (one 3D inverse transform per
+    /// candidate threshold, about 8, once per volume); `paper` uses eq. 16
+    /// with the worst-case response difference h_d (instant, but loose).
+    /// Default: `exact`, or `paper` when --adaptive-hd is given.
+    #[arg(long, value_name = "BOUND", value_parser = Bound::from_name)]
+    pub(crate) adaptive_bound: Option<Bound>,
+    /// Progressive preview level: 0 full resolution; L renders the image at
+    /// 1/2^L of the size from the central 1/4^L of the slice (4^L times fewer
+    /// interpolations). Plain X-ray views only. (`--level` is the PNG
+    /// window level, as in radiology viewers.)
+    #[arg(long, value_name = "L", default_value_t = 0)]
+    pub(crate) preview_level: u32,
+    /// For a built-in phantom, also print the SNR against its exact line integrals.
+    #[arg(long)]
+    pub(crate) exact: bool,
+    #[command(flatten)]
+    pub(crate) input: InputArgs,
+}
+
+impl RenderArgs {
+    pub(crate) fn volume_spec(&self) -> Result<&str, Error> {
+        self.volume.as_deref().ok_or_else(|| {
+            "no volume: give VOLUME, or `volume.path` or `volume.builtin` in the scene".into()
+        })
+    }
+
+    pub(crate) fn view(&self) -> Result<View, Error> {
+        let dir = self.dir.ok_or_else(|| {
+            "no view direction: give --dir, or `camera.dir` in the scene".to_string()
+        })?;
+        Ok(View { dir, up: self.up })
+    }
+
+    pub(crate) fn out_path(&self) -> Result<&Path, Error> {
+        self.out
+            .as_deref()
+            .ok_or_else(|| "no output file: give --out, or `output.path` in the scene".into())
+    }
+}
+
+pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
+    let out = args.out_path()?;
+    let volume_spec = args.volume_spec()?;
+    let ext = out.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if ext != "png" && ext != "nrrd" {
+        return Err(format!("output `{}` must end in .png or .nrrd", out.display()).into());
+    }
+    let view = args.view()?;
+    view.frame()?;
+    let style = args.png.style()?;
+    let t0 = Instant::now();
+    let mut volume = args.input.load(volume_spec)?;
+    if let Some(largest) = args.resample {
+        volume = volume.resample_isotropic(largest)?;
+    }
+    let t_load = t0.elapsed();
+    let scene = build_scene(args)?;
+    let t1 = Instant::now();
+    let (spectra, filter) = prepare_scene_with_progress(
+        &volume,
+        args.frame.spectrum.filter,
+        args.frame.spectrum.oversample,
+        args.frame.spectrum.kb_design,
+        args.frame.spectrum.precision,
+        &scene,
+    )?;
+    let t_prep = t1.elapsed();
+    let volume_sum: f64 = volume.data.iter().map(|&v| v as f64).sum();
+    let storage_snr = spectra.density.storage_snr_estimate_db(volume_sum);
+    if storage_snr < STORAGE_SNR_WARNING_DB {
+        eprintln!(
+            "fvr: warning: premultiplying for {} at oversample {} amplifies this volume's edges; \
+             the {} spectrum is estimated to hold only {storage_snr:.1} dB. \
+             Use --oversample 2, --filter cubic, or --precision f32.",
+            args.frame.spectrum.filter.name(),
+            args.frame.spectrum.oversample,
+            args.frame.spectrum.precision
+        );
+    }
+    let (lowest, share) = negative_cue_share(&volume, &scene, &view)?;
+    if share > NEGATIVE_CUE_WARNING_SHARE {
+        eprintln!(
+            "fvr: warning: the depth cue is given between t = -R and +R; extrapolated beyond, \
+             into the volume's corners on this view, it falls to {lowest:.3}, and {:.2}% of the \
+             weighted density counts negatively. Raise the smaller of FRONT and BACK to avoid it.",
+            100.0 * share
+        );
+    }
+    let n = spectra.density.n();
+    let default_side = n / args.frame.spectrum.oversample as usize;
+    let (w, h) = args.frame.size.unwrap_or((default_side, default_side));
+    let sampling = args.frame.units.sampling(&volume, n, default_side)?;
+    let plain_view = scene.channels() == 1 && !scene.has_partner_terms();
+    if (args.preview_level > 0 || args.adaptive.is_some()) && !plain_view {
+        return Err(
+            "--preview-level and --adaptive work on plain X-ray views: leave out --depth-cue, \
+                    --light, --light-ring and a coloured --ambient"
+                .into(),
+        );
+    }
+    if args.preview_level > 0 && args.adaptive.is_some() {
+        return Err("--preview-level and --adaptive cannot be combined: choose one".into());
+    }
+    // Cubic voxels imaged at their own size read the slice along the frame's
+    // own axes: only the gain ΔV/p² = Δ differs from voxel units.
+    if args.adaptive.is_some() && sampling.uniform_pitch().is_none() {
+        return Err(format!(
+            "--adaptive needs cubic voxels imaged at their own size (or voxel units), and this \
+             render uses {} mm voxels and {} mm pixels: add --resample N, drop --pixel-size, \
+             or add --ignore-spacing",
+            fmt_spacing(sampling.spacing()),
+            sampling.pixel_size()
+        )
+        .into());
+    }
+    let mut adaptive_report = None;
+    let t2 = Instant::now();
+    let (image, w, h) = if args.preview_level > 0 {
+        let (pw, ph) = fvr_core::render::preview_size(w, h, args.preview_level);
+        let data =
+            spectra
+                .density
+                .render_level_sampled(&view, &sampling, pw, ph, args.preview_level)?;
+        (
+            fvr_host::image::Image {
+                channels: 1,
+                width: pw,
+                height: ph,
+                data: data.into_iter().map(|v| v * scene.ambient[0]).collect(),
+            },
+            pw,
+            ph,
+        )
+    } else if let Some(tolerance) = args.adaptive {
+        let settings = AdaptiveSettings {
+            tolerance_db: tolerance,
+            chain: parse_chain(&args.adaptive_chain)?,
+            h_d: args.adaptive_hd,
+            bound: args.adaptive_bound.unwrap_or(match args.adaptive_hd {
+                Some(_) => Bound::Paper,
+                None => Bound::Exact,
+            }),
+        };
+        let report = adaptive_render(&spectra.density, &view, w, h, &settings)?;
+        let gain = sampling.gain() * scene.ambient[0];
+        let data = report.image.iter().map(|v| v * gain).collect();
+        adaptive_report = Some(report);
+        (
+            fvr_host::image::Image {
+                channels: 1,
+                width: w,
+                height: h,
+                data,
+            },
+            w,
+            h,
+        )
+    } else {
+        let image = spectra.render_sampled(&scene, &view, &sampling, w, h)?;
+        (image, w, h)
+    };
+    let t_view = adaptive_report
+        .as_ref()
+        .map_or(t2.elapsed(), |r| r.view_time);
+    if ext == "png" {
+        if image.channels == 1 {
+            write_png(out, w, h, &image.data, &style)?;
+        } else {
+            image.write_png(out)?;
+        }
+    } else {
+        image.write_nrrd(out)?;
+    }
+    let kind = if image.channels == 1 { "grey" } else { "RGB" };
+    println!("wrote {} ({w}x{h} {kind})", out.display());
+    let rendered = Rendered {
+        args,
+        volume_spec,
+        volume,
+        view,
+        scene,
+        sampling,
+        spectra,
+        filter,
+        storage_snr,
+        image,
+        w,
+        h,
+        n,
+        t_load,
+        t_prep,
+        t_view,
+        adaptive_report,
+    };
+    if args.stats && !args.stats_json {
+        rendered.print_human()?;
+    }
+    if args.stats_json {
+        rendered.print_json();
+    }
+    if args.exact {
+        rendered.print_exact()?;
+    }
+    Ok(())
+}
+
+pub(crate) fn fmt_spacing(s: [f64; 3]) -> String {
+    format!("{} x {} x {}", s[0], s[1], s[2])
+}
+
+/// The scene from the command line: cue, ambient, lights.
+pub(crate) fn build_scene(args: &RenderArgs) -> Result<Scene, Error> {
+    let cue = parse_depth_cue(&args.depth_cue, args.cue_harmonics)?;
+    let mut lights = args.lights.clone();
+    if let Some((count, tilt)) = args.light_ring {
+        lights.extend(light_ring(&args.view()?, count, tilt)?);
+    }
+    let default_ambient = if lights.is_empty() { 1.0 } else { 0.2 };
+    let mut scene = Scene {
+        cue,
+        ambient: args.ambient.unwrap_or([default_ambient; 3]),
+        correct_cue_shading: !args.no_cue_correction,
+        ..Scene::xray()
+    };
+    if lights.len() > MAX_LIGHTS {
+        return Err(format!(
+            "{} lights given, but a scene holds at most {MAX_LIGHTS}",
+            lights.len()
+        )
+        .into());
+    }
+    for light in &lights {
+        scene.add_light(*light)?;
+    }
+    scene.validate()?;
+    Ok(scene)
+}
+
+/// `fvr render --stats-json`, in the order printed.
+#[derive(Serialize)]
+struct RenderStats<'a> {
+    volume: &'a str,
+    dims: [usize; 3],
+    spacing_mm: Box<RawValue>,
+    pixel_size: f64,
+    ignore_spacing: bool,
+    image: [usize; 3],
+    spectrum_side: usize,
+    precision: &'a str,
+    spectrum_bytes: usize,
+    gradient_spectrum_bytes: Option<usize>,
+    filter: &'a str,
+    oversample: u32,
+    storage_snr_db: f64,
+    load_ms: f64,
+    preprocess_ms: f64,
+    view_ms: f64,
+    preview_level: u32,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    adaptive: Option<AdaptiveJson>,
+}
+
+/// A finished render and what `--stats`, `--stats-json` and `--exact`
+/// report of it.
+struct Rendered<'a> {
+    args: &'a RenderArgs,
+    volume_spec: &'a str,
+    volume: Volume,
+    view: View,
+    scene: Scene,
+    sampling: Sampling,
+    spectra: SceneSpectra,
+    filter: Filter,
+    storage_snr: f64,
+    image: Image,
+    w: usize,
+    h: usize,
+    n: usize,
+    t_load: Duration,
+    t_prep: Duration,
+    t_view: Duration,
+    adaptive_report: Option<AdaptiveReport>,
+}
+
+impl Rendered<'_> {
+    /// `--stats`: sizes, memory, filter and timings, one per line.
+    fn print_human(&self) -> Result<(), Error> {
+        let &Rendered {
+            args,
+            volume_spec,
+            ref volume,
+            ref scene,
+            ref sampling,
+            ref spectra,
+            filter,
+            storage_snr,
+            w,
+            h,
+            n,
+            t_load,
+            t_prep,
+            t_view,
+            ref adaptive_report,
+            ..
+        } = self;
+        let d = volume.dims;
+        println!(
+            "  volume        {}x{}x{} ({})",
+            d[0], d[1], d[2], volume_spec
+        );
+        let [dx, dy, dz] = volume.spacing;
+        println!(
+            "  spacing       {dx} x {dy} x {dz} mm{}",
+            if args.frame.units.ignore_spacing {
+                " (ignored: --ignore-spacing, voxel units)"
+            } else {
+                ""
+            }
+        );
+        println!(
+            "  pixel size    {} {}",
+            sampling.pixel_size(),
+            if args.frame.units.ignore_spacing {
+                "voxel"
+            } else {
+                "mm (values in mm x volume units)"
+            }
+        );
+        println!(
+            "  spectrum      {n}^3 {} = {} bytes ({} bytes/voxel)",
+            args.frame.spectrum.precision,
+            spectra.density.bytes(),
+            args.frame.spectrum.precision.bytes()
+        );
+        match &spectra.gradient {
+            Some(g) => println!(
+                "  |grad f|      {} bytes (second spectrum, for the lights)",
+                g.bytes()
+            ),
+            None => println!("  |grad f|      not built (no light needs it)"),
+        }
+        let working = match args.frame.spectrum.precision {
+            Precision::F64 => SceneRenderer::<f64>::new(n, filter, scene).map(|r| r.bytes()),
+            _ => SceneRenderer::<f32>::new(n, filter, scene).map(|r| r.bytes()),
+        }?;
+        println!(
+            "  per view      {working} bytes ({} slice fields, tables, twiddles)",
+            scene.field_count()
+        );
+        println!("  held          {} bytes in all", spectra.bytes() + working);
+        let f = spectra.density.filter();
+        if f.kind().is_kaiser_bessel() {
+            println!(
+                "  filter        {} (oversample {}, beta {:.3})",
+                f.kind().name(),
+                f.oversample(),
+                f.beta()
+            );
+        } else {
+            println!(
+                "  filter        {} (oversample {})",
+                f.kind().name(),
+                f.oversample()
+            );
+        }
+        println!("  storage SNR   {storage_snr:.1} dB (estimate, against the f64 pipeline)");
+        println!("  load          {:.1} ms", t_load.as_secs_f64() * 1e3);
+        println!("  preprocess    {:.1} ms", t_prep.as_secs_f64() * 1e3);
+        println!("  view          {:.2} ms", t_view.as_secs_f64() * 1e3);
+        if args.preview_level > 0 {
+            println!(
+                "  level         {} ({w}x{h} at pitch {} {}, central 1/{} of the slice)",
+                args.preview_level,
+                (1u64 << args.preview_level) as f64 * sampling.pixel_size(),
+                if *sampling == Sampling::UNIT {
+                    "voxels"
+                } else {
+                    "mm"
+                },
+                1u64 << (2 * args.preview_level)
+            );
+        }
+        if let Some(r) = &adaptive_report {
+            r.print_human();
+        }
+        Ok(())
+    }
+
+    /// `--stats-json`: the same as one JSON object.
+    fn print_json(&self) {
+        let &Rendered {
+            args,
+            volume_spec,
+            ref volume,
+            ref sampling,
+            ref spectra,
+            filter,
+            storage_snr,
+            ref image,
+            w,
+            h,
+            n,
+            t_load,
+            t_prep,
+            t_view,
+            ref adaptive_report,
+            ..
+        } = self;
+        let stats = RenderStats {
+            volume: volume_spec,
+            dims: volume.dims,
+            spacing_mm: debug_triple(volume.spacing),
+            pixel_size: sampling.pixel_size(),
+            ignore_spacing: args.frame.units.ignore_spacing,
+            image: [w, h, image.channels],
+            spectrum_side: n,
+            precision: args.frame.spectrum.precision.name(),
+            spectrum_bytes: spectra.density.bytes(),
+            gradient_spectrum_bytes: spectra.gradient.as_ref().map(|g| g.bytes()),
+            filter: filter.kind().name(),
+            oversample: filter.oversample(),
+            storage_snr_db: storage_snr,
+            load_ms: t_load.as_secs_f64() * 1e3,
+            preprocess_ms: t_prep.as_secs_f64() * 1e3,
+            view_ms: t_view.as_secs_f64() * 1e3,
+            preview_level: args.preview_level,
+            adaptive: adaptive_report.as_ref().map(AdaptiveReport::json),
+        };
+        println!("{}", one_line(&stats));
+    }
+
+    /// `--exact`: the SNR against the phantom's exact image, where there is one.
+    fn print_exact(&self) -> Result<(), Error> {
+        let &Rendered {
+            volume_spec,
+            ref volume,
+            ref view,
+            ref scene,
+            ref sampling,
+            ref image,
+            w,
+            h,
+            ..
+        } = self;
+        let plain = scene.channels() == 1 && !scene.has_partner_terms();
+        match phantom_by_name(volume_spec) {
+            Some(Ok(p)) if plain => {
+                let exact = exact_projection_sampled(
+                    p.phantom.as_ref(),
+                    volume.dims,
+                    view,
+                    sampling,
+                    w,
+                    h,
+                )?;
+                let ambient = scene.ambient[0];
+                let exact: Vec<f64> = exact.iter().map(|v| v * ambient).collect();
+                println!("  SNR vs exact  {:.2} dB", snr_db(&exact, &image.data));
+            }
+            Some(Ok(p)) => match p.phantom.as_gaussian_mixture() {
+                Some(mixture) => {
+                    let exact = exact_scene_projection_sampled(
+                        mixture,
+                        volume.dims,
+                        sampling,
+                        scene,
+                        view,
+                        (w, h),
+                        0.05,
+                    )?;
+                    println!("  SNR vs exact  {:.2} dB", snr_db(&exact.data, &image.data));
+                }
+                None => println!(
+                    "  SNR vs exact  n/a (cued or shaded references exist for gaussians only)"
+                ),
+            },
+            _ => println!("  SNR vs exact  n/a (not a built-in phantom)"),
+        }
+        Ok(())
+    }
+}

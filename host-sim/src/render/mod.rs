@@ -1,0 +1,10 @@
+//! The core with owned buffers on the host: the stored spectrum and view
+//! renderer, shaded renders, adaptive filtering, turntables and scene files.
+
+pub mod adaptive;
+pub mod filter;
+pub mod scene_file;
+pub mod shaded;
+pub mod spectrum;
+pub mod turntable;
+pub mod view;

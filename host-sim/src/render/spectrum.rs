@@ -1,0 +1,380 @@
+//! The owned spectrum: the core pipeline's spectrum with its buffers, for
+//! the host ([`ViewRenderer`] renders views of it, [`super::filter`] chooses
+//! its filter).
+//!
+//! Three precisions share the one generic core:
+//! - `f16`: spectrum stored as IEEE binary16 (2 bytes a voxel), f32 arithmetic;
+//! - `f32`: spectrum and arithmetic in f32;
+//! - `f64`: spectrum and arithmetic in f64 (the reference pipeline).
+
+use std::fmt;
+use std::str::FromStr;
+
+use fvr_core::dht::Twiddles;
+use fvr_core::filter::{Filter, KernelTable};
+use fvr_core::geometry::{Sampling, View};
+use fvr_core::image::aux_len;
+use fvr_core::num::{Real, Sample};
+use fvr_core::render::{render, Buffers, Request, Source};
+use fvr_core::spectrum::{prepare_scratch_len, Spectrum};
+use fvr_core::volume::{padded_size, DenseVolume};
+use half::f16;
+
+use crate::volume::Volume;
+
+pub use super::filter::{
+    choose_filter, choose_oversampling, premultiplication_gain_db, KbDesign, CONDITIONING_LIMIT_DB,
+};
+pub use super::view::ViewRenderer;
+
+/// Storage and arithmetic of a pipeline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Precision {
+    /// f16 storage, f32 arithmetic (the product).
+    F16,
+    /// f32 storage and arithmetic.
+    F32,
+    /// f64 storage and arithmetic (reference).
+    F64,
+}
+
+impl Precision {
+    /// Every precision.
+    pub const ALL: [Precision; 3] = [Precision::F16, Precision::F32, Precision::F64];
+
+    /// Command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Precision::F16 => "f16",
+            Precision::F32 => "f32",
+            Precision::F64 => "f64",
+        }
+    }
+
+    /// Bytes per stored coefficient.
+    pub fn bytes(self) -> usize {
+        match self {
+            Precision::F16 => 2,
+            Precision::F32 => 4,
+            Precision::F64 => 8,
+        }
+    }
+}
+
+impl fmt::Display for Precision {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Precision {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Precision::ALL
+            .into_iter()
+            .find(|p| p.name() == s)
+            .ok_or_else(|| format!("unknown precision `{s}`: expected f16, f32 or f64"))
+    }
+}
+
+/// An owned, prepared spectrum in storage format `S`.
+#[derive(Clone, Debug)]
+pub struct OwnedSpectrum<S> {
+    data: Vec<S>,
+    n: usize,
+    scale: f64,
+    filter: Filter,
+    dims: [usize; 3],
+}
+
+impl<S: Sample> OwnedSpectrum<S> {
+    /// Premultiply, pad and transform `volume` for `filter`, with arithmetic `T`.
+    ///
+    /// # Errors
+    /// As [`Spectrum::prepare`]; also a volume whose padded cube would not fit
+    /// in memory is refused before allocating.
+    pub fn prepare<T: Real>(volume: &Volume, filter: Filter) -> Result<Self, PipelineError> {
+        let n = padded_size(volume.dims, filter.oversample())?;
+        check_memory(n, std::mem::size_of::<S>())?;
+        let source = DenseVolume::new(volume.dims, &volume.data)?;
+        let mut data = vec![S::default(); n * n * n];
+        let mut scratch = vec![T::ZERO; prepare_scratch_len(n)];
+        let mut tw_buf = vec![T::ZERO; Twiddles::<T>::buffer_len(n)];
+        let tw = Twiddles::new(&mut tw_buf, n)?;
+        let spec = Spectrum::prepare(&source, filter, &mut data, &mut scratch, &tw)?;
+        let (scale, dims) = (spec.scale(), spec.dims());
+        Ok(Self {
+            data,
+            n,
+            scale,
+            filter,
+            dims,
+        })
+    }
+
+    /// Borrow as a core spectrum.
+    pub fn view(&self) -> Spectrum<'_, S> {
+        Spectrum::from_parts(&self.data, self.n, self.scale, self.filter, self.dims)
+            .expect("parts come from a prepared spectrum")
+    }
+
+    /// Side of the padded cube.
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
+    /// Bytes of stored coefficients.
+    pub fn bytes(&self) -> usize {
+        std::mem::size_of_val(self.data.as_slice())
+    }
+
+    /// The filter the volume was premultiplied for.
+    pub fn filter(&self) -> Filter {
+        self.filter
+    }
+
+    /// Estimated SNR (dB) of images against the same pipeline in f64, from
+    /// the storage format's rounding alone:
+    /// `(Σf)²/n² ÷ (r·u²/3 · Σg²)`.
+    ///
+    /// `g` is the premultiplied volume; `Σg² = Σ_k H_k²/n³` by Parseval,
+    /// read off the stored spectrum. Each of the `r = 4` roundings (input and
+    /// three passes) adds noise of relative variance `u²/3` (`u` the unit
+    /// roundoff) to every coefficient, and a slice inherits it; the image
+    /// energy is at least `(Σf)²/n²` by Cauchy–Schwarz. Premultiplication
+    /// that amplifies the volume's edges (Kaiser–Bessel at σ = 1 on data that
+    /// fills the grid) inflates `Σg²` and shows up here.
+    pub fn storage_snr_estimate_db(&self, volume_sum: f64, unit_roundoff: f64) -> f64 {
+        let n3 = (self.n * self.n * self.n) as f64;
+        let sum_sq: f64 = self
+            .data
+            .iter()
+            .map(|v| {
+                let x = v.to_f64() / self.scale;
+                x * x
+            })
+            .sum();
+        let g2 = sum_sq / n3;
+        let signal = volume_sum * volume_sum / (self.n * self.n) as f64;
+        let noise = 4.0 * unit_roundoff * unit_roundoff / 3.0 * g2;
+        10.0 * (signal / noise).log10()
+    }
+
+    /// Stored coefficients.
+    pub fn data(&self) -> &[S] {
+        &self.data
+    }
+
+    /// Scale of the stored values.
+    pub fn scale(&self) -> f64 {
+        self.scale
+    }
+}
+
+/// Why a host pipeline could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum PipelineError {
+    /// The core refused (bad view, bad size, non-finite voxel, ...).
+    #[error(transparent)]
+    Core(#[from] fvr_core::Error),
+    /// The padded spectrum would need more memory than is available.
+    #[error("a {n}^3 spectrum needs {needed} bytes, more than the {limit} bytes available")]
+    OutOfMemory {
+        /// Bytes the spectrum would need.
+        needed: u64,
+        /// Bytes available.
+        limit: u64,
+        /// Side of the padded cube.
+        n: usize,
+    },
+}
+
+/// Refuse a spectrum of side `n` whose storage and f32 working buffers would
+/// exceed the memory available, before allocating it.
+pub(crate) fn check_memory(n: usize, bytes_per_sample: usize) -> Result<(), PipelineError> {
+    let needed = (n as u64)
+        .checked_pow(3)
+        .and_then(|c| c.checked_mul(bytes_per_sample as u64))
+        .unwrap_or(u64::MAX);
+    let limit = crate::io::nrrd::memory_limit_bytes();
+    if needed > limit {
+        return Err(PipelineError::OutOfMemory { needed, limit, n });
+    }
+    Ok(())
+}
+
+/// A prepared spectrum in any of the three precisions.
+#[derive(Clone, Debug)]
+pub enum AnySpectrum {
+    /// f16 storage.
+    F16(OwnedSpectrum<f16>),
+    /// f32 storage.
+    F32(OwnedSpectrum<f32>),
+    /// f64 storage.
+    F64(OwnedSpectrum<f64>),
+}
+
+impl AnySpectrum {
+    /// Prepare `volume` at `precision` for `filter`.
+    ///
+    /// # Errors
+    /// As [`OwnedSpectrum::prepare`].
+    pub fn prepare(
+        volume: &Volume,
+        filter: Filter,
+        precision: Precision,
+    ) -> Result<Self, PipelineError> {
+        Ok(match precision {
+            Precision::F16 => AnySpectrum::F16(OwnedSpectrum::prepare::<f32>(volume, filter)?),
+            Precision::F32 => AnySpectrum::F32(OwnedSpectrum::prepare::<f32>(volume, filter)?),
+            Precision::F64 => AnySpectrum::F64(OwnedSpectrum::prepare::<f64>(volume, filter)?),
+        })
+    }
+
+    /// Side of the padded cube.
+    pub fn n(&self) -> usize {
+        match self {
+            AnySpectrum::F16(s) => s.n(),
+            AnySpectrum::F32(s) => s.n(),
+            AnySpectrum::F64(s) => s.n(),
+        }
+    }
+
+    /// Bytes of stored coefficients.
+    pub fn bytes(&self) -> usize {
+        match self {
+            AnySpectrum::F16(s) => s.bytes(),
+            AnySpectrum::F32(s) => s.bytes(),
+            AnySpectrum::F64(s) => s.bytes(),
+        }
+    }
+
+    /// The filter the spectrum was premultiplied for.
+    pub fn filter(&self) -> Filter {
+        match self {
+            AnySpectrum::F16(s) => s.filter(),
+            AnySpectrum::F32(s) => s.filter(),
+            AnySpectrum::F64(s) => s.filter(),
+        }
+    }
+
+    /// [`OwnedSpectrum::storage_snr_estimate_db`] for this precision's unit
+    /// roundoff (`+∞` for f64, the reference).
+    pub fn storage_snr_estimate_db(&self, volume_sum: f64) -> f64 {
+        match self {
+            AnySpectrum::F16(s) => s.storage_snr_estimate_db(volume_sum, 2f64.powi(-11)),
+            AnySpectrum::F32(s) => s.storage_snr_estimate_db(volume_sum, 2f64.powi(-24)),
+            AnySpectrum::F64(_) => f64::INFINITY,
+        }
+    }
+
+    /// Render one view; the image comes back in f64 whatever the precision.
+    ///
+    /// # Errors
+    /// As [`fvr_core::render::render`].
+    pub fn render(
+        &self,
+        view: &View,
+        width: usize,
+        height: usize,
+    ) -> Result<Vec<f64>, fvr_core::Error> {
+        self.render_sampled(view, &Sampling::UNIT, width, height)
+    }
+
+    /// [`AnySpectrum::render`] in physical units: voxel spacing and pixel
+    /// size from `sampling`, values in mm × volume units.
+    ///
+    /// # Errors
+    /// As [`fvr_core::render::render_sampled`].
+    pub fn render_sampled(
+        &self,
+        view: &View,
+        sampling: &Sampling,
+        width: usize,
+        height: usize,
+    ) -> Result<Vec<f64>, fvr_core::Error> {
+        fn go<S: Sample, T: Real>(
+            s: &OwnedSpectrum<S>,
+            view: &View,
+            sampling: &Sampling,
+            w: usize,
+            h: usize,
+        ) -> Result<Vec<f64>, fvr_core::Error> {
+            let mut r = ViewRenderer::<T>::new(s.n(), s.filter());
+            let mut out = vec![T::ZERO; w * h];
+            r.render_sampled_into(s, view, sampling, w, h, &mut out)?;
+            Ok(out.into_iter().map(T::to_f64).collect())
+        }
+        match self {
+            AnySpectrum::F16(s) => go::<_, f32>(s, view, sampling, width, height),
+            AnySpectrum::F32(s) => go::<_, f32>(s, view, sampling, width, height),
+            AnySpectrum::F64(s) => go::<_, f64>(s, view, sampling, width, height),
+        }
+    }
+
+    /// The progressive preview at `level` ([`fvr_core::progressive`]):
+    /// a `width × height` image at pitch `2^level` voxels.
+    ///
+    /// # Errors
+    /// As [`fvr_core::render::render_level`].
+    pub fn render_level(
+        &self,
+        view: &View,
+        width: usize,
+        height: usize,
+        level: u32,
+    ) -> Result<Vec<f64>, fvr_core::Error> {
+        self.render_level_sampled(view, &Sampling::UNIT, width, height, level)
+    }
+
+    /// [`AnySpectrum::render_level`] in physical units: pixels
+    /// `2^level·sampling.pixel_size()` mm apart.
+    ///
+    /// # Errors
+    /// As [`fvr_core::render::render_level_sampled`].
+    pub fn render_level_sampled(
+        &self,
+        view: &View,
+        sampling: &Sampling,
+        width: usize,
+        height: usize,
+        level: u32,
+    ) -> Result<Vec<f64>, fvr_core::Error> {
+        fn go<S: Sample, T: Real>(
+            s: &OwnedSpectrum<S>,
+            view: &View,
+            sampling: &Sampling,
+            w: usize,
+            h: usize,
+            level: u32,
+        ) -> Result<Vec<f64>, fvr_core::Error> {
+            let n = s.n();
+            let m = (n >> level.min(usize::BITS - 1)).max(1);
+            let mut tw_buf = vec![T::ZERO; Twiddles::<T>::buffer_len(n)];
+            let tw = Twiddles::new(&mut tw_buf, n)?;
+            let kernel = KernelTable::<T>::new(s.filter());
+            let mut grid = vec![T::ZERO; m * m];
+            let mut aux = vec![T::ZERO; aux_len(m)];
+            let mut out = vec![T::ZERO; w * h];
+            render(
+                &Source::new(&s.view(), &kernel, &tw),
+                &Request {
+                    sampling: *sampling,
+                    level,
+                    ..Request::new(*view, w, h)
+                },
+                Buffers {
+                    grid: &mut grid,
+                    aux: &mut aux,
+                    out: &mut out,
+                },
+            )?;
+            Ok(out.into_iter().map(T::to_f64).collect())
+        }
+        match self {
+            AnySpectrum::F16(s) => go::<_, f32>(s, view, sampling, width, height, level),
+            AnySpectrum::F32(s) => go::<_, f32>(s, view, sampling, width, height, level),
+            AnySpectrum::F64(s) => go::<_, f64>(s, view, sampling, width, height, level),
+        }
+    }
+}

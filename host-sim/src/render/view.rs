@@ -1,0 +1,135 @@
+//! Reusable per-view buffers: one extraction and one 2D inverse transform
+//! per view, no allocation after the first.
+
+use fvr_core::dht::Twiddles;
+use fvr_core::filter::{Filter, KernelTable};
+use fvr_core::geometry::{Sampling, View};
+use fvr_core::image::{aux_len, check_image, finish, grid_len, placement_on_axes, Crop};
+use fvr_core::num::{Real, Sample};
+use fvr_core::render::{render, Buffers, Request, Source};
+use fvr_core::slice::extract_slice_rows;
+
+use super::spectrum::OwnedSpectrum;
+
+/// Reusable per-view buffers and tables for arithmetic `T`.
+#[derive(Debug)]
+pub struct ViewRenderer<T> {
+    kernel: KernelTable<T>,
+    tw: Vec<T>,
+    grid: Vec<T>,
+    aux: Vec<T>,
+    n: usize,
+    threads: usize,
+}
+
+impl<T: Real> ViewRenderer<T> {
+    /// Buffers for spectra of side `n` and `filter`.
+    pub fn new(n: usize, filter: Filter) -> Self {
+        let mut tw = vec![T::ZERO; Twiddles::<T>::buffer_len(n)];
+        Twiddles::new(&mut tw, n).expect("n is a power of two");
+        Self {
+            kernel: KernelTable::new(filter),
+            tw,
+            grid: vec![T::ZERO; grid_len(n)],
+            aux: vec![T::ZERO; aux_len(n)],
+            n,
+            threads: 0,
+        }
+    }
+
+    /// Extract the slice on `threads` threads (0, the default: one per
+    /// core). The image is the same bit for bit whatever the count.
+    pub fn with_threads(mut self, threads: usize) -> Self {
+        self.threads = threads;
+        self
+    }
+
+    /// Render one view into `out` (`width × height`, row 0 at the top).
+    ///
+    /// The slice is extracted in blocks of rows on the renderer's threads
+    /// ([`fvr_core::slice::extract_slice_rows`]; the core stays
+    /// single-threaded), then inverse-transformed on this one.
+    ///
+    /// # Errors
+    /// As [`fvr_core::render::render`].
+    pub fn render_into<S: Sample>(
+        &mut self,
+        spec: &OwnedSpectrum<S>,
+        view: &View,
+        width: usize,
+        height: usize,
+        out: &mut [T],
+    ) -> Result<(), fvr_core::Error> {
+        self.render_sampled_into(spec, view, &Sampling::UNIT, width, height, out)
+    }
+
+    /// [`ViewRenderer::render_into`] in physical units
+    /// ([`fvr_core::render::render_sampled`]).
+    ///
+    /// # Errors
+    /// As [`fvr_core::render::render_sampled`].
+    pub fn render_sampled_into<S: Sample>(
+        &mut self,
+        spec: &OwnedSpectrum<S>,
+        view: &View,
+        sampling: &Sampling,
+        width: usize,
+        height: usize,
+        out: &mut [T],
+    ) -> Result<(), fvr_core::Error> {
+        let tw = Twiddles::from_table(&self.tw, self.n)?;
+        let spec = spec.view();
+        let n = spec.n();
+        let threads = match self.threads {
+            0 => std::thread::available_parallelism().map_or(1, |t| t.get()),
+            t => t,
+        };
+        // Blocks of at least 16 rows: below that a thread costs more than it saves.
+        let blocks = threads.min(n / 16).max(1);
+        if blocks == 1 || self.grid.len() != grid_len(n) || self.kernel.filter() != spec.filter() {
+            return render(
+                &Source::new(&spec, &self.kernel, &tw),
+                &Request {
+                    sampling: *sampling,
+                    ..Request::new(*view, width, height)
+                },
+                Buffers {
+                    grid: &mut self.grid,
+                    aux: &mut self.aux,
+                    out,
+                },
+            )
+            .map(|_| ());
+        }
+        let axes = sampling.slice_axes(&view.frame()?);
+        check_image(width, height, n)?;
+        let rows_per_block = n.div_ceil(blocks);
+        let kernel = &self.kernel;
+        let spec_ref = &spec;
+        let axes_ref = &axes;
+        std::thread::scope(|scope| {
+            let workers: Vec<_> = self
+                .grid
+                .chunks_mut(rows_per_block * n)
+                .enumerate()
+                .map(|(block, rows)| {
+                    scope.spawn(move || {
+                        extract_slice_rows(spec_ref, kernel, axes_ref, block * rows_per_block, rows)
+                    })
+                })
+                .collect();
+            workers
+                .into_iter()
+                .try_for_each(|w| w.join().expect("an extraction thread panicked"))
+        })?;
+        let place = placement_on_axes(spec.dims(), &axes, width, height, 1.0);
+        finish(
+            &mut self.grid,
+            n,
+            &Crop::new(place, sampling.gain() / spec.scale(), width, height),
+            &tw,
+            &mut self.aux,
+            out,
+        )
+    }
+}

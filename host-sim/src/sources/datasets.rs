@@ -1,0 +1,106 @@
+//! Named real data sets: `brainsmall` (embedded) and `ct-head` (installed).
+//!
+//! - `brainsmall`: VolPack's 128 × 128 × 84 MRI head (BSD-3, see
+//!   `host-sim/tests/data/README.md`), embedded in the binary as `.den.gz`.
+//! - `ct-head`: InVesalius' `Cranium.inv3`, a 256 × 256 × 108 CT head with
+//!   0.957 × 0.957 × 1.5 mm voxels (GPL-2, never committed). It is found at
+//!   `$FVR_CT_HEAD` if set, else where Debian's `invesalius-examples`
+//!   installs it; `scripts/fetch-ct-head.sh` installs it.
+//!
+//! Other modules get either with [`crate::sources::load_volume`]`("ct-head", None)`,
+//! or [`load_dataset`].
+
+use std::path::{Path, PathBuf};
+
+use indicatif::ProgressBar;
+
+use crate::io::den::parse_den;
+use crate::io::read_volume_with_progress;
+use crate::volume::Volume;
+
+/// Environment variable that points at the CT head's `.inv3` file.
+pub const CT_HEAD_ENV: &str = "FVR_CT_HEAD";
+
+/// Where Debian's `invesalius-examples` installs the CT head.
+pub const CT_HEAD_DEBIAN_PATH: &str = "/usr/share/doc/invesalius-examples/examples/Cranium.inv3";
+
+/// Sizes `[x, y, z]` of the CT head.
+pub const CT_HEAD_DIMS: [usize; 3] = [256, 256, 108];
+
+/// Voxel spacing of the CT head in mm, from its `main.plist`.
+pub const CT_HEAD_SPACING: [f64; 3] = [0.957_031_2, 0.957_031_2, 1.5];
+
+/// Sizes `[x, y, z]` of `brainsmall`.
+pub const BRAINSMALL_DIMS: [usize; 3] = [128, 128, 84];
+
+/// `brainsmall.den`, gzip-compressed.
+pub const BRAINSMALL_DEN_GZ: &[u8] = include_bytes!("../../tests/data/brainsmall.den.gz");
+
+/// The names [`load_dataset`] knows, with a description each.
+pub const DATASETS: &[(&str, &str)] = &[
+    (
+        "brainsmall",
+        "VolPack's 128x128x84 MRI head (embedded, BSD-3)",
+    ),
+    (
+        "ct-head",
+        "InVesalius' 256x256x108 CT head, 0.957x0.957x1.5 mm (installed by scripts/fetch-ct-head.sh)",
+    ),
+];
+
+/// Help text listing the data sets.
+pub const DATASETS_HELP: &str = "data sets: `brainsmall` (VolPack's 128x128x84 MRI head, embedded) and \
+`ct-head` (InVesalius' 256x256x108 CT head, installed by scripts/fetch-ct-head.sh or found at $FVR_CT_HEAD)";
+
+/// The CT head's file: `$FVR_CT_HEAD` if set, else Debian's install path.
+///
+/// # Errors
+/// `$FVR_CT_HEAD` names a missing file, or it is unset and the Debian
+/// package is not installed; the message says how to install it.
+pub fn ct_head_path() -> Result<PathBuf, String> {
+    if let Some(p) = std::env::var_os(CT_HEAD_ENV) {
+        let path = PathBuf::from(p);
+        return if path.is_file() {
+            Ok(path)
+        } else {
+            Err(format!(
+                "{CT_HEAD_ENV} is set to `{}`, which is not a file",
+                path.display()
+            ))
+        };
+    }
+    let debian = Path::new(CT_HEAD_DEBIAN_PATH);
+    if debian.is_file() {
+        return Ok(debian.to_path_buf());
+    }
+    Err(format!(
+        "the CT head is not installed: run `bash scripts/fetch-ct-head.sh` (it installs Debian's \
+         `invesalius-examples`, GPL-2, to {CT_HEAD_DEBIAN_PATH}), or set {CT_HEAD_ENV} to a copy of Cranium.inv3"
+    ))
+}
+
+/// Load a named data set, or `None` if `name` is not one.
+///
+/// # Errors
+/// The data set is not installed, or its file cannot be read.
+pub fn load_dataset(name: &str) -> Option<Result<Volume, String>> {
+    load_dataset_with_progress(name, &ProgressBar::hidden())
+}
+
+/// [`load_dataset`], advancing `progress` by the bytes read from disk.
+///
+/// # Errors
+/// As [`load_dataset`].
+pub fn load_dataset_with_progress(
+    name: &str,
+    progress: &ProgressBar,
+) -> Option<Result<Volume, String>> {
+    match name {
+        "brainsmall" => Some(parse_den(BRAINSMALL_DEN_GZ).map_err(|e| format!("brainsmall: {e}"))),
+        "ct-head" => Some(
+            ct_head_path()
+                .and_then(|p| read_volume_with_progress(&p, progress).map_err(|e| e.to_string())),
+        ),
+        _ => None,
+    }
+}

@@ -1,0 +1,178 @@
+//! Volumes by name: files on disk, named data sets or built-in phantoms.
+
+pub mod datasets;
+pub mod phantom;
+pub mod teapot;
+
+use std::path::Path;
+
+use indicatif::ProgressBar;
+
+use crate::io::nrrd::{read_raw, Endian, SampleType};
+use crate::io::{read_volume_with_progress, FORMATS_HELP};
+use crate::sources::datasets::{load_dataset_with_progress, DATASETS_HELP};
+use crate::sources::phantom::{sample, GaussianMixture, Phantom, SheppLogan, Sphere};
+use crate::sources::teapot::{voxelize_teapot, DEFAULT_TEAPOT_SIZE};
+use crate::volume::Volume;
+
+/// Default side of built-in phantoms.
+pub const DEFAULT_PHANTOM_SIZE: usize = 64;
+/// Largest side accepted for a built-in phantom.
+pub const MAX_PHANTOM_SIZE: usize = 1024;
+/// Seed of the `gaussians` phantom unless one is given.
+pub const DEFAULT_SEED: u64 = 1;
+/// Components of the `gaussians` phantom.
+pub const GAUSSIAN_COUNT: usize = 8;
+/// Components of the `blobs` phantom.
+pub const BLOB_COUNT: usize = 24;
+/// Largest σ of the `blobs` phantom, as a fraction of its side.
+pub const BLOB_SIGMA_FRACTION: f64 = 0.05;
+
+/// The built-in phantoms, as `name[@SIZE][:SEED]`.
+pub const PHANTOM_HELP: &str = "built-in phantoms: `gaussians[@N][:SEED]` (8 random anisotropic \
+Gaussians, sigma 1.5 to 0.12 N voxels, inside the sphere of radius 0.4 N), `blobs[@N][:SEED]` (24 \
+smaller ones, sigma 1.5 to 0.05 N), `shepp-logan[@N]` (modified 3D \
+Shepp-Logan), `sphere[@N]` (uniform ball of radius 0.3 N); N defaults to 64; and \
+`teapot[@N]` (Newell's Utah teapot voxelized from its 32 Bezier patches, N defaults to 128)";
+
+/// A phantom with its sampled volume.
+pub struct PhantomVolume {
+    /// The analytic phantom (for exact references).
+    pub phantom: Box<dyn Phantom>,
+    /// Its samples.
+    pub volume: Volume,
+}
+
+/// Parse `name[@N][:SEED]` into a built-in phantom, or `None` if `spec` names
+/// no phantom.
+///
+/// # Errors
+/// A known name with a malformed size or seed.
+pub fn phantom_by_name(spec: &str) -> Option<Result<PhantomVolume, String>> {
+    let (head, seed) = match spec.split_once(':') {
+        Some((h, s)) => (h, Some(s)),
+        None => (spec, None),
+    };
+    let (name, size) = match head.split_once('@') {
+        Some((n, s)) => (n, Some(s)),
+        None => (head, None),
+    };
+    if !["gaussians", "blobs", "shepp-logan", "sphere"].contains(&name) {
+        return None;
+    }
+    Some(build_phantom(name, size, seed))
+}
+
+fn build_phantom(
+    name: &str,
+    size: Option<&str>,
+    seed: Option<&str>,
+) -> Result<PhantomVolume, String> {
+    let n = match size {
+        None => DEFAULT_PHANTOM_SIZE,
+        Some(s) => s
+            .parse::<usize>()
+            .ok()
+            .filter(|&n| (4..=MAX_PHANTOM_SIZE).contains(&n))
+            .ok_or_else(|| {
+                format!("phantom size `{s}` must be an integer from 4 to {MAX_PHANTOM_SIZE}")
+            })?,
+    };
+    let seed = match seed {
+        None => DEFAULT_SEED,
+        Some(s) if name == "gaussians" || name == "blobs" => s
+            .parse::<u64>()
+            .map_err(|_| format!("phantom seed `{s}` must be a non-negative integer"))?,
+        Some(_) => return Err(format!("phantom `{name}` takes no seed")),
+    };
+    let dims = [n, n, n];
+    let phantom: Box<dyn Phantom> = match name {
+        "gaussians" => Box::new(GaussianMixture::random(seed, n, GAUSSIAN_COUNT)),
+        "blobs" => Box::new(GaussianMixture::random_with(
+            seed,
+            n,
+            BLOB_COUNT,
+            BLOB_SIGMA_FRACTION,
+        )),
+        "shepp-logan" => Box::new(SheppLogan::new(dims)),
+        _ => Box::new(Sphere {
+            center: dims.map(|d| d as f64 / 2.0),
+            radius: 0.3 * n as f64,
+            density: 1.0,
+        }),
+    };
+    let volume = sample(phantom.as_ref(), dims);
+    Ok(PhantomVolume { phantom, volume })
+}
+
+/// Parse `teapot[@N]` into the voxelized Utah teapot ([`crate::sources::teapot`]),
+/// or `None` if `spec` names something else.
+///
+/// # Errors
+/// A malformed or out-of-range size.
+pub fn teapot_by_name(spec: &str) -> Option<Result<Volume, String>> {
+    let size = match spec.strip_prefix("teapot")? {
+        "" => Ok(DEFAULT_TEAPOT_SIZE),
+        rest => match rest.strip_prefix('@') {
+            Some(n) => n.parse::<usize>().map_err(|_| {
+                format!("teapot size `{n}` must be an integer from 8 to {MAX_PHANTOM_SIZE}")
+            }),
+            None if rest.starts_with(':') => Err("phantom `teapot` takes no seed".to_string()),
+            None => return None,
+        },
+    };
+    Some(size.and_then(|n| voxelize_teapot(n).map(|t| t.volume)))
+}
+
+/// Layout of a headerless raw file.
+#[derive(Clone, Copy, Debug)]
+pub struct RawLayout {
+    /// Sizes.
+    pub dims: [usize; 3],
+    /// Sample type.
+    pub ty: SampleType,
+    /// Byte order.
+    pub endian: Endian,
+}
+
+/// Load a volume: a built-in phantom (`gaussians@64`), a named data set
+/// (`brainsmall`, `ct-head`: [`crate::sources::datasets`]), a raw file when `raw` is
+/// given, or a volume file of any format [`crate::io`] reads.
+///
+/// # Errors
+/// Unknown names, missing data sets, unreadable or malformed files, with
+/// the file and the field at fault.
+pub fn load_volume(spec: &str, raw: Option<RawLayout>) -> Result<Volume, String> {
+    load_volume_with_progress(spec, raw, &ProgressBar::hidden())
+}
+
+/// [`load_volume`], advancing `progress` by the bytes read from disk.
+///
+/// # Errors
+/// As [`load_volume`].
+pub fn load_volume_with_progress(
+    spec: &str,
+    raw: Option<RawLayout>,
+    progress: &ProgressBar,
+) -> Result<Volume, String> {
+    if let Some(p) = phantom_by_name(spec) {
+        return p.map(|p| p.volume);
+    }
+    if let Some(t) = teapot_by_name(spec) {
+        return t;
+    }
+    let path = Path::new(spec);
+    if let Some(r) = raw {
+        return read_raw(path, r.dims, r.ty, r.endian).map_err(|e| e.to_string());
+    }
+    if !path.exists() {
+        if let Some(v) = load_dataset_with_progress(spec, progress) {
+            return v;
+        }
+        return Err(format!(
+            "`{spec}` is neither a file nor a built-in phantom, and no data set has that name; \
+             files can be {FORMATS_HELP}; {DATASETS_HELP}; {PHANTOM_HELP}"
+        ));
+    }
+    read_volume_with_progress(path, progress).map_err(|e| e.to_string())
+}
