@@ -186,7 +186,9 @@ def run_fvr(fvr, path, gaussians, n, filt, precision, views, work):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--fvr", required=True)
+    p.add_argument("--fvr", help="the fvr binary (not needed with --rtk-only)")
+    p.add_argument("--rtk-only", action="store_true",
+                   help="time RTK alone and print its lines; write nothing")
     p.add_argument("--sizes", default="128,256")
     p.add_argument("--filters", default="kb3,kb4,kb6")
     p.add_argument("--precision", default="f16")
@@ -194,6 +196,8 @@ def main():
     p.add_argument("--work", default="target/peers/work")
     p.add_argument("--out", help="also write the Markdown table to this file")
     args = p.parse_args()
+    if not args.rtk_only and not args.fvr:
+        p.error("--fvr is required unless --rtk-only")
     work = pathlib.Path(args.work)
     work.mkdir(parents=True, exist_ok=True)
     import scipy
@@ -203,12 +207,15 @@ def main():
     rows = []
     for n in (int(s) for s in args.sizes.split(",")):
         vol, gaussians = phantom(n)
+        rtk_ms, rtk_snr, threads = run_rtk(vol, gaussians, args.views)
+        print(f"n={n}: RTK Joseph {rtk_ms:.1f} ms/view, {rtk_snr:.1f} dB "
+              f"({threads} threads, median of {args.views} views)")
+        if args.rtk_only:
+            continue
         path = work / f"gaussians-{n}.nrrd"
         write_nrrd(path, vol)
         fft_ms = median_ms(lambda: scipy.fft.rfftn(vol, workers=-1), 5)
-        rtk_ms, rtk_snr, threads = run_rtk(vol, gaussians, args.views)
-        print(f"n={n}: scipy.fft.rfftn f32 {fft_ms:.1f} ms (all cores); "
-              f"RTK Joseph {rtk_ms:.1f} ms/view, {rtk_snr:.1f} dB ({threads} threads)")
+        print(f"n={n}: scipy.fft.rfftn f32 {fft_ms:.1f} ms (all cores)")
         rows.append((n, "RTK Joseph (f32)", None, rtk_ms, rtk_snr, rtk_ms, fft_ms))
         for filt in args.filters.split(","):
             prep, view, snr = run_fvr(args.fvr, path, gaussians, n, filt,
@@ -216,6 +223,8 @@ def main():
             print(f"n={n}: fvr {filt} {args.precision}: preprocess {prep:.1f} ms, "
                   f"{view:.2f} ms/view, {snr:.1f} dB")
             rows.append((n, f"fvr {filt} {args.precision}", prep, view, snr, rtk_ms, fft_ms))
+    if args.rtk_only:
+        return
     lines = [
         f"Command: `bash bench/peers/run.sh --sizes {args.sizes} --filters {args.filters} "
         f"--precision {args.precision} "

@@ -24,7 +24,10 @@ fi
 if ! "$VENV/bin/python" -c "import itk, scipy; from itk import RTK" 2>/dev/null; then
     "$VENV/bin/pip" install --quiet itk-rtk numpy scipy
 fi
-cargo build --locked --release -p fvr-host
+case " $* " in
+    *" --rtk-only "*) ;;
+    *) cargo build --locked --release -p fvr-host ;;
+esac
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
 mkdir -p docs/performance
 "$VENV/bin/python" bench/peers/peers.py --fvr "$TARGET/release/fvr" \
