@@ -11,11 +11,10 @@ use std::fmt;
 use std::str::FromStr;
 
 use fvr_core::dht::Twiddles;
-use fvr_core::filter::{Filter, KernelTable};
+use fvr_core::filter::Filter;
 use fvr_core::geometry::{Sampling, View};
-use fvr_core::image::aux_len;
 use fvr_core::num::{Real, Sample};
-use fvr_core::render::{render, Buffers, Request, Source};
+use fvr_core::render::Request;
 use fvr_core::spectrum::{prepare_scratch_len, Spectrum};
 use fvr_core::volume::{padded_size, DenseVolume};
 use half::f16;
@@ -348,28 +347,12 @@ impl AnySpectrum {
             h: usize,
             level: u32,
         ) -> Result<Vec<f64>, fvr_core::Error> {
-            let n = s.n();
-            let m = (n >> level.min(usize::BITS - 1)).max(1);
-            let mut tw_buf = vec![T::ZERO; Twiddles::<T>::buffer_len(n)];
-            let tw = Twiddles::new(&mut tw_buf, n)?;
-            let kernel = KernelTable::<T>::new(s.filter());
-            let mut grid = vec![T::ZERO; m * m];
-            let mut aux = vec![T::ZERO; aux_len(m)];
-            let mut out = vec![T::ZERO; w * h];
-            render(
-                &Source::new(&s.view(), &kernel, &tw),
-                &Request {
-                    sampling: *sampling,
-                    level,
-                    ..Request::new(*view, w, h)
-                },
-                Buffers {
-                    grid: &mut grid,
-                    aux: &mut aux,
-                    out: &mut out,
-                },
-            )?;
-            Ok(out.into_iter().map(T::to_f64).collect())
+            let request = Request {
+                sampling: *sampling,
+                level,
+                ..Request::new(*view, w, h)
+            };
+            super::view::render_once::<S, T>(&s.view(), &request)
         }
         match self {
             AnySpectrum::F16(s) => go::<_, f32>(s, view, sampling, width, height, level),

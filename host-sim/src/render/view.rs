@@ -8,6 +8,7 @@ use fvr_core::image::{aux_len, check_image, finish, grid_len, placement_on_axes,
 use fvr_core::num::{Real, Sample};
 use fvr_core::render::{render, Buffers, Request, Source};
 use fvr_core::slice::extract_slice_rows;
+use fvr_core::spectrum::Spectrum;
 
 use super::spectrum::OwnedSpectrum;
 
@@ -132,4 +133,29 @@ impl<T: Real> ViewRenderer<T> {
             out,
         )
     }
+}
+
+/// Render `request` from `spec` once, allocating the kernel table, the
+/// twiddles and the buffers for the request's level; the image as `f64`.
+///
+/// # Errors
+/// As [`fvr_core::render::render`].
+pub fn render_once<S: Sample, T: Real>(
+    spec: &Spectrum<'_, S>,
+    request: &Request<'_>,
+) -> Result<Vec<f64>, fvr_core::Error> {
+    let n = spec.n();
+    let m = (n >> request.level.min(usize::BITS - 1)).max(1);
+    let kernel = KernelTable::<T>::new(*spec.filter());
+    let mut tw_buf = vec![T::ZERO; Twiddles::<T>::buffer_len(n)];
+    let tw = Twiddles::new(&mut tw_buf, n)?;
+    let mut grid = vec![T::ZERO; grid_len(m)];
+    let mut aux = vec![T::ZERO; aux_len(m)];
+    let mut out = vec![T::ZERO; request.width * request.height];
+    render(
+        &Source::new(spec, &kernel, &tw),
+        request,
+        Buffers::new(&mut grid, &mut aux, &mut out),
+    )?;
+    Ok(out.into_iter().map(T::to_f64).collect())
 }

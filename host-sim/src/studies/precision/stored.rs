@@ -1,13 +1,13 @@
 //! A spectrum held in any storage format, with block exponents for block
 //! floating point: prepared in place or rounded once from f32.
 
+use crate::render::view::render_once;
 use fvr_core::dht::{Rounding, Twiddles};
-use fvr_core::filter::{Filter, KernelTable};
+use fvr_core::filter::Filter;
 use fvr_core::geometry::View;
-use fvr_core::image::{aux_len, grid_len};
 use fvr_core::num::{encode_blocks, encode_elements, BlockExponents, BlockLayout, Blocking};
 use fvr_core::num::{Real, Sample};
-use fvr_core::render::{render, Buffers, Request, Source};
+use fvr_core::render::Request;
 use fvr_core::spectrum::{prepare_scratch_len, LineBlockStorage, Spectrum};
 use fvr_core::volume::{padded_size, DenseVolume};
 
@@ -173,23 +173,7 @@ impl<S: Sample> StoredSpectrum<S> {
         width: usize,
         height: usize,
     ) -> Result<Vec<f64>, fvr_core::Error> {
-        let n = self.n;
-        let kernel = KernelTable::<T>::new(self.filter);
-        let mut tw_buf = vec![T::ZERO; Twiddles::<T>::buffer_len(n)];
-        let tw = Twiddles::new(&mut tw_buf, n)?;
-        let mut grid = vec![T::ZERO; grid_len(n)];
-        let mut aux = vec![T::ZERO; aux_len(n)];
-        let mut out = vec![T::ZERO; width * height];
-        render(
-            &Source::new(&self.view(), &kernel, &tw),
-            &Request::new(*view, width, height),
-            Buffers {
-                grid: &mut grid,
-                aux: &mut aux,
-                out: &mut out,
-            },
-        )?;
-        Ok(out.into_iter().map(T::to_f64).collect())
+        render_once::<S, T>(&self.view(), &Request::new(*view, width, height))
     }
 }
 
