@@ -32,3 +32,19 @@ macro_rules! twiddles {
         )+
     };
 }
+
+/// Knuth's MMIX linear congruential generator: a fixed-seed stream of
+/// 64-bit states for test data.
+#[derive(Clone, Debug)]
+pub struct Lcg(pub u64);
+
+impl Lcg {
+    /// The next state.
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        self.0
+    }
+}

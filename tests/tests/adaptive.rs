@@ -172,13 +172,10 @@ fn direct_error_ratio(spec: &OwnedSpectrum<f16>, tau: f64, gain: f64) -> f64 {
 #[test]
 fn marks_match_the_definition_by_brute_force() {
     let n = 8;
-    let mut state = 0x1234_5678_u64;
+    let mut lcg = fvr_tests::Lcg(0x1234_5678);
     let values: Vec<f64> = (0..n * n * n)
         .map(|_| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            let u = (state >> 11) as f64 / (1u64 << 53) as f64;
+            let u = (lcg.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
             // Mostly weak, some strong.
             if u < 0.9 {
                 u * 0.1

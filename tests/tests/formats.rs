@@ -299,14 +299,9 @@ fn q15_line_blocks_prepared_in_place_match_the_f64_spectrum_within_five_rounding
     use fvr_core::spectrum::{prepare_scratch_len, LineBlockStorage, Spectrum};
     use fvr_core::volume::DenseVolume;
     let n = 16usize;
-    let mut state = 7u64;
+    let mut lcg = fvr_tests::Lcg(7);
     let data: Vec<f32> = (0..n * n * n)
-        .map(|_| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 40) as f32 / (1u64 << 24) as f32 - 0.3
-        })
+        .map(|_| (lcg.next_u64() >> 40) as f32 / (1u64 << 24) as f32 - 0.3)
         .collect();
     let source = DenseVolume::new([n; 3], &data).unwrap();
     let filter = Filter::new(FilterKind::Kb4, 2).unwrap();

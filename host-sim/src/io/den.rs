@@ -58,16 +58,7 @@ pub fn has_magic(head: &[u8]) -> bool {
 /// A wrong `map_version` (not a `.den` file), a size that is zero or
 /// negative, or a `map_length` that is not the product of the sizes.
 pub fn parse_header(header: &[u8]) -> Result<DenHeader, IoError> {
-    let Some(header) = header.get(..HEADER_BYTES) else {
-        return Err(format_error(
-            FORMAT,
-            "map_version",
-            format!(
-                "the header needs {HEADER_BYTES} bytes, the file has {}",
-                header.len()
-            ),
-        ));
-    };
+    let header = crate::io::error::header(FORMAT, "map_version", header, HEADER_BYTES)?;
     let endian = match [header[0], header[1]] {
         [1, 0] => Endian::Little,
         [0, 1] => Endian::Big,

@@ -201,6 +201,23 @@ pub(crate) fn format_error(
     }
 }
 
+/// The first `len` bytes of `bytes`, the fixed-size header of `format`;
+/// a file too short for it is an error on `field`.
+pub(crate) fn header<'a>(
+    format: &'static str,
+    field: &'static str,
+    bytes: &'a [u8],
+    len: usize,
+) -> Result<&'a [u8], IoError> {
+    bytes.get(..len).ok_or_else(|| {
+        format_error(
+            format,
+            field,
+            format!("the header needs {len} bytes, the file has {}", bytes.len()),
+        )
+    })
+}
+
 /// A malformed or unsupported field value.
 #[cold]
 pub(crate) fn field_error(field: &'static str, problem: impl Into<String>) -> IoError {

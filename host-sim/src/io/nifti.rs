@@ -178,16 +178,7 @@ impl AxisMap {
 /// unsupported `dim`, `datatype`, `pixdim`, `xyzt_units`, `vox_offset` or
 /// scaling; each names the field.
 pub fn parse_header(bytes: &[u8]) -> Result<NiftiLayout, IoError> {
-    let Some(bytes) = bytes.get(..HEADER_BYTES) else {
-        return Err(format_error(
-            FORMAT,
-            "sizeof_hdr",
-            format!(
-                "the header needs {HEADER_BYTES} bytes, the file has {}",
-                bytes.len()
-            ),
-        ));
-    };
+    let bytes = crate::io::error::header(FORMAT, "sizeof_hdr", bytes, HEADER_BYTES)?;
     let sizeof = [bytes[0], bytes[1], bytes[2], bytes[3]];
     if i32::from_le_bytes(sizeof) == 540 || i32::from_be_bytes(sizeof) == 540 {
         return Err(format_error(

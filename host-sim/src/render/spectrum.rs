@@ -213,6 +213,27 @@ pub enum AnySpectrum {
     F64(OwnedSpectrum<f64>),
 }
 
+/// `body` with `$s` bound to the typed spectrum and `$t` to its
+/// arithmetic: f32 for f16 and f32 storage, f64 for f64.
+macro_rules! with_arithmetic {
+    ($any:expr, $s:ident, $t:ident => $body:expr) => {
+        match $any {
+            AnySpectrum::F16($s) => {
+                type $t = f32;
+                $body
+            }
+            AnySpectrum::F32($s) => {
+                type $t = f32;
+                $body
+            }
+            AnySpectrum::F64($s) => {
+                type $t = f64;
+                $body
+            }
+        }
+    };
+}
+
 impl AnySpectrum {
     /// Prepare `volume` at `precision` for `filter`.
     ///
@@ -292,23 +313,12 @@ impl AnySpectrum {
         width: usize,
         height: usize,
     ) -> Result<Vec<f64>, fvr_core::Error> {
-        fn go<S: Sample, T: Real>(
-            s: &OwnedSpectrum<S>,
-            view: &View,
-            sampling: &Sampling,
-            w: usize,
-            h: usize,
-        ) -> Result<Vec<f64>, fvr_core::Error> {
+        with_arithmetic!(self, s, T => {
             let mut r = ViewRenderer::<T>::new(s.n(), s.filter());
-            let mut out = vec![T::ZERO; w * h];
-            r.render_sampled_into(s, view, sampling, w, h, &mut out)?;
-            Ok(out.into_iter().map(T::to_f64).collect())
-        }
-        match self {
-            AnySpectrum::F16(s) => go::<_, f32>(s, view, sampling, width, height),
-            AnySpectrum::F32(s) => go::<_, f32>(s, view, sampling, width, height),
-            AnySpectrum::F64(s) => go::<_, f64>(s, view, sampling, width, height),
-        }
+            let mut out = vec![<T as Real>::ZERO; width * height];
+            r.render_sampled_into(s, view, sampling, width, height, &mut out)?;
+            Ok(out.into_iter().map(<T as Real>::to_f64).collect())
+        })
     }
 
     /// The progressive preview at `level` ([`fvr_core::progressive`]):
@@ -339,25 +349,11 @@ impl AnySpectrum {
         height: usize,
         level: u32,
     ) -> Result<Vec<f64>, fvr_core::Error> {
-        fn go<S: Sample, T: Real>(
-            s: &OwnedSpectrum<S>,
-            view: &View,
-            sampling: &Sampling,
-            w: usize,
-            h: usize,
-            level: u32,
-        ) -> Result<Vec<f64>, fvr_core::Error> {
-            let request = Request {
-                sampling: *sampling,
-                level,
-                ..Request::new(*view, w, h)
-            };
-            super::view::render_once::<S, T>(&s.view(), &request)
-        }
-        match self {
-            AnySpectrum::F16(s) => go::<_, f32>(s, view, sampling, width, height, level),
-            AnySpectrum::F32(s) => go::<_, f32>(s, view, sampling, width, height, level),
-            AnySpectrum::F64(s) => go::<_, f64>(s, view, sampling, width, height, level),
-        }
+        let request = Request {
+            sampling: *sampling,
+            level,
+            ..Request::new(*view, width, height)
+        };
+        with_arithmetic!(self, s, T => super::view::render_once::<_, T>(&s.view(), &request))
     }
 }

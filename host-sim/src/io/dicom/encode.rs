@@ -122,30 +122,14 @@ impl CtSlice<'_> {
             VR::US,
             PrimitiveValue::from(size[0]),
         );
-        put(
-            &mut obj,
-            tags::BITS_ALLOCATED,
-            VR::US,
-            PrimitiveValue::from(16u16),
-        );
-        put(
-            &mut obj,
-            tags::BITS_STORED,
-            VR::US,
-            PrimitiveValue::from(16u16),
-        );
-        put(
-            &mut obj,
-            tags::HIGH_BIT,
-            VR::US,
-            PrimitiveValue::from(15u16),
-        );
-        put(
-            &mut obj,
-            tags::PIXEL_REPRESENTATION,
-            VR::US,
-            PrimitiveValue::from(1u16),
-        );
+        for (tag, value) in [
+            (tags::BITS_ALLOCATED, 16u16),
+            (tags::BITS_STORED, 16),
+            (tags::HIGH_BIT, 15),
+            (tags::PIXEL_REPRESENTATION, 1),
+        ] {
+            put(&mut obj, tag, VR::US, PrimitiveValue::from(value));
+        }
         put(
             &mut obj,
             tags::RESCALE_INTERCEPT,
