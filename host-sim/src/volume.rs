@@ -41,7 +41,12 @@ impl Volume {
 
     /// A volume of zeros with [`DEFAULT_SPACING`].
     pub fn zeros(dims: [usize; 3]) -> Self {
-        Self::new(dims, vec![0.0; dims[0] * dims[1] * dims[2]])
+        Self::filled(dims, 0.0)
+    }
+
+    /// A volume of `dims` with every voxel `value` and [`DEFAULT_SPACING`].
+    pub fn filled(dims: [usize; 3], value: f32) -> Self {
+        Self::new(dims, vec![value; dims[0] * dims[1] * dims[2]])
     }
 
     /// This volume with voxel spacing `spacing` (mm).

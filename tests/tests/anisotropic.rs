@@ -12,7 +12,6 @@
 //! sample. The image's band `|η| < 1/(2p)` with `p = min Δ` loses at most what
 //! the isotropic image loses at `p = 1` voxel for components 1.5 voxels wide.
 
-use fvr_core::dht::Twiddles;
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::{Sampling, View};
 use fvr_core::image::{aux_len, grid_len};
@@ -164,8 +163,7 @@ fn unit_sampling_is_bit_identical_to_voxel_units() {
     let (spec, filter) = mixture_spectrum::<f16, f32>((5, 40, 6), dims, FilterKind::Kb4, 1);
     let n = spec.n();
     let kernel = KernelTable::<f32>::new(filter);
-    let mut tw_buf = vec![0.0f32; Twiddles::<f32>::buffer_len(n)];
-    let tw = Twiddles::new(&mut tw_buf, n).unwrap();
+    fvr_tests::twiddles!(n; tw: f32);
     let mut grid = vec![0.0f32; grid_len(n)];
     let mut aux = vec![0.0f32; aux_len(n)];
     let unit = Sampling::new([1.0; 3], 1.0).unwrap();

@@ -44,8 +44,7 @@ fn full_range_volume_does_not_overflow_f16() {
     // 2 keeps premultiplication well conditioned on this box-filling volume
     // (see `ill_conditioned_premultiplication_is_flagged`).
     let n = 32;
-    let mut volume = Volume::zeros([n, n, n]);
-    volume.data.fill(65535.0);
+    let volume = Volume::filled([n, n, n], 65535.0);
     let filter = Filter::new(FilterKind::Kb4, 2).unwrap();
     let f16_spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
     assert!(f16_spec.data().iter().all(|v| v.is_finite()));
@@ -106,8 +105,7 @@ fn buffers_and_sizes_are_checked() {
 #[test]
 fn ill_conditioned_premultiplication_is_flagged() {
     let n = 32;
-    let mut boxed = Volume::zeros([n, n, n]);
-    boxed.data.fill(1.0);
+    let boxed = Volume::filled([n, n, n], 1.0);
     let filter = Filter::new(FilterKind::Kb4, 1).unwrap();
     let spec = AnySpectrum::prepare(&boxed, filter, Precision::F16).unwrap();
     let sum = (n * n * n) as f64;

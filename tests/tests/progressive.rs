@@ -2,7 +2,7 @@
 //! projection low-passed to the central (n/2^L)² frequencies and sampled
 //! every 2^L voxels.
 
-use fvr_core::dht::{signed_index, Twiddles};
+use fvr_core::dht::signed_index;
 use fvr_core::filter::{FilterKind, KernelTable};
 use fvr_core::geometry::View;
 use fvr_core::image::{aux_len, finish, placement, Crop};
@@ -17,8 +17,7 @@ fn preview_is_the_low_passed_projection_sampled_at_its_pitch() {
     let (owned, filter) = mixture_spectrum::<f64, f64>((6, n, 8), [n; 3], FilterKind::Kb4, 1);
     let spec = owned.view();
     let kernel = KernelTable::<f64>::new(filter);
-    let mut tw_buf = vec![0.0; Twiddles::<f64>::buffer_len(n)];
-    let tw = Twiddles::new(&mut tw_buf, n).unwrap();
+    fvr_tests::twiddles!(n; tw: f64);
     let view = View::along([1.0, 0.35, -0.25]);
     let frame = view.frame().unwrap();
     assert_eq!(max_level(n), 5);

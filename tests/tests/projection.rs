@@ -43,18 +43,8 @@ fn odd_non_cubic_volume_and_odd_image_match_exact_projection() {
     let dims = [37, 50, 29];
     let phantom = GaussianMixture {
         components: vec![
-            Gaussian {
-                amplitude: 1.0,
-                center: [17.3, 26.1, 14.0],
-                sigmas: [2.0, 2.5, 1.8],
-                rotation: rotation_z(0.4),
-            },
-            Gaussian {
-                amplitude: 0.6,
-                center: [19.0, 22.0, 15.5],
-                sigmas: [1.6, 1.6, 2.0],
-                rotation: rotation_z(-1.0),
-            },
+            Gaussian::new(1.0, [17.3, 26.1, 14.0], [2.0, 2.5, 1.8], rotation_z(0.4)),
+            Gaussian::new(0.6, [19.0, 22.0, 15.5], [1.6, 1.6, 2.0], rotation_z(-1.0)),
         ],
     };
     let volume = sample(&phantom, dims);
@@ -124,12 +114,12 @@ fn pipeline_converges_to_the_ideal_slice() {
 fn spatial_renderer_agrees_with_exact_and_frequency_paths() {
     let n = 48;
     let phantom = GaussianMixture {
-        components: vec![Gaussian {
-            amplitude: 1.0,
-            center: [23.0, 25.0, 24.0],
-            sigmas: [2.5, 3.0, 3.5],
-            rotation: rotation_z(0.3),
-        }],
+        components: vec![Gaussian::new(
+            1.0,
+            [23.0, 25.0, 24.0],
+            [2.5, 3.0, 3.5],
+            rotation_z(0.3),
+        )],
     };
     let volume = sample(&phantom, [n, n, n]);
     let view = View::along([1.0, 1.0, 1.0]);

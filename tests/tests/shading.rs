@@ -294,18 +294,18 @@ fn odd_volume_cue_and_shading_match_closed_forms() {
     let dims = [37, 50, 29];
     let mixture = GaussianMixture {
         components: vec![
-            Gaussian {
-                amplitude: 1.0,
-                center: [15.3, 27.1, 13.0],
-                sigmas: [2.8, 3.5, 2.5],
-                rotation: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
-            },
-            Gaussian {
-                amplitude: 0.7,
-                center: [21.0, 21.0, 15.5],
-                sigmas: [2.2, 2.7, 3.1],
-                rotation: [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]],
-            },
+            Gaussian::new(
+                1.0,
+                [15.3, 27.1, 13.0],
+                [2.8, 3.5, 2.5],
+                [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            ),
+            Gaussian::new(
+                0.7,
+                [21.0, 21.0, 15.5],
+                [2.2, 2.7, 3.1],
+                [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]],
+            ),
         ],
     };
     let volume = sample(&mixture, dims);

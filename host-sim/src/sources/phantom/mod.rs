@@ -177,6 +177,21 @@ pub struct Gaussian {
 }
 
 impl Gaussian {
+    /// A component from its amplitude, centre, principal sigmas and rotation.
+    pub fn new(
+        amplitude: f64,
+        center: [f64; 3],
+        sigmas: [f64; 3],
+        rotation: [[f64; 3]; 3],
+    ) -> Self {
+        Self {
+            amplitude,
+            center,
+            sigmas,
+            rotation,
+        }
+    }
+
     /// `Rᵀ v / σ`: coordinates of `v` in the whitened principal frame.
     pub fn whiten(&self, v: [f64; 3]) -> [f64; 3] {
         let y = mul_transpose(&self.rotation, v);
