@@ -242,18 +242,15 @@ fn renders_a_dicom_series_directory() {
     let dir = temp_dir("io-dicom");
     let series = dir.join("series");
     std::fs::create_dir_all(&series).unwrap();
-    let orientation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
     for k in 0..6u32 {
         let pixels: Vec<i16> = (0..64).map(|i| ((i * 7 + k * 13) % 50) as i16).collect();
         let bytes = fvr_host::io::dicom::CtSlice {
             series: "1.2.3.4",
             instance: k + 1,
-            size: [8, 8],
             pixel_spacing: [0.5, 0.5],
             position: [0.0, 0.0, 1.25 * k as f64],
-            orientation,
             intercept: -10.0,
-            pixels: &pixels,
+            ..fvr_host::io::dicom::CtSlice::axial([8, 8], &pixels)
         }
         .encode();
         std::fs::write(series.join(format!("IM{k:04}")), bytes).unwrap();

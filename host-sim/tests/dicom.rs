@@ -141,28 +141,18 @@ fn gaps_duplicates_and_mismatches_are_refused() {
     let size = temp_dir("size");
     write_series(&size, "1", &[0.0, 1.0], AXIAL, &["1", "2"]);
     let other = CtSlice {
-        series: "1",
         instance: 3,
-        size: [4, 3],
         pixel_spacing: [0.7, 0.6],
         position: [10.0, -20.0, 7.0],
-        orientation: AXIAL,
-        intercept: 0.0,
-        pixels: &[0; 12],
+        ..CtSlice::axial([4, 3], &[0; 12])
     }
     .encode();
     std::fs::write(size.join("3"), other).unwrap();
     assert!(err_of(&size).contains("Rows"), "{}", err_of(&size));
     let zero = temp_dir("zero-spacing");
     let flat = CtSlice {
-        series: "1",
-        instance: 1,
-        size: [2, 2],
         pixel_spacing: [0.0, 0.5],
-        position: [0.0; 3],
-        orientation: AXIAL,
-        intercept: 0.0,
-        pixels: &[0; 4],
+        ..CtSlice::axial([2, 2], &[0; 4])
     }
     .encode();
     std::fs::write(zero.join("1"), flat).unwrap();
@@ -266,16 +256,9 @@ fn sizes_beyond_the_pixel_data_are_refused_before_decoding() {
 
 /// A valid 2×2 axial CT slice of pixels 1..=4 with `intercept`.
 fn tiny_slice(intercept: f64) -> Vec<u8> {
-    let orientation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
     CtSlice {
-        series: "1",
-        instance: 1,
-        size: [2, 2],
-        pixel_spacing: [1.0, 1.0],
-        position: [0.0; 3],
-        orientation,
         intercept,
-        pixels: &[1, 2, 3, 4],
+        ..CtSlice::axial([2, 2], &[1, 2, 3, 4])
     }
     .encode()
 }

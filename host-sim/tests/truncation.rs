@@ -83,16 +83,11 @@ fn prefixes_of_every_format_are_errors() {
 
 #[test]
 fn prefixes_of_a_dicom_slice_are_errors() {
-    let orientation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
     let bytes = CtSlice {
         series: "1.2",
-        instance: 1,
-        size: [3, 2],
         pixel_spacing: [0.5, 0.5],
-        position: [0.0; 3],
-        orientation,
         intercept: -1024.0,
-        pixels: &[1, 2, 3, 4, 5, 6],
+        ..CtSlice::axial([3, 2], &[1, 2, 3, 4, 5, 6])
     }
     .encode();
     let slice = refuse_every_prefix("dicom", &bytes, parse_slice, |s| {

@@ -121,7 +121,8 @@ fn cued_and_shaded_images_meet_floors_against_closed_forms() {
             scenes
                 .iter()
                 .map(|(_, s)| {
-                    exact_scene_projection(&mixture, [N; 3], s, view, N, N, GRADIENT_STEP).unwrap()
+                    exact_scene_projection(&mixture, [N; 3], s, view, (N, N), GRADIENT_STEP)
+                        .unwrap()
                 })
                 .collect()
         })
@@ -160,7 +161,7 @@ fn f64_pipeline_evaluates_the_same_model() {
         back: 1.0,
     });
     let view = views()[0];
-    let exact = exact_scene_projection(&mixture, [N; 3], &scene, &view, N, N, GRADIENT_STEP)
+    let exact = exact_scene_projection(&mixture, [N; 3], &scene, &view, (N, N), GRADIENT_STEP)
         .unwrap()
         .data;
     let f64_image = SceneSpectra::prepare(&volume, filter, Precision::F64, &scene)
@@ -239,7 +240,7 @@ fn eq14_correction_fixes_lights_not_perpendicular_to_the_view() {
     };
     let spectra = SceneSpectra::prepare(&volume, filter, Precision::F32, &oblique).unwrap();
     let exact =
-        exact_scene_projection(&mixture, [N; 3], &oblique, &view, N, N, GRADIENT_STEP).unwrap();
+        exact_scene_projection(&mixture, [N; 3], &oblique, &view, (N, N), GRADIENT_STEP).unwrap();
     let corrected = spectra.render(&oblique, &view, N, N).unwrap();
     let uncorrected_scene = Scene {
         correct_cue_shading: false,
@@ -326,7 +327,7 @@ fn odd_volume_cue_and_shading_match_closed_forms() {
             .render(&scene, &view, 33, 41)
             .unwrap();
         let exact =
-            exact_scene_projection(&mixture, dims, &scene, &view, 33, 41, GRADIENT_STEP).unwrap();
+            exact_scene_projection(&mixture, dims, &scene, &view, (33, 41), GRADIENT_STEP).unwrap();
         let snr = snr_db(&exact.data, &image.data);
         eprintln!("odd dims {:?}: {snr:.1} dB", scene.cue);
         assert!(snr >= 50.0, "{:?}: {snr:.1} dB", scene.cue);

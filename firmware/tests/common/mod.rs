@@ -118,8 +118,7 @@ pub fn exact_image(spec: &FrameSpec) -> Vec<f64> {
                 DIMS,
                 &s.scene().unwrap(),
                 &spec.view,
-                IMAGE_SIDE,
-                IMAGE_SIDE,
+                (IMAGE_SIDE, IMAGE_SIDE),
                 GRADIENT_STEP,
             )
             .unwrap();

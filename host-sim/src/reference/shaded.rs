@@ -132,8 +132,9 @@ fn mixture_gradient(mixture: &GaussianMixture, x: [f64; 3]) -> [f64; 3] {
 }
 
 /// Exact shaded, depth-cued image of a Gaussian mixture sampled on a grid
-/// of `dims` (geometry contract of [`fvr_core::geometry`]). `step` is the
-/// Simpson step for the `|∇f|` term (e.g. 0.05 voxels).
+/// of `dims` (geometry contract of [`fvr_core::geometry`]), on an image of
+/// `size = (width, height)` pixels. `step` is the Simpson step for the
+/// `|∇f|` term (e.g. 0.05 voxels).
 ///
 /// # Errors
 /// Bad view vectors or scene values.
@@ -142,19 +143,10 @@ pub fn exact_scene_projection(
     dims: [usize; 3],
     scene: &Scene,
     view: &View,
-    width: usize,
-    height: usize,
+    size: (usize, usize),
     step: f64,
 ) -> Result<Image, fvr_core::Error> {
-    exact_scene_projection_sampled(
-        mixture,
-        dims,
-        &Sampling::UNIT,
-        scene,
-        view,
-        (width, height),
-        step,
-    )
+    exact_scene_projection_sampled(mixture, dims, &Sampling::UNIT, scene, view, size, step)
 }
 
 /// [`exact_scene_projection`] in physical units, for a mixture given in mm

@@ -25,7 +25,22 @@ pub struct CtSlice<'a> {
     pub pixels: &'a [i16],
 }
 
-impl CtSlice<'_> {
+impl<'a> CtSlice<'a> {
+    /// An axial slice of `size` (columns, rows) at the origin: series "1",
+    /// instance 1, 1 mm pixels, no rescale. Change fields by struct update.
+    pub fn axial(size: [u16; 2], pixels: &'a [i16]) -> Self {
+        CtSlice {
+            series: "1",
+            instance: 1,
+            size,
+            pixel_spacing: [1.0, 1.0],
+            position: [0.0; 3],
+            orientation: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+            intercept: 0.0,
+            pixels,
+        }
+    }
+
     /// The file's bytes.
     ///
     /// # Panics
