@@ -4,7 +4,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use fvr_host::io::den::{encode_den, parse_den, read_den, HEADER_BYTES as DEN_HEADER};
+use fvr_host::io::den::{encode_den, parse_den, HEADER_BYTES as DEN_HEADER};
 use fvr_host::io::inv3::{encode_archive, encode_inv3_i16, main_plist_text, parse_inv3};
 use fvr_host::io::nifti::{encode_nifti_f32, offsets, parse_nifti, read_nifti};
 use fvr_host::io::nrrd::{
@@ -102,7 +102,10 @@ fn den_round_trips_in_both_byte_orders_and_from_files() {
         assert_eq!(vol.get(4, 2, 1), data[4 + 5 * (2 + 3)] as f32);
         let path = dir.join(format!("v-{endian:?}.den.gz"));
         std::fs::write(&path, gzip(&bytes)).unwrap();
-        assert_eq!(read_den(&path).expect("den.gz file").data, vol.data);
+        assert_eq!(
+            fvr_host::io::read_volume(&path).expect("den.gz file").data,
+            vol.data
+        );
         assert_eq!(read_volume(&path).expect("dispatch").data, vol.data);
     }
 }

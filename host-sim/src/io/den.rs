@@ -110,12 +110,8 @@ pub fn parse_header(header: &[u8]) -> Result<DenHeader, IoError> {
     Ok(DenHeader { endian, dims })
 }
 
-/// Read a `.den` or `.den.gz` file. Errors carry the path.
-pub fn read_den(path: &Path) -> Result<Volume, IoError> {
-    read_den_with_progress(path, &ProgressBar::hidden())
-}
-
-/// [`read_den`], advancing `progress` by the bytes read from disk.
+/// Read a `.den` or `.den.gz` file, advancing `progress` by the bytes read
+/// from disk. Errors carry the path.
 pub fn read_den_with_progress(path: &Path, progress: &ProgressBar) -> Result<Volume, IoError> {
     let go = || read_den_from(open_counted(path, progress)?);
     go().map_err(|e| e.in_file(path))

@@ -181,12 +181,8 @@ fn numpy_type(dtype: &str) -> Result<SampleType, IoError> {
     })
 }
 
-/// Read an `.inv3` project's image matrix. Errors carry the path.
-pub fn read_inv3(path: &Path) -> Result<Volume, IoError> {
-    read_inv3_with_progress(path, &ProgressBar::hidden())
-}
-
-/// [`read_inv3`], advancing `progress` by the bytes read from disk.
+/// Read an `.inv3` project's image matrix, advancing `progress` by the bytes
+/// read from disk. Errors carry the path.
 pub fn read_inv3_with_progress(path: &Path, progress: &ProgressBar) -> Result<Volume, IoError> {
     let go = || read_inv3_from(open_counted(path, progress)?);
     go().map_err(|e| e.in_file(path))
