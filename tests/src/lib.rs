@@ -48,3 +48,15 @@ impl Lcg {
         self.0
     }
 }
+
+/// `scene` with one more light (towards `towards`, of `color`).
+pub fn with_light(
+    mut scene: fvr_core::shading::Scene,
+    towards: [f64; 3],
+    color: [f64; 3],
+) -> fvr_core::shading::Scene {
+    scene
+        .add_light(fvr_core::shading::Light { towards, color })
+        .unwrap();
+    scene
+}

@@ -11,17 +11,28 @@ use fvr_host::render::spectrum::{AnySpectrum, OwnedSpectrum, Precision};
 use fvr_host::volume::Volume;
 use half::f16;
 
+/// Prepare `vol` into an f16 spectrum of `storage` elements with tables
+/// for side `n`; the error, if any.
+fn prepare_f16(
+    vol: &DenseVolume<'_, f32>,
+    filter: Filter,
+    storage: usize,
+    n: usize,
+) -> Result<(), Error> {
+    let mut storage = vec![f16::ZERO; storage];
+    let mut scratch = vec![0.0f32; prepare_scratch_len(n)];
+    let mut tw = vec![0.0f32; Twiddles::<f32>::buffer_len(n)];
+    let tw = Twiddles::new(&mut tw, n).unwrap();
+    Spectrum::prepare(vol, filter, &mut storage, &mut scratch, &tw).map(|_| ())
+}
+
 #[test]
 fn nan_and_infinite_voxels_are_named_by_index() {
     let mut data = vec![1.0f32; 8 * 8 * 8];
     data[3 + 8 * (4 + 8 * 5)] = f32::INFINITY;
     let vol = DenseVolume::new([8, 8, 8], &data).unwrap();
     let filter = Filter::new(FilterKind::Kb3, 1).unwrap();
-    let mut storage = vec![f16::ZERO; 512];
-    let mut scratch = vec![0.0f32; prepare_scratch_len(8)];
-    let mut tw = vec![0.0f32; Twiddles::<f32>::buffer_len(8)];
-    let tw = Twiddles::new(&mut tw, 8).unwrap();
-    let err = Spectrum::prepare(&vol, filter, &mut storage, &mut scratch, &tw).unwrap_err();
+    let err = prepare_f16(&vol, filter, 512, 8).unwrap_err();
     assert_eq!(
         err,
         Error::NonFiniteVoxel {
@@ -76,11 +87,7 @@ fn buffers_and_sizes_are_checked() {
     );
     let vol = DenseVolume::new([3, 3, 3], &data).unwrap();
     let filter = Filter::new(FilterKind::Linear, 1).unwrap();
-    let mut storage = vec![f16::ZERO; 10];
-    let mut scratch = vec![0.0f32; prepare_scratch_len(4)];
-    let mut tw = vec![0.0f32; Twiddles::<f32>::buffer_len(4)];
-    let tw = Twiddles::new(&mut tw, 4).unwrap();
-    let err = Spectrum::prepare(&vol, filter, &mut storage, &mut scratch, &tw).unwrap_err();
+    let err = prepare_f16(&vol, filter, 10, 4).unwrap_err();
     assert!(
         matches!(
             err,

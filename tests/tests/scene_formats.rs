@@ -9,7 +9,7 @@ use fvr_core::image::aux_len;
 use fvr_core::num::{BlockLayout, Blocking, Q15};
 use fvr_core::render::{render, Buffers, Request, Source};
 use fvr_core::shading::fields_len;
-use fvr_core::shading::{DepthCue, Light, Scene};
+use fvr_core::shading::{DepthCue, Scene};
 use fvr_core::spectrum::Spectrum;
 use fvr_host::reference::snr_db;
 use fvr_host::render::shaded::gradient_volume;
@@ -55,20 +55,18 @@ fn block_floating_point_spectra_render_cued_and_shaded_scenes() {
     let volume = sample(&GaussianMixture::random(8, n, 6), [n; 3]);
     let gradient = gradient_volume(&volume).unwrap();
     let filter = Filter::new(FilterKind::Kb4, 1).unwrap();
-    let mut scene = Scene {
-        cue: DepthCue::Linear {
-            front: 1.0,
-            back: 0.3,
+    let scene = fvr_tests::with_light(
+        Scene {
+            cue: DepthCue::Linear {
+                front: 1.0,
+                back: 0.3,
+            },
+            ambient: [0.2; 3],
+            ..Scene::xray()
         },
-        ambient: [0.2; 3],
-        ..Scene::xray()
-    };
-    scene
-        .add_light(Light {
-            towards: [0.2, 1.0, 0.3],
-            color: [1.0, 0.5, 0.2],
-        })
-        .unwrap();
+        [0.2, 1.0, 0.3],
+        [1.0, 0.5, 0.2],
+    );
     let view = View::along([1.0, 0.4, -0.2]);
 
     let reference = {

@@ -259,17 +259,15 @@ fn eq14_correction_fixes_lights_not_perpendicular_to_the_view() {
         good - bad
     );
 
-    let mut perpendicular = Scene {
-        cue,
-        ambient: [0.1; 3],
-        ..Scene::xray()
-    };
-    perpendicular
-        .add_light(Light {
-            towards: [0.0, 0.6, 0.8],
-            color: [1.0, 1.0, 1.0],
-        })
-        .unwrap();
+    let perpendicular = fvr_tests::with_light(
+        Scene {
+            cue,
+            ambient: [0.1; 3],
+            ..Scene::xray()
+        },
+        [0.0, 0.6, 0.8],
+        [1.0; 3],
+    );
     let with = spectra.render(&perpendicular, &view, N, N).unwrap();
     let without = spectra
         .render(
