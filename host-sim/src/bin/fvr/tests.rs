@@ -11,46 +11,7 @@ use fvr_host::render::spectrum::{KbDesign, Precision};
 use std::path::PathBuf;
 
 /// A scene that sets every key `fvr render` reads.
-const FULL_SCENE: &str = r#"
-    [volume]
-    path = "v.raw"
-    raw_dims = [4, 5, 6]
-    raw_type = "u16"
-    raw_endian = "big"
-    background = -1024
-    resample = 96
-    [camera]
-    dir = [1, 0.5, -0.25]
-    up = [0, 1, 0]
-    size = [64, 32]
-    pixel_size = 0.5
-    [spectrum]
-    filter = "cubic"
-    oversample = 2
-    precision = "f32"
-    kb_design = 1.5
-    [shading]
-    ambient = 0.1
-    depth_cue = "linear:1,0.3"
-    cue_harmonics = 6
-    cue_correction = false
-    [light_ring]
-    count = 2
-    tilt = 10
-    [[lights]]
-    direction = [0, 1, 0]
-    color = [1, 0, 0]
-    [output]
-    path = "a.png"
-    bits = 16
-    window = 2.0
-    level = 1
-    colormap = "bone"
-    [turntable]
-    frames = 12
-    fps = 6
-    path = "spin.apng"
-"#;
+const FULL_SCENE: &str = include_str!("../../../tests/data/every-key.toml");
 
 fn parse_cli(argv: &[&str]) -> (Cli, ArgMatches) {
     let m = Cli::command()

@@ -21,58 +21,17 @@ fn edit_distance_counts_insertions_deletions_and_substitutions() {
 
 #[test]
 fn full_scene_parses_every_key() {
-    let s = parse(
-        r#"
-        [volume]
-        path = "head.nii.gz"
-        raw_dims = [4, 5, 6]
-        raw_type = "u16"
-        raw_endian = "big"
-        background = -1024
-        resample = 128
-        ignore_spacing = false
-        [camera]
-        dir = [1, 0.5, -0.25]
-        up = [0, 0, 1]
-        size = [64, 32]
-        pixel_size = 0.75
-        [spectrum]
-        filter = "cubic"
-        oversample = 2
-        precision = "f32"
-        kb_design = 1.5
-        [shading]
-        ambient = 0.1
-        depth_cue = "linear:1,0.3"
-        cue_harmonics = 6
-        cue_correction = false
-        [light_ring]
-        count = 3
-        [[lights]]
-        direction = [0, 1, 0]
-        color = [1, 0, 0]
-        [output]
-        path = "out/a.png"
-        bits = 16
-        window = 2.0
-        level = 1
-        colormap = "bone"
-        [turntable]
-        frames = 12
-        fps = 6
-        path = "spin.apng"
-        "#,
-    )
-    .unwrap();
-    assert_eq!(s.volume.spec.as_deref(), Some("/scenes/head.nii.gz"));
+    let s = parse(include_str!("../../../tests/data/every-key.toml")).unwrap();
+    assert_eq!(s.volume.spec.as_deref(), Some("/scenes/v.raw"));
     assert_eq!(s.volume.raw_dims, Some([4, 5, 6]));
     assert_eq!(s.volume.raw_type, Some(SampleType::U16));
     assert_eq!(s.volume.raw_endian, Some(Endian::Big));
     assert_eq!(s.volume.background, Some(-1024.0));
-    assert_eq!(s.volume.resample, Some(128));
+    assert_eq!(s.volume.resample, Some(96));
     assert_eq!(s.camera.dir, Some([1.0, 0.5, -0.25]));
+    assert_eq!(s.camera.up, Some([0.0, 1.0, 0.0]));
     assert_eq!(s.camera.size, Some((64, 32)));
-    assert_eq!(s.camera.pixel_size, Some(0.75));
+    assert_eq!(s.camera.pixel_size, Some(0.5));
     assert_eq!(s.volume.ignore_spacing, Some(false));
     assert_eq!(s.spectrum.filter, Some(FilterKind::Cubic));
     assert_eq!(s.spectrum.oversample, Some(2));
@@ -82,7 +41,7 @@ fn full_scene_parses_every_key() {
     assert_eq!(s.shading.depth_cue.as_deref(), Some("linear:1,0.3"));
     assert_eq!(s.shading.cue_harmonics, Some(6));
     assert_eq!(s.shading.cue_correction, Some(false));
-    assert_eq!(s.light_ring, Some((3, 30.0)));
+    assert_eq!(s.light_ring, Some((2, 10.0)));
     assert_eq!(
         s.lights,
         Some(vec![Light {
@@ -90,7 +49,7 @@ fn full_scene_parses_every_key() {
             color: [1.0, 0.0, 0.0]
         }])
     );
-    assert_eq!(s.output.path, Some(PathBuf::from("/scenes/out/a.png")));
+    assert_eq!(s.output.path, Some(PathBuf::from("/scenes/a.png")));
     assert_eq!(s.output.bits, Some(Bits::Sixteen));
     assert_eq!((s.output.window, s.output.level), (Some(2.0), Some(1.0)));
     assert_eq!(s.output.colormap, Some(Colormap::Bone));
