@@ -10,6 +10,7 @@
 //! - [`studies`]: the measuring commands (accuracy, adaptive table,
 //!   precision, growth, trade) and their timing.
 
+pub mod budget;
 pub mod image;
 pub mod io;
 pub mod progress;

@@ -39,6 +39,23 @@ impl Volume {
         }
     }
 
+    /// The dims [`Volume::resample_isotropic`] gives for `largest` samples
+    /// along the longest physical side.
+    ///
+    /// # Errors
+    /// `largest` is 0.
+    pub fn resampled_dims(&self, largest: usize) -> Result<[usize; 3], String> {
+        if largest == 0 {
+            return Err("resampling needs at least 1 sample along the longest side".into());
+        }
+        let extent = self.extent_mm();
+        let longest = extent.iter().copied().fold(0.0f64, f64::max);
+        let h = longest / largest as f64;
+        Ok(std::array::from_fn(|a| {
+            ((extent[a] / h).round() as usize).clamp(1, largest)
+        }))
+    }
+
     /// A volume of zeros with [`DEFAULT_SPACING`].
     pub fn zeros(dims: [usize; 3]) -> Self {
         Self::filled(dims, 0.0)
@@ -101,14 +118,8 @@ impl Volume {
     /// # Errors
     /// `largest` of 0.
     pub fn resample_isotropic(&self, largest: usize) -> Result<Volume, String> {
-        if largest == 0 {
-            return Err("resampling needs at least 1 sample along the longest side".into());
-        }
-        let extent = self.extent_mm();
-        let longest = extent.iter().copied().fold(0.0f64, f64::max);
-        let h = longest / largest as f64;
-        let dims: [usize; 3] =
-            std::array::from_fn(|a| ((extent[a] / h).round() as usize).clamp(1, largest));
+        let dims = self.resampled_dims(largest)?;
+        let h = self.extent_mm().iter().copied().fold(0.0f64, f64::max) / largest as f64;
         let mut data = Vec::with_capacity(dims[0] * dims[1] * dims[2]);
         let sample = |a: usize, v: usize| {
             // Old-voxel coordinate of the new sample centre.

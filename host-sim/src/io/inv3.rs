@@ -290,10 +290,10 @@ fn read_plist<R: Read>(entry: tar::Entry<'_, R>) -> Result<String, IoError> {
 /// A whole member, within the memory limit.
 fn read_member<R: Read>(entry: tar::Entry<'_, R>) -> Result<Vec<u8>, IoError> {
     let size = entry.size();
-    if size > crate::io::nrrd::memory_limit_bytes() {
+    if size > crate::budget::limit_bytes() {
         return Err(IoError::TooLarge {
             needed: size,
-            limit: crate::io::nrrd::memory_limit_bytes(),
+            limit: crate::budget::limit_bytes(),
         });
     }
     let mut bytes = Vec::new();

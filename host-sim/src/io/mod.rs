@@ -17,7 +17,7 @@
 //!
 //! Every reader treats its input as untrusted: sizes are checked for zero
 //! and overflow, the memory needed is checked against
-//! [`crate::io::nrrd::memory_limit_bytes`] before allocating, gzip data is never
+//! [`crate::budget::limit_bytes`] before allocating, gzip data is never
 //! decompressed far beyond what the header calls for, and every problem is
 //! an [`IoError`] that names the file and the field.
 
@@ -27,6 +27,7 @@ mod error;
 pub mod inv3;
 pub mod nifti;
 pub mod nrrd;
+pub mod paths;
 
 use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read};
@@ -396,7 +397,7 @@ pub(crate) fn decode_samples<R: BufRead>(
     sizes: SizeField,
 ) -> Result<Volume, IoError> {
     let (count, data_bytes) = check_dims(dims, ty, sizes)?;
-    nrrd::check_memory(count, ty, nrrd::memory_limit_bytes())?;
+    nrrd::check_memory(count, ty, crate::budget::limit_bytes())?;
     let layout = nrrd::Layout::samples(dims, count, data_bytes, ty, endian);
     let source = reader.source();
     let data = nrrd::decode_stream(&mut reader, &layout, source)?;

@@ -10,7 +10,7 @@
 //! Input is untrusted: malformed headers, truncated or corrupt data and
 //! NaN/Inf samples are reported as [`IoError`]s, never panics. Before
 //! allocating, the memory a volume needs is checked against
-//! [`memory_limit_bytes`], and gzip data is never decompressed beyond the
+//! [`crate::budget::limit_bytes`], and gzip data is never decompressed beyond the
 //! expected size plus a small margin.
 //!
 //! Notes on the NRRD dialect accepted:
@@ -53,9 +53,6 @@ pub(crate) use header::{geometry, Layout};
 use error::invalid_argument;
 use header::read_header;
 
-/// Memory limit when `/proc/meminfo` cannot be read: 8 GiB.
-pub const DEFAULT_MEMORY_LIMIT: u64 = 8 << 30;
-
 /// Decompressed bytes read past the expected data, to reach the end of the
 /// gzip member and check its CRC.
 const GZIP_MARGIN: u64 = 4096;
@@ -68,28 +65,6 @@ const INITIAL_SAMPLES: usize = 1 << 24;
 
 /// Read buffer for files.
 const FILE_BUFFER_BYTES: usize = 1 << 16;
-
-/// The most memory a decoded volume may use: `MemAvailable` from
-/// `/proc/meminfo` if readable, else [`DEFAULT_MEMORY_LIMIT`].
-pub fn memory_limit_bytes() -> u64 {
-    std::fs::read_to_string("/proc/meminfo")
-        .ok()
-        .and_then(|s| mem_available(&s))
-        .unwrap_or(DEFAULT_MEMORY_LIMIT)
-}
-
-/// `MemAvailable` in bytes from the text of `/proc/meminfo`.
-fn mem_available(meminfo: &str) -> Option<u64> {
-    let rest = meminfo
-        .lines()
-        .find_map(|l| l.strip_prefix("MemAvailable:"))?;
-    let mut words = rest.split_whitespace();
-    let value: u64 = words.next()?.parse().ok()?;
-    match words.next() {
-        Some("kB") => value.checked_mul(1024),
-        _ => None,
-    }
-}
 
 /// Refuse volumes whose decoding would need more than `limit` bytes: the
 /// `f32` output plus the raw samples.
@@ -114,7 +89,7 @@ pub fn read_nrrd(path: &Path) -> Result<Volume, IoError> {
 /// [`read_nrrd`], advancing `progress` by the bytes read from the file
 /// that holds the samples (its length is set to that file's size).
 pub fn read_nrrd_with_progress(path: &Path, progress: &ProgressBar) -> Result<Volume, IoError> {
-    read_nrrd_limited(path, memory_limit_bytes(), progress)
+    read_nrrd_limited(path, crate::budget::limit_bytes(), progress)
 }
 
 fn read_nrrd_limited(path: &Path, limit: u64, progress: &ProgressBar) -> Result<Volume, IoError> {
@@ -145,7 +120,7 @@ fn read_nrrd_limited(path: &Path, limit: u64, progress: &ProgressBar) -> Result<
 
 /// Parse a whole NRRD file held in memory; see [`read_nrrd`].
 pub fn parse_nrrd(bytes: &[u8]) -> Result<Volume, IoError> {
-    parse_nrrd_limited(bytes, memory_limit_bytes())
+    parse_nrrd_limited(bytes, crate::budget::limit_bytes())
 }
 
 /// [`parse_nrrd`] with an explicit memory limit in bytes.
@@ -375,7 +350,7 @@ pub fn read_raw(
     ty: SampleType,
     endian: Endian,
 ) -> Result<Volume, IoError> {
-    let limit = memory_limit_bytes();
+    let limit = crate::budget::limit_bytes();
     let open = || -> Result<Volume, IoError> {
         let mut reader = BufReader::with_capacity(FILE_BUFFER_BYTES, File::open(path)?);
         read_raw_from(&mut reader, dims, ty, endian, limit)
@@ -391,7 +366,7 @@ pub fn parse_raw(
     endian: Endian,
 ) -> Result<Volume, IoError> {
     let mut reader = bytes;
-    read_raw_from(&mut reader, dims, ty, endian, memory_limit_bytes())
+    read_raw_from(&mut reader, dims, ty, endian, crate::budget::limit_bytes())
 }
 
 fn read_raw_from<R: Read>(

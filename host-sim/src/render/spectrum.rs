@@ -195,7 +195,7 @@ pub(crate) fn check_memory(n: usize, bytes_per_sample: usize) -> Result<(), Pipe
         .checked_pow(3)
         .and_then(|c| c.checked_mul(bytes_per_sample as u64))
         .unwrap_or(u64::MAX);
-    let limit = crate::io::nrrd::memory_limit_bytes();
+    let limit = crate::budget::limit_bytes();
     if needed > limit {
         return Err(PipelineError::OutOfMemory { needed, limit, n });
     }

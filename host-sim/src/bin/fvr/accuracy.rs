@@ -11,6 +11,13 @@ pub(crate) struct AccuracyArgs {
 }
 
 pub(crate) fn accuracy(args: &AccuracyArgs) -> Result<(), Error> {
+    if let Some(&bad) = args
+        .sizes
+        .iter()
+        .find(|&&n| !(8..=512).contains(&n) || !n.is_power_of_two())
+    {
+        return Err(format!("--sizes: {bad} is not a power of two from 8 to 512").into());
+    }
     let rows = fvr_host::studies::accuracy::accuracy_table(&args.sizes)?;
     print!("{}", fvr_host::studies::accuracy::markdown(&rows));
     Ok(())

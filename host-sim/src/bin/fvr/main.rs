@@ -78,6 +78,11 @@ pub(crate) struct Cli {
     /// No progress bars (they are shown only when stderr is a terminal anyway).
     #[arg(long, global = true)]
     quiet: bool,
+    /// The most memory a job may plan to hold (bytes, or with K, M or G).
+    /// Default: the smallest of the address-space limit (ulimit -v), the
+    /// cgroup's memory limit and MemAvailable.
+    #[arg(long, global = true, value_name = "BYTES")]
+    max_memory: Option<String>,
     #[command(subcommand)]
     command: Option<Command>,
 }
@@ -123,6 +128,15 @@ fn main() -> ExitCode {
     let matches = Cli::command().get_matches();
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     progress::set_quiet(cli.quiet);
+    if let Some(text) = &cli.max_memory {
+        match fvr_host::budget::parse_bytes("--max-memory", text) {
+            Ok(bytes) => fvr_host::budget::set_max_memory(bytes),
+            Err(e) => {
+                eprintln!("fvr: error: {e}");
+                return ExitCode::from(2);
+            }
+        }
+    }
     let given = |sub: &str, id: &str| {
         matches
             .subcommand_matches(sub)

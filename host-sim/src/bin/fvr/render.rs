@@ -166,12 +166,14 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     if ext != "png" && ext != "nrrd" {
         return Err(format!("output `{}` must end in .png or .nrrd", out.display()).into());
     }
+    check_output(out, &["png", "nrrd"], volume_spec)?;
     let view = args.view()?;
     view.frame()?;
     let style = args.png.style()?;
     let t0 = Instant::now();
     let mut volume = args.input.load(volume_spec)?;
     if let Some(largest) = args.resample {
+        check_resample(&volume, largest)?;
         volume = volume.resample_isotropic(largest)?;
     }
     let t_load = t0.elapsed();
@@ -210,6 +212,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     let n = spectra.density.n();
     let default_side = n / args.frame.spectrum.oversample as usize;
     let (w, h) = args.frame.size.unwrap_or((default_side, default_side));
+    fvr_core::image::check_image(w, h, n)?;
     let sampling = args.frame.units.sampling(&volume, n, default_side)?;
     let plain_view = scene.channels() == 1 && !scene.has_partner_terms();
     if (args.preview_level > 0 || args.adaptive.is_some()) && !plain_view {
@@ -283,6 +286,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     let t_view = adaptive_report
         .as_ref()
         .map_or(t2.elapsed(), |r| r.view_time);
+    check_finite(&image.data)?;
     if ext == "png" {
         if image.channels == 1 {
             write_png(out, w, h, &image.data, &style)?;
@@ -598,5 +602,42 @@ impl Rendered<'_> {
             _ => println!("  SNR vs exact  n/a (not a built-in phantom)"),
         }
         Ok(())
+    }
+}
+
+/// Checks of the output path before any work: its directory exists, and it
+/// is not the input file (compared by file identity).
+pub(crate) fn check_output(
+    out: &Path,
+    allowed: &'static [&'static str],
+    volume_spec: &str,
+) -> Result<(), Error> {
+    fvr_host::io::paths::check_output(out, allowed, &[Path::new(volume_spec)])?;
+    Ok(())
+}
+
+/// Refuse a resampled volume beyond the memory limit before allocating it.
+pub(crate) fn check_resample(volume: &Volume, largest: usize) -> Result<(), Error> {
+    let dims = volume.resampled_dims(largest)?;
+    let mut budget = fvr_host::budget::Budget::new();
+    budget.hold(
+        "resampled volume",
+        dims.iter().map(|&d| d as u64).product(),
+        4,
+    );
+    budget.check(fvr_host::budget::limit(), "use a smaller --resample")?;
+    Ok(())
+}
+
+/// Refuse to write an image with a NaN or infinite pixel.
+pub(crate) fn check_finite(data: &[f64]) -> Result<(), Error> {
+    match data.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(format!(
+            "the image has non-finite pixels (the first is value {i}, {:e}): a setting overflowed; \
+             lower --ambient, the --light colours or the --depth-cue weights",
+            data[i]
+        )
+        .into()),
     }
 }

@@ -5,9 +5,7 @@ use crate::Error;
 use std::path::PathBuf;
 
 use clap::Args;
-use fvr_host::studies::trade::{
-    csv, human_bytes, measure, parse_bytes, plot, summary, Sweep, SweepAxes,
-};
+use fvr_host::studies::trade::{csv, human_bytes, measure, plot, summary, Sweep, SweepAxes};
 
 /// Arguments of `fvr trade`.
 #[derive(Args, Debug, Clone)]
@@ -91,13 +89,16 @@ fn command_line() -> String {
 pub(crate) fn run(args: &TradeArgs) -> Result<(), Error> {
     let sweep = Sweep::from_axes(&args.axes())?;
     let (available, source) = match &args.memory_limit {
-        Some(text) => (parse_bytes(text)?, "--memory-limit"),
-        None => (
-            fvr_host::io::nrrd::memory_limit_bytes(),
-            "MemAvailable in /proc/meminfo",
+        Some(text) => (
+            fvr_host::budget::parse_bytes("--memory-limit", text)?,
+            "--memory-limit".to_string(),
         ),
+        None => {
+            let limit = fvr_host::budget::limit();
+            (limit.bytes, limit.source.to_string())
+        }
     };
-    sweep.check_memory(available, source)?;
+    sweep.check_memory(available, &source)?;
     let dir = &args.out_dir;
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
     let total = sweep.settings().len();

@@ -57,6 +57,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     let volume_spec = args.volume.as_deref().ok_or_else(|| {
         "no volume: give VOLUME, or `volume.path` or `volume.builtin` in the scene".to_string()
     })?;
+    crate::render::check_output(&args.out, &["apng", "png"], volume_spec)?;
     let volume = args.input.load(volume_spec)?;
     let t_load = t0.elapsed();
     let t1 = Instant::now();
@@ -71,6 +72,13 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     let n = spec.n();
     let side = n / args.frame.spectrum.oversample as usize;
     let (w, h) = args.frame.size.unwrap_or((side, side));
+    fvr_core::image::check_image(w, h, n)?;
+    let mut budget = fvr_host::budget::Budget::new();
+    budget.hold("frames", views.len() as u64, (w * h * 8) as u64);
+    budget.check(
+        fvr_host::budget::limit(),
+        "use fewer --frames or a smaller --size",
+    )?;
     let sampling = args.frame.units.sampling(&volume, n, side)?;
     let bar = progress::count(views.len() as u64, "frames");
     let t2 = Instant::now();
@@ -78,6 +86,9 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     let t_views = t2.elapsed();
     bar.finish_and_clear();
     let frames = frames?;
+    for frame in &frames {
+        crate::render::check_finite(frame)?;
+    }
     write_apng(&args.out, w, h, &frames, args.fps, &style)?;
     let secs = t_views.as_secs_f64();
     println!(

@@ -303,7 +303,7 @@ fn check_pixel_size(obj: &DefaultDicomObject) -> Result<(), IoError> {
             "the pixel data holds",
         ),
     };
-    let limit = crate::io::nrrd::memory_limit_bytes();
+    let limit = crate::budget::limit_bytes();
     if needed > available || needed > limit {
         return Err(format_error(
             FORMAT,

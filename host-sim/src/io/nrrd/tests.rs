@@ -579,15 +579,6 @@ fn gzip_bomb_is_not_fully_decompressed() {
 }
 
 #[test]
-fn memory_limit_parsing() {
-    let meminfo = "MemTotal:       16318416 kB\nMemFree:  1000 kB\nMemAvailable:    8000000 kB\n";
-    assert_eq!(mem_available(meminfo), Some(8_000_000 * 1024));
-    assert_eq!(mem_available("MemTotal: 5 kB\n"), None);
-    assert_eq!(mem_available("MemAvailable: lots kB\n"), None);
-    assert!(memory_limit_bytes() > 0);
-}
-
-#[test]
 fn non_finite_float_samples_name_the_voxel() {
     let mut values = vec![1.0f64; 24];
     let (i, j, k) = (2, 1, 1);

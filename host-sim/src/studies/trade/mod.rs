@@ -24,6 +24,8 @@ mod tests;
 pub use measure::{exact_at_pitch, measure, peak_rss, view_directions};
 pub use report::{csv, dominates, mark_fronts, pareto_front, plot, summary, Row, CSV_HEADER};
 
+pub use crate::budget::human_bytes;
+
 use std::fmt::Write as _;
 
 use fvr_core::dht::Twiddles;
@@ -287,43 +289,6 @@ fn parse_trade_format(s: &str) -> Result<Format, String> {
             "format `{s}` is not swept (f64 is the reference; 8-bit and per-brick formats are \
              in `fvr precision`): use {FORMATS_HELP}"
         )),
-    }
-}
-
-/// Parse a byte count with an optional `K`, `M` or `G` suffix (powers of 1024).
-///
-/// # Errors
-/// Anything else, or an overflow.
-pub fn parse_bytes(s: &str) -> Result<u64, String> {
-    let t = s.trim();
-    let (digits, shift) = match t.char_indices().last() {
-        Some((i, 'K' | 'k')) => (&t[..i], 10),
-        Some((i, 'M' | 'm')) => (&t[..i], 20),
-        Some((i, 'G' | 'g')) => (&t[..i], 30),
-        _ => (t, 0),
-    };
-    digits
-        .parse::<u64>()
-        .ok()
-        .and_then(|v| v.checked_mul(1u64 << shift))
-        .ok_or_else(|| {
-            format!("--memory-limit `{s}`: expected a number of bytes, optionally with K, M or G")
-        })
-}
-
-/// Bytes in binary units, e.g. `1.5 GiB`.
-pub fn human_bytes(b: u64) -> String {
-    let units = ["B", "KiB", "MiB", "GiB", "TiB"];
-    let mut v = b as f64;
-    let mut u = 0;
-    while v >= 1024.0 && u + 1 < units.len() {
-        v /= 1024.0;
-        u += 1;
-    }
-    if u == 0 {
-        format!("{b} B")
-    } else {
-        format!("{v:.1} {}", units[u])
     }
 }
 

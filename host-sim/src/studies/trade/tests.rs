@@ -143,6 +143,7 @@ fn exact_at_pitch_subsamples_the_full_image() {
 
 #[test]
 fn byte_counts_parse_with_suffixes() {
+    let parse_bytes = |s| crate::budget::parse_bytes("--memory-limit", s);
     assert_eq!(parse_bytes("1024").unwrap(), 1024);
     assert_eq!(parse_bytes("3K").unwrap(), 3072);
     assert_eq!(parse_bytes("2M").unwrap(), 2 << 20);

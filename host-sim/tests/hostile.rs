@@ -1,0 +1,124 @@
+//! Hostile requests: each is refused before any large allocation with one
+//! line naming the problem (exit 2), never with an abort, and never by
+//! touching an input or writing a non-finite image.
+
+mod common;
+
+use std::path::Path;
+
+use common::{assert_error, fvr, fvr_line, temp_dir};
+use fvr_host::io::nrrd::{encode_nrrd, Encoding::Raw, Endian::Little, SampleType::U8};
+
+/// `line` run in `dir` exits 2 naming every needle and leaves no `output`.
+fn refused(dir: &Path, line: &str, needles: &[&str], output: &str) {
+    assert_error(&fvr_line(line, dir), needles);
+    assert!(!dir.join(output).exists(), "`{line}` wrote {output}");
+}
+
+#[test]
+fn images_larger_than_the_slice_are_refused_before_allocating() {
+    let dir = temp_dir("hostile-size");
+    let big = "--dir 1,0,0 --size 100000x100000 --out x.png";
+    refused(
+        &dir,
+        &format!("render sphere@32 {big}"),
+        &["100000"],
+        "x.png",
+    );
+    refused(
+        &dir,
+        &format!("render sphere@32 {big} --preview-level 1"),
+        &["100000"],
+        "x.png",
+    );
+    let turn = "turntable sphere@32 --size 100000 --frames 2 --out t.apng";
+    refused(&dir, turn, &["100000"], "t.apng");
+}
+
+#[test]
+fn jobs_beyond_the_memory_limit_name_what_they_need() {
+    let dir = temp_dir("hostile-memory");
+    let out = fvr_line(
+        "--max-memory 64M render sphere@32 --dir 1,0,0 --resample 2500 --out x.png",
+        &dir,
+    );
+    assert_error(&out, &["resampled volume", "--max-memory", "--resample"]);
+    let out = fvr_line(
+        "--max-memory 1M turntable sphere@16 --frames 3600 --out t.apng",
+        &dir,
+    );
+    assert_error(&out, &["frames", "--frames"]);
+    let out = fvr_line(
+        "--max-memory lots render sphere@16 --dir 1,0,0 --out x.png",
+        &dir,
+    );
+    assert_error(&out, &["--max-memory `lots`"]);
+}
+
+/// The address-space limit of `ulimit -v` is a memory limit too: under
+/// 2 GiB, a 13.5 GB resampling is refused by name, not aborted.
+#[test]
+fn the_address_space_limit_is_respected() {
+    let dir = temp_dir("hostile-rlimit");
+    let out = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v 2097152 && exec '{}' render sphere@32 --dir 1,0,0 --resample 1500 --out x.png",
+            env!("CARGO_BIN_EXE_fvr")
+        ))
+        .current_dir(&dir)
+        .output()
+        .expect("sh runs");
+    assert_error(&out, &["address-space limit", "resampled volume"]);
+}
+
+#[test]
+fn accuracy_sizes_must_be_powers_of_two_in_range() {
+    let dir = temp_dir("hostile-accuracy");
+    assert_error(
+        &fvr_line("accuracy --sizes 100000", &dir),
+        &["100000", "power of two"],
+    );
+    assert_error(
+        &fvr_line("accuracy --sizes 3", &dir),
+        &["3 is not", "power of two"],
+    );
+}
+
+#[test]
+fn an_output_equal_to_the_input_is_refused_and_the_input_kept() {
+    let dir = temp_dir("hostile-clobber");
+    let bytes = encode_nrrd(&[8, 8, 8], U8, Raw, Little, &[3.0; 512]);
+    std::fs::write(dir.join("vol.nrrd"), &bytes).unwrap();
+    let out = fvr_line("render vol.nrrd --dir 1,0,0 --out vol.nrrd", &dir);
+    assert_error(&out, &["vol.nrrd", "overwrite an input"]);
+    let out = fvr(
+        &[
+            "render",
+            "vol.nrrd",
+            "--dir",
+            "1,0,0",
+            "--out",
+            "./sub/../vol.nrrd",
+        ],
+        &dir,
+    );
+    assert_eq!(out.status.code(), Some(2));
+    let out = fvr_line("turntable vol.nrrd --frames 2 --out vol.nrrd", &dir);
+    assert_error(&out, &["vol.nrrd", ".apng"]);
+    assert_eq!(std::fs::read(dir.join("vol.nrrd")).unwrap(), bytes);
+}
+
+#[test]
+fn overflowing_settings_never_write_a_non_finite_image() {
+    let dir = temp_dir("hostile-overflow");
+    let view = "render sphere@16 --dir 1,0,0 --out a.nrrd";
+    let ambient = format!("{view} --ambient 1e308 --light 0,1,0:1,1,1");
+    refused(&dir, &ambient, &["non-finite"], "a.nrrd");
+    refused(
+        &dir,
+        &format!("{view} --light 0,1,0:1e308"),
+        &["non-finite"],
+        "a.nrrd",
+    );
+}
