@@ -3,7 +3,8 @@
 mod common;
 use common::{assert_error, assert_ok, fvr, fvr_in, fvr_line, read, temp_dir};
 
-use fvr_host::io::nrrd::{encode_nrrd, Encoding, Endian, SampleType};
+use fvr_host::io::nrrd::SampleType::{F32, U16};
+use fvr_host::io::nrrd::{encode_nrrd, Encoding, Endian};
 
 #[test]
 fn no_arguments_renders_the_default_scene_and_says_where() {
@@ -95,24 +96,12 @@ fn nan_voxels_truncated_and_malformed_files_are_named() {
     let dir = temp_dir("files");
     let mut values = vec![1.0; 4 * 4 * 4];
     values[1 + 4 * (2 + 4 * 3)] = f64::NAN;
-    let nan = encode_nrrd(
-        &[4, 4, 4],
-        SampleType::F32,
-        Encoding::Raw,
-        Endian::Little,
-        &values,
-    );
+    let nan = encode_nrrd(&[4, 4, 4], F32, Encoding::Raw, Endian::Little, &values);
     std::fs::write(dir.join("nan.nrrd"), &nan).unwrap();
     let out = fvr_line("render nan.nrrd --dir 1,0,0 --out x.png", &dir);
     assert_error(&out, &["NaN", "(1, 2, 3)"]);
 
-    let good = encode_nrrd(
-        &[4, 4, 4],
-        SampleType::U16,
-        Encoding::Gzip,
-        Endian::Big,
-        &[7.0; 64],
-    );
+    let good = encode_nrrd(&[4, 4, 4], U16, Encoding::Gzip, Endian::Big, &[7.0; 64]);
     std::fs::write(dir.join("short.nrrd"), &good[..good.len() - 20]).unwrap();
     let out = fvr_line("render short.nrrd --dir 1,0,0 --out x.png", &dir);
     assert_eq!(out.status.code(), Some(2));

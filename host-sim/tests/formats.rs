@@ -7,9 +7,8 @@ use std::path::{Path, PathBuf};
 use fvr_host::io::den::{encode_den, parse_den, HEADER_BYTES as DEN_HEADER};
 use fvr_host::io::inv3::{encode_archive, encode_inv3_i16, main_plist_text, parse_inv3};
 use fvr_host::io::nifti::{encode_nifti_f32, offsets, parse_nifti, read_nifti};
-use fvr_host::io::nrrd::{
-    encode_nrrd, parse_nrrd, read_nrrd, Encoding, Endian, IoError, SampleType,
-};
+use fvr_host::io::nrrd::Encoding::Raw;
+use fvr_host::io::nrrd::{encode_nrrd, parse_nrrd, read_nrrd, Endian, IoError, SampleType};
 use fvr_host::io::{detect, read_volume, Format};
 use fvr_host::sources::datasets::{BRAINSMALL_DEN_GZ, BRAINSMALL_DIMS};
 use fvr_host::volume::{check_spacing, Volume, DEFAULT_SPACING};
@@ -533,13 +532,7 @@ fn sizes_whose_product_overflows_are_refused_before_allocating() {
     assert!(raw.unwrap_err().to_string().contains("overflows"));
     // A header that claims a large volume but holds a few bytes fails on
     // the missing bytes, not on memory.
-    let claims = encode_nrrd(
-        &[2],
-        SampleType::U8,
-        Encoding::Raw,
-        Endian::Little,
-        &[1.0, 2.0],
-    );
+    let claims = encode_nrrd(&[2], SampleType::U8, Raw, Endian::Little, &[1.0, 2.0]);
     let text = String::from_utf8_lossy(&claims).replace("sizes: 2", "sizes: 600000000");
     let msg = parse_nrrd(text.as_bytes()).unwrap_err().to_string();
     assert!(
@@ -553,13 +546,7 @@ fn sizes_whose_product_overflows_are_refused_before_allocating() {
 #[test]
 fn formats_are_detected_by_magic_before_extension() {
     let dir = temp_dir("detect");
-    let nrrd = encode_nrrd(
-        &[2, 2, 2],
-        SampleType::U8,
-        Encoding::Raw,
-        Endian::Little,
-        &[1.0; 8],
-    );
+    let nrrd = encode_nrrd(&[2, 2, 2], SampleType::U8, Raw, Endian::Little, &[1.0; 8]);
     let nii = encode_nifti_f32([2, 2, 2], [1.0; 3], (1.0, 0.0), &[1.0; 8], Endian::Little);
     let den = encode_den([2, 2, 2], &[1; 8], Endian::Little);
     let inv3 = encode_inv3_i16([2, 2, 2], [1.0; 3], &[1; 8]);
