@@ -9,7 +9,7 @@ use std::process::Output;
 
 use fvr_host::io::den::encode_den;
 use fvr_host::io::nifti::encode_nifti_f32;
-use fvr_host::io::nrrd::Endian;
+use fvr_host::io::nrrd::Endian::{self, Little};
 
 fn stdout(out: &Output) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
@@ -132,13 +132,7 @@ fn turntable_options_match_render_options() {
 fn renders_nifti_den_and_named_volumes_to_styled_pngs() {
     let dir = temp_dir("io-formats");
     let data: Vec<f32> = (0..16 * 16 * 8).map(|i| ((i * 37) % 101) as f32).collect();
-    let nii = encode_nifti_f32(
-        [16, 16, 8],
-        [1.0, 1.0, 2.0],
-        (1.0, 0.0),
-        &data,
-        Endian::Little,
-    );
+    let nii = encode_nifti_f32([16, 16, 8], [1.0, 1.0, 2.0], (1.0, 0.0), &data, Little);
     std::fs::write(dir.join("v.nii"), nii).unwrap();
     let den = encode_den([8, 8, 8], &[7; 512], Endian::Big);
     std::fs::write(dir.join("v.den"), den).unwrap();

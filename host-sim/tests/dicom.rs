@@ -62,13 +62,8 @@ fn err_of(path: &Path) -> String {
 fn a_series_is_sorted_by_position_with_spacing_and_rescale() {
     let dir = temp_dir("axial");
     // Depths out of file-name order: c=0, a=2.5, d=5, b=7.5.
-    write_series(
-        &dir,
-        "1.2.3",
-        &[2.5, 7.5, 0.0, 5.0],
-        AXIAL,
-        &["a.dcm", "b.dcm", "c.dcm", "d.dcm"],
-    );
+    let names = ["a.dcm", "b.dcm", "c.dcm", "d.dcm"];
+    write_series(&dir, "1.2.3", &[2.5, 7.5, 0.0, 5.0], AXIAL, &names);
     std::fs::write(dir.join("notes.txt"), "not DICOM").unwrap();
     assert_eq!(detect(&dir).unwrap(), Format::Dicom);
     let vol = read_volume(&dir).expect("series");

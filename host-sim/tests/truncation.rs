@@ -9,7 +9,7 @@ use fvr_host::io::dicom::{parse_slice, CtSlice};
 use fvr_host::io::inv3::{encode_inv3_i16, parse_inv3};
 use fvr_host::io::nifti::{encode_nifti_f32, parse_nifti};
 use fvr_host::io::nrrd::IoError;
-use fvr_host::io::nrrd::{encode_nrrd, parse_nrrd, Encoding, Endian, SampleType};
+use fvr_host::io::nrrd::{encode_nrrd, parse_nrrd, Encoding, Endian, Endian::Little, SampleType};
 use fvr_host::volume::Volume;
 
 fn gzip(bytes: &[u8]) -> Vec<u8> {
@@ -59,13 +59,7 @@ fn prefixes_of_every_format_are_errors() {
     every_prefix_is_refused("den", &den, parse_den);
     every_prefix_is_refused("den.gz", &gzip(&den), parse_den);
     let data: Vec<f32> = (0..24).map(|i| i as f32 * 0.5).collect();
-    let nii = encode_nifti_f32(
-        [4, 3, 2],
-        [0.5, 1.0, 2.0],
-        (2.0, 1.0),
-        &data,
-        Endian::Little,
-    );
+    let nii = encode_nifti_f32([4, 3, 2], [0.5, 1.0, 2.0], (2.0, 1.0), &data, Little);
     every_prefix_is_refused("nii", &nii, parse_nifti);
     every_prefix_is_refused("nii.gz", &gzip(&nii), parse_nifti);
     let inv3 = encode_inv3_i16(
