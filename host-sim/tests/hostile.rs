@@ -122,3 +122,61 @@ fn overflowing_settings_never_write_a_non_finite_image() {
         "a.nrrd",
     );
 }
+
+#[test]
+fn endless_or_blocking_inputs_are_refused_by_kind() {
+    let dir = temp_dir("hostile-devices");
+    refused(
+        &dir,
+        "render /dev/zero --dir 1,0,0 --out x.png",
+        &["/dev/zero", "not a regular file"],
+        "x.png",
+    );
+    refused(
+        &dir,
+        "render --scene /dev/zero --out x.png",
+        &["scene file", "not a regular file"],
+        "x.png",
+    );
+    let cue = "render sphere@16 --dir 1,0,0 --depth-cue profile:@/dev/zero --out x.png";
+    refused(&dir, cue, &["depth profile", "not a regular file"], "x.png");
+    let header = "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 4\nencoding: raw\n\
+                  data file: /dev/zero\nbyte skip: 999999999999999\n\n";
+    std::fs::write(dir.join("zero.nhdr"), header).unwrap();
+    refused(
+        &dir,
+        "render zero.nhdr --dir 1,0,0 --out x.png",
+        &["not a regular file"],
+        "x.png",
+    );
+    let fifo = dir.join("fifo");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    if made.is_ok_and(|s| s.success()) {
+        refused(
+            &dir,
+            "render fifo --dir 1,0,0 --out x.png",
+            &["not a regular file"],
+            "x.png",
+        );
+    }
+}
+
+#[test]
+fn comparing_against_an_all_zero_image_is_an_error() {
+    let dir = temp_dir("hostile-compare");
+    let zero = "NRRD0004\ntype: float\ndimension: 2\nsizes: 2 2\nencoding: raw\nendian: little\n\n";
+    let mut bytes = zero.as_bytes().to_vec();
+    bytes.extend_from_slice(&[0u8; 16]);
+    std::fs::write(dir.join("z.nrrd"), &bytes).unwrap();
+    let out = fvr_line("compare z.nrrd z.nrrd", &dir);
+    assert_error(&out, &["all zero", "undefined"]);
+}
+
+/// `--ambient -1` reaches the value check (as other numeric flags do) and
+/// is refused there by name, not by the parser as an unknown argument.
+#[test]
+fn a_negative_ambient_is_refused_by_its_value() {
+    let dir = temp_dir("hostile-ambient");
+    let line = "render sphere@16 --dir 1,0,0 --ambient -1 --out x.nrrd";
+    refused(&dir, line, &["ambient", "-1", "not allowed"], "x.nrrd");
+}

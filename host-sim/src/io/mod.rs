@@ -130,7 +130,7 @@ pub fn detect(path: &Path) -> Result<Format, IoError> {
         return Ok(Format::Dicom);
     }
     let go = || -> Result<Format, IoError> {
-        let mut reader = BufReader::new(File::open(path)?);
+        let mut reader = BufReader::new(open_file(path)?);
         let (head, gzip) = sniff(&mut reader)?;
         Format::from_magic(&head, gzip)
             .or_else(|| Format::from_extension(path))
@@ -202,12 +202,46 @@ pub fn read_volume_with_progress(path: &Path, progress: &ProgressBar) -> Result<
     }
 }
 
+/// Open `path` for reading if it is a regular file. A FIFO, a device such
+/// as `/dev/zero` or a directory is refused before it is opened: reading
+/// one could block or never end.
+///
+/// # Errors
+/// The path does not exist, cannot be opened, or is not a regular file.
+pub fn open_file(path: &Path) -> io::Result<File> {
+    if !std::fs::metadata(path)?.is_file() {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            "not a regular file (a directory, FIFO or device cannot be read as data)",
+        ));
+    }
+    File::open(path)
+}
+
+/// The text of the small file `path` (a scene or a depth profile): a
+/// regular file of at most `max` bytes.
+///
+/// # Errors
+/// One line naming `what`, the path and the problem.
+pub fn read_small_text(path: &Path, what: &str, max: u64) -> Result<String, String> {
+    let fail = |e: &dyn std::fmt::Display| format!("cannot read {what} `{}`: {e}", path.display());
+    let file = open_file(path).map_err(|e| fail(&e))?;
+    let mut text = String::new();
+    file.take(max + 1)
+        .read_to_string(&mut text)
+        .map_err(|e| fail(&e))?;
+    if text.len() as u64 > max {
+        return Err(fail(&format!("larger than {max} bytes")));
+    }
+    Ok(text)
+}
+
 /// Open `path` for reading, counting the bytes read into `progress`.
 pub(crate) fn open_counted(
     path: &Path,
     progress: &ProgressBar,
 ) -> Result<BufReader<impl Read>, IoError> {
-    let file = File::open(path)?;
+    let file = open_file(path)?;
     progress.set_length(file.metadata().map(|m| m.len()).unwrap_or(0));
     Ok(BufReader::with_capacity(
         FILE_BUFFER_BYTES,

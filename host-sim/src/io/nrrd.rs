@@ -35,7 +35,6 @@ mod samples;
 #[cfg(test)]
 mod tests;
 
-use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read};
 use std::path::Path;
 
@@ -94,7 +93,7 @@ pub fn read_nrrd_with_progress(path: &Path, progress: &ProgressBar) -> Result<Vo
 
 fn read_nrrd_limited(path: &Path, limit: u64, progress: &ProgressBar) -> Result<Volume, IoError> {
     let open = || -> Result<Volume, IoError> {
-        let file = File::open(path)?;
+        let file = crate::io::open_file(path)?;
         progress.set_length(file.metadata().map(|m| m.len()).unwrap_or(0));
         let mut reader = BufReader::with_capacity(FILE_BUFFER_BYTES, progress.wrap_read(file));
         let layout = read_header(&mut reader)?;
@@ -107,7 +106,7 @@ fn read_nrrd_limited(path: &Path, limit: u64, progress: &ProgressBar) -> Result<
             None => Path::new(name).to_path_buf(),
         };
         let read_detached = || -> Result<Volume, IoError> {
-            let file = File::open(&data_path)?;
+            let file = crate::io::open_file(&data_path)?;
             progress.set_position(0);
             progress.set_length(file.metadata().map(|m| m.len()).unwrap_or(0));
             let mut data = BufReader::with_capacity(FILE_BUFFER_BYTES, progress.wrap_read(file));
@@ -352,7 +351,7 @@ pub fn read_raw(
 ) -> Result<Volume, IoError> {
     let limit = crate::budget::limit_bytes();
     let open = || -> Result<Volume, IoError> {
-        let mut reader = BufReader::with_capacity(FILE_BUFFER_BYTES, File::open(path)?);
+        let mut reader = BufReader::with_capacity(FILE_BUFFER_BYTES, crate::io::open_file(path)?);
         read_raw_from(&mut reader, dims, ty, endian, limit)
     };
     open().map_err(|e| e.in_file(path))

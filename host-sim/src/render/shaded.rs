@@ -364,8 +364,8 @@ pub fn parse_depth_cue(spec: &str, harmonics: usize) -> Result<DepthCue, String>
         let (front, back) = pair(rest, "sine")?;
         Ok(DepthCue::Sine { front, back })
     } else if let Some(path) = spec.strip_prefix("profile:@") {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| format!("cannot read depth profile `{path}`: {e}"))?;
+        let text =
+            crate::io::read_small_text(std::path::Path::new(path), "depth profile", 1 << 20)?;
         weights(parse_numbers(&text).map_err(|e| format!("depth profile `{path}`: {e}"))?)
     } else if let Some(rest) = spec.strip_prefix("profile:gauss:") {
         let (c, s) = pair(rest, "profile:gauss")?;

@@ -25,6 +25,13 @@ pub(crate) fn compare(args: &CompareArgs) -> Result<(), Error> {
     }
     let ra: Vec<f64> = ia.data.iter().map(|&v| v as f64).collect();
     let rb: Vec<f64> = ib.data.iter().map(|&v| v as f64).collect();
+    if ra.iter().all(|&v| v == 0.0) {
+        return Err(format!(
+            "reference image `{}` is all zero: an SNR against it is undefined",
+            a.display()
+        )
+        .into());
+    }
     println!(
         "SNR of {} against {}: {:.2} dB (max abs error {:.3e})",
         b.display(),

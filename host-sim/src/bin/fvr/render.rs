@@ -67,7 +67,7 @@ pub(crate) struct RenderArgs {
     pub(crate) cue_harmonics: usize,
     /// Ambient colour R,G,B or one grey value (paper eq. 7). Default: 1 without
     /// lights, 0.2 with.
-    #[arg(long, value_parser = parse_rgb)]
+    #[arg(long, value_parser = parse_rgb, allow_hyphen_values = true)]
     pub(crate) ambient: Option<[f64; 3]>,
     /// A directional light X,Y,Z:R,G,B: the direction towards the light and
     /// its colour (or one grey value). Repeatable, up to 8. Surfaces of denser

@@ -219,6 +219,9 @@ pub(crate) const OUTPUT_KEYS: &[&str] =
     &["path", "bits", "window", "level", "percentiles", "colormap"];
 pub(crate) const TURNTABLE_KEYS: &[&str] = &["frames", "fps", "path"];
 
+/// The largest scene file read (1 MiB).
+pub const SCENE_MAX_BYTES: u64 = 1 << 20;
+
 impl SceneFile {
     /// Read and check the scene file at `path`.
     ///
@@ -227,8 +230,7 @@ impl SceneFile {
     /// the wrong type or out of range; every problem is reported, one per
     /// line, each naming the file and the key.
     pub fn load(path: &Path) -> Result<Self, String> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| format!("cannot read scene file `{}`: {e}", path.display()))?;
+        let text = crate::io::read_small_text(path, "scene file", SCENE_MAX_BYTES)?;
         let base = path.parent().unwrap_or(Path::new(""));
         Self::parse(&text, &path.display().to_string(), base)
     }
