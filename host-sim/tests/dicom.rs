@@ -156,6 +156,19 @@ fn gaps_duplicates_and_mismatches_are_refused() {
         msg.contains("PixelSpacing") && msg.contains("zero"),
         "{msg}"
     );
+    let skew = temp_dir("skew");
+    let half = std::f64::consts::FRAC_1_SQRT_2;
+    let bytes = CtSlice {
+        orientation: [1.0, 0.0, 0.0, half, half, 0.0],
+        ..CtSlice::axial([2, 2], &[0; 4])
+    }
+    .encode();
+    std::fs::write(skew.join("1"), bytes).unwrap();
+    assert!(
+        err_of(&skew).contains("ImageOrientationPatient"),
+        "{}",
+        err_of(&skew)
+    );
     let empty = temp_dir("empty");
     std::fs::write(empty.join("readme"), "nothing here").unwrap();
     assert!(err_of(&empty).contains("no DICOM image"));

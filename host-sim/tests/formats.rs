@@ -754,6 +754,33 @@ fn nifti_bad_orientations_are_named() {
         }
     });
     expect_err(parse_nifti(&not_unit), &["quatern_b", "unit quaternion"]);
+    // Rank 1: every index axis maps to the same world direction.
+    let rank_one = nifti_with_dims([4, 3, 2], [1.0; 3], &data, |b| {
+        put_i16(b, offsets::SFORM_CODE, 1);
+        for c in 0..3 {
+            put_f32(b, offsets::SROW_X + 4 * c, 1.0);
+        }
+    });
+    expect_err(parse_nifti(&rank_one), &["srow_x", "singular"]);
+}
+
+#[test]
+fn nrrd_degenerate_geometry_and_non_spatial_kinds_are_named() {
+    let header = |extra: &str| {
+        format!("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n{extra}\n")
+            .into_bytes()
+            .into_iter()
+            .chain([1u8; 8])
+            .collect::<Vec<u8>>()
+    };
+    let repeated = header("space directions: (1,0,0) (1,0,0) (0,0,1)\n");
+    expect_err(parse_nrrd(&repeated), &["space directions", "parallel"]);
+    let singular = header("space directions: (1,0,0) (0,1,0) (1,1,0)\n");
+    expect_err(parse_nrrd(&singular), &["space directions", "parallel"]);
+    let rgb = header("kinds: RGB-color domain domain\n");
+    expect_err(parse_nrrd(&rgb), &["kinds", "RGB-color"]);
+    let fine = header("kinds: domain domain domain\nspace directions: (2,0,0) (0,1,0) (0,0,3)\n");
+    assert_eq!(parse_nrrd(&fine).unwrap().spacing, [2.0, 1.0, 3.0]);
 }
 
 fn nifti_with_dims(

@@ -202,6 +202,26 @@ pub fn read_volume_with_progress(path: &Path, progress: &ProgressBar) -> Result<
     }
 }
 
+/// Whether unit vectors (two or three) are far from linearly dependent: the
+/// area or volume they span is at least 1e-3 of a unit square or cube.
+pub(crate) fn spans_independent_axes(units: &[[f64; 3]]) -> bool {
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    match units {
+        [a, b] => cross(*a, *b).iter().map(|c| c * c).sum::<f64>().sqrt() >= 1e-3,
+        [a, b, c] => {
+            let n = cross(*a, *b);
+            (n[0] * c[0] + n[1] * c[1] + n[2] * c[2]).abs() >= 1e-3
+        }
+        _ => true,
+    }
+}
+
 /// Open `path` for reading if it is a regular file. A FIFO, a device such
 /// as `/dev/zero` or a directory is refused before it is opened: reading
 /// one could block or never end.

@@ -234,6 +234,24 @@ fn parse_orientation(h: &NiftiHeader) -> Result<AxisMap, IoError> {
         let rows = [h.srow_x, h.srow_y, h.srow_z];
         let m: [[f64; 3]; 3] =
             core::array::from_fn(|w| core::array::from_fn(|a| rows[w][a] as f64));
+        let columns: [[f64; 3]; 3] = core::array::from_fn(|a| {
+            let c: [f64; 3] = core::array::from_fn(|w| m[w][a]);
+            let norm = c.iter().map(|v| v * v).sum::<f64>().sqrt();
+            c.map(|v| v / norm)
+        });
+        if columns.iter().flatten().all(|v| v.is_finite())
+            && !crate::io::spans_independent_axes(&columns)
+        {
+            return Err(format_error(
+                FORMAT,
+                "srow_x",
+                format!(
+                    "sform_code is {} but the sform's 3×3 part is singular (its axes are \
+                     parallel or nearly so): srow_x {:?}, srow_y {:?}, srow_z {:?}",
+                    h.sform_code, h.srow_x, h.srow_y, h.srow_z
+                ),
+            ));
+        }
         return AxisMap::closest(m, "sform").ok_or_else(|| {
             format_error(
                 FORMAT,

@@ -433,7 +433,8 @@ pub fn assemble(mut slices: Vec<Slice>) -> Result<Volume, IoError> {
     let col = [3, 4, 5].map(|i| first.orientation[i]);
     let normal = cross(row, col);
     let norm = dot(normal, normal).sqrt();
-    if norm.is_nan() || norm <= 0.5 {
+    let unit = |v: [f64; 3]| (dot(v, v).sqrt() - 1.0).abs() < 1e-2;
+    if !(unit(row) && unit(col) && dot(row, col).abs() < 1e-3) {
         return Err(format_error(
             SERIES,
             "ImageOrientationPatient",

@@ -75,6 +75,7 @@ struct Fields {
     data_file: Option<String>,
     spacings: Option<String>,
     space_directions: Option<String>,
+    kinds: Option<String>,
 }
 
 impl Fields {
@@ -92,6 +93,7 @@ impl Fields {
             "data file" | "datafile" => ("data file", &mut self.data_file),
             "spacings" => ("spacings", &mut self.spacings),
             "space directions" => ("space directions", &mut self.space_directions),
+            "kinds" => ("kinds", &mut self.kinds),
             _ => return None,
         })
     }
@@ -126,6 +128,9 @@ impl Fields {
         let byte_skip = parse_skip(self.byte_skip.as_deref(), "byte skip")?;
         let line_skip = parse_skip(self.line_skip.as_deref(), "line skip")?;
         let (dims, count, data_bytes) = geometry(&sizes, ty)?;
+        if let Some(kinds) = &self.kinds {
+            check_kinds(kinds)?;
+        }
         let spacing = match (self.spacings, self.space_directions) {
             // The format forbids both; `space directions` is the fuller one.
             (_, Some(d)) => parse_space_directions(&d, dimension)?,
@@ -216,6 +221,7 @@ fn parse_spacings(value: &str, dimension: usize) -> Result<[f64; 3], IoError> {
 fn parse_space_directions(value: &str, dimension: usize) -> Result<[f64; 3], IoError> {
     let bad = |why: String| field_error("space directions", why);
     let mut spacing = crate::volume::DEFAULT_SPACING;
+    let mut units: Vec<[f64; 3]> = Vec::new();
     let mut rest = value.trim();
     let mut axis = 0;
     while !rest.is_empty() {
@@ -258,8 +264,17 @@ fn parse_space_directions(value: &str, dimension: usize) -> Result<[f64; 3], IoE
             )));
         }
         spacing[axis] = length;
+        if let [x, y, z] = components[..] {
+            units.push([x / length, y / length, z / length]);
+        }
         rest = inner.1.trim_start();
         axis += 1;
+    }
+    if !crate::io::spans_independent_axes(&units) {
+        return Err(bad(format!(
+            "the vectors of `{}` are parallel or nearly so: the grid would have no volume",
+            excerpt(value.trim())
+        )));
     }
     if axis != dimension {
         return Err(bad(format!(
@@ -267,6 +282,24 @@ fn parse_space_directions(value: &str, dimension: usize) -> Result<[f64; 3], IoE
         )));
     }
     Ok(spacing)
+}
+
+/// The `kinds` field: every axis must be a spatial one (`domain`, `space`,
+/// or unknown: `none`, `???`). A colour, vector or list axis would be
+/// rendered as space.
+fn check_kinds(value: &str) -> Result<(), IoError> {
+    for (axis, kind) in value.split_whitespace().enumerate() {
+        if !matches!(kind, "domain" | "space" | "none" | "???") {
+            return Err(field_error(
+                "kinds",
+                format!(
+                    "axis {axis} is `{}`: only scalar volumes with spatial axes can be rendered",
+                    excerpt(kind)
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The `data file` field: a single file name. The multi-file forms
