@@ -238,8 +238,11 @@ impl fmt::Display for Error {
             Error::EmptyVolume => write!(f, "volume has a zero dimension"),
             Error::NonFiniteVoxel { index, value } => write!(
                 f,
-                "voxel ({}, {}, {}) is {value}: NaN and infinite voxels cannot be rendered",
-                index[0], index[1], index[2]
+                "voxel ({}, {}, {}) is {}: NaN and infinite voxels cannot be rendered",
+                index[0],
+                index[1],
+                index[2],
+                Num(value)
             ),
             Error::Overflow { stage } => write!(
                 f,
@@ -253,7 +256,7 @@ impl fmt::Display for Error {
                 "the spectrum was premultiplied for a different filter or oversampling"
             ),
             Error::InvalidSceneValue { what, index, value } => {
-                write!(f, "{what} #{index} is {value}, which is not allowed")
+                write!(f, "{what} #{index} is {}, which is not allowed", Num(value))
             }
             Error::ZeroLightVector { index } => write!(
                 f,
@@ -289,21 +292,24 @@ impl fmt::Display for Error {
             ),
             Error::InvalidSpacing { axis, value } => write!(
                 f,
-                "voxel spacing {value} along axis {} is not allowed: spacings must be finite and positive (mm)",
+                "voxel spacing {} along axis {} is not allowed: spacings must be finite and positive (mm)",
+                Num(value),
                 ["i (x)", "j (y)", "k (z)"][axis.min(2)]
             ),
             Error::InvalidPixelSize { value } => write!(
                 f,
-                "pixel size {value} is not allowed: it must be finite and positive (mm)"
+                "pixel size {} is not allowed: it must be finite and positive (mm)",
+                Num(value)
             ),
             Error::SamplingOutOfRange {
                 spacing,
                 pixel_size,
             } => write!(
                 f,
-                "voxel spacing {} mm and pixel size {pixel_size} mm are too far apart: \
+                "voxel spacing {} mm and pixel size {} mm are too far apart: \
                  their ratios or the gain spacing volume / pixel area leave the f64 range",
-                V3(spacing)
+                V3(spacing),
+                Num(pixel_size)
             ),
             Error::UnsupportedFormat { format, reason } => {
                 write!(f, "storage format {format} is not supported here: {reason}")
@@ -320,7 +326,23 @@ struct V3([f64; 3]);
 
 impl fmt::Display for V3 {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "({}, {}, {})", self.0[0], self.0[1], self.0[2])
+        let [x, y, z] = self.0.map(Num);
+        write!(f, "({x}, {y}, {z})")
+    }
+}
+
+/// A number as `{}` prints it, or as `{:e}` when that would be long (at or
+/// beyond 1e6, or below 1e-4 but not zero), so messages stay one short line.
+struct Num(f64);
+
+impl fmt::Display for Num {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let a = self.0.abs();
+        if a.is_finite() && a != 0.0 && !(1e-4..1e6).contains(&a) {
+            write!(f, "{:e}", self.0)
+        } else {
+            write!(f, "{}", self.0)
+        }
     }
 }
 

@@ -204,13 +204,23 @@ impl View {
                 up: err_fields.1,
             });
         }
+        // Components near the ends of the f64 range (1e±300) would make the
+        // norms and the cross product overflow or vanish: scale such a vector
+        // by its largest component first, which keeps its direction.
+        let (d, u0) = (fit_range(d), fit_range(u0));
         let (dn, un) = (norm(d), norm(u0));
         if dn == 0.0 || un == 0.0 {
-            return Err(Error::ZeroViewVector { dir: d, up: u0 });
+            return Err(Error::ZeroViewVector {
+                dir: err_fields.0,
+                up: err_fields.1,
+            });
         }
         let r = cross(d, u0);
         if norm(r) <= 1e-9 * dn * un {
-            return Err(Error::ParallelViewVectors { dir: d, up: u0 });
+            return Err(Error::ParallelViewVectors {
+                dir: err_fields.0,
+                up: err_fields.1,
+            });
         }
         let dir = scale(d, 1.0 / dn);
         let right = scale(r, 1.0 / norm(r));
@@ -261,6 +271,21 @@ pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
         a[2] * b[0] - a[0] * b[2],
         a[0] * b[1] - a[1] * b[0],
     ]
+}
+
+/// `a` itself when its norm is comfortably inside the f64 range, else `a`
+/// divided by its largest absolute component.
+fn fit_range(a: [f64; 3]) -> [f64; 3] {
+    let n = norm(a);
+    if (1e-150..1e150).contains(&n) {
+        return a;
+    }
+    let m = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if m > 0.0 {
+        scale(a, 1.0 / m)
+    } else {
+        a
+    }
 }
 
 fn norm(a: [f64; 3]) -> f64 {
