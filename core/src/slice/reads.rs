@@ -145,3 +145,16 @@ pub(crate) struct XRun<'a, const W: usize> {
     /// The taps' indices, wrapped around the line.
     pub(crate) index: &'a [usize; W],
 }
+
+/// `w` with every weight times `gain` (the `2^e` of [`Real::load_raw`]
+/// folded into the x-weights): the same products as `w.map(|w| w * gain)`,
+/// as a loop that is always inlined, since `[_; N]::map` (through
+/// `try_map`) stays out of line when its instance lands in another codegen
+/// unit than the per-point loop.
+#[inline(always)]
+pub(crate) fn scaled<T: Real, const W: usize>(mut w: [T; W], gain: T) -> [T; W] {
+    for v in w.iter_mut() {
+        *v *= gain;
+    }
+    w
+}
