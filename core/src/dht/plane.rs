@@ -27,7 +27,7 @@ use crate::num::Real;
 /// # Errors
 /// A side not a power of two or longer than the table, a `data` length other
 /// than `nx·ny`, or short scratch.
-#[inline]
+#[inline(always)]
 pub fn dht_2d<T: Real>(
     data: &mut [T],
     nx: usize,

@@ -175,7 +175,7 @@ pub(super) fn extract_general<const W: usize, S: Sample, Z: CubeSide, T: Real>(
     let nn = n * n;
     let reads = LineReads::of(spec);
     let mask = n - 1;
-    geometry.for_each(n, grid, |g, q| {
+    geometry.for_each::<W>(n, grid, |g, q| {
         let (mut wx, mut wy, mut wz) = ([T::ZERO; W], [T::ZERO; W], [T::ZERO; W]);
         let jx = kernel.taps_fixed(q[0], &mut wx);
         let jy = kernel.taps_fixed(q[1], &mut wy);
