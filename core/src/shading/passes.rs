@@ -416,7 +416,10 @@ pub(crate) fn accumulate_cue<S: Sample, Z: CubeSide, T: Real>(
     Ok(())
 }
 
-/// `P(k) += Q(−k)` over the `n × n` slice.
+/// `P(k) += Q(−k)` over the `n × n` slice. Always inlined into the scene
+/// render (a per-element loop; out of line it cost the M4F's linear-cue
+/// frame 18 k instructions).
+#[inline(always)]
 pub(crate) fn fold_partner<T: Real>(fields: &mut [T], n: usize, acc: Accumulators) {
     let Some(q) = acc.partner else { return };
     let nn = n * n;
