@@ -27,7 +27,7 @@ use crate::num::Real;
 /// # Errors
 /// A side not a power of two or longer than the table, a `data` length other
 /// than `nx·ny`, or short scratch.
-#[inline]
+#[inline(always)]
 pub fn dht_2d<T: Real>(
     data: &mut [T],
     nx: usize,
@@ -443,7 +443,7 @@ fn dht_columns_stages<T: Real>(
                 let (c, s) = tw.cos_sin(h * stride2);
                 radix4_rows_half(r0, r1, r2, r3, c, s);
                 for k in 1..h {
-                    let rows = rows_mut(
+                    let rows = rows_mut8(
                         block,
                         nx,
                         [
@@ -497,18 +497,64 @@ fn radix2_columns_stage<T: Real>(data: &mut [T], nx: usize, m: usize, tw: &Twidd
     }
 }
 
-/// Rows `idx[0] < idx[1] < …` (each `nx` long) of `block`, borrowed apart.
+/// Rows `idx[0] < idx[1] < idx[2] < idx[3]` (each `nx` long) of `block`,
+/// borrowed apart. An explicit array of four, not `core::array::from_fn`:
+/// `from_fn`'s `try_from_fn` is not `#[inline]`, and whenever its instance
+/// lands in another codegen unit than the 2D transform it is called out of
+/// line at every use (+150 k instructions on the M4F's 64 × 64 transform).
 #[inline(always)]
-fn rows_mut<T, const K: usize>(block: &mut [T], nx: usize, idx: [usize; K]) -> [&mut [T]; K] {
-    let mut rest = block;
-    let mut next = 0;
-    core::array::from_fn(|j| {
-        let (_, tail) = core::mem::take(&mut rest).split_at_mut((idx[j] - next) * nx);
-        let (row, tail) = tail.split_at_mut(nx);
-        rest = tail;
-        next = idx[j] + 1;
+fn rows_mut<T>(block: &mut [T], nx: usize, idx: [usize; 4]) -> [&mut [T]; 4] {
+    let mut rows = RowTaker {
+        rest: block,
+        next: 0,
+        nx,
+    };
+    [
+        rows.take(idx[0]),
+        rows.take(idx[1]),
+        rows.take(idx[2]),
+        rows.take(idx[3]),
+    ]
+}
+
+/// [`rows_mut`] for eight rows.
+#[inline(always)]
+fn rows_mut8<T>(block: &mut [T], nx: usize, idx: [usize; 8]) -> [&mut [T]; 8] {
+    let mut rows = RowTaker {
+        rest: block,
+        next: 0,
+        nx,
+    };
+    [
+        rows.take(idx[0]),
+        rows.take(idx[1]),
+        rows.take(idx[2]),
+        rows.take(idx[3]),
+        rows.take(idx[4]),
+        rows.take(idx[5]),
+        rows.take(idx[6]),
+        rows.take(idx[7]),
+    ]
+}
+
+/// Rows of `nx` borrowed one after another from what is left of a block:
+/// `next` is the index of the first row of `rest`.
+struct RowTaker<'a, T> {
+    rest: &'a mut [T],
+    next: usize,
+    nx: usize,
+}
+
+impl<'a, T> RowTaker<'a, T> {
+    /// Row `i` (at least `next`), leaving the rows after it.
+    #[inline(always)]
+    fn take(&mut self, i: usize) -> &'a mut [T] {
+        let (_, tail) = core::mem::take(&mut self.rest).split_at_mut((i - self.next) * self.nx);
+        let (row, tail) = tail.split_at_mut(self.nx);
+        self.rest = tail;
+        self.next = i + 1;
         row
-    })
+    }
 }
 
 /// The twiddled butterfly of [`dht_stages`] on one set of operands:

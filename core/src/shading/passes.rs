@@ -8,7 +8,7 @@ use crate::error::{Error, Result};
 use crate::filter::{DerivativeTable, KernelTable, PhaseTable, MAX_WIDTH};
 use crate::geometry::Frame;
 use crate::num::{Real, Sample};
-use crate::slice::{LineReads, XRun};
+use crate::slice::{scaled, LineReads, XRun};
 use crate::spectrum::{CubeSide, Spectrum};
 
 const PI: f64 = core::f64::consts::PI;
@@ -75,6 +75,33 @@ struct Axis<T, const W: usize> {
     index: [usize; W],
 }
 
+impl<T: Real, const W: usize> Axis<T, W> {
+    /// The taps at `q` from the phase tables: weights from `phases`,
+    /// derivative weights from `slopes` (zero without). One axis at a time,
+    /// always inlined: through `core::array::from_fn` the per-axis closure
+    /// stays out of line when its instance lands in another codegen unit.
+    #[inline(always)]
+    fn from_phases(
+        phases: &PhaseTable<T, W>,
+        slopes: Option<&PhaseTable<T, W>>,
+        q: T,
+        mask: usize,
+    ) -> Self {
+        let y = PhaseTable::<T, W>::fixed_position(q);
+        let (j0, weights) = phases.taps_fixed_point(y);
+        let derivative = match slopes {
+            Some(table) => table.taps_fixed_point(y).1,
+            None => [T::ZERO; W],
+        };
+        Axis {
+            weights,
+            derivative,
+            first: j0 as usize & mask,
+            index: core::array::from_fn(|t| (j0 + t as i32) as usize & mask),
+        }
+    }
+}
+
 impl<T, const W: usize> Axis<T, W> {
     /// The x-taps as one read ([`XRun`]).
     #[inline(always)]
@@ -116,23 +143,15 @@ fn run_pass_width<const W: usize, S: Sample, Z: CubeSide, T: Real, const MODE: u
         if filled && (MODE != mode::VALUE_GRADIENT || slopes.is_some()) {
             let raw_gain = T::exp2i(T::raw_exponent::<S>());
             let mask = spec.n() - 1;
+            let slopes = slopes.as_ref();
             for_each_point::<W, S, Z, T, MODE, true>(spec, reads, geo, fields, targets, |q| {
-                let mut axes: [Axis<T, W>; 3] = core::array::from_fn(|a| {
-                    let y = PhaseTable::<T, W>::fixed_position(q[a]);
-                    let (j0, weights) = phases.taps_fixed_point(y);
-                    let derivative = match &slopes {
-                        Some(table) => table.taps_fixed_point(y).1,
-                        None => [T::ZERO; W],
-                    };
-                    Axis {
-                        weights,
-                        derivative,
-                        first: j0 as usize & mask,
-                        index: core::array::from_fn(|t| (j0 + t as i32) as usize & mask),
-                    }
-                });
-                axes[0].weights = axes[0].weights.map(|w| w * raw_gain);
-                axes[0].derivative = axes[0].derivative.map(|w| w * raw_gain);
+                let mut axes: [Axis<T, W>; 3] = [
+                    Axis::from_phases(&phases, slopes, q[0], mask),
+                    Axis::from_phases(&phases, slopes, q[1], mask),
+                    Axis::from_phases(&phases, slopes, q[2], mask),
+                ];
+                axes[0].weights = scaled(axes[0].weights, raw_gain);
+                axes[0].derivative = scaled(axes[0].derivative, raw_gain);
                 axes
             });
             return;
@@ -397,7 +416,10 @@ pub(crate) fn accumulate_cue<S: Sample, Z: CubeSide, T: Real>(
     Ok(())
 }
 
-/// `P(k) += Q(−k)` over the `n × n` slice.
+/// `P(k) += Q(−k)` over the `n × n` slice. Always inlined into the scene
+/// render (a per-element loop; out of line it cost the M4F's linear-cue
+/// frame 18 k instructions).
+#[inline(always)]
 pub(crate) fn fold_partner<T: Real>(fields: &mut [T], n: usize, acc: Accumulators) {
     let Some(q) = acc.partner else { return };
     let nn = n * n;

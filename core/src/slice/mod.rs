@@ -20,7 +20,7 @@ mod reads;
 mod rows;
 mod taps;
 
-pub(crate) use reads::{LineReads, XRun};
+pub(crate) use reads::{scaled, LineReads, XRun};
 
 use crate::error::{Error, Result};
 use crate::filter::{KernelTable, PhaseTable, MAX_WIDTH};

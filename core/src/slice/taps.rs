@@ -113,6 +113,7 @@ impl<const W: usize, const LINE_EXP: bool, S: Sample> TapSums<'_, W, LINE_EXP, S
 /// products are the same numbers as with the full widening (a power of two
 /// moved between factors is exact). `LINE_EXP`: multiply each line's sum
 /// by its block exponent's power of two (`exponents`, one per x-line).
+#[inline(always)]
 pub(super) fn extract_lines<
     const W: usize,
     const LINE_EXP: bool,
@@ -163,6 +164,7 @@ pub(super) fn extract_lines<
 
 /// The extraction for any storage (e.g. bricked block exponents): taps
 /// through [`LineReads::sums`], weights from the kernel table.
+#[inline(always)]
 pub(super) fn extract_general<const W: usize, S: Sample, Z: CubeSide, T: Real>(
     spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
@@ -173,7 +175,7 @@ pub(super) fn extract_general<const W: usize, S: Sample, Z: CubeSide, T: Real>(
     let nn = n * n;
     let reads = LineReads::of(spec);
     let mask = n - 1;
-    geometry.for_each(n, grid, |g, q| {
+    geometry.for_each::<W>(n, grid, |g, q| {
         let (mut wx, mut wy, mut wz) = ([T::ZERO; W], [T::ZERO; W], [T::ZERO; W]);
         let jx = kernel.taps_fixed(q[0], &mut wx);
         let jy = kernel.taps_fixed(q[1], &mut wy);
