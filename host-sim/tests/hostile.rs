@@ -180,3 +180,27 @@ fn a_negative_ambient_is_refused_by_its_value() {
     let line = "render sphere@16 --dir 1,0,0 --ambient -1 --out x.nrrd";
     refused(&dir, line, &["ambient", "-1", "not allowed"], "x.nrrd");
 }
+
+/// A direction of huge components is the direction it points in, and
+/// messages print such numbers short.
+#[test]
+fn extreme_view_vectors_keep_their_direction_and_short_messages() {
+    let dir = temp_dir("hostile-extreme-dir");
+    let huge = "render sphere@16 --dir 1e308,1e308,1e308 --out huge.nrrd";
+    assert!(fvr_line(huge, &dir).status.success());
+    assert!(
+        fvr_line("render sphere@16 --dir 1,1,1 --out one.nrrd", &dir)
+            .status
+            .success()
+    );
+    let read = |name: &str| std::fs::read(dir.join(name)).unwrap();
+    assert_eq!(read("huge.nrrd"), read("one.nrrd"));
+    let parallel = "render sphere@16 --dir 1e308,1e308,1e308 --up 1e308,1e308,1e308 --out x.png";
+    let out = fvr_line(parallel, &dir);
+    assert_error(&out, &["parallel", "1e308"]);
+    assert!(
+        out.stderr.len() < 200,
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
