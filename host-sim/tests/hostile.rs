@@ -204,3 +204,20 @@ fn extreme_view_vectors_keep_their_direction_and_short_messages() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// A shared scene cannot write outside its own directory.
+#[test]
+fn scene_output_paths_stay_beside_the_scene() {
+    let dir = temp_dir("hostile-scene-out");
+    std::fs::create_dir_all(dir.join("scenes")).unwrap();
+    std::fs::write(dir.join("victim.txt"), "keep me").unwrap();
+    let scene =
+        "[volume]\nbuiltin = \"sphere@16\"\n[turntable]\nframes = 2\npath = \"../victim.txt\"\n";
+    std::fs::write(dir.join("scenes/s.toml"), scene).unwrap();
+    let out = fvr_line("turntable --scene scenes/s.toml", &dir);
+    assert_error(&out, &["turntable.path", "scene's directory"]);
+    assert_eq!(
+        std::fs::read_to_string(dir.join("victim.txt")).unwrap(),
+        "keep me"
+    );
+}

@@ -31,13 +31,6 @@ pub enum PathError {
         /// The path.
         path: PathBuf,
     },
-    /// A scene file's output path leaves the scene's directory.
-    OutsideScene {
-        /// The path as written in the scene.
-        path: PathBuf,
-        /// The scene file.
-        scene: PathBuf,
-    },
 }
 
 impl std::fmt::Display for PathError {
@@ -47,7 +40,11 @@ impl std::fmt::Display for PathError {
                 f,
                 "output {}: the extension must be one of {}",
                 path.display(),
-                allowed.iter().map(|e| format!(".{e}")).collect::<Vec<_>>().join(", ")
+                allowed
+                    .iter()
+                    .map(|e| format!(".{e}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
             ),
             PathError::SameAsInput { output, input } => write!(
                 f,
@@ -59,14 +56,12 @@ impl std::fmt::Display for PathError {
                 write!(f, "output {}: its directory does not exist", path.display())
             }
             PathError::NotAFile { path } => {
-                write!(f, "output {} exists and is not a regular file", path.display())
+                write!(
+                    f,
+                    "output {} exists and is not a regular file",
+                    path.display()
+                )
             }
-            PathError::OutsideScene { path, scene } => write!(
-                f,
-                "output path {} in {} leaves the scene's directory; give it on the command line instead",
-                path.display(),
-                scene.display()
-            ),
         }
     }
 }
@@ -142,12 +137,9 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
     }
 }
 
-/// Resolve a path written in a scene file against the scene's directory,
-/// refusing absolute paths and any `..` that leaves it.
-///
-/// # Errors
-/// [`PathError::OutsideScene`].
-pub fn scene_relative(scene: &Path, written: &Path) -> Result<PathBuf, PathError> {
+/// `written` joined to `base` if it stays inside `base`: relative, and no
+/// `..` that climbs above it. `None` otherwise.
+pub fn inside(base: &Path, written: &Path) -> Option<PathBuf> {
     use std::path::Component;
     let mut depth = 0usize;
     for c in written.components() {
@@ -155,16 +147,10 @@ pub fn scene_relative(scene: &Path, written: &Path) -> Result<PathBuf, PathError
             Component::Normal(_) => depth += 1,
             Component::CurDir => {}
             Component::ParentDir if depth > 0 => depth -= 1,
-            _ => {
-                return Err(PathError::OutsideScene {
-                    path: written.to_path_buf(),
-                    scene: scene.to_path_buf(),
-                })
-            }
+            _ => return None,
         }
     }
-    let base = scene.parent().unwrap_or(Path::new("."));
-    Ok(base.join(written))
+    Some(base.join(written))
 }
 
 #[cfg(test)]
@@ -193,14 +179,11 @@ mod tests {
             check_output(&dir.join("missing/a.png"), OUT, &[]),
             Err(PathError::NoDirectory { .. })
         ));
-        let scene = dir.join("s.toml");
-        assert_eq!(
-            scene_relative(&scene, Path::new("out/a.png")).unwrap(),
-            dir.join("out/a.png")
-        );
-        assert!(scene_relative(&scene, Path::new("a/../b.png")).is_ok());
-        assert!(scene_relative(&scene, Path::new("../victim.txt")).is_err());
-        assert!(scene_relative(&scene, Path::new("/etc/passwd")).is_err());
+        let out = Some(dir.join("out/a.png"));
+        assert_eq!(inside(&dir, Path::new("out/a.png")), out);
+        assert!(inside(&dir, Path::new("a/../b.png")).is_some());
+        assert!(inside(&dir, Path::new("a/../../victim.txt")).is_none());
+        assert!(inside(&dir, Path::new("/etc/passwd")).is_none());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -252,6 +252,21 @@ impl Checker<'_> {
         Some(self.base.join(s))
     }
 
+    /// An output path: like [`Self::path`], but it must stay in the scene's
+    /// directory, so a shared scene cannot write over files elsewhere.
+    fn output_path(&mut self, t: &Table, prefix: &str, key: &str) -> Option<PathBuf> {
+        let s = self.string(t, prefix, key)?;
+        let inside = crate::io::paths::inside(self.base, Path::new(s));
+        if inside.is_none() || s.is_empty() {
+            self.bad(
+                &join(prefix, key),
+                "must be a path inside the scene's directory (give other outputs with --out)"
+                    .into(),
+            );
+        }
+        inside.filter(|_| !s.is_empty())
+    }
+
     pub(super) fn scene(&mut self, top: &Table) -> SceneFile {
         self.unknown_keys(top, "", TOP_KEYS);
         let mut scene = SceneFile::default();
@@ -308,7 +323,7 @@ impl Checker<'_> {
                 fps: self
                     .integer(t, p, "fps", 1, MAX_FPS as i64)
                     .map(|v| v as u16),
-                path: self.path(t, p, "path"),
+                path: self.output_path(t, p, "path"),
             };
         }
         scene
@@ -514,7 +529,7 @@ impl Checker<'_> {
             self.bad(p, "give `window`/`level` or `percentiles`, not both".into());
         }
         OutputSection {
-            path: self.path(t, p, "path"),
+            path: self.output_path(t, p, "path"),
             bits,
             window,
             level,
