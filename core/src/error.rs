@@ -186,6 +186,14 @@ pub enum Error {
         /// What was asked for.
         what: &'static str,
     },
+    /// The volume's magnitude is too small or too large for the preparation
+    /// arithmetic to bring it to the storage format's working range.
+    MagnitudeOutOfRange {
+        /// `Σ|premultiplied voxel|`, the quantity the scale is derived from.
+        sum: f64,
+        /// The power-of-two scale that would be needed.
+        scale: f64,
+    },
 }
 
 /// Shorthand for results of this crate.
@@ -314,6 +322,14 @@ impl fmt::Display for Error {
             Error::UnsupportedFormat { format, reason } => {
                 write!(f, "storage format {format} is not supported here: {reason}")
             }
+            Error::MagnitudeOutOfRange { sum, scale } => write!(
+                f,
+                "the volume's magnitude (sum of |premultiplied voxels| {}) needs a scale of {}, \
+                 under which the premultiplied values leave the preparation arithmetic's range; \
+                 rescale the voxel values",
+                Num(sum),
+                Num(scale)
+            ),
         }
     }
 }

@@ -275,7 +275,7 @@ pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 
 /// `a` itself when its norm is comfortably inside the f64 range, else `a`
 /// divided by its largest absolute component.
-fn fit_range(a: [f64; 3]) -> [f64; 3] {
+pub(crate) fn fit_range(a: [f64; 3]) -> [f64; 3] {
     let n = norm(a);
     if (1e-150..1e150).contains(&n) {
         return a;

@@ -18,4 +18,5 @@ pub mod reference;
 pub mod render;
 pub mod sources;
 pub mod studies;
+pub mod text;
 pub mod volume;

@@ -19,6 +19,38 @@ pub struct Volume {
     pub spacing: [f64; 3],
 }
 
+/// The most cells a padded cube may have per voxel of the volume before
+/// [`check_padding`] refuses it (the cube is padded from the longest axis, so
+/// a flat or thin volume wastes the rest).
+pub const MAX_PADDING_RATIO: u64 = 256;
+
+/// Cubes up to this many cells (128³ at f16: 4 MiB; 256³ at f16: 32 MiB)
+/// are always accepted by [`check_padding`], however thin the volume.
+pub const PADDING_FLOOR_CELLS: u64 = 1 << 24;
+
+/// Refuse a volume whose cubic grid of side `n` would hold more than
+/// [`MAX_PADDING_RATIO`] cells per voxel (above [`PADDING_FLOOR_CELLS`]):
+/// a 1000×1×1 file must not become a 1024³ transform.
+///
+/// # Errors
+/// A one-line message with the dims, the grid and what to do.
+pub fn check_padding(dims: [usize; 3], n: usize) -> Result<(), String> {
+    let voxels = dims.iter().fold(1u64, |a, &d| a.saturating_mul(d as u64));
+    let cells = (n as u64).saturating_pow(3);
+    if cells <= PADDING_FLOOR_CELLS || cells <= voxels.saturating_mul(MAX_PADDING_RATIO) {
+        return Ok(());
+    }
+    Err(format!(
+        "a {}x{}x{} volume would be padded to a {n}^3 spectrum, {} cells for each of its {voxels} voxels \
+         (at most {MAX_PADDING_RATIO}): the grid is a cube as long as the longest axis; \
+         crop the long axes or give a volume with more slices",
+        dims[0],
+        dims[1],
+        dims[2],
+        cells / voxels.max(1),
+    ))
+}
+
 impl Volume {
     /// A volume of `data` (`i` fastest) with [`DEFAULT_SPACING`].
     ///

@@ -255,6 +255,13 @@ fn nifti_bad_input_names_the_field() {
         parse_nifti(&nifti_with(|b| put_i16(b, offsets::DIM, 0))),
         &["dim[0]", "is 0"],
     );
+    // 8 and 256 are each other's byte swap: the order comes from sizeof_hdr.
+    for rank in [8, 256, -1] {
+        expect_err(
+            parse_nifti(&nifti_with(|b| put_i16(b, offsets::DIM, rank))),
+            &["dim[0]", &format!("is {rank};")],
+        );
+    }
     let four_d = nifti_with(|b| {
         put_i16(b, offsets::DIM, 4);
         put_i16(b, offsets::DIM + 8, 3);

@@ -301,7 +301,9 @@ impl ViewPlan {
                 along_view: 0.0,
             };
             for light in scene.lights.iter() {
-                let l = light.towards;
+                // Scaled first, so that a direction like 1e-300 or 1e300
+                // per component does not square to 0 or infinity.
+                let l = crate::geometry::fit_range(light.towards);
                 let len = libm::sqrt(dot(l, l));
                 let l = [l[0] / len, l[1] / len, l[2] / len];
                 let half = 0.5 * light.color[c];

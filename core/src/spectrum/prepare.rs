@@ -198,10 +198,12 @@ fn prepare_into<S: Sample, T: Real, V: VoxelSource, L: LineStore<T>>(
     // Pass 2: place the scaled, premultiplied volume, circularly shifted,
     // one x-line at a time (rows the volume does not reach stay zero).
     let sc = T::from_f64(scale);
-    if sc.to_f64() != scale {
-        return Err(Error::Overflow {
-            stage: "scaling (the volume's magnitude is beyond the arithmetic type's range)",
-        });
+    // The largest factor a voxel meets below is premul³·scale.
+    let pmax = premul[..n]
+        .iter()
+        .fold(0.0f64, |m, p| libm::fmax(m, libm::fabs(p.to_f64())));
+    if sc.to_f64() != scale || !T::from_f64(pmax * pmax * pmax * scale).is_finite() {
+        return Err(Error::MagnitudeOutOfRange { sum: bound, scale });
     }
     let mut finite = true;
     for k in 0..dims[2] {

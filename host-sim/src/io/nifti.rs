@@ -42,6 +42,9 @@ use crate::volume::{check_spacing, Volume};
 /// Bytes of a NIfTI-1 header.
 pub const HEADER_BYTES: usize = 348;
 
+/// Offset of `dim[0]` in the header.
+const DIM_OFFSET: usize = 40;
+
 /// Format name in error messages.
 const FORMAT: &str = "NIfTI-1 header";
 
@@ -198,6 +201,15 @@ pub fn parse_header(bytes: &[u8]) -> Result<NiftiLayout, IoError> {
             ),
         ));
     }
+    // The nifti crate guesses the byte order from `dim[0]`, so a bad
+    // `dim[0]` would be reported byte-swapped; `sizeof_hdr` tells the order.
+    let dim0 = [bytes[DIM_OFFSET], bytes[DIM_OFFSET + 1]];
+    let dim0 = if i32::from_le_bytes(sizeof) == 348 {
+        i16::from_le_bytes(dim0)
+    } else {
+        i16::from_be_bytes(dim0)
+    };
+    check_rank(dim0)?;
     let h = NiftiHeader::from_reader(bytes).map_err(|e| {
         format_error(
             FORMAT,
@@ -308,20 +320,24 @@ fn hex(bytes: &[u8]) -> String {
     format!("`{}`", parts.join(" "))
 }
 
+/// `dim[0]` (the number of dimensions) as a rank from 1 to 7.
+fn check_rank(dim0: i16) -> Result<usize, IoError> {
+    if !(1..=7).contains(&dim0) {
+        return Err(format_error(
+            FORMAT,
+            "dim",
+            format!("dim[0] (the number of dimensions) is {dim0}; it must be 1 to 7"),
+        ));
+    }
+    Ok(dim0 as usize)
+}
+
 /// `dim[0]` spatial rank 1 to 3 (higher ranks only with sizes of 1), and
 /// `dim[1..=3]` positive.
 fn parse_dim(dim: &[u16; 8]) -> Result<[usize; 3], IoError> {
     // The header stores `dim` as i16; the crate reads it as u16.
     let signed = dim.map(|d| d as i16);
-    let rank = signed[0];
-    if !(1..=7).contains(&rank) {
-        return Err(format_error(
-            FORMAT,
-            "dim",
-            format!("dim[0] (the number of dimensions) is {rank}; it must be 1 to 7"),
-        ));
-    }
-    let rank = rank as usize;
+    let rank = check_rank(signed[0])?;
     let mut dims = [1usize; 3];
     for (axis, &n) in signed.iter().enumerate().take(rank + 1).skip(1) {
         if n <= 0 {

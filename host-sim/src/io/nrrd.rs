@@ -380,7 +380,15 @@ fn read_raw_from<R: Read>(
             "raw volume dimensions must be positive, got {dims:?}"
         )));
     }
-    let (dims, count, data_bytes) = geometry(&dims, ty)?;
+    let (dims, count, data_bytes) = geometry(&dims, ty).map_err(|_| {
+        invalid_argument(format!(
+            "--raw-dims {}x{}x{} of {} samples: the byte count overflows",
+            dims[0],
+            dims[1],
+            dims[2],
+            ty.nrrd_name()
+        ))
+    })?;
     check_memory(count, ty, limit)?;
     let layout = Layout::samples(dims, count, data_bytes, ty, endian);
     let data = decode_stream(reader, &layout, Source::Raw)?;

@@ -277,6 +277,7 @@ pub(crate) fn prepare_scene_with_progress(
 ) -> Result<(SceneSpectra, fvr_core::filter::Filter), Error> {
     let bar = progress::spinner("fitting filter");
     let result = (|| -> Result<_, Error> {
+        check_padding(volume, oversample)?;
         let filter = choose_filter(volume, kind, oversample, design)?;
         bar.set_message(if scene.needs_gradient_spectrum() {
             "preprocess (density and |grad f| spectra)"
@@ -303,12 +304,20 @@ pub(crate) fn prepare_with_progress(
 ) -> Result<AnySpectrum, Error> {
     let bar = progress::spinner("fitting filter");
     let result = (|| -> Result<_, Error> {
+        check_padding(volume, oversample)?;
         let filter = choose_filter(volume, kind, oversample, design)?;
         bar.set_message("preprocess");
         Ok(AnySpectrum::prepare(volume, filter, precision)?)
     })();
     bar.finish_and_clear();
     result
+}
+
+/// [`fvr_host::volume::check_padding`] for the grid `volume` gets at
+/// `oversample`.
+fn check_padding(volume: &fvr_host::volume::Volume, oversample: u32) -> Result<(), Error> {
+    let n = fvr_core::volume::padded_size(volume.dims, oversample)?;
+    Ok(fvr_host::volume::check_padding(volume.dims, n)?)
 }
 
 pub(crate) fn volume_help() -> String {

@@ -125,8 +125,13 @@ pub(crate) enum Command {
 }
 
 fn main() -> ExitCode {
-    let matches = Cli::command().get_matches();
-    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    let parsed = Cli::command()
+        .try_get_matches()
+        .and_then(|m| Cli::from_arg_matches(&m).map(|cli| (m, cli)));
+    let (matches, cli) = match parsed {
+        Ok(ok) => ok,
+        Err(e) => return clap_exit(&e),
+    };
     progress::set_quiet(cli.quiet);
     if let Some(text) = &cli.max_memory {
         match fvr_host::budget::parse_bytes("--max-memory", text) {
@@ -160,7 +165,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("fvr: error: {e}");
+            eprintln!("fvr: error: {}", fvr_host::text::bounded(&e.to_string()));
             ExitCode::from(2)
         }
     }
@@ -209,4 +214,19 @@ fn default_scene() -> Result<(), Error> {
          120 degrees apart, as in the paper's figure 8 (run `fvr --help` for options)"
     );
     render(&args)
+}
+
+/// Print a parser error (or `--help`/`--version`) as clap would, but with
+/// echoed values bounded in length ([`fvr_host::text::bounded`]).
+fn clap_exit(e: &clap::Error) -> ExitCode {
+    let text = e.render();
+    let code = e.exit_code();
+    if e.use_stderr() {
+        eprint!("{}", fvr_host::text::bounded(&text.to_string()));
+        eprintln!();
+    } else {
+        // Help and version text: printed whole (it is ours, not the user's).
+        let _ = e.print();
+    }
+    ExitCode::from(u8::try_from(code).unwrap_or(2))
 }

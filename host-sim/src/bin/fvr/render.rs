@@ -204,8 +204,9 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     if share > NEGATIVE_CUE_WARNING_SHARE {
         eprintln!(
             "fvr: warning: the depth cue is given between t = -R and +R; extrapolated beyond, \
-             into the volume's corners on this view, it falls to {lowest:.3}, and {:.2}% of the \
+             into the volume's corners on this view, it falls to {}, and {:.2}% of the \
              weighted density counts negatively. Raise the smaller of FRONT and BACK to avoid it.",
+            fvr_host::text::num3(lowest),
             100.0 * share
         );
     }
@@ -634,7 +635,7 @@ pub(crate) fn check_finite(data: &[f64]) -> Result<(), Error> {
     match data.iter().position(|v| !v.is_finite()) {
         None => Ok(()),
         Some(i) => Err(format!(
-            "the image has non-finite pixels (the first is value {i}, {:e}): a setting overflowed; \
+            "the image has non-finite pixels (the first is pixel {i}, value {:e}): a setting overflowed; \
              lower --ambient, the --light colours or the --depth-cue weights",
             data[i]
         )

@@ -55,7 +55,7 @@ fn describe(v: &Value) -> String {
     let shown = match v {
         Value::String(s) if s.len() <= 40 => format!("{s:?}"),
         Value::Integer(i) => i.to_string(),
-        Value::Float(x) => x.to_string(),
+        Value::Float(x) => crate::text::num(*x),
         Value::Boolean(b) => b.to_string(),
         _ => return v.type_str().to_string(),
     };

@@ -243,7 +243,7 @@ impl SceneFile {
     pub fn parse(text: &str, origin: &str, base: &Path) -> Result<Self, String> {
         let table: Table = text
             .parse()
-            .map_err(|e: toml::de::Error| format!("{origin}: not valid TOML: {e}"))?;
+            .map_err(|e: toml::de::Error| toml_error(text, origin, &e))?;
         let mut c = Checker {
             base,
             errors: Vec::new(),
@@ -272,4 +272,23 @@ pub fn parse_endian(s: &str) -> Result<Endian, String> {
         "big" => Ok(Endian::Big),
         _ => Err(format!("unknown byte order `{s}`: expected little or big")),
     }
+}
+
+/// One line for a TOML syntax error: where, and what (the parser's own
+/// display quotes the whole offending line, however long).
+fn toml_error(text: &str, origin: &str, e: &toml::de::Error) -> String {
+    let place = e
+        .span()
+        .map(|span| {
+            let before = text.get(..span.start).unwrap_or(text);
+            let line = before.matches('\n').count() + 1;
+            let column = before.rsplit('\n').next().unwrap_or("").chars().count() + 1;
+            format!(" at line {line}, column {column}")
+        })
+        .unwrap_or_default();
+    let what = e.message().lines().next().unwrap_or("").trim();
+    format!(
+        "{origin}: not valid TOML{place}: {}",
+        crate::text::bounded(what)
+    )
 }

@@ -170,7 +170,22 @@ fn too_many_lights_and_bad_toml_are_errors() {
     let e = parse(&text).unwrap_err();
     assert!(e.contains("make 9 lights"), "{e}");
     let e = parse("[camera\n").unwrap_err();
-    assert!(e.starts_with("s.toml: not valid TOML"), "{e}");
+    assert!(
+        e.starts_with("s.toml: not valid TOML at line 1, column "),
+        "{e}"
+    );
+    assert_eq!(e.lines().count(), 1, "{e}");
+    // A 900 000-digit number: one short line, not the line echoed whole.
+    let e = parse(&format!(
+        "[camera]\ndir = [{}, 0, 0]\n",
+        "1".repeat(900_000)
+    ))
+    .unwrap_err();
+    assert!(
+        e.starts_with("s.toml: not valid TOML at line 2, column 8: "),
+        "{e}"
+    );
+    assert!(e.len() < 200, "{} bytes", e.len());
 }
 
 #[test]
