@@ -186,6 +186,12 @@ pub enum Error {
         /// What was asked for.
         what: &'static str,
     },
+    /// A mixed-radix transform length that is zero or has a prime factor
+    /// above 5.
+    UnsupportedLength {
+        /// The length given.
+        len: usize,
+    },
 }
 
 /// Shorthand for results of this crate.
@@ -314,6 +320,10 @@ impl fmt::Display for Error {
             Error::UnsupportedFormat { format, reason } => {
                 write!(f, "storage format {format} is not supported here: {reason}")
             }
+            Error::UnsupportedLength { len } => write!(
+                f,
+                "transform length {len} is not 2^a·3^b·5^c (at least 1, no prime factor above 5)"
+            ),
         }
     }
 }
