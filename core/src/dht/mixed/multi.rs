@@ -26,35 +26,38 @@ const fn max(a: usize, b: usize) -> usize {
     }
 }
 
-/// Scratch elements [`dht_2d_mixed`] needs for an `nx × ny` array.
+/// Scratch elements [`dht_2d_mixed`] needs for an `nx × ny` array
+/// (saturating).
 pub const fn dht_2d_mixed_scratch_len(nx: usize, ny: usize) -> usize {
-    max(mixed_scratch_len(nx), ny + mixed_scratch_len(ny))
+    max(
+        mixed_scratch_len(nx),
+        ny.saturating_add(mixed_scratch_len(ny)),
+    )
 }
 
 /// Scratch elements [`dht_3d_mixed`] needs for dims `[nx, ny, nz]`: one
 /// line and its transform scratch for the x and y passes, four z-lines and
-/// one transform scratch for the z pass.
+/// one transform scratch for the z pass (saturating).
 pub const fn dht_3d_mixed_scratch_len(dims: [usize; 3]) -> usize {
     let [nx, ny, nz] = dims;
     max(
-        max(nx + mixed_scratch_len(nx), ny + mixed_scratch_len(ny)),
-        4 * nz + mixed_scratch_len(nz),
+        max(
+            nx.saturating_add(mixed_scratch_len(nx)),
+            ny.saturating_add(mixed_scratch_len(ny)),
+        ),
+        nz.saturating_mul(4).saturating_add(mixed_scratch_len(nz)),
     )
 }
 
-/// The product of `dims`, or [`Error::LengthMismatch`] against `got` if it
+/// `Ok` if the product of `dims` is `got`; [`Error::LengthMismatch`]
+/// otherwise, with `expected` saturated to `usize::MAX` if the product
 /// overflows.
-fn volume(what: &'static str, dims: &[usize], got: usize) -> Result<usize> {
-    let mut v: usize = 1;
-    for &d in dims {
-        v = v.checked_mul(d).ok_or(Error::LengthMismatch {
-            what,
-            expected: usize::MAX,
-            got,
-        })?;
-    }
-    check_len(what, v, got)?;
-    Ok(v)
+fn volume(what: &'static str, dims: &[usize], got: usize) -> Result<()> {
+    let v = dims
+        .iter()
+        .try_fold(1usize, |v, &d| v.checked_mul(d))
+        .unwrap_or(usize::MAX);
+    check_len(what, v, got)
 }
 
 /// True 2D DHT in place of an `nx × ny` array stored with `x` fastest,
@@ -158,6 +161,13 @@ pub fn dht_3d_mixed_store<T: Real, L: LineStore<T>>(
     plans: [&MixedPlan<'_, T>; 3],
 ) -> Result<()> {
     let [nx, ny, nz] = dims;
+    if nx.checked_mul(ny).and_then(|p| p.checked_mul(nz)).is_none() {
+        return Err(Error::LengthMismatch {
+            what: "3D store (nx·ny·nz overflows)",
+            expected: usize::MAX,
+            got: 0,
+        });
+    }
     plans[0].check("x-axis plan of the 3D transform", nx)?;
     plans[1].check("y-axis plan of the 3D transform", ny)?;
     plans[2].check("z-axis plan of the 3D transform", nz)?;

@@ -27,19 +27,20 @@ pub struct MixedPlan<'a, T> {
 }
 
 /// Table elements a plan of length `n` needs: `2n` (a complex root of
-/// unity per index).
+/// unity per index), saturating.
 pub const fn mixed_table_len(n: usize) -> usize {
-    2 * n
+    n.saturating_mul(2)
 }
 
 /// Scratch elements a 1D transform of length `n` needs: `n` for even `n`
 /// (a complex FFT of `n/2` ping-pongs between the data and the scratch),
-/// `4n` for odd `n` (a complex FFT of `n` on two complex buffers).
+/// `4n` for odd `n` (a complex FFT of `n` on two complex buffers),
+/// saturating.
 pub const fn mixed_scratch_len(n: usize) -> usize {
     if n % 2 == 0 {
         n
     } else {
-        4 * n
+        n.saturating_mul(4)
     }
 }
 
