@@ -108,11 +108,11 @@ impl<T: Real> Stage<'_, T> {
     fn run<const R: usize>(&self, x: &[T], y: &mut [T], bfly: impl Fn([C<T>; R]) -> [C<T>; R]) {
         let (m, s) = (self.m, self.s);
         let run = 2 * s; // reals in one run of s complex values
-        let quarter = 2 * m * s; // reals from input index p to p + m
+        let span = 2 * m * s; // reals from input index p to p + m
         for (p, out) in y.chunks_exact_mut(R * run).enumerate().take(m) {
             let w: [C<T>; R] = core::array::from_fn(|k| self.twiddle(p * k));
             let ins: [&[T]; R] = core::array::from_fn(|j| {
-                let start = p * run + j * quarter;
+                let start = p * run + j * span;
                 x.get(start..start + run).unwrap_or(&[])
             });
             let mut chunks = out.chunks_exact_mut(run);
