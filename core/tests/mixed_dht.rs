@@ -419,3 +419,70 @@ fn one_plan_serves_two_axes() {
     let r = ratio::<f64>(rel_rms(&data, &naive_dht(&input, [10, 10, 3])), 300);
     assert!(r <= 2.0, "{r:.3}");
 }
+
+#[test]
+fn f16_storage_rounds_once_per_pass() {
+    // f16 storage, f32 arithmetic: three roundings to f16 (unit roundoff
+    // u = 2^-11) dominate, each adding a relative RMS error of at most u;
+    // bound 3u.
+    use fvr_core::f16;
+    let dims = [20usize, 18, 16];
+    let n: usize = dims.iter().product();
+    let input = signal(n, 11);
+    let mut data: Vec<f16> = input.iter().map(|&v| f16::from_f64(v)).collect();
+    let exact: Vec<f64> = data.iter().map(|v| v.to_f64()).collect();
+    let mut tabs = tables::<f32>(&dims);
+    let [tx, ty, tz] = &mut tabs[..] else {
+        unreachable!()
+    };
+    let px = MixedPlan::new(tx, dims[0]).unwrap();
+    let py = MixedPlan::new(ty, dims[1]).unwrap();
+    let pz = MixedPlan::new(tz, dims[2]).unwrap();
+    let mut scratch = vec![0.0f32; dht_3d_mixed_scratch_len(dims)];
+    dht_3d_mixed(&mut data, dims, &mut scratch, [&px, &py, &pz]).unwrap();
+    let got: Vec<f64> = data.iter().map(|v| v.to_f64()).collect();
+    let err = rel_rms(&got, &naive_dht(&exact, dims));
+    let u = 2f64.powi(-11);
+    assert!(err <= 3.0 * u, "{err:.3e}");
+    println!(
+        "3D {dims:?} f16 storage: relative RMS error {:.2}·u",
+        err / u
+    );
+}
+
+#[test]
+fn overflowing_the_storage_is_an_error() {
+    use fvr_core::f16;
+    let dims = [6usize, 5, 4];
+    let mut data = vec![f16::from_f64(60000.0); 120];
+    let mut t6 = vec![0.0f32; mixed_table_len(6)];
+    let mut t5 = vec![0.0f32; mixed_table_len(5)];
+    let mut t4 = vec![0.0f32; mixed_table_len(4)];
+    let p6 = MixedPlan::new(&mut t6, 6).unwrap();
+    let p5 = MixedPlan::new(&mut t5, 5).unwrap();
+    let p4 = MixedPlan::new(&mut t4, 4).unwrap();
+    let mut scratch = vec![0.0f32; dht_3d_mixed_scratch_len(dims)];
+    assert!(matches!(
+        dht_3d_mixed(&mut data, dims, &mut scratch, [&p6, &p5, &p4]),
+        Err(Error::Overflow { .. })
+    ));
+}
+
+#[test]
+fn a_stored_table_gives_the_same_transform() {
+    let n = 360;
+    let mut buf = vec![0.0f32; mixed_table_len(n)];
+    let input: Vec<f32> = signal(n, 1).iter().map(|&v| v as f32).collect();
+    let mut scratch = vec![0.0f32; mixed_scratch_len(n)];
+    let mut a = input.clone();
+    dht_mixed(&mut a, &mut scratch, &MixedPlan::new(&mut buf, n).unwrap()).unwrap();
+    let mut b = input;
+    let stored = MixedPlan::from_table(&buf, n).unwrap();
+    assert_eq!(stored.len(), n);
+    dht_mixed(&mut b, &mut scratch, &stored).unwrap();
+    assert_eq!(a, b);
+    assert!(matches!(
+        MixedPlan::<f32>::from_table(&buf[..719], n),
+        Err(Error::BufferTooSmall { needed: 720, .. })
+    ));
+}
