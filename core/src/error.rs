@@ -194,6 +194,12 @@ pub enum Error {
         /// The power-of-two scale that would be needed.
         scale: f64,
     },
+    /// A mixed-radix transform length that is zero or has a prime factor
+    /// above 5.
+    UnsupportedLength {
+        /// The length given.
+        len: usize,
+    },
 }
 
 /// Shorthand for results of this crate.
@@ -329,6 +335,10 @@ impl fmt::Display for Error {
                  rescale the voxel values",
                 Num(sum),
                 Num(scale)
+            ),
+            Error::UnsupportedLength { len } => write!(
+                f,
+                "transform length {len} is not 2^a·3^b·5^c (at least 1, no prime factor above 5)"
             ),
         }
     }

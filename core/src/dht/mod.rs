@@ -1,4 +1,5 @@
-//! In-place radix-2 discrete Hartley transforms.
+//! In-place discrete Hartley transforms: radix 2, and mixed radix for
+//! lengths `2^a·3^b·5^c` ([`mixed`]).
 //!
 //! # Normalization and order
 //! The forward transform of a length-`N` sequence is
@@ -19,12 +20,18 @@
 
 mod cube;
 mod line;
+pub mod mixed;
 mod plane;
 mod store;
 mod twiddles;
 
 pub use cube::{dht_3d, dht_3d_rounding, dht_3d_scratch_len, dht_3d_store, Rounding};
 pub use line::{dht, idht};
+pub use mixed::{
+    dht_2d_mixed, dht_2d_mixed_scratch_len, dht_3d_mixed, dht_3d_mixed_scratch_len,
+    dht_3d_mixed_store, dht_mixed, fast_len, idht_mixed, is_fast_len, mixed_scratch_len,
+    mixed_table_len, MixedPlan,
+};
 pub use plane::{dht_2d, dht_2d_lines, idht_2d};
 pub use store::{Elements, LineBlocks, LineStore, Pass};
 pub use twiddles::Twiddles;
