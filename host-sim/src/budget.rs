@@ -61,9 +61,24 @@ pub fn set_max_memory(bytes: u64) {
     let _ = MAX_MEMORY.set(bytes);
 }
 
-/// The limit in force: [`MemoryLimit::detect`] with `--max-memory`.
+/// The machine's and process's limit, read once, when the job first asks
+/// (before it allocates anything large), so that `MemAvailable` is not
+/// lowered by the job's own buffers and then counted twice.
+static DETECTED: std::sync::OnceLock<MemoryLimit> = std::sync::OnceLock::new();
+
+/// The limit in force: [`MemoryLimit::detect`] with `--max-memory`, less
+/// what the job already [`hold`]s.
 pub fn limit() -> MemoryLimit {
-    MemoryLimit::detect(MAX_MEMORY.get().copied())
+    let machine = *DETECTED.get_or_init(|| MemoryLimit::detect(None));
+    let mut l = match MAX_MEMORY.get() {
+        Some(&b) if b <= machine.bytes => MemoryLimit {
+            bytes: b,
+            source: LimitSource::Flag,
+        },
+        _ => machine,
+    };
+    l.bytes = l.bytes.saturating_sub(held());
+    l
 }
 
 /// [`limit`] in bytes.
@@ -370,5 +385,77 @@ mod tests {
                 ""
             )
             .is_err());
+    }
+}
+
+/// What a job will build from the volume it loads, given the volume's dims:
+/// set by the program before loading ([`set_plan`]), so that a reader can
+/// refuse a volume before decoding or decompressing it.
+type Plan = Box<dyn Fn([usize; 3]) -> Budget + Send + Sync>;
+
+static PLAN: std::sync::OnceLock<(Plan, &'static str)> = std::sync::OnceLock::new();
+
+/// Declare what this job builds from a volume of given dims (spectra, images,
+/// frames), and how to ask for less; the first call wins.
+pub fn set_plan(hint: &'static str, plan: impl Fn([usize; 3]) -> Budget + Send + Sync + 'static) {
+    let _ = PLAN.set((Box::new(plan), hint));
+}
+
+/// Check, before decoding, a volume of `dims` whose decoding also holds
+/// `transit` bytes of raw samples, together with what the job plans to
+/// build from it ([`set_plan`]) and what it already holds ([`hold`]).
+///
+/// # Errors
+/// [`OverBudget`], naming the largest item.
+pub fn check_load(dims: [usize; 3], transit: u64) -> Result<(), OverBudget> {
+    let count = dims.iter().fold(1u64, |a, &d| a.saturating_mul(d as u64));
+    let (mut budget, hint) = match PLAN.get() {
+        Some((plan, hint)) => (plan(dims), *hint),
+        None => (Budget::new(), "use a smaller volume or raise --max-memory"),
+    };
+    budget.hold("decoded volume", count, 4);
+    budget.hold("raw samples in transit", transit, 1);
+    budget.check(limit(), hint)
+}
+
+/// Check what the job plans to build from a loaded volume of `dims`
+/// ([`set_plan`]) against the limit, less what it holds (the volume, once
+/// [`hold`] counts it). For volumes made in memory (phantoms) this is the
+/// first check; for files it repeats [`check_load`]'s with the actual dims.
+///
+/// # Errors
+/// [`OverBudget`].
+pub fn check_plan(dims: [usize; 3]) -> Result<(), OverBudget> {
+    match PLAN.get() {
+        Some((plan, hint)) => plan(dims).check(limit(), hint),
+        None => Ok(()),
+    }
+}
+
+/// Bytes held by live [`Held`] guards.
+static HELD: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// A long-lived buffer counted against the limit while the guard lives:
+/// [`limit`] is lowered by its size, so that every later check sees the
+/// whole job (the volume while its spectrum is checked, the first image
+/// while `compare` reads the second).
+#[derive(Debug)]
+#[must_use = "the bytes are counted only while the guard lives"]
+pub struct Held(u64);
+
+/// Count `bytes` as held until the returned guard drops.
+pub fn hold(bytes: u64) -> Held {
+    HELD.fetch_add(bytes, std::sync::atomic::Ordering::SeqCst);
+    Held(bytes)
+}
+
+/// Bytes currently held through [`hold`].
+pub fn held() -> u64 {
+    HELD.load(std::sync::atomic::Ordering::SeqCst)
+}
+
+impl Drop for Held {
+    fn drop(&mut self) {
+        HELD.fetch_sub(self.0, std::sync::atomic::Ordering::SeqCst);
     }
 }

@@ -2,6 +2,7 @@
 //! output, windowing, colormaps and APNG ([`output`]), and study plots
 //! ([`plot`]).
 
+mod apng;
 pub mod output;
 pub mod plot;
 mod png;

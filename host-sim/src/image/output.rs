@@ -21,8 +21,6 @@
 //! - `hot`: black–red–yellow–white, for seeing small differences in dense
 //!   regions.
 
-use std::fs::File;
-use std::io::BufWriter;
 use std::path::Path;
 use std::str::FromStr;
 
@@ -226,14 +224,14 @@ impl Default for Style {
 }
 
 impl Style {
-    fn png_color(&self) -> png::ColorType {
+    pub(crate) fn png_color(&self) -> png::ColorType {
         match self.colormap {
             Colormap::Gray => png::ColorType::Grayscale,
             _ => png::ColorType::Rgb,
         }
     }
 
-    fn png_depth(&self) -> png::BitDepth {
+    pub(crate) fn png_depth(&self) -> png::BitDepth {
         match self.bits {
             Bits::Eight => png::BitDepth::Eight,
             Bits::Sixteen => png::BitDepth::Sixteen,
@@ -301,61 +299,4 @@ pub fn write_png(
     )
 }
 
-/// Write `frames` (each `width × height`, row 0 at the top) as an animated
-/// PNG that loops forever at `fps` frames per second, in `style`. One
-/// window serves all frames (percentiles over every frame's pixels), so the
-/// brightness does not flicker.
-///
-/// # Errors
-/// No frames, a frame of the wrong size, a frame rate outside 1–1000, file
-/// creation or encoding failure; the message names the path.
-pub fn write_apng(
-    path: &Path,
-    width: usize,
-    height: usize,
-    frames: &[Vec<f64>],
-    fps: u16,
-    style: &Style,
-) -> Result<(), String> {
-    let fail = |e: &dyn std::fmt::Display| format!("cannot write APNG `{}`: {e}", path.display());
-    if frames.is_empty() {
-        return Err(fail(&"no frames to write"));
-    }
-    if !(1..=1000).contains(&fps) {
-        return Err(fail(&format!(
-            "frame rate {fps} must be 1 to 1000 per second"
-        )));
-    }
-    if let Some(bad) = frames
-        .iter()
-        .find(|f| f.len() != width.saturating_mul(height))
-    {
-        return Err(fail(&format!(
-            "a frame of {} pixels in a {width}x{height} animation",
-            bad.len()
-        )));
-    }
-    let range = match style.window {
-        Window::Range(lo, hi) => (lo, hi),
-        Window::Percentiles(..) => style.window.resolve(&frames.concat()),
-    };
-    let file = File::create(path).map_err(|e| fail(&e))?;
-    let mut enc = super::png::encoder(
-        BufWriter::new(file),
-        width,
-        height,
-        style.png_color(),
-        style.png_depth(),
-    )
-    .map_err(|e| fail(&e))?;
-    let count = u32::try_from(frames.len()).map_err(|e| fail(&e))?;
-    enc.set_animated(count, 0).map_err(|e| fail(&e))?;
-    enc.set_frame_delay(1, fps).map_err(|e| fail(&e))?;
-    let mut writer = enc.write_header().map_err(|e| fail(&e))?;
-    for frame in frames {
-        writer
-            .write_image_data(&style.encode(frame, range))
-            .map_err(|e| fail(&e))?;
-    }
-    writer.finish().map_err(|e| fail(&e))
-}
+pub use super::apng::{write_apng, ApngStream};

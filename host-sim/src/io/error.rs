@@ -77,6 +77,10 @@ pub enum IoError {
         /// The memory limit in bytes.
         limit: u64,
     },
+    /// The job (this volume and what will be built from it) would exceed
+    /// the memory limit.
+    #[error(transparent)]
+    OverBudget(#[from] crate::budget::OverBudget),
     /// The gzip-encoded data could not be decompressed.
     #[error("corrupt or truncated gzip stream: {source}")]
     Gzip {

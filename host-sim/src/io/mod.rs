@@ -451,7 +451,7 @@ pub(crate) fn decode_samples<R: BufRead>(
     sizes: SizeField,
 ) -> Result<Volume, IoError> {
     let (count, data_bytes) = check_dims(dims, ty, sizes)?;
-    nrrd::check_memory(count, ty, crate::budget::limit_bytes())?;
+    nrrd::check_memory(dims, count, ty, crate::budget::limit_bytes())?;
     let layout = nrrd::Layout::samples(dims, count, data_bytes, ty, endian);
     let source = reader.source();
     let data = nrrd::decode_stream(&mut reader, &layout, source)?;

@@ -59,7 +59,7 @@ const GZIP_MARGIN: u64 = 4096;
 /// Bytes converted per step when streaming samples (a multiple of 8).
 const CHUNK_BYTES: usize = 1 << 16;
 
-/// Samples allocated before any are read; the buffer then grows with the data.
+/// Samples reserved before any are read.
 const INITIAL_SAMPLES: usize = 1 << 24;
 
 /// Read buffer for files.
@@ -67,12 +67,21 @@ const FILE_BUFFER_BYTES: usize = 1 << 16;
 
 /// Refuse volumes whose decoding would need more than `limit` bytes: the
 /// `f32` output plus the raw samples.
-pub(crate) fn check_memory(count: usize, ty: SampleType, limit: u64) -> Result<(), IoError> {
+///
+/// Then the whole job: the volume of `dims` with what the program plans to
+/// build from it ([`crate::budget::check_load`]).
+pub(crate) fn check_memory(
+    dims: [usize; 3],
+    count: usize,
+    ty: SampleType,
+    limit: u64,
+) -> Result<(), IoError> {
     let per_sample = 4 + ty.size_bytes() as u64;
     let needed = (count as u64).saturating_mul(per_sample);
     if needed > limit {
         return Err(IoError::TooLarge { needed, limit });
     }
+    crate::budget::check_load(dims, CHUNK_BYTES as u64)?;
     Ok(())
 }
 
@@ -97,7 +106,7 @@ fn read_nrrd_limited(path: &Path, limit: u64, progress: &ProgressBar) -> Result<
         progress.set_length(file.metadata().map(|m| m.len()).unwrap_or(0));
         let mut reader = BufReader::with_capacity(FILE_BUFFER_BYTES, progress.wrap_read(file));
         let layout = read_header(&mut reader)?;
-        check_memory(layout.count, layout.ty, limit)?;
+        check_memory(layout.dims, layout.count, layout.ty, limit)?;
         let Some(name) = &layout.data_file else {
             return read_data(&mut reader, &layout);
         };
@@ -132,7 +141,7 @@ fn parse_nrrd_limited(bytes: &[u8], limit: u64) -> Result<Volume, IoError> {
 /// before reading any data.
 fn read_nrrd_from<R: BufRead>(reader: &mut R, limit: u64) -> Result<Volume, IoError> {
     let layout = read_header(reader)?;
-    check_memory(layout.count, layout.ty, limit)?;
+    check_memory(layout.dims, layout.count, layout.ty, limit)?;
     if let Some(file) = &layout.data_file {
         return Err(IoError::DetachedData {
             file: excerpt(file),
@@ -279,8 +288,10 @@ pub(crate) fn decode_stream<R: Read>(
     source: Source,
 ) -> Result<Vec<f32>, IoError> {
     let total = layout.data_bytes;
-    // Capacity grows with the data actually read (doubling, capped at the
-    // count), so a short file that claims a huge volume costs little.
+    // The first INITIAL_SAMPLES are reserved at once, so a short file that
+    // claims a huge volume costs little; past them, the whole volume (within
+    // the budget, checked before). Doubling instead would peak at twice the
+    // volume during a reallocation; this peaks at the volume plus 64 MiB.
     let mut out = Vec::with_capacity(layout.count.min(INITIAL_SAMPLES));
     let mut buf = vec![0u8; CHUNK_BYTES.min(total)];
     let mut done = 0;
@@ -292,10 +303,8 @@ pub(crate) fn decode_stream<R: Read>(
             return Err(source.truncated(total, done + got));
         }
         let first = out.len();
-        let needed = first + want / layout.ty.size_bytes();
-        if needed > out.capacity() {
-            let target = out.capacity().saturating_mul(2).clamp(needed, layout.count);
-            out.reserve_exact(target - first);
+        if first + want / layout.ty.size_bytes() > out.capacity() {
+            out.reserve_exact(layout.count - first);
         }
         samples::decode_into(chunk, layout.ty, layout.endian, &mut out);
         check_finite(&out, first, chunk, layout)?;
@@ -389,7 +398,7 @@ fn read_raw_from<R: Read>(
             ty.nrrd_name()
         ))
     })?;
-    check_memory(count, ty, limit)?;
+    check_memory(dims, count, ty, limit)?;
     let layout = Layout::samples(dims, count, data_bytes, ty, endian);
     let data = decode_stream(reader, &layout, Source::Raw)?;
     Ok(Volume::new(dims, data))

@@ -68,6 +68,8 @@ impl SceneSpectra {
     ) -> Result<Self, PipelineError> {
         let density = AnySpectrum::prepare(volume, filter, precision)?;
         let gradient = if scene.needs_gradient_spectrum() {
+            // The density spectrum counts against the limit from here on.
+            let _density = crate::budget::hold(density.bytes() as u64);
             let g = gradient_volume(volume)?;
             Some(AnySpectrum::prepare(&g, filter, precision)?)
         } else {

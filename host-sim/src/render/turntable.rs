@@ -68,27 +68,54 @@ pub fn render_views(
     height: usize,
     progress: &ProgressBar,
 ) -> Result<Vec<Vec<f64>>, fvr_core::Error> {
-    fn go<S: Sample, T: Real>(
+    let mut frames = Vec::with_capacity(views.len());
+    render_each(spec, views, sampling, (width, height), progress, |_, f| {
+        frames.push(f.to_vec());
+        Ok::<(), fvr_core::Error>(())
+    })?;
+    Ok(frames)
+}
+
+/// Where [`render_each`] hands each frame: `(index, pixels)`.
+pub type FrameSink<'a, E> = dyn FnMut(usize, &[f64]) -> Result<(), E> + 'a;
+
+/// Render the views one by one like [`render_views`], handing each frame to
+/// `each(index, pixels)` instead of keeping it: memory is one frame.
+///
+/// # Errors
+/// As [`render_views`], or the first error of `each`.
+pub fn render_each<E: From<fvr_core::Error>>(
+    spec: &AnySpectrum,
+    views: &[View],
+    sampling: &Sampling,
+    size: (usize, usize),
+    progress: &ProgressBar,
+    mut each: impl FnMut(usize, &[f64]) -> Result<(), E>,
+) -> Result<(), E> {
+    fn go<S: Sample, T: Real, E: From<fvr_core::Error>>(
         s: &OwnedSpectrum<S>,
         views: &[View],
         sampling: &Sampling,
-        w: usize,
-        h: usize,
+        (w, h): (usize, usize),
         progress: &ProgressBar,
-    ) -> Result<Vec<Vec<f64>>, fvr_core::Error> {
+        each: &mut FrameSink<'_, E>,
+    ) -> Result<(), E> {
         let mut renderer = ViewRenderer::<T>::new(s.n(), s.filter());
         let mut out = vec![T::ZERO; w * h];
-        let mut frames = Vec::with_capacity(views.len());
-        for view in views {
+        let mut frame = vec![0.0f64; w * h];
+        for (i, view) in views.iter().enumerate() {
             renderer.render_sampled_into(s, view, sampling, w, h, &mut out)?;
-            frames.push(out.iter().map(|v| v.to_f64()).collect());
+            for (f, v) in frame.iter_mut().zip(&out) {
+                *f = v.to_f64();
+            }
+            each(i, &frame)?;
             progress.inc(1);
         }
-        Ok(frames)
+        Ok(())
     }
     match spec {
-        AnySpectrum::F16(s) => go::<_, f32>(s, views, sampling, width, height, progress),
-        AnySpectrum::F32(s) => go::<_, f32>(s, views, sampling, width, height, progress),
-        AnySpectrum::F64(s) => go::<_, f64>(s, views, sampling, width, height, progress),
+        AnySpectrum::F16(s) => go::<_, f32, E>(s, views, sampling, size, progress, &mut each),
+        AnySpectrum::F32(s) => go::<_, f32, E>(s, views, sampling, size, progress, &mut each),
+        AnySpectrum::F64(s) => go::<_, f64, E>(s, views, sampling, size, progress, &mut each),
     }
 }

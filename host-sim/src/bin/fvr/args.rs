@@ -320,6 +320,39 @@ fn check_padding(volume: &fvr_host::volume::Volume, oversample: u32) -> Result<(
     Ok(fvr_host::volume::check_padding(volume.dims, n)?)
 }
 
+/// Declare, before loading, what the job builds from its volume: `spectra`
+/// spectra (2 with a `|∇f|` spectrum, which also needs a gradient volume),
+/// on the grid of `resample` (or of the volume's longest side) at the
+/// flags' oversampling and precision, and `per_grid(n)` bytes of images or
+/// frames (named `label`) for a grid of side `n`. Readers check it before decoding
+/// ([`fvr_host::budget::check_load`]).
+pub(crate) fn plan_job(
+    spectrum: &SpectrumArgs,
+    resample: Option<usize>,
+    spectra: u64,
+    (label, per_grid): (&'static str, impl Fn(u64) -> u64 + Send + Sync + 'static),
+    hint: &'static str,
+) {
+    let (oversample, bytes) = (spectrum.oversample, spectrum.precision.bytes() as u64);
+    fvr_host::budget::set_plan(hint, move |dims| {
+        let largest = resample.unwrap_or_else(|| dims.iter().copied().max().unwrap_or(1));
+        let n = fvr_core::volume::padded_size([largest, 1, 1], oversample)
+            .map_or(u64::MAX, |n| n as u64);
+        let cells = n.saturating_pow(3);
+        let mut budget = fvr_host::budget::Budget::new();
+        budget.hold("spectrum", cells.saturating_mul(spectra), bytes);
+        if spectra > 1 {
+            let count = dims.iter().fold(1u64, |a, &d| a.saturating_mul(d as u64));
+            budget.hold("gradient volume", count, 4);
+        }
+        if let Some(r) = resample {
+            budget.hold("resampled volume", (r as u64).saturating_pow(3), 4);
+        }
+        budget.hold(label, per_grid(n), 1);
+        budget
+    });
+}
+
 pub(crate) fn volume_help() -> String {
     format!(
         "Volume: a file ({FORMATS_HELP}), a raw file (with --raw-dims), one of the {DATASETS_HELP}, or one of the {PHANTOM_HELP}"

@@ -170,14 +170,36 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     let view = args.view()?;
     view.frame()?;
     let style = args.png.style()?;
+    let scene = build_scene(args)?;
+    let size = args.frame.size;
+    crate::args::plan_job(
+        &args.frame.spectrum,
+        args.resample,
+        if scene.needs_gradient_spectrum() {
+            2
+        } else {
+            1
+        },
+        // Per-view grids (slice, scratch, output) and the RGB image.
+        ("view buffers and image", move |n| {
+            // A size beyond the grid is refused later, by name.
+            let (w, h) = size.map_or((n, n), |(w, h)| ((w as u64).min(n), (h as u64).min(n)));
+            n.saturating_mul(n)
+                .saturating_mul(24)
+                .saturating_add(w.saturating_mul(h).saturating_mul(32))
+        }),
+        "use a smaller --resample or --size, --precision f16 or --oversample 1",
+    );
     let t0 = Instant::now();
     let mut volume = args.input.load(volume_spec)?;
+    let mut _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
     if let Some(largest) = args.resample {
         check_resample(&volume, largest)?;
         volume = volume.resample_isotropic(largest)?;
+        _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
     }
+    fvr_host::budget::check_plan(volume.dims)?;
     let t_load = t0.elapsed();
-    let scene = build_scene(args)?;
     let t1 = Instant::now();
     let (spectra, filter) = prepare_scene_with_progress(
         &volume,

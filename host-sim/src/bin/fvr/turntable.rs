@@ -10,9 +10,13 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
-use fvr_host::image::output::write_apng;
+use fvr_core::geometry::{Sampling, View};
+use fvr_host::image::output::{write_apng, ApngStream, Window};
 use fvr_host::progress;
+use fvr_host::render::spectrum::AnySpectrum;
 use fvr_host::render::turntable;
+use indicatif::ProgressBar;
+use std::time::Duration;
 
 #[derive(Args)]
 pub(crate) struct TurntableArgs {
@@ -50,6 +54,14 @@ pub(crate) struct TurntableArgs {
     pub(crate) input: InputArgs,
 }
 
+/// Frames are kept for an exact percentile window up to this many bytes;
+/// beyond, the window comes from [`SAMPLE_FRAMES`] evenly spaced frames
+/// rendered first, and every frame is encoded as soon as it is rendered.
+const HOLD_FRAMES_BYTES: u64 = 256 << 20;
+
+/// Frames rendered first to set the window of a streamed animation.
+const SAMPLE_FRAMES: usize = 16;
+
 pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     let views = turntable::orbit(args.dir, args.up, args.frames as usize)?;
     let style = args.png.style()?;
@@ -58,7 +70,32 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
         "no volume: give VOLUME, or `volume.path` or `volume.builtin` in the scene".to_string()
     })?;
     crate::render::check_output(&args.out, &["apng", "png"], volume_spec)?;
+    let (size, oversample, frames) = (args.frame.size, args.frame.spectrum.oversample, views.len());
+    crate::args::plan_job(
+        &args.frame.spectrum,
+        None,
+        1,
+        ("frames and view buffers", move |n| {
+            let side = n / oversample as u64;
+            // A size beyond the grid is refused later, by name.
+            let (w, h) = size.map_or((side, side), |(w, h)| {
+                ((w as u64).min(n), (h as u64).min(n))
+            });
+            let frame = w.saturating_mul(h).saturating_mul(8);
+            let all = frame.saturating_mul(frames as u64);
+            // Per-view grids (slice, scratch, output) and the frames kept.
+            let grids = n.saturating_mul(n).saturating_mul(24);
+            grids.saturating_add(if all <= HOLD_FRAMES_BYTES {
+                all
+            } else {
+                frame.saturating_mul(SAMPLE_FRAMES as u64 + 1)
+            })
+        }),
+        "use fewer --frames, a smaller --size, --precision f16 or --oversample 1",
+    );
     let volume = args.input.load(volume_spec)?;
+    let _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
+    fvr_host::budget::check_plan(volume.dims)?;
     let t_load = t0.elapsed();
     let t1 = Instant::now();
     let spec = prepare_with_progress(
@@ -73,37 +110,35 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     let side = n / args.frame.spectrum.oversample as usize;
     let (w, h) = args.frame.size.unwrap_or((side, side));
     fvr_core::image::check_image(w, h, n)?;
-    let mut budget = fvr_host::budget::Budget::new();
-    budget.hold("frames", views.len() as u64, (w * h * 8) as u64);
-    budget.check(
-        fvr_host::budget::limit(),
-        "use fewer --frames or a smaller --size",
-    )?;
     let sampling = args.frame.units.sampling(&volume, n, side)?;
-    let bar = progress::count(views.len() as u64, "frames");
+    let all_bytes = (views.len() as u64).saturating_mul((w * h * 8) as u64);
+    let sampled = !matches!(style.window, Window::Range(..)) && all_bytes > HOLD_FRAMES_BYTES;
+    let extra = if sampled {
+        SAMPLE_FRAMES.min(views.len())
+    } else {
+        0
+    };
+    let bar = progress::count((views.len() + extra) as u64, "frames");
     let t2 = Instant::now();
-    let frames = turntable::render_views(&spec, &views, &sampling, w, h, &bar);
-    let t_views = t2.elapsed();
+    let result = write_frames(&spec, &views, &sampling, (w, h), &bar, args, sampled);
     bar.finish_and_clear();
-    let frames = frames?;
-    for frame in &frames {
-        crate::render::check_finite(frame)?;
-    }
-    write_apng(&args.out, w, h, &frames, args.fps, &style)?;
+    let encode = result?;
+    let t_views = t2.elapsed().saturating_sub(encode);
+    let frames = views.len();
     let secs = t_views.as_secs_f64();
     println!(
         "wrote {} ({} frames, {w}x{h}, {} fps)",
         args.out.display(),
-        frames.len(),
+        frames,
         args.fps
     );
-    let views_per_second = frames.len() as f64 / secs.max(1e-9);
+    let views_per_second = frames as f64 / secs.max(1e-9);
     if args.stats_json {
         let stats = TurntableStats {
             volume: volume_spec,
             dims: volume.dims,
             image: [w, h],
-            frames: frames.len(),
+            frames,
             fps: args.fps,
             spectrum_side: n,
             precision: args.frame.spectrum.precision.name(),
@@ -113,7 +148,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
             load_ms: t_load.as_secs_f64() * 1e3,
             preprocess_ms: t_prep.as_secs_f64() * 1e3,
             views_ms: secs * 1e3,
-            ms_per_view: secs * 1e3 / frames.len().max(1) as f64,
+            ms_per_view: secs * 1e3 / frames.max(1) as f64,
             views_per_second,
         };
         println!("{}", one_line(&stats));
@@ -123,12 +158,59 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
             t_load.as_secs_f64() * 1e3,
             t_prep.as_secs_f64() * 1e3,
             args.frame.spectrum.precision,
-            frames.len(),
+            frames,
             secs * 1e3,
             views_per_second
         );
     }
     Ok(())
+}
+
+/// Render the views and write the animation. With a fixed window, or with
+/// `sampled` (the window from evenly spaced frames rendered first), each
+/// frame is encoded as it comes; otherwise all frames are kept for an exact
+/// percentile window. Returns the time spent encoding.
+fn write_frames(
+    spec: &AnySpectrum,
+    views: &[View],
+    sampling: &Sampling,
+    (w, h): (usize, usize),
+    bar: &ProgressBar,
+    args: &TurntableArgs,
+    sampled: bool,
+) -> Result<Duration, Error> {
+    let style = &args.png.style()?;
+    let range = match style.window {
+        Window::Range(lo, hi) => Some((lo, hi)),
+        Window::Percentiles(..) if sampled => {
+            let k = SAMPLE_FRAMES.min(views.len());
+            let picks: Vec<View> = (0..k).map(|i| views[i * views.len() / k]).collect();
+            let frames = turntable::render_views(spec, &picks, sampling, w, h, bar)?;
+            Some(style.window.resolve(&frames.concat()))
+        }
+        Window::Percentiles(..) => None,
+    };
+    let Some(range) = range else {
+        let frames = turntable::render_views(spec, views, sampling, w, h, bar)?;
+        for frame in &frames {
+            crate::render::check_finite(frame)?;
+        }
+        let t = Instant::now();
+        write_apng(&args.out, w, h, &frames, args.fps, style)?;
+        return Ok(t.elapsed());
+    };
+    let mut stream = ApngStream::create(&args.out, (w, h), views.len(), args.fps, style, range)?;
+    let mut encode = Duration::ZERO;
+    turntable::render_each(spec, views, sampling, (w, h), bar, |_, frame| {
+        crate::render::check_finite(frame)?;
+        let t = Instant::now();
+        stream.push(frame)?;
+        encode += t.elapsed();
+        Ok::<(), Error>(())
+    })?;
+    let t = Instant::now();
+    stream.finish()?;
+    Ok(encode + t.elapsed())
 }
 
 /// `fvr turntable --stats-json`, in the order printed.

@@ -513,6 +513,7 @@ pub fn read_dicom_with_progress(path: &Path, progress: &ProgressBar) -> Result<V
             })
             .collect();
         files.sort();
+        let candidates = files.len();
         let size = |p: &PathBuf| fs::metadata(p).map_or(0, |m| m.len());
         progress.set_length(files.iter().map(size).sum());
         let mut slices = Vec::new();
@@ -540,6 +541,13 @@ pub fn read_dicom_with_progress(path: &Path, progress: &ProgressBar) -> Result<V
                 slice_from(&obj).map(Some)
             };
             if let Some(s) = read_one().map_err(|e| e.in_file(&file))? {
+                if slices.is_empty() {
+                    // At most one slice a file; assembling copies the
+                    // slices' samples into the volume, so both are held.
+                    let dims = [s.size[0], s.size[1], candidates];
+                    let count = dims.iter().fold(1u64, |a, &d| a.saturating_mul(d as u64));
+                    crate::budget::check_load(dims, count.saturating_mul(4))?;
+                }
                 slices.push(s);
             }
         }
