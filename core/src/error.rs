@@ -186,6 +186,14 @@ pub enum Error {
         /// What was asked for.
         what: &'static str,
     },
+    /// A stored integer table (e.g. fixed-point twiddles from flash) holds
+    /// an entry outside the range its arithmetic is proved safe for.
+    TableEntryOutOfRange {
+        /// Which table.
+        what: &'static str,
+        /// Index of the first bad entry.
+        index: usize,
+    },
 }
 
 /// Shorthand for results of this crate.
@@ -313,6 +321,9 @@ impl fmt::Display for Error {
             ),
             Error::UnsupportedFormat { format, reason } => {
                 write!(f, "storage format {format} is not supported here: {reason}")
+            }
+            Error::TableEntryOutOfRange { what, index } => {
+                write!(f, "{what} entry {index} is out of range")
             }
         }
     }

@@ -18,6 +18,7 @@
 //! naive O(N²) transform evaluated in f64.
 
 mod cube;
+pub mod fixed;
 mod line;
 mod plane;
 mod store;

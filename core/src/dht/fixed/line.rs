@@ -1,0 +1,171 @@
+//! The fixed-point 1D radix-2 DHT in place with one block exponent, and
+//! the stages the 2D transform shares.
+
+use super::{peak, round_shift, FixedSample, FixedTwiddles, Shift};
+use crate::dht::line::for_each_bit_reversed_swap;
+use crate::error::Result;
+
+/// Forward DHT of `data` in place, unnormalized (see [`super`]); returns
+/// the exponent `e`: the transform is `data · 2^e` in the input's units.
+///
+/// # Errors
+/// The length is not a power of two, or exceeds the twiddle table's length.
+pub fn dht<S: FixedSample>(data: &mut [S], tw: &FixedTwiddles<'_, S>) -> Result<i32> {
+    tw.check(data.len())?;
+    let n = data.len();
+    for_each_bit_reversed_swap(n, |i, j| data.swap(i, j));
+    let (exp, _) = stages(data, n, 1, peak(data), tw);
+    Ok(exp)
+}
+
+/// Inverse DHT in place: [`dht`] with `log₂N` taken off the exponent (the
+/// `1/N` is exact in block floating point).
+///
+/// # Errors
+/// As [`dht`].
+pub fn idht<S: FixedSample>(data: &mut [S], tw: &FixedTwiddles<'_, S>) -> Result<i32> {
+    let exp = dht(data, tw)?;
+    Ok(exp - data.len().trailing_zeros() as i32)
+}
+
+/// Every radix-2 stage of length-`n` transforms on `data`, whose elements
+/// are groups of `w` values (the same butterfly on each value of a group):
+/// `w = 1` for lines laid end to end, `w = nx` for the columns of an
+/// `nx`-wide array, whose rows are then the elements. Elements are already
+/// in bit-reversed order; `peak` is `max |v|` over `data`. Returns the
+/// summed exponent and the final peak.
+///
+/// Decimation in time as in [`crate::dht`]: a block of `2m` combines the
+/// DHTs `X` (even) and `Y` (odd) of length `m`,
+/// `H(k) = X(k) + c·Y(k) + s·Y(m−k)`, `H(k+m) = X(k) − (same)`, with
+/// `(c, s) = (cos, sin)(πk/m)`.
+#[inline(always)]
+pub(super) fn stages<S: FixedSample>(
+    data: &mut [S],
+    n: usize,
+    w: usize,
+    mut peak: i64,
+    tw: &FixedTwiddles<'_, S>,
+) -> (i32, i64) {
+    let limits = S::LIMITS;
+    if n == 1 && peak >> S::FRAC_BITS != 0 {
+        // The identity on the most negative integer: halve it (exactly) so
+        // that no output holds the overflow flag of Q15 storage.
+        for v in data.iter_mut() {
+            *v = S::narrow(v.widen() >> 1);
+        }
+        return (1, peak >> 1);
+    }
+    let mut exp = 0;
+    let mut m = 1;
+    while m < n {
+        // Stages of half-length 1 and 2 have no twiddled butterfly.
+        let kind = if m <= 2 {
+            limits.plain
+        } else {
+            limits.twiddled
+        };
+        let shift = Shift::choose(peak, kind);
+        peak = stage(data, w, m, shift, tw);
+        exp += shift.exponent();
+        m *= 2;
+    }
+    (exp, peak)
+}
+
+/// One stage of half-length `m`; returns the peak of its outputs.
+#[inline(always)]
+pub(super) fn stage<S: FixedSample>(
+    data: &mut [S],
+    w: usize,
+    m: usize,
+    shift: Shift,
+    tw: &FixedTwiddles<'_, S>,
+) -> i64 {
+    let stride = tw.len / (2 * m);
+    let mut top = S::Wide::from(0);
+    for block in data.chunks_exact_mut(2 * m * w) {
+        let (x, y) = block.split_at_mut(m * w);
+        plain(&mut x[..w], &mut y[..w], shift, &mut top);
+        if m >= 2 {
+            let h = m / 2;
+            plain(
+                &mut x[h * w..(h + 1) * w],
+                &mut y[h * w..(h + 1) * w],
+                shift,
+                &mut top,
+            );
+            for k in 1..h {
+                let (c, s) = tw.cos_sin(k * stride);
+                let (x_low, x_high) = x.split_at_mut((m - k) * w);
+                let (y_low, y_high) = y.split_at_mut((m - k) * w);
+                twiddled(
+                    [
+                        &mut x_low[k * w..(k + 1) * w],
+                        &mut x_high[..w],
+                        &mut y_low[k * w..(k + 1) * w],
+                        &mut y_high[..w],
+                    ],
+                    (c, s),
+                    shift,
+                    &mut top,
+                );
+            }
+        }
+    }
+    S::wide_to_i64(top)
+}
+
+/// `|v|` into the running peak `top`.
+#[inline(always)]
+fn track<W: Copy + Ord + From<i16> + core::ops::Sub<Output = W>>(top: &mut W, v: W) {
+    let zero = W::from(0);
+    let a = if v < zero { zero - v } else { v };
+    if a > *top {
+        *top = a;
+    }
+}
+
+/// `(x, y) ← (x + y, x − y)` over two groups, with the stage's shift.
+#[inline(always)]
+fn plain<S: FixedSample>(x: &mut [S], y: &mut [S], shift: Shift, top: &mut S::Wide) {
+    for (a, b) in x.iter_mut().zip(y.iter_mut()) {
+        let (p, q) = (a.widen() << shift.pre, b.widen() << shift.pre);
+        let (u, v) = (
+            round_shift(p + q, shift.post),
+            round_shift(p - q, shift.post),
+        );
+        track(top, u);
+        track(top, v);
+        *a = S::narrow(u);
+        *b = S::narrow(v);
+    }
+}
+
+/// The twiddled butterfly over four groups `x[k], x[m−k], y[k], y[m−k]`:
+/// `t1 = c·y[k] + s·y[m−k]`, `t2 = s·y[k] − c·y[m−k]` (each rounded from
+/// the wide product once), then `x[k] ± t1` and `x[m−k] ± t2`.
+#[inline(always)]
+fn twiddled<S: FixedSample>(
+    [xk, xmk, yk, ymk]: [&mut [S]; 4],
+    (c, s): (S::Wide, S::Wide),
+    shift: Shift,
+    top: &mut S::Wide,
+) {
+    let len = xk.len();
+    let (xmk, yk, ymk) = (&mut xmk[..len], &mut yk[..len], &mut ymk[..len]);
+    for i in 0..len {
+        let (a, b) = (yk[i].widen() << shift.pre, ymk[i].widen() << shift.pre);
+        let t1 = round_shift(c * a + s * b, S::FRAC_BITS);
+        let t2 = round_shift(s * a - c * b, S::FRAC_BITS);
+        let (p, q) = (xk[i].widen() << shift.pre, xmk[i].widen() << shift.pre);
+        let out = [p + t1, q + t2, p - t1, q - t2].map(|v| round_shift(v, shift.post));
+        for v in out {
+            track(top, v);
+        }
+        xk[i] = S::narrow(out[0]);
+        xmk[i] = S::narrow(out[1]);
+        yk[i] = S::narrow(out[2]);
+        ymk[i] = S::narrow(out[3]);
+    }
+}
