@@ -159,13 +159,23 @@ fn twiddled<S: FixedSample>(
         let t1 = round_shift(c * a + s * b, S::FRAC_BITS);
         let t2 = round_shift(s * a - c * b, S::FRAC_BITS);
         let (p, q) = (xk[i].widen() << shift.pre, xmk[i].widen() << shift.pre);
-        let out = [p + t1, q + t2, p - t1, q - t2].map(|v| round_shift(v, shift.post));
-        for v in out {
-            track(top, v);
-        }
-        xk[i] = S::narrow(out[0]);
-        xmk[i] = S::narrow(out[1]);
-        yk[i] = S::narrow(out[2]);
-        ymk[i] = S::narrow(out[3]);
+        // Written out, not `[..].map`: `array::map` is left out of line on
+        // thumb targets, a call per butterfly.
+        let (o0, o1) = (
+            round_shift(p + t1, shift.post),
+            round_shift(q + t2, shift.post),
+        );
+        let (o2, o3) = (
+            round_shift(p - t1, shift.post),
+            round_shift(q - t2, shift.post),
+        );
+        track(top, o0);
+        track(top, o1);
+        track(top, o2);
+        track(top, o3);
+        xk[i] = S::narrow(o0);
+        xmk[i] = S::narrow(o1);
+        yk[i] = S::narrow(o2);
+        ymk[i] = S::narrow(o3);
     }
 }

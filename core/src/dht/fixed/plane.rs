@@ -94,7 +94,7 @@ fn hao_bracewell<S: FixedSample>(data: &mut [S], nx: usize, ny: usize, top: i64)
                 (ny - v) * nx + u,
                 (ny - v) * nx + nx - u,
             ];
-            let [a, b, c, d] = idx.map(|i| data[i]);
+            let [a, b, c, d] = [data[idx[0]], data[idx[1]], data[idx[2]], data[idx[3]]];
             data[idx[0]] = bracket(a, b, c, d);
             data[idx[1]] = bracket(b, a, d, c);
             data[idx[2]] = bracket(c, d, a, b);
