@@ -10,11 +10,14 @@
 //! over `L = log₂N` stages (`2·log₂N` for a 2D block, plus one rounding for
 //! the Hao–Bracewell correction).
 //!
-//! `P_min` follows from the rule: before a stage the peak is brought to at
-//! least half the no-shift limit (left shift), and a right shift leaves it
-//! above a quarter of the one-shift limit, so the peak never sits below
-//! `2^F / 2^H` with `H = 3` bits (twiddled stage: limit 13,571 = 2^13.7,
-//! halved to 2^12.7, conservatively 2^12). The mean square is the peak
+//! `P_min` follows from the rule. A stage's output peak is at least its
+//! input peak over `√2` (a butterfly's larger output is at least its larger
+//! input, and the twiddle pair rotates `(y[k], y[m−k])` without changing
+//! its norm). The left shift brings the peak above half the no-shift limit
+//! (twiddled stages: 13,572 = 2^13.7), a right shift happens only above that
+//! limit, so a stage's outputs peak above `13,572 / (2√2)` = 2^12.2 after
+//! one halving or none, and above `27,145 / (4√2)` after two: the peak
+//! never sits below `2^F / 2^H`, `H = 3` bits. The mean square is the peak
 //! squared over the crest factor `κ²` (peak / RMS) of the class:
 //! `P_min = (2^(F−H)/κ)²`. So
 //! `floor = 20·log10(2^(F−H)) + 10·log10 6 − 10·log10 L − 20·log10 κ`,
@@ -26,8 +29,7 @@
 //! the `N` values at stage `j`, but the rounding noise stays on those same
 //! values, so its κ is that of the nonzero values, `√2` (the cas values);
 //! a constant and the alternating signal concentrate into one value per
-//! group whose partner is exactly zero, again κ = 1 on the nonzero values
-//! (their roundings are exact: the sums are of equal values).
+//! group whose partner is exactly zero, κ = 1 on the nonzero values.
 
 extern crate std;
 
