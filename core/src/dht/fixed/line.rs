@@ -49,10 +49,11 @@ pub(super) fn stages<S: FixedSample>(
 ) -> (i32, i64) {
     let limits = S::LIMITS;
     if n == 1 && peak >> S::FRAC_BITS != 0 {
-        // The identity on the most negative integer: halve it (exactly) so
-        // that no output holds the overflow flag of Q15 storage.
+        // The identity, on data holding the most negative integer: halve
+        // the block so that no output holds the overflow flag of Q15
+        // storage.
         for v in data.iter_mut() {
-            *v = S::narrow(v.widen() >> 1);
+            *v = S::narrow(round_shift(v.widen(), 1));
         }
         return (1, peak >> 1);
     }
