@@ -67,40 +67,51 @@ pub(super) fn stages<S: FixedSample>(
             limits.twiddled
         };
         let shift = Shift::choose(peak, kind);
-        peak = stage(data, w, m, shift, tw);
+        if shift.pre > 0 {
+            // Rare (small inputs, or a stage that cancelled): a pass of its
+            // own keeps the shift out of the butterflies.
+            for v in data.iter_mut() {
+                *v = S::narrow(v.widen() << shift.pre);
+            }
+        }
+        peak = match shift.post {
+            0 => stage::<S, 0>(data, w, m, tw),
+            1 => stage::<S, 1>(data, w, m, tw),
+            _ => stage::<S, 2>(data, w, m, tw),
+        };
         exp += shift.exponent();
         m *= 2;
     }
     (exp, peak)
 }
 
-/// One stage of half-length `m`; returns the peak of its outputs.
+/// One stage of half-length `m` whose outputs are shifted right by `POST`
+/// (a constant, so that an unscaled stage pays nothing for it); returns
+/// the peak of its outputs.
 #[inline(always)]
-pub(super) fn stage<S: FixedSample>(
+pub(super) fn stage<S: FixedSample, const POST: u32>(
     data: &mut [S],
     w: usize,
     m: usize,
-    shift: Shift,
     tw: &FixedTwiddles<'_, S>,
 ) -> i64 {
     let stride = tw.len / (2 * m);
     let mut top = S::Wide::from(0);
     for block in data.chunks_exact_mut(2 * m * w) {
         let (x, y) = block.split_at_mut(m * w);
-        plain(&mut x[..w], &mut y[..w], shift, &mut top);
+        plain::<S, POST>(&mut x[..w], &mut y[..w], &mut top);
         if m >= 2 {
             let h = m / 2;
-            plain(
+            plain::<S, POST>(
                 &mut x[h * w..(h + 1) * w],
                 &mut y[h * w..(h + 1) * w],
-                shift,
                 &mut top,
             );
             for k in 1..h {
                 let (c, s) = tw.cos_sin(k * stride);
                 let (x_low, x_high) = x.split_at_mut((m - k) * w);
                 let (y_low, y_high) = y.split_at_mut((m - k) * w);
-                twiddled(
+                twiddled::<S, POST>(
                     [
                         &mut x_low[k * w..(k + 1) * w],
                         &mut x_high[..w],
@@ -108,7 +119,6 @@ pub(super) fn stage<S: FixedSample>(
                         &mut y_high[..w],
                     ],
                     (c, s),
-                    shift,
                     &mut top,
                 );
             }
@@ -127,15 +137,12 @@ fn track<W: Copy + Ord + From<i16> + core::ops::Sub<Output = W>>(top: &mut W, v:
     }
 }
 
-/// `(x, y) ← (x + y, x − y)` over two groups, with the stage's shift.
+/// `(x, y) ← (x + y, x − y)` over two groups, shifted right by `POST`.
 #[inline(always)]
-fn plain<S: FixedSample>(x: &mut [S], y: &mut [S], shift: Shift, top: &mut S::Wide) {
+fn plain<S: FixedSample, const POST: u32>(x: &mut [S], y: &mut [S], top: &mut S::Wide) {
     for (a, b) in x.iter_mut().zip(y.iter_mut()) {
-        let (p, q) = (a.widen() << shift.pre, b.widen() << shift.pre);
-        let (u, v) = (
-            round_shift(p + q, shift.post),
-            round_shift(p - q, shift.post),
-        );
+        let (p, q) = (a.widen(), b.widen());
+        let (u, v) = (round_shift(p + q, POST), round_shift(p - q, POST));
         track(top, u);
         track(top, v);
         *a = S::narrow(u);
@@ -145,31 +152,25 @@ fn plain<S: FixedSample>(x: &mut [S], y: &mut [S], shift: Shift, top: &mut S::Wi
 
 /// The twiddled butterfly over four groups `x[k], x[m−k], y[k], y[m−k]`:
 /// `t1 = c·y[k] + s·y[m−k]`, `t2 = s·y[k] − c·y[m−k]` (each rounded from
-/// the wide product once), then `x[k] ± t1` and `x[m−k] ± t2`.
+/// the wide product once), then `x[k] ± t1` and `x[m−k] ± t2`, shifted
+/// right by `POST`.
 #[inline(always)]
-fn twiddled<S: FixedSample>(
+fn twiddled<S: FixedSample, const POST: u32>(
     [xk, xmk, yk, ymk]: [&mut [S]; 4],
     (c, s): (S::Wide, S::Wide),
-    shift: Shift,
     top: &mut S::Wide,
 ) {
     let len = xk.len();
     let (xmk, yk, ymk) = (&mut xmk[..len], &mut yk[..len], &mut ymk[..len]);
     for i in 0..len {
-        let (a, b) = (yk[i].widen() << shift.pre, ymk[i].widen() << shift.pre);
-        let t1 = round_shift(c * a + s * b, S::FRAC_BITS);
-        let t2 = round_shift(s * a - c * b, S::FRAC_BITS);
-        let (p, q) = (xk[i].widen() << shift.pre, xmk[i].widen() << shift.pre);
+        let (a, b) = (yk[i].widen(), ymk[i].widen());
+        let t1 = round_product::<S>(c * a + s * b);
+        let t2 = round_product::<S>(s * a - c * b);
+        let (p, q) = (xk[i].widen(), xmk[i].widen());
         // Written out, not `[..].map`: `array::map` is left out of line on
         // thumb targets, a call per butterfly.
-        let (o0, o1) = (
-            round_shift(p + t1, shift.post),
-            round_shift(q + t2, shift.post),
-        );
-        let (o2, o3) = (
-            round_shift(p - t1, shift.post),
-            round_shift(q - t2, shift.post),
-        );
+        let (o0, o1) = (round_shift(p + t1, POST), round_shift(q + t2, POST));
+        let (o2, o3) = (round_shift(p - t1, POST), round_shift(q - t2, POST));
         track(top, o0);
         track(top, o1);
         track(top, o2);
@@ -179,4 +180,13 @@ fn twiddled<S: FixedSample>(
         yk[i] = S::narrow(o2);
         ymk[i] = S::narrow(o3);
     }
+}
+
+/// A product sum in units of `2^−2F` to units of `2^−F`, rounded half up:
+/// `(v + 2^(F−1)) >> F`. A tie needs the `F` low bits to be exactly
+/// `2^(F−1)`, one pattern in `2^F`, so the bias is about `2^−(F+1)` of a
+/// unit; half to even would cost two more operations per product.
+#[inline(always)]
+fn round_product<S: FixedSample>(v: S::Wide) -> S::Wide {
+    (v + (S::Wide::from(1) << (S::FRAC_BITS - 1))) >> S::FRAC_BITS
 }

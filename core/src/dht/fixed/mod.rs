@@ -31,10 +31,12 @@
 //! `docs/precision.md` gives the result of the rule chosen.
 //!
 //! # Rounding
-//! Every right shift — the `2^F` of a twiddle product and the block
-//! scaling — rounds half to even: `(v + 2^(s−1) − 1 + ((v >> s) & 1)) >> s`,
-//! unbiased, so the DC bin does not collect a drift from the many ties of
-//! a halving (half the values of a halved stage are ties).
+//! The block scaling rounds half to even,
+//! `(v + 2^(s−1) − 1 + ((v >> s) & 1)) >> s`: unbiased, so the DC bin does
+//! not collect a drift from the many ties of a halving (half the values of
+//! a halved stage are ties). A twiddle product sum rounds half up,
+//! `(v + 2^(F−1)) >> F`: a tie there is one pattern of the `F` low bits in
+//! `2^F`, so its bias is negligible and the two operations are saved.
 //!
 //! # Overflow
 //! Let `M ≤ 2^F` be a stage's input peak (after the left shift, if any),
@@ -43,8 +45,8 @@
 //! - Products: `|c·y + s·y'| ≤ 2·MAX·2^F < 2^(2F+1)`, plus the rounding
 //!   term `2^(F−1)`: below `2^31` for Q15 in `i32` (2,147,434,496) and
 //!   below `2^63` for Q31 in `i64`.
-//! - Twiddled butterfly: `|t| ≤ ⌊(C·M + 2^(F−1))/2^F⌋` (round half to even
-//!   is at most `⌊x + ½⌋`), so `|x ± t| ≤ M + |t| = B(M) < 2^(F+2)`, well
+//! - Twiddled butterfly: `|t| ≤ ⌊(C·M + 2^(F−1))/2^F⌋` (either rounding
+//!   is at most `⌊x + ½⌋` in magnitude), so `|x ± t| ≤ M + |t| = B(M) < 2^(F+2)`, well
 //!   inside the wide type; plain butterflies `|x ± y| ≤ 2M`; the
 //!   Hao–Bracewell bracket `|a + b + c − d| ≤ 4M`.
 //! - Stored value: `⌊(B + 2^(s−1))/2^s⌋` after a right shift by `s`.

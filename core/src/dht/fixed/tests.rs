@@ -37,7 +37,7 @@ use std::vec;
 use std::vec::Vec;
 
 use super::line::stage;
-use super::{dht, dht_2d, idht, idht_2d, FixedSample, FixedTwiddles, Shift};
+use super::{dht, dht_2d, idht, idht_2d, FixedSample, FixedTwiddles};
 use crate::dht::line::for_each_bit_reversed_swap;
 use crate::error::Error;
 
@@ -609,7 +609,7 @@ fn dht_unconditional(data: &mut [i16], tw: &FixedTwiddles<'_, i16>) -> i32 {
     for_each_bit_reversed_swap(n, |i, j| data.swap(i, j));
     let mut m = 1;
     while m < n {
-        stage(data, 1, m, Shift { pre: 0, post: 1 }, tw);
+        stage::<i16, 1>(data, 1, m, tw);
         m *= 2;
     }
     n.trailing_zeros() as i32
