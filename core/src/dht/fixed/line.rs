@@ -124,14 +124,22 @@ pub(super) fn stage<S: FixedSample, const POST: u32>(
             }
         }
     }
-    S::wide_to_i64(top)
+    // One above the largest ones' complement bounds the peak (exact, or one
+    // over). Zero means every output is 0 or −1, which no stage can grow
+    // past its limits unscaled, so it stands for a peak of 0.
+    match S::wide_to_i64(top) {
+        0 => 0,
+        top => top + 1,
+    }
 }
 
-/// `|v|` into the running peak `top`.
+/// `|v|` or `|v| − 1` (for negative `v`: the ones' complement
+/// `v ^ sign`, one instruction on Thumb-2) into the running `top`; the
+/// stage's peak is then `top + 1` at most. Outputs are below `2^(F+2)` in
+/// magnitude, so `v >> (F + 2)` is the sign.
 #[inline(always)]
-fn track<W: Copy + Ord + From<i16> + core::ops::Sub<Output = W>>(top: &mut W, v: W) {
-    let zero = W::from(0);
-    let a = if v < zero { zero - v } else { v };
+fn track<S: FixedSample>(top: &mut S::Wide, v: S::Wide) {
+    let a = v ^ (v >> (S::FRAC_BITS + 2));
     if a > *top {
         *top = a;
     }
@@ -143,8 +151,8 @@ fn plain<S: FixedSample, const POST: u32>(x: &mut [S], y: &mut [S], top: &mut S:
     for (a, b) in x.iter_mut().zip(y.iter_mut()) {
         let (p, q) = (a.widen(), b.widen());
         let (u, v) = (round_shift(p + q, POST), round_shift(p - q, POST));
-        track(top, u);
-        track(top, v);
+        track::<S>(top, u);
+        track::<S>(top, v);
         *a = S::narrow(u);
         *b = S::narrow(v);
     }
@@ -171,10 +179,10 @@ fn twiddled<S: FixedSample, const POST: u32>(
         // thumb targets, a call per butterfly.
         let (o0, o1) = (round_shift(p + t1, POST), round_shift(q + t2, POST));
         let (o2, o3) = (round_shift(p - t1, POST), round_shift(q - t2, POST));
-        track(top, o0);
-        track(top, o1);
-        track(top, o2);
-        track(top, o3);
+        track::<S>(top, o0);
+        track::<S>(top, o1);
+        track::<S>(top, o2);
+        track::<S>(top, o3);
         xk[i] = S::narrow(o0);
         xmk[i] = S::narrow(o1);
         yk[i] = S::narrow(o2);

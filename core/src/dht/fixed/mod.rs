@@ -15,8 +15,9 @@
 //! reserves it as the overflow flag); inputs may hold it (as −1).
 //!
 //! # Scaling rule: conditional, from the peak
-//! Before each stage the transform knows the peak `M = max |v|` of the
-//! block (the previous stage returns it). A table of limits derived from
+//! Before each stage the transform knows a bound `M` on the peak
+//! `max |v|` of the block, exact or one over (the previous stage tracks it
+//! as it stores). A table of limits derived from
 //! the worst-case growth of the stage ([`Limits`]) picks the shift:
 //! - `M` at most the no-shift limit: shift the inputs *left* by the most
 //!   bits that keep `M` under it (exact, exponent decreases), so small
@@ -65,7 +66,7 @@ mod twiddles;
 mod tests;
 
 use core::fmt::Debug;
-use core::ops::{Add, BitAnd, Mul, Shl, Shr, Sub};
+use core::ops::{Add, BitAnd, BitXor, Mul, Shl, Shr, Sub};
 
 pub use line::{dht, idht};
 pub use plane::{dht_2d, idht_2d};
@@ -92,7 +93,8 @@ pub trait FixedSample: Copy + Default + Debug + PartialEq + Send + Sync + privat
         + Mul<Output = Self::Wide>
         + Shl<u32, Output = Self::Wide>
         + Shr<u32, Output = Self::Wide>
-        + BitAnd<Output = Self::Wide>;
+        + BitAnd<Output = Self::Wide>
+        + BitXor<Output = Self::Wide>;
     /// Fraction bits `F`: the value of mantissa `m` is `m / 2^F`.
     const FRAC_BITS: u32;
     /// The shift limits of every stage kind (see [`Limits`]).
