@@ -15,21 +15,23 @@
 //! reserves it as the overflow flag); inputs may hold it (as −1).
 //!
 //! # Scaling rule: conditional, from the peak
-//! Before each stage the transform knows a bound `M` on the peak
+//! Before each stage the transform knows a bound `M ≤ 2^F` on the peak
 //! `max |v|` of the block, exact or one over (the previous stage tracks it
-//! as it stores). A table of limits derived from
-//! the worst-case growth of the stage ([`Limits`]) picks the shift:
+//! as it stores). A table of limits derived from the worst-case growth of
+//! the stage ([`Limits`]) picks the shift:
 //! - `M` at most the no-shift limit: shift the inputs *left* by the most
 //!   bits that keep `M` under it (exact, exponent decreases), so small
 //!   inputs use the whole word and rounding noise stays relative to the
 //!   signal;
 //! - else halve the outputs once (`M` up to the one-shift limit), or twice.
 //!
-//! The alternative, an unconditional ½ per stage, was not taken: a
-//! stage's outputs grow by at most `1 + √2` but typically by `√2` (random
-//! data) or 1 (an impulse), so halving every stage throws away up to a bit
-//! per stage that conditional scaling keeps; the measured table in
-//! `docs/precision.md` gives the result of the rule chosen.
+//! The alternative, an unconditional ½ per stage, was measured and not
+//! taken: a stage's outputs grow by at most `1 + √2` but typically by `√2`
+//! (random data) or 1 (an impulse), so halving every stage throws away up
+//! to a bit per stage that conditional scaling keeps, and inputs far below
+//! full scale keep only their few bits. At N = 1024 it gave 60.9 dB
+//! against 71.9 dB on full-scale random data, and 2.1 dB against 72.5 dB
+//! at 1e-3 of full scale (`docs/precision.md`).
 //!
 //! # Rounding
 //! The block scaling rounds half to even,
@@ -47,9 +49,10 @@
 //!   term `2^(F−1)`: below `2^31` for Q15 in `i32` (2,147,434,496) and
 //!   below `2^63` for Q31 in `i64`.
 //! - Twiddled butterfly: `|t| ≤ ⌊(C·M + 2^(F−1))/2^F⌋` (either rounding
-//!   is at most `⌊x + ½⌋` in magnitude), so `|x ± t| ≤ M + |t| = B(M) < 2^(F+2)`, well
-//!   inside the wide type; plain butterflies `|x ± y| ≤ 2M`; the
-//!   Hao–Bracewell bracket `|a + b + c − d| ≤ 4M`.
+//!   is at most `⌊x + ½⌋` in magnitude), so
+//!   `|x ± t| ≤ M + |t| = B(M) < 2^(F+2)`, well inside the wide type;
+//!   plain butterflies `|x ± y| ≤ 2M`; the Hao–Bracewell bracket
+//!   `|a + b + c − d| ≤ 4M`.
 //! - Stored value: `⌊(B + 2^(s−1))/2^s⌋` after a right shift by `s`.
 //!   [`Limits`] holds, per stage kind and `s ∈ {0, 1}`, the largest `M` for
 //!   which that is `≤ MAX`, computed by exact integer arithmetic at
