@@ -200,6 +200,14 @@ pub enum Error {
         /// The length given.
         len: usize,
     },
+    /// A stored integer table (e.g. fixed-point twiddles from flash) holds
+    /// an entry outside the range its arithmetic is proved safe for.
+    TableEntryOutOfRange {
+        /// Which table.
+        what: &'static str,
+        /// Index of the first bad entry.
+        index: usize,
+    },
 }
 
 /// Shorthand for results of this crate.
@@ -340,6 +348,9 @@ impl fmt::Display for Error {
                 f,
                 "transform length {len} is not 2^a·3^b·5^c (at least 1, no prime factor above 5)"
             ),
+            Error::TableEntryOutOfRange { what, index } => {
+                write!(f, "{what} entry {index} is out of range")
+            }
         }
     }
 }

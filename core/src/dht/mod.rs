@@ -19,6 +19,7 @@
 //! naive O(N²) transform evaluated in f64.
 
 mod cube;
+pub mod fixed;
 mod line;
 pub mod mixed;
 mod plane;
