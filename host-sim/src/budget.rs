@@ -241,20 +241,28 @@ pub struct OverBudget {
     pub needed: u64,
     /// The limit.
     pub limit: MemoryLimit,
-    /// The largest item.
-    pub largest: (&'static str, u64),
+    /// The items that are not empty, largest first.
+    pub items: Vec<(&'static str, u64)>,
     /// How to ask for less.
     pub hint: &'static str,
 }
 
 impl fmt::Display for OverBudget {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let mut parts: Vec<String> = self
+            .items
+            .iter()
+            .take(3)
+            .map(|(what, b)| format!("{what} {}", human_bytes(*b)))
+            .collect();
+        if self.items.len() > 3 {
+            parts.push(format!("{} more", self.items.len() - 3));
+        }
         write!(
             f,
-            "this job needs about {} ({} {}) but the memory limit is {} ({}); {}",
+            "this job needs about {} ({}) but the memory limit is {} ({}); {}",
             human_bytes(self.needed),
-            self.largest.0,
-            human_bytes(self.largest.1),
+            parts.join(" + "),
             human_bytes(self.limit.bytes),
             self.limit.source,
             self.hint
@@ -298,16 +306,12 @@ impl Budget {
         if needed <= limit.bytes && !self.overflow {
             return Ok(());
         }
-        let largest = self
-            .items
-            .iter()
-            .copied()
-            .max_by_key(|&(_, b)| b)
-            .unwrap_or(("nothing", 0));
+        let mut items: Vec<_> = self.items.iter().copied().filter(|&(_, b)| b > 0).collect();
+        items.sort_by(|a, b| b.1.cmp(&a.1));
         Err(OverBudget {
             needed,
             limit,
-            largest,
+            items,
             hint,
         })
     }
@@ -406,7 +410,7 @@ pub fn set_plan(hint: &'static str, plan: impl Fn([usize; 3]) -> Budget + Send +
 /// build from it ([`set_plan`]) and what it already holds ([`hold`]).
 ///
 /// # Errors
-/// [`OverBudget`], naming the largest item.
+/// [`OverBudget`], naming the largest items.
 pub fn check_load(dims: [usize; 3], transit: u64) -> Result<(), OverBudget> {
     let count = dims.iter().fold(1u64, |a, &d| a.saturating_mul(d as u64));
     let (mut budget, hint) = match PLAN.get() {

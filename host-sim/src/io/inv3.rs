@@ -184,13 +184,13 @@ fn numpy_type(dtype: &str) -> Result<SampleType, IoError> {
 /// Read an `.inv3` project's image matrix, advancing `progress` by the bytes
 /// read from disk. Errors carry the path.
 pub fn read_inv3_with_progress(path: &Path, progress: &ProgressBar) -> Result<Volume, IoError> {
-    let go = || read_inv3_from(open_counted(path, progress)?);
+    let go = || read_inv3_from(|| open_counted(path, progress));
     go().map_err(|e| e.in_file(path))
 }
 
 /// Parse an `.inv3` archive (gzip-compressed or plain tar) held in memory.
 pub fn parse_inv3(bytes: &[u8]) -> Result<Volume, IoError> {
-    read_inv3_from(bytes)
+    read_inv3_from(|| Ok(bytes))
 }
 
 #[cold]
@@ -202,62 +202,68 @@ fn tar_error(e: std::io::Error) -> IoError {
     )
 }
 
-fn read_inv3_from<R: BufRead>(reader: R) -> Result<Volume, IoError> {
+/// Read the archive that `open` yields. The samples are decoded as they
+/// stream past: when their member comes before `main.plist` (which says how
+/// to read them), the archive is opened again for a second pass rather than
+/// buffering the member, so memory is the decoded volume alone.
+fn read_inv3_from<R: BufRead>(open: impl Fn() -> Result<R, IoError>) -> Result<Volume, IoError> {
+    let (info, volume) = scan(open()?, None)?;
+    let volume = match (volume, info) {
+        (Some(volume), _) => volume,
+        (None, None) => {
+            return Err(format_error(
+                ARCHIVE,
+                MAIN_PLIST,
+                "the archive has no main.plist: not an InVesalius project",
+            ))
+        }
+        (None, Some(info)) => match scan(open()?, Some(&info))? {
+            (_, Some(volume)) => volume,
+            (_, None) => {
+                return Err(format_error(
+                    ARCHIVE,
+                    "matrix.filename",
+                    format!(
+                        "main.plist names `{}`, which is not in the archive",
+                        excerpt(&info.filename)
+                    ),
+                ))
+            }
+        },
+    };
+    Ok(volume)
+}
+
+/// One pass over the archive: `main.plist` (unless `known` already) and
+/// the samples, if their member comes after it. Reads the archive to its
+/// end (the end-of-archive padding and the gzip trailer), so that damage
+/// anywhere is reported.
+fn scan<R: BufRead>(
+    reader: R,
+    known: Option<&MatrixInfo>,
+) -> Result<(Option<MatrixInfo>, Option<Volume>), IoError> {
     let mut archive = tar::Archive::new(MaybeGzip::new(reader)?);
     let mut info: Option<MatrixInfo> = None;
-    // The samples, if their member came before `main.plist`.
-    let mut early: Option<(String, Vec<u8>)> = None;
     let mut volume: Option<Volume> = None;
     for entry in archive.entries().map_err(tar_error)? {
         let entry = entry.map_err(tar_error)?;
         if volume.is_some() {
-            // Read through the rest, so that damage anywhere is reported.
             continue;
         }
         let name = member_name(&entry);
-        if name == MAIN_PLIST {
-            let parsed = parse_main_plist(&read_plist(entry)?)?;
-            if let Some((early_name, bytes)) = early.take() {
-                if early_name == parsed.filename {
-                    volume = Some(decode_matrix(
-                        &parsed,
-                        bytes.as_slice(),
-                        bytes.len() as u64,
-                    )?);
-                }
-            }
-            info = Some(parsed);
-        } else if let Some(info) = &info {
+        if known.is_none() && name == MAIN_PLIST {
+            info = Some(parse_main_plist(&read_plist(entry)?)?);
+        } else if let Some(info) = known.or(info.as_ref()) {
             if name == info.filename {
                 let size = entry.size();
                 volume = Some(decode_matrix(info, entry, size)?);
             }
-        } else if name == "matrix.dat" && early.is_none() {
-            early = Some((name, read_member(entry)?));
         }
     }
-    let Some(volume) = volume else {
-        return Err(match info {
-            None => format_error(
-                ARCHIVE,
-                MAIN_PLIST,
-                "the archive has no main.plist: not an InVesalius project",
-            ),
-            Some(info) => format_error(
-                ARCHIVE,
-                "matrix.filename",
-                format!(
-                    "main.plist names `{}`, which is not in the archive",
-                    excerpt(&info.filename)
-                ),
-            ),
-        });
-    };
-    // The end-of-archive padding and the gzip trailer (CRC, size).
     let mut rest = archive.into_inner();
     std::io::copy(&mut rest, &mut std::io::sink()).map_err(tar_error)?;
     rest.finish()?;
-    Ok(volume)
+    Ok((info, volume))
 }
 
 /// The last component of a member's path (`tmpXYZ/main.plist` → `main.plist`).
@@ -285,23 +291,6 @@ fn read_plist<R: Read>(entry: tar::Entry<'_, R>) -> Result<String, IoError> {
         .map_err(tar_error)?;
     String::from_utf8(bytes)
         .map_err(|e| format_error(PLIST, "xml", format!("is not UTF-8 text: {e}")))
-}
-
-/// A whole member, within the memory limit.
-fn read_member<R: Read>(entry: tar::Entry<'_, R>) -> Result<Vec<u8>, IoError> {
-    let size = entry.size();
-    if size > crate::budget::limit_bytes() {
-        return Err(IoError::TooLarge {
-            needed: size,
-            limit: crate::budget::limit_bytes(),
-        });
-    }
-    let mut bytes = Vec::new();
-    entry
-        .take(size)
-        .read_to_end(&mut bytes)
-        .map_err(tar_error)?;
-    Ok(bytes)
 }
 
 /// Decode the member `reader` of `size` bytes as `info` describes.
