@@ -307,7 +307,7 @@ impl Budget {
             return Ok(());
         }
         let mut items: Vec<_> = self.items.iter().copied().filter(|&(_, b)| b > 0).collect();
-        items.sort_by(|a, b| b.1.cmp(&a.1));
+        items.sort_by_key(|&(_, b)| std::cmp::Reverse(b));
         Err(OverBudget {
             needed,
             limit,
