@@ -397,12 +397,22 @@ mod tests {
 /// refuse a volume before decoding or decompressing it.
 type Plan = Box<dyn Fn([usize; 3]) -> Budget + Send + Sync>;
 
-static PLAN: std::sync::OnceLock<(Plan, &'static str)> = std::sync::OnceLock::new();
+static PLAN: std::sync::Mutex<Option<(Plan, &'static str)>> = std::sync::Mutex::new(None);
 
 /// Declare what this job builds from a volume of given dims (spectra, images,
-/// frames), and how to ask for less; the first call wins.
+/// frames), and how to ask for less; replaces any earlier plan.
 pub fn set_plan(hint: &'static str, plan: impl Fn([usize; 3]) -> Budget + Send + Sync + 'static) {
-    let _ = PLAN.set((Box::new(plan), hint));
+    let mut slot = PLAN.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    *slot = Some((Box::new(plan), hint));
+}
+
+/// The plan's budget for `dims` (empty without a plan), and its hint.
+fn planned(dims: [usize; 3]) -> (Budget, &'static str) {
+    let slot = PLAN.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    match slot.as_ref() {
+        Some((plan, hint)) => (plan(dims), *hint),
+        None => (Budget::new(), "use a smaller volume or raise --max-memory"),
+    }
 }
 
 /// Check, before decoding, a volume of `dims` whose decoding also holds
@@ -413,10 +423,7 @@ pub fn set_plan(hint: &'static str, plan: impl Fn([usize; 3]) -> Budget + Send +
 /// [`OverBudget`], naming the largest items.
 pub fn check_load(dims: [usize; 3], transit: u64) -> Result<(), OverBudget> {
     let count = dims.iter().fold(1u64, |a, &d| a.saturating_mul(d as u64));
-    let (mut budget, hint) = match PLAN.get() {
-        Some((plan, hint)) => (plan(dims), *hint),
-        None => (Budget::new(), "use a smaller volume or raise --max-memory"),
-    };
+    let (mut budget, hint) = planned(dims);
     budget.hold("decoded volume", count, 4);
     budget.hold("raw samples in transit", transit, 1);
     budget.check(limit(), hint)
@@ -430,10 +437,8 @@ pub fn check_load(dims: [usize; 3], transit: u64) -> Result<(), OverBudget> {
 /// # Errors
 /// [`OverBudget`].
 pub fn check_plan(dims: [usize; 3]) -> Result<(), OverBudget> {
-    match PLAN.get() {
-        Some((plan, hint)) => plan(dims).check(limit(), hint),
-        None => Ok(()),
-    }
+    let (budget, hint) = planned(dims);
+    budget.check(limit(), hint)
 }
 
 /// Bytes held by live [`Held`] guards.

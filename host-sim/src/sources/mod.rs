@@ -86,6 +86,7 @@ fn build_phantom(
         Some(_) => return Err(format!("phantom `{name}` takes no seed")),
     };
     let dims = [n, n, n];
+    crate::budget::check_load(dims, 0).map_err(|e| e.to_string())?;
     let phantom: Box<dyn Phantom> = match name {
         "gaussians" => Box::new(GaussianMixture::random(seed, n, GAUSSIAN_COUNT)),
         "blobs" => Box::new(GaussianMixture::random_with(
@@ -121,7 +122,12 @@ pub fn teapot_by_name(spec: &str) -> Option<Result<Volume, String>> {
             None => return None,
         },
     };
-    Some(size.and_then(|n| voxelize_teapot(n).map(|t| t.volume)))
+    Some(size.and_then(|n| {
+        // Voxelizing holds three f64 grids (coverage, smoothing) besides the volume.
+        let count = (n as u64).saturating_pow(3);
+        crate::budget::check_load([n; 3], count.saturating_mul(24)).map_err(|e| e.to_string())?;
+        voxelize_teapot(n).map(|t| t.volume)
+    }))
 }
 
 /// Layout of a headerless raw file.

@@ -1,10 +1,16 @@
 //! `fvr`: frequency-domain volume rendering from the command line.
+//!
+//! Built with `--cfg fuzzing` (by `cargo fuzz`, from `fuzz/`), the same
+//! program is a libFuzzer target over arguments and scene files ([`fuzz`]).
+#![cfg_attr(fuzzing, no_main)]
 
 mod accuracy;
 mod adaptive_report;
 mod adaptive_table;
 mod args;
 mod compare;
+#[cfg(fuzzing)]
+mod fuzz;
 mod growth;
 mod json;
 mod precision;
@@ -124,9 +130,19 @@ pub(crate) enum Command {
     AdaptiveTable(crate::adaptive_table::AdaptiveTableArgs),
 }
 
+#[cfg(not(fuzzing))]
 fn main() -> ExitCode {
+    run(std::env::args_os())
+}
+
+/// Parse `args` (the program's name first) and run the command.
+pub(crate) fn run<I, T>(args: I) -> ExitCode
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
     let parsed = Cli::command()
-        .try_get_matches()
+        .try_get_matches_from(args)
         .and_then(|m| Cli::from_arg_matches(&m).map(|cli| (m, cli)));
     let (matches, cli) = match parsed {
         Ok(ok) => ok,
