@@ -12,9 +12,10 @@ pub const LEN: usize = SIDE * SIDE;
 const SEED: u32 = 0x2545_F491;
 
 /// The Q15 mantissas of a spectrum-like block, `x` fastest: a smooth
-/// bump around the zero frequency (indices wrap, as frequencies do),
-/// `(256 − r²)²/4` for `r² < 256` (peak 16,384), plus uniform noise in
-/// `[−2048, 2047]` from an LCG (Numerical Recipes constants).
+/// elliptic bump around the zero frequency (indices wrap, as frequencies
+/// do), `(256 − r²)²/4` for `r² = dx² + 2·dy² < 256` (peak 16,384), plus
+/// uniform noise in `[−2048, 2047]` from an LCG (Numerical Recipes
+/// constants).
 pub fn q15_block(out: &mut [i16]) {
     let mut state = SEED;
     for (i, v) in out.iter_mut().enumerate() {

@@ -57,11 +57,17 @@ mod device {
         (clock.now() - t0, out)
     }
 
-    fn write(name: &str, parts: &[&[u8]]) -> Result<(), RunError> {
+    /// Write `head`, then each of `values`, to the file `name` on the host.
+    fn send<const W: usize>(
+        name: &str,
+        head: &[u8],
+        values: impl Iterator<Item = [u8; W]>,
+    ) -> Result<(), RunError> {
+        let failed = |_| RunError::Host("write to the host");
         let mut file = HostFile::create(name)?;
-        for part in parts {
-            file.put(part)
-                .map_err(|_| RunError::Host("write to the host"))?;
+        file.put(head).map_err(failed)?;
+        for v in values {
+            file.put(&v).map_err(failed)?;
         }
         Ok(())
     }
@@ -104,11 +110,11 @@ mod device {
             q15,
             exp
         );
-        let mut bytes = [0u8; 2 * LEN];
-        for (b, m) in bytes.chunks_exact_mut(2).zip(blocks.q15.iter()) {
-            b.copy_from_slice(&m.to_le_bytes());
-        }
-        write("fvr-fixed-bench-q15.bin", &[&exp.to_le_bytes(), &bytes])?;
+        send(
+            "fvr-fixed-bench-q15.bin",
+            &exp.to_le_bytes(),
+            blocks.q15.iter().map(|m| m.to_le_bytes()),
+        )?;
 
         // (b) Q31, on the same values.
         let tw31 = FixedTwiddles::from_table(&TWIDDLES_Q31, SIDE).map_err(core_error)?;
@@ -123,17 +129,11 @@ mod device {
             q31,
             exp
         );
-        let mut file = HostFile::create("fvr-fixed-bench-q31.bin")?;
-        file.put(&exp.to_le_bytes())
-            .map_err(|_| RunError::Host("write to the host"))?;
-        for chunk in blocks.q31.chunks(SIDE) {
-            let mut row = [0u8; 4 * SIDE];
-            for (b, m) in row.chunks_exact_mut(4).zip(chunk) {
-                b.copy_from_slice(&m.to_le_bytes());
-            }
-            file.put(&row)
-                .map_err(|_| RunError::Host("write to the host"))?;
-        }
+        send(
+            "fvr-fixed-bench-q31.bin",
+            &exp.to_le_bytes(),
+            blocks.q31.iter().map(|m| m.to_le_bytes()),
+        )?;
 
         // (c) f32 in soft float, on the same values.
         let mut f32_twiddles = [0.0f32; Twiddles::<f32>::buffer_len(SIDE)];
@@ -150,15 +150,11 @@ mod device {
             "fixed idht-2d-f32: {=u64} instructions (64x64, soft float)",
             soft
         );
-        let mut file = HostFile::create("fvr-fixed-bench-f32.bin")?;
-        for chunk in blocks.f32.chunks(SIDE) {
-            let mut row = [0u8; 4 * SIDE];
-            for (b, v) in row.chunks_exact_mut(4).zip(chunk) {
-                b.copy_from_slice(&v.to_le_bytes());
-            }
-            file.put(&row)
-                .map_err(|_| RunError::Host("write to the host"))?;
-        }
+        send(
+            "fvr-fixed-bench-f32.bin",
+            &[],
+            blocks.f32.iter().map(|v| v.to_le_bytes()),
+        )?;
 
         if clock.wrapped() {
             return Err(RunError::CounterWrapped);
