@@ -9,7 +9,11 @@
 #  4. checks every QEMU image against the host core bit for bit, and the
 #     display bytes against the host image (firmware/tests/qemu_agreement.rs);
 #  5. prints the instruction counts and the flash/RAM footprint;
-#  6. checks that a scene over the flash budget fails to build, naming the
+#  6. the same for the Cortex-M3 (no FPU): builds fvr-fixed-bench for
+#     thumbv7m-none-eabi, runs it under QEMU mps2-an385, checks its integer
+#     transforms against the host bit for bit (firmware/tests/qemu_fixed.rs)
+#     and prints its counts and footprint;
+#  7. checks that a scene over the flash budget fails to build, naming the
 #     excess (build.rs for the tables alone, the linker for tables + code).
 # Usage: bash scripts/firmware.sh
 set -euo pipefail
@@ -17,6 +21,8 @@ cd "$(dirname "$0")/.."
 
 TARGET=thumbv7em-none-eabihf
 PROGRAMS=(fvr-scene fvr-filter-bench)
+M3_TARGET=thumbv7m-none-eabi
+M3_PROGRAM=fvr-fixed-bench
 QEMU_TIMEOUT_S=120
 DEFMT_PRINT_VERSION=1.2.0
 
@@ -26,7 +32,7 @@ fail() {
 }
 
 echo "== firmware: tools"
-rustup target add "$TARGET"
+rustup target add "$TARGET" "$M3_TARGET"
 if ! command -v qemu-system-arm >/dev/null; then
     echo "qemu-system-arm is missing: installing it with apt-get"
     if [ "$(id -u)" -eq 0 ]; then
@@ -57,21 +63,23 @@ cargo build --locked -p fvr-firmware --target "$TARGET" --release
 echo "== firmware: run in QEMU (mps2-an386, -icount shift=0, timeout ${QEMU_TIMEOUT_S}s)"
 rm -rf "$run_dir"
 mkdir -p "$run_dir"
-for program in "${PROGRAMS[@]}"; do
-    elf="$bin_dir/$program"
+run_in_qemu() { # machine cpu elf program
     set +e
     (cd "$run_dir" && timeout --kill-after=5 "$QEMU_TIMEOUT_S" qemu-system-arm \
-        -machine mps2-an386 -cpu cortex-m4 -nographic -monitor none -serial none \
+        -machine "$1" -cpu "$2" -nographic -monitor none -serial none \
         -semihosting-config enable=on,target=native -icount shift=0 \
-        -kernel "$elf" >"$program.defmt")
-    status=$?
+        -kernel "$3" >"$4.defmt")
+    local status=$?
     set -e
-    defmt-print -e "$elf" <"$run_dir/$program.defmt" | tee "$run_dir/$program.log"
+    defmt-print -e "$3" <"$run_dir/$4.defmt" | tee "$run_dir/$4.log"
     case $status in
         0) ;;
-        124 | 137) fail "$program: QEMU timed out after ${QEMU_TIMEOUT_S}s (a HardFault loop or a hang)" ;;
-        *) fail "$program: exited with status $status (101 panic, 102 HardFault, 1 error)" ;;
+        124 | 137) fail "$4: QEMU timed out after ${QEMU_TIMEOUT_S}s (a HardFault loop or a hang)" ;;
+        *) fail "$4: exited with status $status (101 panic, 102 HardFault, 1 error)" ;;
     esac
+}
+for program in "${PROGRAMS[@]}"; do
+    run_in_qemu mps2-an386 cortex-m4 "$bin_dir/$program" "$program"
 done
 
 echo "== firmware: QEMU images against the host core (bit for bit)"
@@ -100,26 +108,54 @@ grep -h '^frame' "$run_dir"/*.log >/dev/null || fail "no instruction counts in t
 grep -q 'inverse again on other data' "$run_dir/fvr-scene.log" || fail "fvr-scene: no re-timed inverse of its plain frame"
 
 echo "== firmware: footprint (bytes)"
-printf '%-18s %8s %8s %8s %8s %8s %10s %10s\n' program .text .rodata .data .bss stack flash RAM
-for program in "${PROGRAMS[@]}"; do
-    read -r text rodata data bss vt < <(size -A "$bin_dir/$program" | awk '
+footprint_header() {
+    printf '%-18s %8s %8s %8s %8s %8s %10s %10s\n' program .text .rodata .data .bss stack flash RAM
+}
+footprint() { # elf program
+    read -r text rodata data bss vt < <(size -A "$1" | awk '
         $1==".text"{t=$2} $1==".rodata"{r=$2} $1==".data"{d=$2} $1==".bss"{b=$2} $1==".vector_table"{v=$2}
         END{print t+0, r+0, d+0, b+0, v+0}')
-    stack=$(sed -n 's/^stack: peak \([0-9]*\) bytes.*/\1/p' "$run_dir/$program.log")
-    [ -n "$stack" ] || fail "$program: no stack measurement in its log"
-    printf '%-18s %8s %8s %8s %8s %8s %10s %10s\n' "$program" "$text" "$rodata" "$data" "$bss" "$stack" \
+    stack=$(sed -n 's/^stack: peak \([0-9]*\) bytes.*/\1/p' "$run_dir/$2.log")
+    [ -n "$stack" ] || fail "$2: no stack measurement in its log"
+    printf '%-18s %8s %8s %8s %8s %8s %10s %10s\n' "$2" "$text" "$rodata" "$data" "$bss" "$stack" \
         $((vt + text + rodata + data)) $((data + bss + stack))
+}
+footprint_header
+for program in "${PROGRAMS[@]}"; do
+    footprint "$bin_dir/$program" "$program"
 done
 
+echo "== firmware: Cortex-M3 ($M3_TARGET, release, $M3_PROGRAM)"
+cargo clippy --locked -p fvr-firmware --target "$M3_TARGET" --release --lib --bin "$M3_PROGRAM" -- -D warnings
+cargo build --locked -p fvr-firmware --target "$M3_TARGET" --release --bin "$M3_PROGRAM"
+m3_elf="$target_dir/$M3_TARGET/release/$M3_PROGRAM"
+echo "== firmware: run in QEMU (mps2-an385, Cortex-M3, -icount shift=0, timeout ${QEMU_TIMEOUT_S}s)"
+run_in_qemu mps2-an385 cortex-m3 "$m3_elf" "$M3_PROGRAM"
+grep -q '^calibration: delay loop of 2000002 instructions counted as 2000000$' "$run_dir/$M3_PROGRAM.log" \
+    || fail "$M3_PROGRAM: the SysTick calibration is off on mps2-an385"
+echo "== firmware: Cortex-M3 integer transforms against the host (bit for bit)"
+FVR_QEMU_OUT="$run_dir" cargo test --locked -p fvr-firmware --test qemu_fixed -- --ignored --nocapture
+echo "== firmware: instruction counts (64x64 block, Cortex-M3, exact to +-40)"
+printf '%-20s %11s\n' item instructions
+sed -n 's/^fixed \([^:]*\): \([0-9]*\) instructions.*/\1 \2/p; s/^fixed \(twiddles-q15\): build \([0-9]*\) instructions.*, flash \([0-9]*\) .*/\1-build \2\n\1-flash \3/p' \
+    "$run_dir/$M3_PROGRAM.log" | while read -r item n; do printf '%-20s %11s\n' "$item" "$n"; done
+q15=$(sed -n 's/^fixed idht-2d-q15: \([0-9]*\) .*/\1/p' "$run_dir/$M3_PROGRAM.log")
+soft=$(sed -n 's/^fixed idht-2d-f32: \([0-9]*\) .*/\1/p' "$run_dir/$M3_PROGRAM.log")
+[ -n "$q15" ] && [ -n "$soft" ] || fail "$M3_PROGRAM: no transform counts in its log"
+echo "soft-float f32 / Q15: $(python3 -c "print(f'{$soft / $q15:.2f}')")"
+echo "== firmware: Cortex-M3 footprint (bytes)"
+footprint_header
+footprint "$m3_elf" "$M3_PROGRAM"
+
 echo "== firmware: a scene over the flash budget fails to build, naming the excess"
-# In a copy of the workspace whose memory.x is smaller (the linker reads
-# memory.x from the workspace root), with its own target directory.
+# In a copy of the workspace whose firmware/memory.x is smaller, with its own
+# target directory.
 budget_ws=$(mktemp -d)
 trap 'rm -rf "$budget_ws"' EXIT
 git ls-files -z --cached --others --exclude-standard | xargs -0 cp --parents -t "$budget_ws"
 expect_build_failure() { # flash-length pattern what
-    sed -i "s/^\( *FLASH *: *ORIGIN = 0x00000000, LENGTH = \).*/\1$1/" "$budget_ws/memory.x"
-    grep -q "LENGTH = $1\$" "$budget_ws/memory.x" || fail "could not set FLASH to $1 in the copy of memory.x"
+    sed -i "s/^\( *FLASH *: *ORIGIN = 0x00000000, LENGTH = \).*/\1$1/" "$budget_ws/firmware/memory.x"
+    grep -q "LENGTH = $1\$" "$budget_ws/firmware/memory.x" || fail "could not set FLASH to $1 in the copy of firmware/memory.x"
     set +e
     (cd "$budget_ws" && CARGO_TARGET_DIR="$target_dir/fvr-firmware-budget" \
         cargo build --locked -p fvr-firmware --target "$TARGET" --release) >"$budget_ws/build.log" 2>&1

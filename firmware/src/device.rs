@@ -1,6 +1,8 @@
 //! The device runtime (thumbv7em-none-eabihf under QEMU mps2-an386):
 //! instruction counting with SysTick, host files over semihosting, the
 //! stack scan, the panic handler and [`firmware_main!`](crate::firmware_main).
+//! The Cortex-M3 (thumbv7m-none-eabi, mps2-an385, no FPU) uses all but the
+//! scene's [`run`] and the VCVTB measurement, which need the M4F.
 //!
 //! # Instruction counts
 //! QEMU runs with `-icount shift=0`: one instruction is one nanosecond of
@@ -10,6 +12,7 @@
 //! would after 671 M instructions); [`run`] fails if it did.
 
 use core::ffi::CStr;
+#[cfg(target_abi = "eabihf")]
 use core::fmt::Write as _;
 
 use cortex_m::peripheral::syst::SystClkSource;
@@ -17,15 +20,17 @@ use cortex_m::peripheral::SYST;
 use semihosting::fs::File;
 use semihosting::io::Write as _;
 
-use crate::capture::{ByteSink, CaptureBus};
-use crate::display::{DcsPanel, Image, Window};
-use crate::frame::{
-    check_linked_tables, render_frame, tables_for, FrameBuffers, FrameError, InstructionClock,
-    Split, IMAGE_LEN,
+use crate::capture::ByteSink;
+use crate::frame::{FrameError, InstructionClock};
+#[cfg(target_abi = "eabihf")]
+use crate::{
+    capture::CaptureBus,
+    display::{DcsPanel, Image, Window},
+    frame::{check_linked_tables, render_frame, tables_for, FrameBuffers, Split, IMAGE_LEN},
+    nrrd::{write_samples_le, Header},
+    scene::{FrameSpec, IMAGE_SIDE},
+    stored::{twiddles, StoredDerivative, StoredSpectrum},
 };
-use crate::nrrd::{write_samples_le, Header};
-use crate::scene::{FrameSpec, IMAGE_SIDE};
-use crate::stored::{twiddles, StoredDerivative, StoredSpectrum};
 
 // The critical-section implementation defmt-semihosting needs.
 use cortex_m as _;
@@ -118,12 +123,14 @@ impl From<FrameError> for RunError {
     }
 }
 
+#[cfg(target_abi = "eabihf")]
 /// A `core::fmt` buffer for file names.
 struct Name {
     buf: [u8; 80],
     len: usize,
 }
 
+#[cfg(target_abi = "eabihf")]
 impl core::fmt::Write for Name {
     fn write_str(&mut self, s: &str) -> core::fmt::Result {
         let end = self.len + s.len();
@@ -136,6 +143,7 @@ impl core::fmt::Write for Name {
     }
 }
 
+#[cfg(target_abi = "eabihf")]
 impl Name {
     fn new(program: &str, frame: &str, ext: &str) -> Result<Self, RunError> {
         let mut n = Name {
@@ -150,6 +158,7 @@ impl Name {
     }
 }
 
+#[cfg(target_abi = "eabihf")]
 /// Render every frame of `frames` from `spectra` and `derivatives` into
 /// `bufs`, write each image to `<program>-<frame>.nrrd` and its display
 /// recording to `<program>-<frame>.spi` on the host, log the counts with
@@ -171,6 +180,7 @@ pub fn run(
     semihosting::process::exit(status)
 }
 
+#[cfg(target_abi = "eabihf")]
 fn run_inner(
     program: &str,
     frames: &[FrameSpec],
@@ -273,6 +283,7 @@ fn run_inner(
     Ok(())
 }
 
+#[cfg(target_abi = "eabihf")]
 /// On the target's own arithmetic: the fast f16 → f32 widening of the core
 /// (`fvr_core::num::f16_bits_to_f32`) against `half`'s, for all 65,536
 /// patterns, and the instructions per conversion of each over the 63,488
@@ -351,6 +362,7 @@ pub mod unsafe_parts {
         pub available: usize,
     }
 
+    #[cfg(target_abi = "eabihf")]
     /// The FPv4-SP instruction `VCVTB.F32.F16` (IEEE half, FPSCR.AHP = 0):
     /// the conversion the core cannot use, because it forbids `unsafe` and
     /// stable Rust has no other way to emit it. Measured here to show what

@@ -1,0 +1,199 @@
+//! `fvr-fixed-bench`: the integer-only Hartley transforms of the core on a
+//! Cortex-M3 without FPU (thumbv7m-none-eabi, QEMU mps2-an385). On one
+//! 64 × 64 block (`src/fixed_input.rs`) it counts the instructions of the
+//! inverse 2D transform in Q15, in Q31 and in soft-float f32, and of making
+//! the Q15 twiddle table on the device (soft-float `sin`) against taking it
+//! from flash (made by `build.rs`). It writes every result to the host
+//! (`fvr-fixed-bench-{q15,q31,f32}.bin`) for `tests/qemu_fixed.rs`
+//! (`bash scripts/firmware.sh`).
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(target_os = "none")]
+#[allow(dead_code)]
+#[path = "../fixed_input.rs"]
+mod fixed_input;
+
+#[cfg(target_os = "none")]
+mod device {
+    use fvr_core::dht::fixed::{idht_2d, FixedTwiddles};
+    use fvr_core::dht::{self, Twiddles};
+    use fvr_firmware::capture::ByteSink;
+    use fvr_firmware::device::{unsafe_parts, HostFile, RunError, SysTickClock};
+    use fvr_firmware::frame::{FrameError, InstructionClock};
+
+    use crate::fixed_input::{f32_from_q15, q15_block, q31_from_q15, LEN, SIDE};
+
+    include!(concat!(env!("OUT_DIR"), "/fixed_tables.rs"));
+
+    const PROGRAM: &str = "fvr-fixed-bench";
+    const TWIDDLES_LEN: usize = FixedTwiddles::<i16>::buffer_len(SIDE);
+
+    /// The blocks, in `.bss`.
+    pub struct Blocks {
+        pub q15: &'static mut [i16; LEN],
+        pub q31: &'static mut [i32; LEN],
+        pub f32: &'static mut [f32; LEN],
+    }
+
+    pub fn run(blocks: Blocks) -> ! {
+        let status = match measure(blocks) {
+            Ok(()) => 0,
+            Err(e) => {
+                defmt::error!("{=str}: {}", PROGRAM, defmt::Debug2Format(&e));
+                1
+            }
+        };
+        semihosting::process::exit(status)
+    }
+
+    fn core_error(e: fvr_core::Error) -> RunError {
+        RunError::Frame(FrameError::Core(e))
+    }
+
+    /// Instructions `f` takes, and its result.
+    fn count<T>(clock: &SysTickClock, f: impl FnOnce() -> T) -> (u64, T) {
+        let t0 = clock.now();
+        let out = f();
+        (clock.now() - t0, out)
+    }
+
+    /// Write `head`, then each of `values`, to the file `name` on the host.
+    fn send<const W: usize>(
+        name: &str,
+        head: &[u8],
+        values: impl Iterator<Item = [u8; W]>,
+    ) -> Result<(), RunError> {
+        let failed = |_| RunError::Host("write to the host");
+        let mut file = HostFile::create(name)?;
+        file.put(head).map_err(failed)?;
+        for v in values {
+            file.put(&v).map_err(failed)?;
+        }
+        Ok(())
+    }
+
+    fn measure(blocks: Blocks) -> Result<(), RunError> {
+        let peripherals =
+            cortex_m::Peripherals::take().ok_or(RunError::Host("peripherals taken"))?;
+        let mut clock = SysTickClock::start(peripherals.SYST);
+        let (calibration, ()) = count(&clock, || cortex_m::asm::delay(1_000_000));
+        defmt::println!(
+            "calibration: delay loop of 2000002 instructions counted as {=u64}",
+            calibration
+        );
+
+        // (d) The Q15 twiddles: made here in soft float, or checked in flash.
+        let mut made = [0i16; TWIDDLES_LEN];
+        let (build, built) = count(&clock, || {
+            FixedTwiddles::<i16>::new(&mut made, SIDE).map(|_| ())
+        });
+        built.map_err(core_error)?;
+        let (load, tw) = count(&clock, || FixedTwiddles::from_table(&TWIDDLES_Q15, SIDE));
+        let tw = tw.map_err(core_error)?;
+        if made != TWIDDLES_Q15 {
+            return Err(RunError::Host(
+                "the Q15 twiddles made on the device differ from the flash table",
+            ));
+        }
+        defmt::println!(
+            "fixed twiddles-q15: build {=u64} instructions (soft-float sin), flash {=u64} (range checks); equal tables",
+            build,
+            load
+        );
+
+        // (a) Q15.
+        q15_block(&mut blocks.q15[..]);
+        let (q15, exp) = count(&clock, || idht_2d(&mut blocks.q15[..], SIDE, SIDE, &tw));
+        let exp = exp.map_err(core_error)?;
+        defmt::println!(
+            "fixed idht-2d-q15: {=u64} instructions (64x64, exponent {=i32})",
+            q15,
+            exp
+        );
+        send(
+            "fvr-fixed-bench-q15.bin",
+            &exp.to_le_bytes(),
+            blocks.q15.iter().map(|m| m.to_le_bytes()),
+        )?;
+
+        // (b) Q31, on the same values.
+        let tw31 = FixedTwiddles::from_table(&TWIDDLES_Q31, SIDE).map_err(core_error)?;
+        q15_block(&mut blocks.q15[..]);
+        for (w, &m) in blocks.q31.iter_mut().zip(blocks.q15.iter()) {
+            *w = q31_from_q15(m);
+        }
+        let (q31, exp) = count(&clock, || idht_2d(&mut blocks.q31[..], SIDE, SIDE, &tw31));
+        let exp = exp.map_err(core_error)?;
+        defmt::println!(
+            "fixed idht-2d-q31: {=u64} instructions (64x64, exponent {=i32})",
+            q31,
+            exp
+        );
+        send(
+            "fvr-fixed-bench-q31.bin",
+            &exp.to_le_bytes(),
+            blocks.q31.iter().map(|m| m.to_le_bytes()),
+        )?;
+
+        // (c) f32 in soft float, on the same values.
+        let mut f32_twiddles = [0.0f32; Twiddles::<f32>::buffer_len(SIDE)];
+        let ftw = Twiddles::new(&mut f32_twiddles, SIDE).map_err(core_error)?;
+        for (f, &m) in blocks.f32.iter_mut().zip(blocks.q15.iter()) {
+            *f = f32_from_q15(m);
+        }
+        let mut column = [0.0f32; SIDE];
+        let (soft, done) = count(&clock, || {
+            dht::idht_2d(&mut blocks.f32[..], SIDE, SIDE, &mut column, &ftw)
+        });
+        done.map_err(core_error)?;
+        defmt::println!(
+            "fixed idht-2d-f32: {=u64} instructions (64x64, soft float)",
+            soft
+        );
+        send(
+            "fvr-fixed-bench-f32.bin",
+            &[],
+            blocks.f32.iter().map(|v| v.to_le_bytes()),
+        )?;
+
+        if clock.wrapped() {
+            return Err(RunError::CounterWrapped);
+        }
+        let stack = unsafe_parts::stack_usage();
+        defmt::println!(
+            "stack: peak {=usize} bytes of {=usize} free for the stack",
+            stack.peak,
+            stack.available
+        );
+        Ok(())
+    }
+}
+
+#[cfg(target_os = "none")]
+#[cortex_m_rt::entry]
+fn main() -> ! {
+    use fixed_input::LEN;
+    let q15 = cortex_m::singleton!(Q15: [i16; LEN] = [0; LEN]);
+    let q31 = cortex_m::singleton!(Q31: [i32; LEN] = [0; LEN]);
+    let f32 = cortex_m::singleton!(F32: [f32; LEN] = [0.0; LEN]);
+    // Each singleton is taken once, here.
+    let (Some(q15), Some(q31), Some(f32)) = (q15, q31, f32) else {
+        fvr_firmware::device::abort("blocks taken twice")
+    };
+    device::run(device::Blocks { q15, q31, f32 })
+}
+
+#[cfg(target_os = "none")]
+#[allow(unsafe_code)]
+#[cortex_m_rt::exception]
+unsafe fn HardFault(_frame: &cortex_m_rt::ExceptionFrame) -> ! {
+    fvr_firmware::device::hard_fault()
+}
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!(
+        "fvr-fixed-bench runs on thumbv7m-none-eabi under QEMU mps2-an385: bash scripts/firmware.sh"
+    );
+    std::process::exit(2);
+}
