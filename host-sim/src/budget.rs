@@ -402,13 +402,17 @@ static PLAN: std::sync::Mutex<Option<(Plan, &'static str)>> = std::sync::Mutex::
 /// Declare what this job builds from a volume of given dims (spectra, images,
 /// frames), and how to ask for less; replaces any earlier plan.
 pub fn set_plan(hint: &'static str, plan: impl Fn([usize; 3]) -> Budget + Send + Sync + 'static) {
-    let mut slot = PLAN.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let mut slot = PLAN
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     *slot = Some((Box::new(plan), hint));
 }
 
 /// The plan's budget for `dims` (empty without a plan), and its hint.
 fn planned(dims: [usize; 3]) -> (Budget, &'static str) {
-    let slot = PLAN.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let slot = PLAN
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     match slot.as_ref() {
         Some((plan, hint)) => (plan(dims), *hint),
         None => (Budget::new(), "use a smaller volume or raise --max-memory"),

@@ -68,6 +68,36 @@ fn the_whole_job_is_checked_before_decompressing() {
     assert_error(&out, &["second image 512.0 MiB"]);
 }
 
+/// The same under `ulimit -v 3000000` (about 2.9 GiB), in a child process:
+/// a 1200³ volume (6.4 GiB decoded) is refused by the address-space limit
+/// before its 10-byte gzip stream is touched.
+#[test]
+fn the_address_space_limit_bounds_a_gzip_bomb() {
+    let dir = temp_dir("budget-rlimit");
+    nrrd_header(
+        &dir,
+        "bomb.nrrd",
+        "1200 1200 1200",
+        "gzip",
+        &[0x1f, 0x8b, 8, 0, 0, 0, 0, 0, 0, 3],
+    );
+    for cmd in [
+        "render bomb.nrrd --dir 1,0,0 --out x.png",
+        "compare bomb.nrrd bomb.nrrd",
+    ] {
+        let out = std::process::Command::new("sh")
+            .arg("-c")
+            .arg(format!(
+                "ulimit -v 3000000 && exec '{}' {cmd}",
+                env!("CARGO_BIN_EXE_fvr")
+            ))
+            .current_dir(&dir)
+            .output()
+            .expect("sh runs");
+        assert_error(&out, &["address-space limit"]);
+    }
+}
+
 #[test]
 fn compare_plans_for_both_images() {
     let dir = temp_dir("budget-compare");

@@ -68,20 +68,20 @@ const FILE_BUFFER_BYTES: usize = 1 << 16;
 /// Refuse volumes whose decoding would need more than `limit` bytes: the
 /// `f32` output plus the raw samples.
 ///
-/// Then the whole job: the volume of `dims` with what the program plans to
-/// build from it ([`crate::budget::check_load`]).
+/// First the whole job: the volume of `dims` with what the program plans to
+/// build from it, against the process's limit ([`crate::budget::check_load`]).
 pub(crate) fn check_memory(
     dims: [usize; 3],
     count: usize,
     ty: SampleType,
     limit: u64,
 ) -> Result<(), IoError> {
+    crate::budget::check_load(dims, CHUNK_BYTES as u64)?;
     let per_sample = 4 + ty.size_bytes() as u64;
     let needed = (count as u64).saturating_mul(per_sample);
     if needed > limit {
         return Err(IoError::TooLarge { needed, limit });
     }
-    crate::budget::check_load(dims, CHUNK_BYTES as u64)?;
     Ok(())
 }
 
