@@ -67,6 +67,24 @@ impl SysTickClock {
     pub fn wrapped(&mut self) -> bool {
         self.syst.has_wrapped()
     }
+
+    /// The end of a run: fail if the counter wrapped, else log the peak
+    /// stack use.
+    ///
+    /// # Errors
+    /// [`RunError::CounterWrapped`].
+    pub fn finish(&mut self) -> Result<(), RunError> {
+        if self.wrapped() {
+            return Err(RunError::CounterWrapped);
+        }
+        let stack = unsafe_parts::stack_usage();
+        defmt::println!(
+            "stack: peak {=usize} bytes of {=usize} free for the stack",
+            stack.peak,
+            stack.available
+        );
+        Ok(())
+    }
 }
 
 impl InstructionClock for SysTickClock {
@@ -271,16 +289,7 @@ fn run_inner(
         }
     }
 
-    if clock.wrapped() {
-        return Err(RunError::CounterWrapped);
-    }
-    let stack = unsafe_parts::stack_usage();
-    defmt::println!(
-        "stack: peak {=usize} bytes of {=usize} free for the stack",
-        stack.peak,
-        stack.available
-    );
-    Ok(())
+    clock.finish()
 }
 
 #[cfg(target_abi = "eabihf")]

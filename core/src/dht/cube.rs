@@ -166,7 +166,7 @@ pub fn dht_3d_store<T: Real, L: LineStore<T>>(
     overflow_check(finite, "z pass of the 3D transform")
 }
 
-fn overflow_check(finite: bool, stage: &'static str) -> Result<()> {
+pub(crate) fn overflow_check(finite: bool, stage: &'static str) -> Result<()> {
     if finite {
         Ok(())
     } else {

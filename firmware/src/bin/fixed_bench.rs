@@ -18,7 +18,7 @@ mod device {
     use fvr_core::dht::fixed::{idht_2d, FixedTwiddles};
     use fvr_core::dht::{self, Twiddles};
     use fvr_firmware::capture::ByteSink;
-    use fvr_firmware::device::{unsafe_parts, HostFile, RunError, SysTickClock};
+    use fvr_firmware::device::{HostFile, RunError, SysTickClock};
     use fvr_firmware::frame::{FrameError, InstructionClock};
 
     use crate::fixed_input::{f32_from_q15, q15_block, q31_from_q15, LEN, SIDE};
@@ -156,16 +156,7 @@ mod device {
             blocks.f32.iter().map(|v| v.to_le_bytes()),
         )?;
 
-        if clock.wrapped() {
-            return Err(RunError::CounterWrapped);
-        }
-        let stack = unsafe_parts::stack_usage();
-        defmt::println!(
-            "stack: peak {=usize} bytes of {=usize} free for the stack",
-            stack.peak,
-            stack.available
-        );
-        Ok(())
+        clock.finish()
     }
 }
 

@@ -4,6 +4,7 @@
 
 use super::line::dht_mixed_unchecked;
 use super::plan::{mixed_scratch_len, MixedPlan};
+use crate::dht::cube::overflow_check;
 use crate::dht::store::{Elements, LineStore, Pass};
 use crate::error::{check_len, require_len, Error, Result};
 use crate::num::{Real, Sample};
@@ -237,17 +238,4 @@ fn correct_z_lines<T: Real>(lines: &mut [T], nz: usize) {
             lines[at(i)] = T::HALF * (t[i ^ 1] + t[i ^ 2] + t[i ^ 4] - t[i ^ 7]);
         }
     }
-}
-
-fn overflow_check(finite: bool, stage: &'static str) -> Result<()> {
-    if finite {
-        Ok(())
-    } else {
-        Err(overflow(stage))
-    }
-}
-
-#[cold]
-fn overflow(stage: &'static str) -> Error {
-    Error::Overflow { stage }
 }
