@@ -34,7 +34,7 @@
 //! voxel, against the `3·log₂n` passes and premultiplication of a spectrum).
 //! It is split by where the content sits: the **edge** term comes from
 //! voxels where some axis's weights leak more than [`EDGE_LEAK`] (`|c − 1| +
-//! |s|`), the **kernel** term from the rest (the kernel's finite stopband
+//! |s|`) and more than twice as much as at the centre, the **kernel** term from the rest (the kernel's finite stopband
 //! everywhere else). The total is the energy of their sum.
 //!
 //! Storage rounding adds independent noise: each of `r` roundings of the
@@ -71,8 +71,13 @@ use super::spectrum::{check_memory, Precision};
 use crate::volume::Volume;
 
 /// The weights' leak `|c − 1| + |s|` above which an axis position counts
-/// towards the edge term (−40 dB).
+/// towards the edge term (−40 dB), if it is also [`EDGE_OVER_CENTRE`] times
+/// the leak at the centre (even-width kernels have one more tap on one side,
+/// which alone errs by about 2% everywhere at oversampling 1).
 pub const EDGE_LEAK: f64 = 0.01;
+
+/// See [`EDGE_LEAK`].
+pub const EDGE_OVER_CENTRE: f64 = 2.0;
 
 /// Late roundings proportional to the image (`r_late`): the last pass's
 /// store, and the two before it for the view along the axis transformed
@@ -218,7 +223,11 @@ fn axis_weights(filter: &Filter, n: usize) -> AxisWeights {
         out.c[idx] = c * p;
         out.s[idx] = s * p;
         out.p[idx] = p;
-        out.edge[idx] = (c * p - 1.0).abs() + (s * p).abs() > EDGE_LEAK;
+    }
+    let leak = |idx: usize| (out.c[idx] - 1.0).abs() + out.s[idx].abs();
+    let threshold = EDGE_LEAK.max(EDGE_OVER_CENTRE * leak(0));
+    for idx in 0..n {
+        out.edge[idx] = leak(idx) > threshold;
     }
     out
 }

@@ -7,6 +7,7 @@ mod args;
 mod compare;
 mod growth;
 mod json;
+mod plan;
 mod precision;
 mod render;
 mod scene;
@@ -150,9 +151,11 @@ fn main() -> ExitCode {
     let result = match cli.command {
         None => default_scene(),
         Some(Command::Render(mut args)) => {
+            args.frame.spectrum.given = plan::Given::from_flags(&|id| given("render", id));
             merge_scene(&mut *args, &|id| given("render", id)).and_then(|()| render(&args))
         }
         Some(Command::Turntable(mut args)) => {
+            args.frame.spectrum.given = plan::Given::from_flags(&|id| given("turntable", id));
             merge_scene(&mut args, &|id| given("turntable", id)).and_then(|()| turntable(&args))
         }
         Some(Command::Compare(args)) => compare(&args),

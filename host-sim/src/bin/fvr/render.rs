@@ -41,7 +41,7 @@ pub(crate) const STORAGE_SNR_WARNING_DB: f64 = 50.0;
 /// warns (see `negative_cue_share`).
 pub(crate) const NEGATIVE_CUE_WARNING_SHARE: f64 = 1e-3;
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 pub(crate) struct RenderArgs {
     /// A volume file, a raw file with --raw-dims, a data set, or a built-in phantom.
     #[arg(help = volume_help(), required_unless_present = "scene")]
@@ -176,6 +176,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         check_resample(&volume, largest)?;
         volume = volume.resample_isotropic(largest)?;
     }
+    let args = &crate::plan::planned(args, &volume)?;
     let t_load = t0.elapsed();
     let scene = build_scene(args)?;
     let t1 = Instant::now();
@@ -382,6 +383,7 @@ struct RenderStats<'a> {
     preprocess_ms: f64,
     view_ms: f64,
     preview_level: u32,
+    accuracy: Option<crate::plan::AccuracyJson>,
     #[serde(skip_serializing_if = "Option::is_none")]
     adaptive: Option<AdaptiveJson>,
 }
@@ -490,6 +492,7 @@ impl Rendered<'_> {
             );
         }
         println!("  storage SNR   {storage_snr:.1} dB (estimate, against the f64 pipeline)");
+        crate::plan::print_human(&args.frame.spectrum);
         println!("  load          {:.1} ms", t_load.as_secs_f64() * 1e3);
         println!("  preprocess    {:.1} ms", t_prep.as_secs_f64() * 1e3);
         println!("  view          {:.2} ms", t_view.as_secs_f64() * 1e3);
@@ -550,6 +553,7 @@ impl Rendered<'_> {
             preprocess_ms: t_prep.as_secs_f64() * 1e3,
             view_ms: t_view.as_secs_f64() * 1e3,
             preview_level: args.preview_level,
+            accuracy: crate::plan::json(&args.frame.spectrum),
             adaptive: adaptive_report.as_ref().map(AdaptiveReport::json),
         };
         println!("{}", one_line(&stats));

@@ -14,7 +14,7 @@ use fvr_host::image::output::write_apng;
 use fvr_host::progress;
 use fvr_host::render::turntable;
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 pub(crate) struct TurntableArgs {
     /// A volume file, a raw file with --raw-dims, a data set, or a built-in phantom.
     #[arg(help = volume_help(), required_unless_present = "scene")]
@@ -59,6 +59,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     })?;
     crate::render::check_output(&args.out, &["apng", "png"], volume_spec)?;
     let volume = args.input.load(volume_spec)?;
+    let args = &crate::plan::planned(args, &volume)?;
     let t_load = t0.elapsed();
     let t1 = Instant::now();
     let spec = prepare_with_progress(
@@ -115,6 +116,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
             views_ms: secs * 1e3,
             ms_per_view: secs * 1e3 / frames.len().max(1) as f64,
             views_per_second,
+            accuracy: crate::plan::json(&args.frame.spectrum),
         };
         println!("{}", one_line(&stats));
     } else {
@@ -127,6 +129,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
             secs * 1e3,
             views_per_second
         );
+        crate::plan::print_human(&args.frame.spectrum);
     }
     Ok(())
 }
@@ -149,4 +152,5 @@ struct TurntableStats<'a> {
     views_ms: f64,
     ms_per_view: f64,
     views_per_second: f64,
+    accuracy: Option<crate::plan::AccuracyJson>,
 }
