@@ -63,10 +63,16 @@ fn explicit_flags_win_and_an_unmet_target_warns() {
     );
     assert_ok(&out);
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("no configuration is predicted to reach 45 dB"), "{err}");
+    assert!(
+        err.contains("no configuration is predicted to reach 45 dB"),
+        "{err}"
+    );
     let stats = json_line(&out.stdout);
     assert_eq!(stats["oversample"], 1, "{stats}");
-    assert!(stats["accuracy"]["predicted_db"].as_f64().unwrap() < 45.0, "{stats}");
+    assert!(
+        stats["accuracy"]["predicted_db"].as_f64().unwrap() < 45.0,
+        "{stats}"
+    );
 }
 
 #[test]
@@ -76,7 +82,10 @@ fn without_accuracy_a_low_prediction_warns_and_names_the_remedy() {
     let out = fvr(&args, &dir);
     assert_ok(&out);
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("predicted to reach only") && err.contains("--accuracy"), "{err}");
+    assert!(
+        err.contains("predicted to reach only") && err.contains("--accuracy"),
+        "{err}"
+    );
     let out = fvr(
         &["render", "gaussians@32", "--dir", "0,1,0", "--out", "b.png"],
         &dir,
