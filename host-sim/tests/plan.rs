@@ -187,6 +187,28 @@ fn chooser_meets_40_and_50_db_on_edge_touching_volumes() {
 }
 
 #[test]
+fn voxel_sums_only_for_axis_views_with_pixels_on_voxels() {
+    let volume = phantom("sphere@16");
+    let oblique = fvr_core::geometry::View::along([1.0, 0.3, 0.2]);
+    assert!(axis_projection(&volume, &oblique, 16, 16)
+        .unwrap()
+        .is_none());
+    // An odd image size puts the pixel centres half a voxel off the grid.
+    assert!(axis_projection(&volume, &AXIS_VIEWS[0], 15, 16)
+        .unwrap()
+        .is_none());
+    let sums = axis_projection(&volume, &AXIS_VIEWS[2], 16, 16)
+        .unwrap()
+        .unwrap();
+    let total: f64 = volume.data.iter().map(|&v| v as f64).sum();
+    let imaged: f64 = sums.iter().sum();
+    assert!(
+        (imaged - total).abs() <= 1e-9 * total.abs(),
+        "{imaged} against {total}"
+    );
+}
+
+#[test]
 fn explicit_settings_constrain_the_choice() {
     let volume = rolled_gaussians();
     let given = Constraints {

@@ -56,7 +56,8 @@
 //! `Σref² / (Σ(image − ref)² + noise)`; a configuration's prediction is the
 //! worst of the views along x, y and z.
 //!
-//! Oblique views and physical units are predicted by the axis views: the
+//! Odd sizes put the pixels half a voxel off the grid; they are predicted
+//! as if on it. Oblique views and physical units are predicted by the axis views: the
 //! weights then vary with the sub-voxel phase of each slice sample, but the
 //! edge leak, which dominates real data, has the same size.
 
