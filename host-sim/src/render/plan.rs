@@ -514,32 +514,51 @@ pub fn choose(
     let precisions: Vec<Precision> = constraints
         .precision
         .map_or(vec![Precision::F16, Precision::F32], |p| vec![p]);
-    let mut predictions = Vec::new();
+    let mut jobs = Vec::new();
     for &oversample in &oversamples {
         let n = padded_size(volume.dims, oversample)?;
         if crate::volume::check_padding(volume.dims, n).is_err() {
             continue;
         }
-        for &kind in &filters {
-            let fits: Vec<Precision> = precisions
-                .iter()
-                .copied()
-                .filter(|p| check_memory(n, p.bytes()).is_ok())
-                .collect();
-            if fits.is_empty() {
-                continue;
-            }
-            let filter = choose_filter(volume, kind, oversample, design)?;
-            let interp = interpolation(volume, &filter)?;
-            for precision in fits {
-                let candidate = Candidate {
-                    filter: kind,
-                    oversample,
-                    precision,
-                };
-                predictions.push(combine(&interp, candidate, filter.beta()));
-            }
+        let fits: Vec<Precision> = precisions
+            .iter()
+            .copied()
+            .filter(|p| check_memory(n, p.bytes()).is_ok())
+            .collect();
+        if !fits.is_empty() {
+            jobs.extend(filters.iter().map(|&kind| (kind, oversample, fits.clone())));
         }
+    }
+    // One pass over the volume per filter and oversampling, on their own threads.
+    let results: Vec<Result<Vec<Prediction>, fvr_core::Error>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = jobs
+            .iter()
+            .map(|(kind, oversample, fits)| {
+                scope.spawn(move || {
+                    let filter = choose_filter(volume, *kind, *oversample, design)?;
+                    let interp = interpolation(volume, &filter)?;
+                    Ok(fits
+                        .iter()
+                        .map(|&precision| {
+                            let candidate = Candidate {
+                                filter: *kind,
+                                oversample: *oversample,
+                                precision,
+                            };
+                            combine(&interp, candidate, filter.beta())
+                        })
+                        .collect())
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("a prediction thread panicked"))
+            .collect()
+    });
+    let mut predictions = Vec::new();
+    for r in results {
+        predictions.extend(r?);
     }
     let costs: Vec<(f64, f64)> = predictions
         .iter()

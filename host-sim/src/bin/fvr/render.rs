@@ -176,8 +176,8 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         check_resample(&volume, largest)?;
         volume = volume.resample_isotropic(largest)?;
     }
-    let args = &crate::plan::planned(args, &volume)?;
     let t_load = t0.elapsed();
+    let args = &crate::plan::planned(args, &volume)?;
     let scene = build_scene(args)?;
     let t1 = Instant::now();
     let (spectra, filter) = prepare_scene_with_progress(

@@ -59,8 +59,8 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     })?;
     crate::render::check_output(&args.out, &["apng", "png"], volume_spec)?;
     let volume = args.input.load(volume_spec)?;
-    let args = &crate::plan::planned(args, &volume)?;
     let t_load = t0.elapsed();
+    let args = &crate::plan::planned(args, &volume)?;
     let t1 = Instant::now();
     let spec = prepare_with_progress(
         &volume,
