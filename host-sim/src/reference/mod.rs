@@ -7,7 +7,10 @@
 //!    points (the ideal interpolation filter), for small volumes.
 //! 4. The full pipeline in f64: [`crate::render::spectrum::Precision::F64`].
 //! 5. [`spatial_projection`]: a spatial-domain ray integrator.
+//! 6. [`axis::axis_projection`]: the exact image of the band-limited
+//!    interpolant for views along an axis with pixels on voxels.
 
+pub mod axis;
 pub mod raycast;
 pub mod shaded;
 

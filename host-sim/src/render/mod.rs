@@ -3,6 +3,7 @@
 
 pub mod adaptive;
 pub mod filter;
+pub mod plan;
 pub mod scene_file;
 pub mod shaded;
 pub mod spectrum;

@@ -140,6 +140,18 @@ pub(crate) struct SpectrumArgs {
     /// distribution; a number is the design oversampling of Beatty's formula.
     #[arg(long, default_value = "auto")]
     pub(crate) kb_design: KbDesign,
+    /// Target SNR in dB against the exact projection: choose the cheapest
+    /// filter, oversampling and precision predicted to reach it (--filter,
+    /// --oversample and --precision given on the command line are kept).
+    /// Without it, those flags apply as given.
+    #[arg(long, value_name = "DB", value_parser = parse_accuracy)]
+    pub(crate) accuracy: Option<f64>,
+    /// Which of the settings above were given on the command line.
+    #[arg(skip)]
+    pub(crate) given: crate::plan::Given,
+    /// The prediction made for the settings used.
+    #[arg(skip)]
+    pub(crate) outcome: Option<crate::plan::Outcome>,
 }
 
 impl Default for SpectrumArgs {
@@ -149,7 +161,17 @@ impl Default for SpectrumArgs {
             oversample: 1,
             precision: Precision::F16,
             kb_design: KbDesign::Auto,
+            accuracy: None,
+            given: crate::plan::Given::default(),
+            outcome: None,
         }
+    }
+}
+
+pub(crate) fn parse_accuracy(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("expected a positive number of decibels, got `{s}`")),
     }
 }
 

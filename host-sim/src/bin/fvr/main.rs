@@ -13,6 +13,7 @@ mod compare;
 mod fuzz;
 mod growth;
 mod json;
+mod plan;
 mod precision;
 mod render;
 mod scene;
@@ -166,9 +167,11 @@ where
     let result = match cli.command {
         None => default_scene(),
         Some(Command::Render(mut args)) => {
+            args.frame.spectrum.given = plan::Given::from_flags(&|id| given("render", id));
             merge_scene(&mut *args, &|id| given("render", id)).and_then(|()| render(&args))
         }
         Some(Command::Turntable(mut args)) => {
+            args.frame.spectrum.given = plan::Given::from_flags(&|id| given("turntable", id));
             merge_scene(&mut args, &|id| given("turntable", id)).and_then(|()| turntable(&args))
         }
         Some(Command::Compare(args)) => compare(&args),

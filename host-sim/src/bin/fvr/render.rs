@@ -41,7 +41,7 @@ pub(crate) const STORAGE_SNR_WARNING_DB: f64 = 50.0;
 /// warns (see `negative_cue_share`).
 pub(crate) const NEGATIVE_CUE_WARNING_SHARE: f64 = 1e-3;
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 pub(crate) struct RenderArgs {
     /// A volume file, a raw file with --raw-dims, a data set, or a built-in phantom.
     #[arg(help = volume_help(), required_unless_present = "scene")]
@@ -159,18 +159,8 @@ impl RenderArgs {
     }
 }
 
-pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
-    let out = args.out_path()?;
-    let volume_spec = args.volume_spec()?;
-    let ext = out.extension().and_then(|e| e.to_str()).unwrap_or("");
-    if ext != "png" && ext != "nrrd" {
-        return Err(format!("output `{}` must end in .png or .nrrd", out.display()).into());
-    }
-    check_output(out, &["png", "nrrd"], volume_spec)?;
-    let view = args.view()?;
-    view.frame()?;
-    let style = args.png.style()?;
-    let scene = build_scene(args)?;
+/// What a render builds from its volume ([`crate::args::plan_job`]).
+fn declare_job(args: &RenderArgs, scene: &Scene) {
     let size = args.frame.size;
     crate::args::plan_job(
         &args.frame.spectrum,
@@ -190,6 +180,21 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         }),
         "use a smaller --resample or --size, --precision f16 or --oversample 1",
     );
+}
+
+pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
+    let out = args.out_path()?;
+    let volume_spec = args.volume_spec()?;
+    let ext = out.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if ext != "png" && ext != "nrrd" {
+        return Err(format!("output `{}` must end in .png or .nrrd", out.display()).into());
+    }
+    check_output(out, &["png", "nrrd"], volume_spec)?;
+    let view = args.view()?;
+    view.frame()?;
+    let style = args.png.style()?;
+    let scene = build_scene(args)?;
+    declare_job(args, &scene);
     let t0 = Instant::now();
     let mut volume = args.input.load(volume_spec)?;
     let mut _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
@@ -200,6 +205,10 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     }
     fvr_host::budget::check_plan(volume.dims)?;
     let t_load = t0.elapsed();
+    let args = &crate::plan::planned(args, &volume)?;
+    // The planner may have changed the spectrum's settings.
+    declare_job(args, &scene);
+    fvr_host::budget::check_plan(volume.dims)?;
     let t1 = Instant::now();
     let (spectra, filter) = prepare_scene_with_progress(
         &volume,
@@ -404,6 +413,7 @@ struct RenderStats<'a> {
     preprocess_ms: f64,
     view_ms: f64,
     preview_level: u32,
+    accuracy: Option<crate::plan::AccuracyJson>,
     #[serde(skip_serializing_if = "Option::is_none")]
     adaptive: Option<AdaptiveJson>,
 }
@@ -512,6 +522,7 @@ impl Rendered<'_> {
             );
         }
         println!("  storage SNR   {storage_snr:.1} dB (estimate, against the f64 pipeline)");
+        crate::plan::print_human(&args.frame.spectrum);
         println!("  load          {:.1} ms", t_load.as_secs_f64() * 1e3);
         println!("  preprocess    {:.1} ms", t_prep.as_secs_f64() * 1e3);
         println!("  view          {:.2} ms", t_view.as_secs_f64() * 1e3);
@@ -572,6 +583,7 @@ impl Rendered<'_> {
             preprocess_ms: t_prep.as_secs_f64() * 1e3,
             view_ms: t_view.as_secs_f64() * 1e3,
             preview_level: args.preview_level,
+            accuracy: crate::plan::json(&args.frame.spectrum),
             adaptive: adaptive_report.as_ref().map(AdaptiveReport::json),
         };
         println!("{}", one_line(&stats));

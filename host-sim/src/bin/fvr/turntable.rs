@@ -18,7 +18,7 @@ use fvr_host::render::turntable;
 use indicatif::ProgressBar;
 use std::time::Duration;
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 pub(crate) struct TurntableArgs {
     /// A volume file, a raw file with --raw-dims, a data set, or a built-in phantom.
     #[arg(help = volume_help(), required_unless_present = "scene")]
@@ -62,15 +62,10 @@ const HOLD_FRAMES_BYTES: u64 = 256 << 20;
 /// Frames rendered first to set the window of a streamed animation.
 const SAMPLE_FRAMES: usize = 16;
 
-pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
-    let views = turntable::orbit(args.dir, args.up, args.frames as usize)?;
-    let style = args.png.style()?;
-    let t0 = Instant::now();
-    let volume_spec = args.volume.as_deref().ok_or_else(|| {
-        "no volume: give VOLUME, or `volume.path` or `volume.builtin` in the scene".to_string()
-    })?;
-    crate::render::check_output(&args.out, &["apng", "png"], volume_spec)?;
-    let (size, oversample, frames) = (args.frame.size, args.frame.spectrum.oversample, views.len());
+/// What a turntable of `frames` frames builds from its volume
+/// ([`crate::args::plan_job`]).
+fn declare_job(args: &TurntableArgs, frames: usize) {
+    let (size, oversample) = (args.frame.size, args.frame.spectrum.oversample);
     crate::args::plan_job(
         &args.frame.spectrum,
         None,
@@ -93,10 +88,25 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
         }),
         "use fewer --frames, a smaller --size, --precision f16 or --oversample 1",
     );
+}
+
+pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
+    let views = turntable::orbit(args.dir, args.up, args.frames as usize)?;
+    let style = args.png.style()?;
+    let t0 = Instant::now();
+    let volume_spec = args.volume.as_deref().ok_or_else(|| {
+        "no volume: give VOLUME, or `volume.path` or `volume.builtin` in the scene".to_string()
+    })?;
+    crate::render::check_output(&args.out, &["apng", "png"], volume_spec)?;
+    declare_job(args, views.len());
     let volume = args.input.load(volume_spec)?;
     let _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
     fvr_host::budget::check_plan(volume.dims)?;
     let t_load = t0.elapsed();
+    let args = &crate::plan::planned(args, &volume)?;
+    // The planner may have changed the spectrum's settings.
+    declare_job(args, views.len());
+    fvr_host::budget::check_plan(volume.dims)?;
     let t1 = Instant::now();
     let spec = prepare_with_progress(
         &volume,
@@ -150,6 +160,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
             views_ms: secs * 1e3,
             ms_per_view: secs * 1e3 / frames.max(1) as f64,
             views_per_second,
+            accuracy: crate::plan::json(&args.frame.spectrum),
         };
         println!("{}", one_line(&stats));
     } else {
@@ -162,6 +173,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
             secs * 1e3,
             views_per_second
         );
+        crate::plan::print_human(&args.frame.spectrum);
     }
     Ok(())
 }
@@ -231,4 +243,5 @@ struct TurntableStats<'a> {
     views_ms: f64,
     ms_per_view: f64,
     views_per_second: f64,
+    accuracy: Option<crate::plan::AccuracyJson>,
 }

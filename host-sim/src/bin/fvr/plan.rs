@@ -1,0 +1,188 @@
+//! `--accuracy DB` for render and turntable: the configuration chosen by
+//! [`fvr_host::render::plan`], its warnings, and its lines in `--stats` and
+//! `--stats-json`.
+
+use crate::args::SpectrumArgs;
+use crate::render::RenderArgs;
+use crate::turntable::TurntableArgs;
+use crate::Error;
+
+use fvr_host::render::plan::{choose, predict, Candidate, Constraints, Prediction};
+use fvr_host::volume::Volume;
+use serde::Serialize;
+
+/// Below this prediction a render without `--accuracy` warns.
+pub(crate) const PREDICTION_WARNING_DB: f64 = 40.0;
+
+/// Which spectrum settings were given on the command line (they win over
+/// the planner's choice).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Given {
+    pub(crate) filter: bool,
+    pub(crate) oversample: bool,
+    pub(crate) precision: bool,
+}
+
+impl Given {
+    /// From `given(id)`: whether the flag `id` was on the command line.
+    pub(crate) fn from_flags(given: &dyn Fn(&str) -> bool) -> Self {
+        Self {
+            filter: given("filter"),
+            oversample: given("oversample"),
+            precision: given("precision"),
+        }
+    }
+}
+
+/// What the planner decided, for `--stats`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Outcome {
+    /// The `--accuracy` target, if one was given.
+    pub(crate) target_db: Option<f64>,
+    /// The prediction for the configuration used.
+    pub(crate) prediction: Prediction,
+}
+
+/// Commands whose spectrum the planner may set.
+pub(crate) trait Planned: Clone {
+    fn spectrum_mut(&mut self) -> &mut SpectrumArgs;
+}
+
+impl Planned for RenderArgs {
+    fn spectrum_mut(&mut self) -> &mut SpectrumArgs {
+        &mut self.frame.spectrum
+    }
+}
+
+impl Planned for TurntableArgs {
+    fn spectrum_mut(&mut self) -> &mut SpectrumArgs {
+        &mut self.frame.spectrum
+    }
+}
+
+/// `args` with the spectrum settings `--accuracy` chooses for `volume`
+/// (or as given, with a warning when they are predicted below
+/// [`PREDICTION_WARNING_DB`]), the outcome recorded for `--stats`.
+pub(crate) fn planned<A: Planned>(args: &A, volume: &Volume) -> Result<A, Error> {
+    let mut out = args.clone();
+    apply(out.spectrum_mut(), volume)?;
+    Ok(out)
+}
+
+fn apply(s: &mut SpectrumArgs, volume: &Volume) -> Result<(), Error> {
+    let Some(target) = s.accuracy else {
+        let candidate = Candidate {
+            filter: s.filter,
+            oversample: s.oversample,
+            precision: s.precision,
+        };
+        let prediction = predict(volume, candidate, s.kb_design)?;
+        if prediction.db < PREDICTION_WARNING_DB {
+            eprintln!(
+                "fvr: warning: {} is predicted to reach only {:.1} dB on this volume ({}); \
+                 --accuracy 50 chooses a configuration predicted to reach 50 dB.",
+                describe(candidate),
+                prediction.db,
+                prediction.dominant().why()
+            );
+        }
+        s.outcome = Some(Outcome {
+            target_db: None,
+            prediction,
+        });
+        return Ok(());
+    };
+    let constraints = Constraints {
+        filter: s.given.filter.then_some(s.filter),
+        oversample: s.given.oversample.then_some(s.oversample),
+        precision: s.given.precision.then_some(s.precision),
+    };
+    let plan = choose(volume, s.kb_design, target, constraints)?;
+    let p = plan.prediction;
+    if !plan.met {
+        eprintln!(
+            "fvr: warning: no configuration is predicted to reach {target} dB{}; using the best, \
+             {}, predicted at {:.1} dB ({}).",
+            if constraints == Constraints::default() {
+                ""
+            } else {
+                " with the settings given"
+            },
+            describe(p.candidate),
+            p.db,
+            p.dominant().why()
+        );
+    }
+    s.filter = p.candidate.filter;
+    s.oversample = p.candidate.oversample;
+    s.precision = p.candidate.precision;
+    s.outcome = Some(Outcome {
+        target_db: Some(target),
+        prediction: p,
+    });
+    Ok(())
+}
+
+fn describe(c: Candidate) -> String {
+    format!(
+        "--filter {} --oversample {} --precision {}",
+        c.filter.name(),
+        c.oversample,
+        c.precision
+    )
+}
+
+/// The `--stats` line: the configuration, its prediction and the term
+/// that limits it.
+pub(crate) fn print_human(s: &SpectrumArgs) {
+    if let Some(o) = s.outcome {
+        let p = o.prediction;
+        let how = match o.target_db {
+            Some(t) => format!("chosen for --accuracy {t}"),
+            None => "as given".to_string(),
+        };
+        println!(
+            "  accuracy      {:.1} dB predicted for {} ({how}; limited by the {} term: {})",
+            p.db,
+            describe(p.candidate),
+            p.dominant().name(),
+            p.dominant().why()
+        );
+    }
+}
+
+/// `--stats-json`: `accuracy` object.
+#[derive(Serialize)]
+pub(crate) struct AccuracyJson {
+    target_db: Option<f64>,
+    predicted_db: Option<f64>,
+    predicted_views_db: [Option<f64>; 3],
+    filter: &'static str,
+    oversample: u32,
+    precision: &'static str,
+    limited_by: &'static str,
+    edge_db: Option<f64>,
+    kernel_db: Option<f64>,
+    storage_db: Option<f64>,
+}
+
+/// The `accuracy` object of `--stats-json`, if a prediction was made; a
+/// term with no error at all (infinite dB) is `null`.
+pub(crate) fn json(s: &SpectrumArgs) -> Option<AccuracyJson> {
+    s.outcome.map(|o| {
+        let p = o.prediction;
+        let finite = |v: f64| v.is_finite().then_some(v);
+        AccuracyJson {
+            target_db: o.target_db,
+            predicted_db: finite(p.db),
+            predicted_views_db: p.views_db.map(finite),
+            filter: p.candidate.filter.name(),
+            oversample: p.candidate.oversample,
+            precision: p.candidate.precision.name(),
+            limited_by: p.dominant().name(),
+            edge_db: finite(p.parts_db[0]),
+            kernel_db: finite(p.parts_db[1]),
+            storage_db: finite(p.parts_db[2]),
+        }
+    })
+}
