@@ -2,9 +2,13 @@
 //! renderer, shaded renders, adaptive filtering, turntables and scene files.
 
 pub mod adaptive;
+pub mod fast_dht;
+pub mod fast_prepare;
 pub mod filter;
 pub mod scene_file;
 pub mod shaded;
 pub mod spectrum;
 pub mod turntable;
 pub mod view;
+#[cfg(test)]
+mod fast_tests;
