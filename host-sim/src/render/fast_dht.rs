@@ -54,10 +54,11 @@ pub fn half_spectrum_bytes<T>(n: usize) -> u64 {
 }
 
 /// Bytes of one thread's tiles in pass 3 (two y-columns of the half
-/// spectrum, `2·(n/2 + 1)·n` complex values) and FFT scratch (at most `n`).
+/// spectrum, each in two layouts: `4·(n/2 + 1)·n` complex values) and FFT
+/// scratch (at most `2n`).
 pub fn tile_bytes<T>(n: usize) -> u64 {
     let complex = 2 * std::mem::size_of::<T>() as u64;
-    ((2 * (n / 2 + 1) * n + 2 * n) as u64).saturating_mul(complex)
+    ((4 * (n / 2 + 1) * n + 2 * n) as u64).saturating_mul(complex)
 }
 
 /// `H(u, v, w) = Σ f(x, y, z) cas(2π(ux + vy + wz)/n)`, unnormalized, into
@@ -110,18 +111,10 @@ pub fn dht_3d_real<T: FastReal, S: Sample>(
                             .expect("lengths come from the plan");
                     }
                 }
-                // tile[u·n + y] = plane[y·h + u]: one line per column u.
-                for (y, row) in plane.chunks_exact(h).enumerate() {
-                    for (u, &c) in row.iter().enumerate() {
-                        tile[u * n + y] = c;
-                    }
-                }
+                // One line per column u: tile[u·n + y] = plane[y·h + u].
+                transpose(plane, h, n, h, tile, n);
                 fft.process_with_scratch(tile, &mut scratch[..fft_scratch]);
-                for (y, row) in plane.chunks_exact_mut(h).enumerate() {
-                    for (u, c) in row.iter_mut().enumerate() {
-                        *c = tile[u * n + y];
-                    }
-                }
+                transpose(tile, n, h, n, plane, h);
             },
         );
 
@@ -145,31 +138,29 @@ pub fn dht_3d_real<T: FastReal, S: Sample>(
     let finite = pairs
         .into_par_iter()
         .map_init(
-            || (vec![zero; 2 * h * n], vec![zero; fft_scratch]),
+            || (vec![zero; 4 * h * n], vec![zero; fft_scratch]),
             |(tiles, scratch), (v, mut rows, mut rows_m)| {
                 let vm = (n - v) % n;
-                let (tile, tile_m) = tiles.split_at_mut(h * n);
-                let columns = |t: &mut [Complex<T>], y: usize| {
-                    // t[u·n + z] = F(u, y, z) after the FFT along z.
-                    for z in 0..n {
-                        let row = &half[(z * n + y) * h..(z * n + y + 1) * h];
-                        for (u, &c) in row.iter().enumerate() {
-                            t[u * n + z] = c;
-                        }
-                    }
+                let (tile, rest) = tiles.split_at_mut(h * n);
+                let (tile_m, rest) = rest.split_at_mut(h * n);
+                let (rows_v, rows_vm) = rest.split_at_mut(h * n);
+                // tile[u·n + z] = F(u, y, z) after the FFT along z, then
+                // rows_y[z·h + u] = the same (row by row for the output).
+                let mut columns = |tile: &mut [Complex<T>], out: &mut [Complex<T>], y: usize| {
+                    transpose(&half[y * h..], n * h, n, h, tile, n);
+                    fft.process_with_scratch(tile, scratch);
+                    transpose(tile, n, h, n, out, h);
                 };
-                columns(tile, v);
-                fft.process_with_scratch(tile, scratch);
-                let tile_m: &[Complex<T>] = if vm == v {
-                    tile
+                columns(tile, rows_v, v);
+                let rows_vm: &[Complex<T>] = if vm == v {
+                    rows_v
                 } else {
-                    columns(tile_m, vm);
-                    fft.process_with_scratch(tile_m, scratch);
-                    tile_m
+                    columns(tile_m, rows_vm, vm);
+                    rows_vm
                 };
-                let mut ok = hartley_rows(tile, tile_m, &mut rows, n);
+                let mut ok = hartley_rows(rows_v, rows_vm, &mut rows, n);
                 if vm != v {
-                    ok &= hartley_rows(tile_m, tile, &mut rows_m, n);
+                    ok &= hartley_rows(rows_vm, rows_v, &mut rows_m, n);
                 }
                 ok
             },
@@ -185,30 +176,56 @@ pub fn dht_3d_real<T: FastReal, S: Sample>(
 }
 
 /// Output rows `(·, v, w)` for every `w` from the z-transformed columns at
-/// `v` (`tile`) and at `−v` (`tile_m`), each `tile[u·n + w] = F(u, ±v, w)`.
-/// `false` if a value is not finite in `S`.
+/// `v` (`at`) and at `−v` (`at_m`), each `at[w·h + u] = F(u, ±v, w)` with
+/// `h = n/2 + 1`. `false` if a value is not finite in `S`.
 fn hartley_rows<T: FastReal, S: Sample>(
-    tile: &[Complex<T>],
-    tile_m: &[Complex<T>],
+    at: &[Complex<T>],
+    at_m: &[Complex<T>],
     rows: &mut [&mut [S]],
     n: usize,
 ) -> bool {
-    let half = n / 2;
+    let h = n / 2 + 1;
     let mut finite = true;
     for (w, row) in rows.iter_mut().enumerate() {
-        let wm = (n - w) % n;
-        for u in 0..=half {
-            let c = tile[u * n + w];
-            let s: S = (c.re - c.im).store();
-            finite &= s.is_finite();
-            row[u] = s;
+        let (low, high) = row.split_at_mut(h);
+        for (o, c) in low.iter_mut().zip(&at[w * h..(w + 1) * h]) {
+            *o = (c.re - c.im).store();
+            finite &= o.is_finite();
         }
-        for u in half + 1..n {
-            let c = tile_m[(n - u) * n + wm];
-            let s: S = (c.re + c.im).store();
-            finite &= s.is_finite();
-            row[u] = s;
+        // u = h + i takes F(n − u, −v, −w): index h − 2 − i of row −w.
+        let wm = (n - w) & (n - 1);
+        let mirror = &at_m[wm * h + 1..wm * h + h - 1];
+        for (o, c) in high.iter_mut().zip(mirror.iter().rev()) {
+            *o = (c.re + c.im).store();
+            finite &= o.is_finite();
         }
     }
     finite
+}
+
+/// Rows and columns of the tiles [`transpose`] moves at a time.
+const BLOCK: usize = 16;
+
+/// `dst[c·dst_stride + r] = src[r·src_stride + c]` for `r < rows`,
+/// `c < cols`, in `BLOCK × BLOCK` tiles so that both sides stay in cache.
+fn transpose<C: Copy>(
+    src: &[C],
+    src_stride: usize,
+    rows: usize,
+    cols: usize,
+    dst: &mut [C],
+    dst_stride: usize,
+) {
+    for r0 in (0..rows).step_by(BLOCK) {
+        let r1 = (r0 + BLOCK).min(rows);
+        for c0 in (0..cols).step_by(BLOCK) {
+            let c1 = (c0 + BLOCK).min(cols);
+            for r in r0..r1 {
+                let line = &src[r * src_stride + c0..r * src_stride + c1];
+                for (c, &v) in (c0..c1).zip(line) {
+                    dst[c * dst_stride + r] = v;
+                }
+            }
+        }
+    }
 }
