@@ -19,11 +19,13 @@
 //! transformed together and, for pass 2, scattered back.
 
 use fvr_core::error::Error;
-use fvr_core::num::{Real, Sample};
+use fvr_core::num::Real;
 use rayon::prelude::*;
 use realfft::RealFftPlanner;
 use rustfft::num_complex::Complex;
 use rustfft::{FftNum, FftPlanner};
+
+use super::fast_store::FastStore;
 
 /// Arithmetic the fast transform runs in: f32 or f64.
 pub trait FastReal: Real + FftNum {}
@@ -55,10 +57,10 @@ pub fn half_spectrum_bytes<T>(n: usize) -> u64 {
 
 /// Bytes of one thread's tiles in pass 3 (two y-columns of the half
 /// spectrum, each in two layouts: `4·(n/2 + 1)·n` complex values) and FFT
-/// scratch (at most `2n`).
+/// scratch (at most `2n`) and a line of `n` values.
 pub fn tile_bytes<T>(n: usize) -> u64 {
     let complex = 2 * std::mem::size_of::<T>() as u64;
-    ((4 * (n / 2 + 1) * n + 2 * n) as u64).saturating_mul(complex)
+    ((4 * (n / 2 + 1) * n + 3 * n) as u64).saturating_mul(complex)
 }
 
 /// `H(u, v, w) = Σ f(x, y, z) cas(2π(ux + vy + wz)/n)`, unnormalized, into
@@ -73,7 +75,7 @@ pub fn tile_bytes<T>(n: usize) -> u64 {
 /// # Panics
 /// If `n` is not a power of two at least 2, or `out` or the row masks have
 /// the wrong length.
-pub fn dht_3d_real<T: FastReal, S: Sample>(
+pub fn dht_3d_real<T: FastReal, S: FastStore>(
     cube: &SparseCube<'_, T>,
     out: &mut [S],
 ) -> Result<(), Error> {
@@ -138,8 +140,14 @@ pub fn dht_3d_real<T: FastReal, S: Sample>(
     let finite = pairs
         .into_par_iter()
         .map_init(
-            || (vec![zero; 4 * h * n], vec![zero; fft_scratch]),
-            |(tiles, scratch), (v, mut rows, mut rows_m)| {
+            || {
+                (
+                    vec![zero; 4 * h * n],
+                    vec![zero; fft_scratch],
+                    vec![<T as Real>::ZERO; n],
+                )
+            },
+            |(tiles, scratch, line), (v, mut rows, mut rows_m)| {
                 let vm = (n - v) % n;
                 let (tile, rest) = tiles.split_at_mut(h * n);
                 let (tile_m, rest) = rest.split_at_mut(h * n);
@@ -158,9 +166,9 @@ pub fn dht_3d_real<T: FastReal, S: Sample>(
                     columns(tile_m, rows_vm, vm);
                     rows_vm
                 };
-                let mut ok = hartley_rows(rows_v, rows_vm, &mut rows, n);
+                let mut ok = hartley_rows(rows_v, rows_vm, &mut rows, line, n);
                 if vm != v {
-                    ok &= hartley_rows(rows_vm, rows_v, &mut rows_m, n);
+                    ok &= hartley_rows(rows_vm, rows_v, &mut rows_m, line, n);
                 }
                 ok
             },
@@ -178,27 +186,27 @@ pub fn dht_3d_real<T: FastReal, S: Sample>(
 /// Output rows `(·, v, w)` for every `w` from the z-transformed columns at
 /// `v` (`at`) and at `−v` (`at_m`), each `at[w·h + u] = F(u, ±v, w)` with
 /// `h = n/2 + 1`. `false` if a value is not finite in `S`.
-fn hartley_rows<T: FastReal, S: Sample>(
+fn hartley_rows<T: FastReal, S: FastStore>(
     at: &[Complex<T>],
     at_m: &[Complex<T>],
     rows: &mut [&mut [S]],
+    line: &mut [T],
     n: usize,
 ) -> bool {
     let h = n / 2 + 1;
     let mut finite = true;
     for (w, row) in rows.iter_mut().enumerate() {
-        let (low, high) = row.split_at_mut(h);
+        let (low, high) = line.split_at_mut(h);
         for (o, c) in low.iter_mut().zip(&at[w * h..(w + 1) * h]) {
-            *o = (c.re - c.im).store();
-            finite &= o.is_finite();
+            *o = c.re - c.im;
         }
         // u = h + i takes F(n − u, −v, −w): index h − 2 − i of row −w.
         let wm = (n - w) & (n - 1);
         let mirror = &at_m[wm * h + 1..wm * h + h - 1];
         for (o, c) in high.iter_mut().zip(mirror.iter().rev()) {
-            *o = (c.re + c.im).store();
-            finite &= o.is_finite();
+            *o = c.re + c.im;
         }
+        finite &= S::store_row(line, row);
     }
     finite
 }

@@ -6,11 +6,12 @@
 
 use fvr_core::error::Error;
 use fvr_core::filter::Filter;
-use fvr_core::num::{Real, Sample};
+use fvr_core::num::Real;
 use fvr_core::spectrum::{premultiplier_table, scale_for_target};
 use fvr_core::volume::padded_size;
 use rayon::prelude::*;
 
+use super::fast_store::FastStore;
 use super::fast_dht::{dht_3d_real, half_spectrum_bytes, tile_bytes, FastReal, SparseCube};
 use super::spectrum::PipelineError;
 use crate::budget::{self, Budget};
@@ -52,7 +53,7 @@ pub fn fast_budget<T, S>(n: usize) -> Budget {
 /// A NaN or infinite voxel (the first in storage order, as the core names
 /// it), a volume beyond the memory limit (checked before allocating, with
 /// [`fast_budget`]), or an overflow.
-pub fn prepare_fast<T: FastReal, S: Sample>(
+pub fn prepare_fast<T: FastReal, S: FastStore>(
     volume: &Volume,
     filter: Filter,
 ) -> Result<FastSpectrum<S>, PipelineError> {

@@ -4,6 +4,7 @@
 pub mod adaptive;
 pub mod fast_dht;
 pub mod fast_prepare;
+pub mod fast_store;
 pub mod filter;
 pub mod scene_file;
 pub mod shaded;

@@ -20,6 +20,7 @@ use fvr_core::volume::{padded_size, DenseVolume};
 use half::f16;
 
 use super::fast_dht::FastReal;
+use super::fast_store::FastStore;
 use super::fast_prepare::prepare_fast;
 use crate::volume::Volume;
 
@@ -97,7 +98,10 @@ impl<S: Sample> OwnedSpectrum<S> {
     /// As [`Spectrum::prepare`]; also a volume whose padded cube and
     /// transient buffers would not fit in memory is refused before
     /// allocating.
-    pub fn prepare<T: FastReal>(volume: &Volume, filter: Filter) -> Result<Self, PipelineError> {
+    pub fn prepare<T: FastReal>(volume: &Volume, filter: Filter) -> Result<Self, PipelineError>
+    where
+        S: FastStore,
+    {
         let n = padded_size(volume.dims, filter.oversample())?;
         if n < 2 {
             return Self::prepare_in_place::<T>(volume, filter);
