@@ -86,7 +86,8 @@ pub fn dht_3d_real<T: FastReal, S: FastStore>(
     assert_eq!(cube.planes_z.len(), n);
     let h = n / 2 + 1;
     let zero = Complex::new(T::ZERO, T::ZERO);
-    let mut half = vec![zero; h * n * n];
+    let mut half = Vec::new();
+    half.par_extend(rayon::iter::repeat_n(zero, h * n * n));
 
     let r2c = RealFftPlanner::<T>::new().plan_fft_forward(n);
     let fft = FftPlanner::<T>::new().plan_fft_forward(n);

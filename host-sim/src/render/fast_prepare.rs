@@ -74,8 +74,10 @@ pub fn prepare_fast<T: FastReal, S: FastStore>(
     let shifted = |idx: usize, axis: usize| (idx + n - offs[axis]) & mask;
     let [nx, ny, nz] = dims;
 
-    // Σ|g| in f64 as the core sums it (per z-plane, then the planes in
-    // order), and the first non-finite voxel.
+    // Σ|g| in f64 (in another order than the core's, which can change the
+    // scale only for a sum within an ulp of a power of two), and the first
+    // non-finite voxel. `pmx[i]` is |p| at volume index i along x.
+    let pmx: Vec<f64> = (0..nx).map(|i| premul[shifted(i, 0)].to_f64().abs()).collect();
     let sums: Vec<Result<f64, Error>> = volume
         .data
         .par_chunks_exact(nx * ny)
@@ -84,16 +86,20 @@ pub fn prepare_fast<T: FastReal, S: FastStore>(
             let pz = premul[shifted(k, 2)].to_f64();
             let mut sum = 0.0f64;
             for (j, line) in plane.chunks_exact(nx).enumerate() {
-                let pyz = premul[shifted(j, 1)].to_f64() * pz;
-                for (i, &v) in line.iter().enumerate() {
-                    if !v.is_finite() {
-                        return Err(Error::NonFiniteVoxel {
-                            index: [i, j, k],
-                            value: v as f64,
-                        });
-                    }
-                    sum += (v as f64 * premul[shifted(i, 0)].to_f64() * pyz).abs();
+                if !line.iter().fold(true, |ok, v| ok & v.is_finite()) {
+                    let i = line.iter().position(|v| !v.is_finite()).unwrap_or(0);
+                    return Err(Error::NonFiniteVoxel {
+                        index: [i, j, k],
+                        value: line[i] as f64,
+                    });
                 }
+                let pyz = (premul[shifted(j, 1)].to_f64() * pz).abs();
+                let row: f64 = line
+                    .iter()
+                    .zip(&pmx)
+                    .map(|(&v, &p)| (v as f64).abs() * p)
+                    .sum();
+                sum += row * pyz;
             }
             Ok(sum)
         })
@@ -133,9 +139,17 @@ pub fn prepare_fast<T: FastReal, S: FastStore>(
         line.fill(<T as Real>::ZERO);
         // The core's products, in its order: v·p(x)·(p(y)·p(z)·s).
         let pyz = premul[py] * premul[pz] * sc;
-        for (i, &v) in src.iter().enumerate() {
-            let px = shifted(i, 0);
-            line[px] = <T as Real>::from_f64(v as f64) * premul[px] * pyz;
+        // x index i lands at (i − offs) mod n: two contiguous runs.
+        let (head, tail) = src.split_at(offs[0]);
+        let (front, back) = line.split_at_mut(n - offs[0]);
+        let runs = [(tail, &mut front[..nx - offs[0]]), (head, &mut back[..])];
+        for (from, to) in runs {
+            for (o, &v) in to.iter_mut().zip(from) {
+                *o = <T as Real>::from_f64(v as f64);
+            }
+        }
+        for (o, &p) in line.iter_mut().zip(premul) {
+            *o = *o * p * pyz;
         }
     };
     let cube = SparseCube {
@@ -144,7 +158,9 @@ pub fn prepare_fast<T: FastReal, S: FastStore>(
         planes_z: &planes_z,
         fill: &fill,
     };
-    let mut data = vec![S::default(); n * n * n];
+    let mut data = Vec::new();
+    // Zeroed on all cores: the first touch of the pages is a large part.
+    data.par_extend(rayon::iter::repeat_n(S::default(), n * n * n));
     dht_3d_real(&cube, &mut data)?;
     Ok(FastSpectrum { data, n, scale })
 }
