@@ -2,7 +2,6 @@
 //! the setup they share.
 
 use fvr_core::filter::{Filter, FilterKind};
-use fvr_core::num::{Real, Sample};
 use fvr_host::render::fast_dht::FastReal;
 use fvr_host::render::fast_store::FastStore;
 use fvr_host::render::spectrum::OwnedSpectrum;

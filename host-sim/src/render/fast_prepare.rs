@@ -11,8 +11,8 @@ use fvr_core::spectrum::{premultiplier_table, scale_for_target};
 use fvr_core::volume::padded_size;
 use rayon::prelude::*;
 
-use super::fast_store::FastStore;
 use super::fast_dht::{dht_3d_real, half_spectrum_bytes, tile_bytes, FastReal, SparseCube};
+use super::fast_store::FastStore;
 use super::spectrum::PipelineError;
 use crate::budget::{self, Budget};
 use crate::volume::Volume;
@@ -77,7 +77,9 @@ pub fn prepare_fast<T: FastReal, S: FastStore>(
     // Σ|g| in f64 (in another order than the core's, which can change the
     // scale only for a sum within an ulp of a power of two), and the first
     // non-finite voxel. `pmx[i]` is |p| at volume index i along x.
-    let pmx: Vec<f64> = (0..nx).map(|i| premul[shifted(i, 0)].to_f64().abs()).collect();
+    let pmx: Vec<f64> = (0..nx)
+        .map(|i| premul[shifted(i, 0)].to_f64().abs())
+        .collect();
     let sums: Vec<Result<f64, Error>> = volume
         .data
         .par_chunks_exact(nx * ny)

@@ -135,7 +135,10 @@ fn fast_budget_counts_the_half_spectrum() {
     let e = b.check(limit, "hint").unwrap_err();
     assert_eq!(e.largest.0, "half spectrum (complex)");
     assert!(matches!(
-        prepare_fast::<f32, f16>(&Volume::filled([1, 1, 1 << 20], 0.0), Filter::new(FilterKind::Kb4, 1).unwrap()),
+        prepare_fast::<f32, f16>(
+            &Volume::filled([1, 1, 1 << 20], 0.0),
+            Filter::new(FilterKind::Kb4, 1).unwrap()
+        ),
         Err(PipelineError::OutOfMemory { .. })
     ));
 }

@@ -5,11 +5,11 @@ pub mod adaptive;
 pub mod fast_dht;
 pub mod fast_prepare;
 pub mod fast_store;
+#[cfg(test)]
+mod fast_tests;
 pub mod filter;
 pub mod scene_file;
 pub mod shaded;
 pub mod spectrum;
 pub mod turntable;
 pub mod view;
-#[cfg(test)]
-mod fast_tests;

@@ -20,8 +20,8 @@ use fvr_core::volume::{padded_size, DenseVolume};
 use half::f16;
 
 use super::fast_dht::FastReal;
-use super::fast_store::FastStore;
 use super::fast_prepare::prepare_fast;
+use super::fast_store::FastStore;
 use crate::volume::Volume;
 
 pub use super::filter::{
