@@ -112,7 +112,7 @@ fn compare_plans_for_both_images() {
 #[test]
 fn spectra_of_a_scene_are_summed() {
     let dir = temp_dir("budget-scene");
-    let base = "--max-memory 48M render sphere@128 --oversample 2 --dir 1,0,0 --out x.png";
+    let base = "--max-memory 120M render sphere@128 --oversample 2 --dir 1,0,0 --out x.png";
     assert_ok(&fvr_line(base, &dir));
     let out = fvr_line(&format!("{base} --light 0,1,0:1"), &dir);
     assert_error(&out, &["this job needs about", "spectrum", "--max-memory"]);

@@ -2,14 +2,15 @@
 //! the setup they share.
 
 use fvr_core::filter::{Filter, FilterKind};
-use fvr_core::num::{Real, Sample};
+use fvr_host::render::fast_dht::FastReal;
+use fvr_host::render::fast_store::FastStore;
 use fvr_host::render::spectrum::OwnedSpectrum;
 use fvr_host::sources::phantom::{sample, GaussianMixture};
 
 /// A random Gaussian mixture (`GaussianMixture::random(seed, n, count)`)
 /// sampled on `dims`, prepared for `kind` at `oversample` in storage `S`
 /// with arithmetic `T`; with the filter.
-pub fn mixture_spectrum<S: Sample, T: Real>(
+pub fn mixture_spectrum<S: FastStore, T: FastReal>(
     (seed, n, count): (u64, usize, usize),
     dims: [usize; 3],
     kind: FilterKind,

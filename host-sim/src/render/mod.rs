@@ -2,6 +2,11 @@
 //! renderer, shaded renders, adaptive filtering, turntables and scene files.
 
 pub mod adaptive;
+pub mod fast_dht;
+pub mod fast_prepare;
+pub mod fast_store;
+#[cfg(test)]
+mod fast_tests;
 pub mod filter;
 pub mod plan;
 pub mod scene_file;

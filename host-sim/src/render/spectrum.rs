@@ -19,6 +19,9 @@ use fvr_core::spectrum::{prepare_scratch_len, Spectrum};
 use fvr_core::volume::{padded_size, DenseVolume};
 use half::f16;
 
+use super::fast_dht::FastReal;
+use super::fast_prepare::prepare_fast;
+use super::fast_store::FastStore;
 use crate::volume::Volume;
 
 pub use super::filter::{
@@ -87,12 +90,43 @@ pub struct OwnedSpectrum<S> {
 }
 
 impl<S: Sample> OwnedSpectrum<S> {
-    /// Premultiply, pad and transform `volume` for `filter`, with arithmetic `T`.
+    /// Premultiply, pad and transform `volume` for `filter`, with arithmetic
+    /// `T`, on all cores through FFTs ([`super::fast_prepare`]): the core's
+    /// input and scale, rounded to `S` once at the end.
+    ///
+    /// # Errors
+    /// As [`Spectrum::prepare`]; also a volume whose padded cube and
+    /// transient buffers would not fit in memory is refused before
+    /// allocating.
+    pub fn prepare<T: FastReal>(volume: &Volume, filter: Filter) -> Result<Self, PipelineError>
+    where
+        S: FastStore,
+    {
+        let n = padded_size(volume.dims, filter.oversample())?;
+        if n < 2 {
+            return Self::prepare_in_place::<T>(volume, filter);
+        }
+        let spec = prepare_fast::<T, S>(volume, filter)?;
+        Ok(Self {
+            data: spec.data,
+            n: spec.n,
+            scale: spec.scale,
+            filter,
+            dims: volume.dims,
+        })
+    }
+
+    /// [`OwnedSpectrum::prepare`] through the core's in-place transform on
+    /// one core ([`Spectrum::prepare`]), rounding to `S` after each pass:
+    /// the device's path, and the reference the fast path is tested against.
     ///
     /// # Errors
     /// As [`Spectrum::prepare`]; also a volume whose padded cube would not fit
     /// in memory is refused before allocating.
-    pub fn prepare<T: Real>(volume: &Volume, filter: Filter) -> Result<Self, PipelineError> {
+    pub fn prepare_in_place<T: Real>(
+        volume: &Volume,
+        filter: Filter,
+    ) -> Result<Self, PipelineError> {
         let n = padded_size(volume.dims, filter.oversample())?;
         check_memory(n, std::mem::size_of::<S>())?;
         let source = DenseVolume::new(volume.dims, &volume.data)?;

@@ -363,6 +363,14 @@ pub(crate) fn plan_job(
         let cells = n.saturating_pow(3);
         let mut budget = fvr_host::budget::Budget::new();
         budget.hold("spectrum", cells.saturating_mul(spectra), bytes);
+        // The fast preparation's complex half spectrum, one spectrum at a
+        // time (fvr_host::render::fast_prepare::fast_budget).
+        let complex = if bytes == 8 { 16 } else { 8 };
+        budget.hold(
+            "preparation half spectrum",
+            (n / 2 + 1).saturating_mul(n).saturating_mul(n),
+            complex,
+        );
         if spectra > 1 {
             let count = dims.iter().fold(1u64, |a, &d| a.saturating_mul(d as u64));
             budget.hold("gradient volume", count, 4);

@@ -1,0 +1,168 @@
+//! Preparation of a spectrum on the host through FFTs on all cores
+//! ([`super::fast_dht`]): the same premultiplication, padding, circular shift
+//! and scale as the core's [`fvr_core::spectrum::Spectrum::prepare`], the
+//! input bit for bit, with the transform rounded to `S` once at the end
+//! instead of after each of its three passes.
+
+use fvr_core::error::Error;
+use fvr_core::filter::Filter;
+use fvr_core::num::Real;
+use fvr_core::spectrum::{premultiplier_table, scale_for_target};
+use fvr_core::volume::padded_size;
+use rayon::prelude::*;
+
+use super::fast_dht::{dht_3d_real, half_spectrum_bytes, tile_bytes, FastReal, SparseCube};
+use super::fast_store::FastStore;
+use super::spectrum::PipelineError;
+use crate::budget::{self, Budget};
+use crate::volume::Volume;
+
+/// A spectrum prepared by [`prepare_fast`].
+#[derive(Debug)]
+pub struct FastSpectrum<S> {
+    /// `n³` stored coefficients, x fastest.
+    pub data: Vec<S>,
+    /// Side of the padded cube.
+    pub n: usize,
+    /// Scale of the stored values.
+    pub scale: f64,
+}
+
+/// What [`prepare_fast`] holds at its peak for side `n`: the stored spectrum
+/// (`n³` of `S`), the complex half spectrum in `T` (`(n/2+1)·n²` complex
+/// values, about `4n³` bytes in f32) and each thread's tiles.
+pub fn fast_budget<T, S>(n: usize) -> Budget {
+    let n64 = n as u64;
+    let threads = rayon::current_num_threads() as u64;
+    let mut b = Budget::new();
+    b.hold(
+        "spectrum",
+        n64.saturating_mul(n64).saturating_mul(n64),
+        std::mem::size_of::<S>() as u64,
+    )
+    .hold("half spectrum (complex)", half_spectrum_bytes::<T>(n), 1)
+    .hold("transform tiles", threads, tile_bytes::<T>(n));
+    b
+}
+
+/// Premultiply `volume` for `filter`, zero-pad it into the cube of side
+/// [`padded_size`]`(dims, filter.oversample())`, scale it by the core's rule
+/// for `S` and take its 3D DHT with arithmetic `T`, on all cores.
+///
+/// # Errors
+/// A NaN or infinite voxel (the first in storage order, as the core names
+/// it), a volume beyond the memory limit (checked before allocating, with
+/// [`fast_budget`]), or an overflow.
+pub fn prepare_fast<T: FastReal, S: FastStore>(
+    volume: &Volume,
+    filter: Filter,
+) -> Result<FastSpectrum<S>, PipelineError> {
+    let dims = volume.dims;
+    let n = padded_size(dims, filter.oversample())?;
+    fvr_core::volume::DenseVolume::new(dims, &volume.data)?;
+    if let Err(e) = fast_budget::<T, S>(n).check(budget::limit(), "use a smaller --resample") {
+        return Err(PipelineError::OutOfMemory {
+            needed: e.needed,
+            limit: e.limit.bytes,
+            n,
+        });
+    }
+    let mut premul = vec![<T as Real>::ZERO; n];
+    premultiplier_table(&filter, n, &mut premul);
+    let mask = n - 1;
+    let offs = dims.map(|d| d / 2);
+    let shifted = |idx: usize, axis: usize| (idx + n - offs[axis]) & mask;
+    let [nx, ny, nz] = dims;
+
+    // Σ|g| in f64 (in another order than the core's, which can change the
+    // scale only for a sum within an ulp of a power of two), and the first
+    // non-finite voxel. `pmx[i]` is |p| at volume index i along x.
+    let pmx: Vec<f64> = (0..nx)
+        .map(|i| premul[shifted(i, 0)].to_f64().abs())
+        .collect();
+    let sums: Vec<Result<f64, Error>> = volume
+        .data
+        .par_chunks_exact(nx * ny)
+        .enumerate()
+        .map(|(k, plane)| {
+            let pz = premul[shifted(k, 2)].to_f64();
+            let mut sum = 0.0f64;
+            for (j, line) in plane.chunks_exact(nx).enumerate() {
+                if !line.iter().fold(true, |ok, v| ok & v.is_finite()) {
+                    let i = line.iter().position(|v| !v.is_finite()).unwrap_or(0);
+                    return Err(Error::NonFiniteVoxel {
+                        index: [i, j, k],
+                        value: line[i] as f64,
+                    });
+                }
+                let pyz = (premul[shifted(j, 1)].to_f64() * pz).abs();
+                let row: f64 = line
+                    .iter()
+                    .zip(&pmx)
+                    .map(|(&v, &p)| (v as f64).abs() * p)
+                    .sum();
+                sum += row * pyz;
+            }
+            Ok(sum)
+        })
+        .collect();
+    let mut bound = 0.0f64;
+    for s in sums {
+        bound += s?;
+    }
+    if !bound.is_finite() {
+        return Err(Error::Overflow {
+            stage: "premultiplication (volume magnitude beyond f64)",
+        }
+        .into());
+    }
+    let scale = scale_for_target(bound, S::SCALE_LOG2);
+    let sc = <T as Real>::from_f64(scale);
+    if sc.to_f64() != scale {
+        return Err(Error::Overflow {
+            stage: "scaling (the volume's magnitude is beyond the arithmetic type's range)",
+        }
+        .into());
+    }
+
+    // Shifted row (y, z) holds volume row ((y + offs) mod n, (z + offs) mod n).
+    let mut rows_y = vec![false; n];
+    let mut planes_z = vec![false; n];
+    for j in 0..ny {
+        rows_y[shifted(j, 1)] = true;
+    }
+    for k in 0..nz {
+        planes_z[shifted(k, 2)] = true;
+    }
+    let premul = &premul;
+    let fill = move |py: usize, pz: usize, line: &mut [T]| {
+        let (j, k) = ((py + offs[1]) & mask, (pz + offs[2]) & mask);
+        let src = &volume.data[nx * (j + ny * k)..][..nx];
+        line.fill(<T as Real>::ZERO);
+        // The core's products, in its order: v·p(x)·(p(y)·p(z)·s).
+        let pyz = premul[py] * premul[pz] * sc;
+        // x index i lands at (i − offs) mod n: two contiguous runs.
+        let (head, tail) = src.split_at(offs[0]);
+        let (front, back) = line.split_at_mut(n - offs[0]);
+        let runs = [(tail, &mut front[..nx - offs[0]]), (head, &mut back[..])];
+        for (from, to) in runs {
+            for (o, &v) in to.iter_mut().zip(from) {
+                *o = <T as Real>::from_f64(v as f64);
+            }
+        }
+        for (o, &p) in line.iter_mut().zip(premul) {
+            *o = *o * p * pyz;
+        }
+    };
+    let cube = SparseCube {
+        n,
+        rows_y: &rows_y,
+        planes_z: &planes_z,
+        fill: &fill,
+    };
+    let mut data = Vec::new();
+    // Zeroed on all cores: the first touch of the pages is a large part.
+    data.par_extend(rayon::iter::repeat_n(S::default(), n * n * n));
+    dht_3d_real(&cube, &mut data)?;
+    Ok(FastSpectrum { data, n, scale })
+}
