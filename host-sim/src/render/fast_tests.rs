@@ -133,7 +133,7 @@ fn fast_budget_counts_the_half_spectrum() {
         source: LimitSource::Flag,
     };
     let e = b.check(limit, "hint").unwrap_err();
-    assert_eq!(e.largest.0, "half spectrum (complex)");
+    assert_eq!(e.items[0].0, "half spectrum (complex)");
     assert!(matches!(
         prepare_fast::<f32, f16>(
             &Volume::filled([1, 1, 1 << 20], 0.0),
