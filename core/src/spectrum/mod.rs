@@ -24,6 +24,7 @@ mod prepare;
 mod stored;
 
 pub use prepare::{
-    premultiplier_table, prepare_scratch_len, scale_for, scale_for_target, LineBlockStorage,
+    check_scale, premultiplier_table, prepare_scratch_len, scale_for, scale_for_target,
+    LineBlockStorage,
 };
 pub use stored::{CubeSide, Side, Spectrum};

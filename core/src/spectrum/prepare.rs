@@ -197,14 +197,7 @@ fn prepare_into<S: Sample, T: Real, V: VoxelSource, L: LineStore<T>>(
 
     // Pass 2: place the scaled, premultiplied volume, circularly shifted,
     // one x-line at a time (rows the volume does not reach stay zero).
-    let sc = T::from_f64(scale);
-    // The largest factor a voxel meets below is premul³·scale.
-    let pmax = premul[..n]
-        .iter()
-        .fold(0.0f64, |m, p| libm::fmax(m, libm::fabs(p.to_f64())));
-    if sc.to_f64() != scale || !T::from_f64(pmax * pmax * pmax * scale).is_finite() {
-        return Err(Error::MagnitudeOutOfRange { sum: bound, scale });
-    }
+    let sc = check_scale(&premul[..n], bound, scale)?;
     let mut finite = true;
     for k in 0..dims[2] {
         let pz = (k + n - offs[2]) & mask;
@@ -227,6 +220,23 @@ fn prepare_into<S: Sample, T: Real, V: VoxelSource, L: LineStore<T>>(
     }
     dht_3d_store(store, [n, n, n], rest, tw, rounding)?;
     Ok(scale)
+}
+
+/// `scale` in `T`, if `T` holds it exactly and the largest factor a voxel
+/// meets in preparation, `premul³·scale`, stays finite in `T`; `bound` is
+/// the `Σ|premultiplied voxel|` the scale was derived from.
+///
+/// # Errors
+/// [`Error::MagnitudeOutOfRange`] (voxels near `1e-38` in f32, say).
+pub fn check_scale<T: Real>(premul: &[T], bound: f64, scale: f64) -> Result<T> {
+    let sc = T::from_f64(scale);
+    let pmax = premul
+        .iter()
+        .fold(0.0f64, |m, p| libm::fmax(m, libm::fabs(p.to_f64())));
+    if sc.to_f64() != scale || !T::from_f64(pmax * pmax * pmax * scale).is_finite() {
+        return Err(Error::MagnitudeOutOfRange { sum: bound, scale });
+    }
+    Ok(sc)
 }
 
 /// Premultiplication factors `1/ĥ(x/n)` for signed positions

@@ -7,7 +7,7 @@
 use fvr_core::error::Error;
 use fvr_core::filter::Filter;
 use fvr_core::num::Real;
-use fvr_core::spectrum::{premultiplier_table, scale_for_target};
+use fvr_core::spectrum::{check_scale, premultiplier_table, scale_for_target};
 use fvr_core::volume::padded_size;
 use rayon::prelude::*;
 
@@ -117,13 +117,7 @@ pub fn prepare_fast<T: FastReal, S: FastStore>(
         .into());
     }
     let scale = scale_for_target(bound, S::SCALE_LOG2);
-    let sc = <T as Real>::from_f64(scale);
-    if sc.to_f64() != scale {
-        return Err(Error::Overflow {
-            stage: "scaling (the volume's magnitude is beyond the arithmetic type's range)",
-        }
-        .into());
-    }
+    let sc = check_scale(&premul, bound, scale)?;
 
     // Shifted row (y, z) holds volume row ((y + offs) mod n, (z + offs) mod n).
     let mut rows_y = vec![false; n];
