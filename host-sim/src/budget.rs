@@ -17,6 +17,12 @@ pub const PROCESS_OVERHEAD: u64 = 256 << 20;
 /// Memory limit when nothing else can be read: 8 GiB.
 pub const FALLBACK_LIMIT: u64 = 8 << 30;
 
+/// What a job may hold without `--max-memory`: 2.75 GiB, so that with
+/// [`PROCESS_OVERHEAD`] the program stays within 3 GiB whatever a file
+/// claims, on any machine. `--max-memory` raises (or lowers) it, up to the
+/// machine's and process's limits.
+pub const DEFAULT_CEILING: u64 = (3 << 30) - PROCESS_OVERHEAD;
+
 /// Where a memory limit comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LimitSource {
@@ -30,6 +36,8 @@ pub enum LimitSource {
     Available,
     /// None could be read: [`FALLBACK_LIMIT`].
     Fallback,
+    /// [`DEFAULT_CEILING`], in force without `--max-memory`.
+    Ceiling,
 }
 
 impl fmt::Display for LimitSource {
@@ -40,6 +48,7 @@ impl fmt::Display for LimitSource {
             LimitSource::Cgroup => "the cgroup memory limit",
             LimitSource::Available => "MemAvailable in /proc/meminfo",
             LimitSource::Fallback => "the default limit",
+            LimitSource::Ceiling => "the default ceiling; raise it with --max-memory",
         })
     }
 }
@@ -66,16 +75,19 @@ pub fn set_max_memory(bytes: u64) {
 /// lowered by the job's own buffers and then counted twice.
 static DETECTED: std::sync::OnceLock<MemoryLimit> = std::sync::OnceLock::new();
 
-/// The limit in force: [`MemoryLimit::detect`] with `--max-memory`, less
-/// what the job already [`hold`]s.
+/// The limit in force: the smallest of [`MemoryLimit::detect`] and
+/// `--max-memory` (or [`DEFAULT_CEILING`] without it), less what the job
+/// already [`hold`]s.
 pub fn limit() -> MemoryLimit {
     let machine = *DETECTED.get_or_init(|| MemoryLimit::detect(None));
-    let mut l = match MAX_MEMORY.get() {
-        Some(&b) if b <= machine.bytes => MemoryLimit {
-            bytes: b,
-            source: LimitSource::Flag,
-        },
-        _ => machine,
+    let (job, source) = match MAX_MEMORY.get() {
+        Some(&b) => (b, LimitSource::Flag),
+        None => (DEFAULT_CEILING, LimitSource::Ceiling),
+    };
+    let mut l = if job <= machine.bytes {
+        MemoryLimit { bytes: job, source }
+    } else {
+        machine
     };
     l.bytes = l.bytes.saturating_sub(held());
     l

@@ -2,7 +2,7 @@
 //! (the `|∇f|` spectrum only when a light needs it) and a reusable renderer.
 
 use crate::image::Image;
-use crate::render::spectrum::{AnySpectrum, OwnedSpectrum, PipelineError, Precision};
+use crate::render::spectrum::{AnySpectrum, OwnedSpectrum, PipelineError, Precision, Preparation};
 use crate::volume::Volume;
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::{DerivativeTable, Filter, KernelTable};
@@ -66,12 +66,26 @@ impl SceneSpectra {
         precision: Precision,
         scene: &Scene,
     ) -> Result<Self, PipelineError> {
-        let density = AnySpectrum::prepare(volume, filter, precision)?;
+        Self::prepare_by(volume, filter, precision, scene, Preparation::Fast)
+    }
+
+    /// [`SceneSpectra::prepare`] by the path `how`.
+    ///
+    /// # Errors
+    /// As [`SceneSpectra::prepare`].
+    pub fn prepare_by(
+        volume: &Volume,
+        filter: Filter,
+        precision: Precision,
+        scene: &Scene,
+        how: Preparation,
+    ) -> Result<Self, PipelineError> {
+        let density = AnySpectrum::prepare_by(volume, filter, precision, how)?;
         let gradient = if scene.needs_gradient_spectrum() {
             // The density spectrum counts against the limit from here on.
             let _density = crate::budget::hold(density.bytes() as u64);
             let g = gradient_volume(volume)?;
-            Some(AnySpectrum::prepare(&g, filter, precision)?)
+            Some(AnySpectrum::prepare_by(&g, filter, precision, how)?)
         } else {
             None
         };

@@ -268,8 +268,20 @@ macro_rules! with_arithmetic {
     };
 }
 
+/// Which host path prepares a spectrum.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Preparation {
+    /// FFTs on all cores, rounded to the storage format once
+    /// ([`OwnedSpectrum::prepare`]).
+    #[default]
+    Fast,
+    /// The core's in-place transform on one core, rounding after each pass
+    /// ([`OwnedSpectrum::prepare_in_place`]): the device's path, bit for bit.
+    InPlace,
+}
+
 impl AnySpectrum {
-    /// Prepare `volume` at `precision` for `filter`.
+    /// Prepare `volume` at `precision` for `filter` ([`Preparation::Fast`]).
     ///
     /// # Errors
     /// As [`OwnedSpectrum::prepare`].
@@ -278,10 +290,38 @@ impl AnySpectrum {
         filter: Filter,
         precision: Precision,
     ) -> Result<Self, PipelineError> {
-        Ok(match precision {
-            Precision::F16 => AnySpectrum::F16(OwnedSpectrum::prepare::<f32>(volume, filter)?),
-            Precision::F32 => AnySpectrum::F32(OwnedSpectrum::prepare::<f32>(volume, filter)?),
-            Precision::F64 => AnySpectrum::F64(OwnedSpectrum::prepare::<f64>(volume, filter)?),
+        Self::prepare_by(volume, filter, precision, Preparation::Fast)
+    }
+
+    /// [`AnySpectrum::prepare`] by the path `how`.
+    ///
+    /// # Errors
+    /// As [`OwnedSpectrum::prepare`] or [`OwnedSpectrum::prepare_in_place`].
+    pub fn prepare_by(
+        volume: &Volume,
+        filter: Filter,
+        precision: Precision,
+        how: Preparation,
+    ) -> Result<Self, PipelineError> {
+        Ok(match (precision, how) {
+            (Precision::F16, Preparation::Fast) => {
+                AnySpectrum::F16(OwnedSpectrum::prepare::<f32>(volume, filter)?)
+            }
+            (Precision::F32, Preparation::Fast) => {
+                AnySpectrum::F32(OwnedSpectrum::prepare::<f32>(volume, filter)?)
+            }
+            (Precision::F64, Preparation::Fast) => {
+                AnySpectrum::F64(OwnedSpectrum::prepare::<f64>(volume, filter)?)
+            }
+            (Precision::F16, Preparation::InPlace) => {
+                AnySpectrum::F16(OwnedSpectrum::prepare_in_place::<f32>(volume, filter)?)
+            }
+            (Precision::F32, Preparation::InPlace) => {
+                AnySpectrum::F32(OwnedSpectrum::prepare_in_place::<f32>(volume, filter)?)
+            }
+            (Precision::F64, Preparation::InPlace) => {
+                AnySpectrum::F64(OwnedSpectrum::prepare_in_place::<f64>(volume, filter)?)
+            }
         })
     }
 

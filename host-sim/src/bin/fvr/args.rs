@@ -360,7 +360,9 @@ pub(crate) fn plan_job(
         let largest = resample.unwrap_or_else(|| dims.iter().copied().max().unwrap_or(1));
         let n = fvr_core::volume::padded_size([largest, 1, 1], oversample)
             .map_or(u64::MAX, |n| n as u64);
-        let cells = n.saturating_pow(3);
+        // A grid too large for the volume's shape is refused later, by name.
+        let thin = resample.is_none() && fvr_host::volume::check_padding(dims, n as usize).is_err();
+        let cells = if thin { 0 } else { n.saturating_pow(3) };
         let mut budget = fvr_host::budget::Budget::new();
         budget.hold("spectrum", cells.saturating_mul(spectra), bytes);
         // The fast preparation's complex half spectrum, one spectrum at a
@@ -368,7 +370,11 @@ pub(crate) fn plan_job(
         let complex = if bytes == 8 { 16 } else { 8 };
         budget.hold(
             "preparation half spectrum",
-            (n / 2 + 1).saturating_mul(n).saturating_mul(n),
+            if thin {
+                0
+            } else {
+                (n / 2 + 1).saturating_mul(n).saturating_mul(n)
+            },
             complex,
         );
         if spectra > 1 {
