@@ -1,6 +1,6 @@
 //! `fvr render --accuracy DB` and `fvr turntable --accuracy DB`: the choice,
-//! its report in `--stats-json`, explicit flags that win, and the warning
-//! without the flag.
+//! its report in `--stats-json`, the default target of 50 dB, explicit flags
+//! and scene settings that win, and the warning for settings predicted low.
 
 mod common;
 use common::{assert_ok, fvr, temp_dir};
@@ -76,21 +76,141 @@ fn explicit_flags_win_and_an_unmet_target_warns() {
 }
 
 #[test]
-fn without_accuracy_a_low_prediction_warns_and_names_the_remedy() {
-    let dir = temp_dir("accuracy-warn");
-    let args = ["render", "brainsmall", "--dir", "0,1,0", "--out", "a.png"];
-    let out = fvr(&args, &dir);
-    assert_ok(&out);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        err.contains("predicted to reach only") && err.contains("--accuracy"),
-        "{err}"
-    );
+fn the_default_target_is_50_db_and_a_touching_head_gets_oversampled() {
+    let dir = temp_dir("accuracy-default");
     let out = fvr(
-        &["render", "gaussians@32", "--dir", "0,1,0", "--out", "b.png"],
+        &[
+            "render",
+            "brainsmall",
+            "--dir",
+            "0,1,0",
+            "--out",
+            "a.png",
+            "--stats-json",
+        ],
         &dir,
     );
     assert_ok(&out);
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!err.contains("predicted to reach only"), "{err}");
+    assert!(!err.contains("warning"), "{err}");
+    let stats = json_line(&out.stdout);
+    let acc = &stats["accuracy"];
+    assert_eq!(acc["target_db"], 50.0, "{stats}");
+    assert_eq!(acc["target_is_default"], true, "{stats}");
+    assert!(acc["predicted_db"].as_f64().unwrap() >= 50.0, "{stats}");
+    assert_eq!(stats["oversample"], 2, "{stats}");
+}
+
+#[test]
+fn settings_given_without_accuracy_win_and_warn_when_predicted_low() {
+    let dir = temp_dir("accuracy-warn");
+    // All three given: used as given, predicted, and warned about.
+    let all = [
+        "render",
+        "brainsmall",
+        "--dir",
+        "0,1,0",
+        "--filter",
+        "kb4",
+        "--oversample",
+        "1",
+        "--precision",
+        "f16",
+        "--out",
+        "a.png",
+        "--stats-json",
+    ];
+    // Only the oversampling given: the planner chooses the rest around it.
+    let one = [
+        "render",
+        "brainsmall",
+        "--dir",
+        "0,1,0",
+        "--oversample",
+        "1",
+        "--out",
+        "b.png",
+        "--stats-json",
+    ];
+    for args in [&all[..], &one[..]] {
+        let out = fvr(args, &dir);
+        assert_ok(&out);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("predicted to reach only") && err.contains("--accuracy"),
+            "{args:?}: {err}"
+        );
+        let stats = json_line(&out.stdout);
+        assert_eq!(stats["oversample"], 1, "{stats}");
+        assert!(
+            stats["accuracy"]["predicted_db"].as_f64().unwrap() < 40.0,
+            "{stats}"
+        );
+    }
+    // A compact phantom at the default: nothing to warn about.
+    let out = fvr(
+        &["render", "gaussians@32", "--dir", "0,1,0", "--out", "c.png"],
+        &dir,
+    );
+    assert_ok(&out);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("warning"), "{err}");
+}
+
+#[test]
+fn a_scene_file_states_the_accuracy_and_its_settings_win() {
+    let dir = temp_dir("accuracy-scene");
+    std::fs::write(
+        dir.join("target.toml"),
+        "[volume]\nbuiltin = \"brainsmall\"\n[spectrum]\naccuracy = 45\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("fixed.toml"),
+        "[volume]\nbuiltin = \"brainsmall\"\n[spectrum]\noversample = 1\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("bad.toml"),
+        "[volume]\nbuiltin = \"brainsmall\"\n[spectrum]\naccuracy = -3\n",
+    )
+    .unwrap();
+    let run = |scene: &str, extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            "--scene",
+            scene,
+            "--dir",
+            "0,1,0",
+            "--out",
+            "s.png",
+            "--stats-json",
+        ];
+        args.extend_from_slice(extra);
+        fvr(&args, &dir)
+    };
+    let out = run("target.toml", &[]);
+    assert_ok(&out);
+    let stats = json_line(&out.stdout);
+    assert_eq!(stats["accuracy"]["target_db"], 45.0, "{stats}");
+    assert_eq!(stats["accuracy"]["target_is_default"], false, "{stats}");
+    // The command line wins over the scene.
+    let out = run("target.toml", &["--accuracy", "60"]);
+    assert_ok(&out);
+    let stats = json_line(&out.stdout);
+    assert_eq!(stats["accuracy"]["target_db"], 60.0, "{stats}");
+    // A setting in the scene is the user's choice: kept, and warned about.
+    let out = run("fixed.toml", &[]);
+    assert_ok(&out);
+    let stats = json_line(&out.stdout);
+    assert_eq!(stats["oversample"], 1, "{stats}");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("predicted to reach only"), "{err}");
+    let out = run("bad.toml", &[]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("`spectrum.accuracy`") && err.contains("positive"),
+        "{err}"
+    );
 }

@@ -141,9 +141,10 @@ pub(crate) struct SpectrumArgs {
     #[arg(long, default_value = "auto")]
     pub(crate) kb_design: KbDesign,
     /// Target SNR in dB against the exact projection: choose the cheapest
-    /// filter, oversampling and precision predicted to reach it (--filter,
-    /// --oversample and --precision given on the command line are kept).
-    /// Without it, those flags apply as given.
+    /// filter, oversampling and precision predicted to reach it on this
+    /// volume (--filter, --oversample and --precision given are kept).
+    /// Default 50; with all three of those given and no --accuracy, they
+    /// apply as given, with a warning below 40 dB predicted.
     #[arg(long, value_name = "DB", value_parser = parse_accuracy)]
     pub(crate) accuracy: Option<f64>,
     /// Which of the settings above were given on the command line.

@@ -8,11 +8,15 @@ use crate::turntable::TurntableArgs;
 use crate::Error;
 
 use fvr_host::render::plan::{choose, predict, Candidate, Constraints, Prediction};
+use fvr_core::volume::padded_size;
 use fvr_host::volume::Volume;
 use serde::Serialize;
 
-/// Below this prediction a render without `--accuracy` warns.
+/// Below this prediction a render whose settings were given warns.
 pub(crate) const PREDICTION_WARNING_DB: f64 = 40.0;
+
+/// The target without `--accuracy` (or a scene's `accuracy`), in dB.
+pub(crate) const DEFAULT_ACCURACY_DB: f64 = 50.0;
 
 /// Which spectrum settings were given on the command line (they win over
 /// the planner's choice).
@@ -32,13 +36,22 @@ impl Given {
             precision: given("precision"),
         }
     }
+
+    /// Whether every setting the planner chooses was given.
+    pub(crate) fn all(self) -> bool {
+        self.filter && self.oversample && self.precision
+    }
 }
 
 /// What the planner decided, for `--stats`.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Outcome {
-    /// The `--accuracy` target, if one was given.
+    /// The target the configuration was chosen for (none when every
+    /// setting was given).
     pub(crate) target_db: Option<f64>,
+    /// Whether the target was given (`--accuracy` or the scene's
+    /// `accuracy`) rather than the default.
+    pub(crate) explicit: bool,
     /// The prediction for the configuration used.
     pub(crate) prediction: Prediction,
 }
@@ -70,28 +83,28 @@ pub(crate) fn planned<A: Planned>(args: &A, volume: &Volume) -> Result<A, Error>
 }
 
 fn apply(s: &mut SpectrumArgs, volume: &Volume) -> Result<(), Error> {
-    let Some(target) = s.accuracy else {
+    // A volume too thin for the smallest grid allowed gets its own message
+    // before any prediction.
+    let least = if s.given.oversample { s.oversample } else { 1 };
+    fvr_host::volume::check_padding(volume.dims, padded_size(volume.dims, least)?)?;
+    let explicit = s.accuracy.is_some();
+    let target = s.accuracy.unwrap_or(DEFAULT_ACCURACY_DB);
+    if !explicit && s.given.all() {
+        // Everything fixed by the user: nothing to choose, only to predict.
         let candidate = Candidate {
             filter: s.filter,
             oversample: s.oversample,
             precision: s.precision,
         };
         let prediction = predict(volume, candidate, s.kb_design)?;
-        if prediction.db < PREDICTION_WARNING_DB {
-            eprintln!(
-                "fvr: warning: {} is predicted to reach only {:.1} dB on this volume ({}); \
-                 --accuracy 50 chooses a configuration predicted to reach 50 dB.",
-                describe(candidate),
-                prediction.db,
-                prediction.dominant().why()
-            );
-        }
+        warn_low(candidate, &prediction);
         s.outcome = Some(Outcome {
             target_db: None,
+            explicit: false,
             prediction,
         });
         return Ok(());
-    };
+    }
     let constraints = Constraints {
         filter: s.given.filter.then_some(s.filter),
         oversample: s.given.oversample.then_some(s.oversample),
@@ -99,7 +112,11 @@ fn apply(s: &mut SpectrumArgs, volume: &Volume) -> Result<(), Error> {
     };
     let plan = choose(volume, s.kb_design, target, constraints)?;
     let p = plan.prediction;
-    if !plan.met {
+    if !explicit && constraints != Constraints::default() {
+        // The default target with some settings given: they win, and only a
+        // prediction below the warning level is worth a line.
+        warn_low(p.candidate, &p);
+    } else if !plan.met {
         eprintln!(
             "fvr: warning: no configuration is predicted to reach {target} dB{}; using the best, \
              {}, predicted at {:.1} dB ({}).",
@@ -118,9 +135,24 @@ fn apply(s: &mut SpectrumArgs, volume: &Volume) -> Result<(), Error> {
     s.precision = p.candidate.precision;
     s.outcome = Some(Outcome {
         target_db: Some(target),
+        explicit,
         prediction: p,
     });
     Ok(())
+}
+
+/// The warning for settings the user gave that are predicted below
+/// [`PREDICTION_WARNING_DB`].
+fn warn_low(candidate: Candidate, prediction: &Prediction) {
+    if prediction.db < PREDICTION_WARNING_DB {
+        eprintln!(
+            "fvr: warning: {} is predicted to reach only {:.1} dB on this volume ({}); \
+             --accuracy 50 chooses a configuration predicted to reach 50 dB.",
+            describe(candidate),
+            prediction.db,
+            prediction.dominant().why()
+        );
+    }
 }
 
 fn describe(c: Candidate) -> String {
@@ -138,7 +170,8 @@ pub(crate) fn print_human(s: &SpectrumArgs) {
     if let Some(o) = s.outcome {
         let p = o.prediction;
         let how = match o.target_db {
-            Some(t) => format!("chosen for --accuracy {t}"),
+            Some(t) if o.explicit => format!("chosen for --accuracy {t}"),
+            Some(t) => format!("chosen for the default --accuracy {t}"),
             None => "as given".to_string(),
         };
         println!(
@@ -155,6 +188,7 @@ pub(crate) fn print_human(s: &SpectrumArgs) {
 #[derive(Serialize)]
 pub(crate) struct AccuracyJson {
     target_db: Option<f64>,
+    target_is_default: bool,
     predicted_db: Option<f64>,
     predicted_views_db: [Option<f64>; 3],
     filter: &'static str,
@@ -174,6 +208,7 @@ pub(crate) fn json(s: &SpectrumArgs) -> Option<AccuracyJson> {
         let finite = |v: f64| v.is_finite().then_some(v);
         AccuracyJson {
             target_db: o.target_db,
+            target_is_default: o.target_db.is_some() && !o.explicit,
             predicted_db: finite(p.db),
             predicted_views_db: p.views_db.map(finite),
             filter: p.candidate.filter.name(),

@@ -82,6 +82,16 @@ pub(crate) fn apply_scene_to_spectrum(
     fill(given, "oversample", &mut spectrum.oversample, s.oversample);
     fill(given, "precision", &mut spectrum.precision, s.precision);
     fill(given, "kb_design", &mut spectrum.kb_design, s.kb_design);
+    fill(
+        given,
+        "accuracy",
+        &mut spectrum.accuracy,
+        s.accuracy.map(Some),
+    );
+    // A setting the scene fixes is the user's choice, as on the command line.
+    spectrum.given.filter |= s.filter.is_some();
+    spectrum.given.oversample |= s.oversample.is_some();
+    spectrum.given.precision |= s.precision.is_some();
 }
 
 /// Fill the PNG settings. `--percentiles` on the command line also drops
@@ -214,7 +224,7 @@ turntable.path, profile:@FILE) are relative to the scene file's directory.
   [volume]     path = \"head.nii.gz\" | builtin = \"teapot@128\", raw_dims = [X, Y, Z],
                raw_type, raw_endian, background, resample
   [camera]     dir = [X, Y, Z], up = [X, Y, Z], size = N | [W, H]
-  [spectrum]   filter, oversample, precision, kb_design
+  [spectrum]   filter, oversample, precision, kb_design, accuracy
   [shading]    ambient = G | [R, G, B], depth_cue = \"linear:1,0.3\", cue_harmonics,
                cue_correction = true
   [light_ring] count, tilt

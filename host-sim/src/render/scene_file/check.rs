@@ -430,6 +430,14 @@ impl Checker<'_> {
                 }
                 _ => self.parsed(t, p, "kb_design", str::parse::<KbDesign>),
             },
+            accuracy: self.number(t, p, "accuracy").and_then(|v| {
+                if v > 0.0 {
+                    Some(v)
+                } else {
+                    self.bad("spectrum.accuracy", format!("must be a positive number of decibels, got {}", crate::text::num(v)));
+                    None
+                }
+            }),
         }
     }
 

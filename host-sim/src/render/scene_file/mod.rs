@@ -22,7 +22,8 @@
 //! # pixel_size = 0.8            # mm; default: the smallest spacing
 //!
 //! [spectrum]
-//! filter = "kb4"                # oversample = 2, precision = "f16", kb_design = "auto"
+//! accuracy = 50                 # dB: the planner chooses what is not given below
+//! # filter = "kb4"              # oversample = 2, precision = "f16", kb_design = "auto"
 //!
 //! [shading]
 //! ambient = 0.05                # or [r, g, b]
@@ -124,6 +125,8 @@ pub struct SpectrumSection {
     pub precision: Option<Precision>,
     /// Kaiser–Bessel design.
     pub kb_design: Option<KbDesign>,
+    /// Target SNR in dB against the exact projection (`--accuracy`).
+    pub accuracy: Option<f64>,
 }
 
 /// The `[shading]` table.
@@ -210,7 +213,8 @@ pub(crate) const VOLUME_KEYS: &[&str] = &[
     "ignore_spacing",
 ];
 pub(crate) const CAMERA_KEYS: &[&str] = &["dir", "up", "size", "pixel_size"];
-pub(crate) const SPECTRUM_KEYS: &[&str] = &["filter", "oversample", "precision", "kb_design"];
+pub(crate) const SPECTRUM_KEYS: &[&str] =
+    &["filter", "oversample", "precision", "kb_design", "accuracy"];
 pub(crate) const SHADING_KEYS: &[&str] =
     &["ambient", "depth_cue", "cue_harmonics", "cue_correction"];
 pub(crate) const LIGHT_RING_KEYS: &[&str] = &["count", "tilt"];
