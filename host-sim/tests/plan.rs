@@ -254,15 +254,18 @@ fn predicted_against_measured_table() {
     println!("| volume | config | predicted dB | measured dB (x, y, z) | dominant |");
     println!("|---|---|---|---|---|");
     for (vname, volume) in &rows {
-        let default = Candidate {
+        let plain = Candidate {
             filter: FilterKind::Kb4,
             oversample: 1,
             precision: Precision::F16,
         };
-        let mut configs = vec![(default, "default".to_string())];
-        for target in [40.0, 50.0] {
+        let mut configs = vec![(plain, "given".to_string())];
+        for (target, note) in [(40.0, ""), (50.0, ", the default")] {
             let plan = choose(volume, KbDesign::Auto, target, Constraints::default()).unwrap();
-            configs.push((plan.prediction.candidate, format!("--accuracy {target}")));
+            configs.push((
+                plan.prediction.candidate,
+                format!("--accuracy {target}{note}"),
+            ));
         }
         for (c, why) in configs {
             let p = predict(volume, c, KbDesign::Auto).unwrap();

@@ -128,13 +128,21 @@ impl UnitArgs {
 #[derive(Args, Clone, Copy)]
 pub(crate) struct SpectrumArgs {
     /// Interpolation filter: nearest, linear, cubic, kb3, kb4, kb5, kb6.
-    #[arg(long, value_parser = parse_filter, default_value = "kb4")]
+    /// Default: chosen for --accuracy.
+    #[arg(long, value_parser = parse_filter, default_value = "kb4", hide_default_value = true)]
     pub(crate) filter: FilterKind,
-    /// Oversampling of the spectrum grid: 1 or 2.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=2))]
+    /// Oversampling of the spectrum grid: 1 or 2. Default: chosen for
+    /// --accuracy.
+    #[arg(
+        long,
+        default_value_t = 1,
+        hide_default_value = true,
+        value_parser = clap::value_parser!(u32).range(1..=2)
+    )]
     pub(crate) oversample: u32,
     /// Spectrum storage and arithmetic: f16 (f32 arithmetic), f32 or f64.
-    #[arg(long, default_value = "f16")]
+    /// Default: chosen for --accuracy.
+    #[arg(long, default_value = "f16", hide_default_value = true)]
     pub(crate) precision: Precision,
     /// Kaiser-Bessel shape: `auto` fits beta to the volume's energy
     /// distribution; a number is the design oversampling of Beatty's formula.

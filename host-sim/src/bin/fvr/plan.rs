@@ -7,8 +7,8 @@ use crate::render::RenderArgs;
 use crate::turntable::TurntableArgs;
 use crate::Error;
 
-use fvr_host::render::plan::{choose, predict, Candidate, Constraints, Prediction};
 use fvr_core::volume::padded_size;
+use fvr_host::render::plan::{choose, predict, Candidate, Constraints, Prediction};
 use fvr_host::volume::Volume;
 use serde::Serialize;
 
