@@ -125,6 +125,15 @@ fn exact_bound_energy_matches_a_direct_evaluation() {
             (direct - ratio).abs() <= 1e-4 * ratio,
             "{tol}: direct {direct} against {ratio}"
         );
+        // The largest ⅛-octave step within the budget: the next one is not
+        // (unless every sample is already below the threshold).
+        let next = level.threshold * 2f64.powf(0.125);
+        let budget = 10f64.powf(-tol / 10.0);
+        let largest = (0..n * n * n).fold(0.0f64, |m, i| m.max(spec.view().value(i).abs()));
+        if next <= largest {
+            let beyond = direct_error_ratio(&spec, next, level.gain);
+            assert!(beyond > budget, "{tol}: {next} is within the budget too");
+        }
         checked += 1;
     }
     assert!(checked >= 2, "{checked}");

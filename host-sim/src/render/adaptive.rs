@@ -2,9 +2,9 @@
 //! spectrum for a tolerance in dB, then views that read the cheaper filters
 //! wherever the marks allow, with statistics.
 
+use crate::render::fast_dht::{dht_3d_real, half_spectrum_bytes, SparseCube};
 use crate::render::spectrum::OwnedSpectrum;
-use fvr_core::dht::signed_index;
-use fvr_core::dht::{dht_3d, dht_3d_scratch_len, Twiddles};
+use fvr_core::dht::{signed_index, Twiddles};
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::View;
 use fvr_core::image::{aux_len, check_image, finish, placement, Crop};
@@ -14,6 +14,7 @@ use fvr_core::slice::adaptive::{
     AdaptiveStats, Marks, MAX_LEVELS,
 };
 use fvr_core::spectrum::Spectrum;
+use rayon::prelude::*;
 
 /// The cheaper filters tried, cheapest first, as the user names them.
 pub fn parse_chain(s: &str) -> Result<Vec<FilterKind>, String> {
@@ -58,8 +59,9 @@ pub enum Bound {
     /// inverse transform of the weak samples per candidate `τ`, and its
     /// energy summed over the whole grid. Exact for the substitution of the
     /// weak set, so the largest `τ` it accepts is the largest the 3D energy
-    /// criterion allows; it costs about `log₂(bins)` 3D transforms once per
-    /// volume.
+    /// criterion allows; it costs 3–4 FFT-based 3D transforms once per
+    /// volume (one for the reference, then the search of
+    /// `ErrorModel::threshold`).
     Exact,
 }
 
@@ -94,25 +96,47 @@ struct ErrorModel {
     /// `Σ (f·h₁)²` over the grid: the energy the tolerance is relative to,
     /// in the same (unnormalized) units as the error energies.
     reference: f64,
+    /// `Σ F²` of the samples in each ⅛-octave magnitude bin `b`
+    /// (`2^((b−1)/8) ≤ |F| < 2^(b/8)`), from bin `lowest` up.
+    bins: Vec<f64>,
+    /// The bin of `bins[0]`.
+    lowest: i64,
     work: Vec<f32>,
-    scratch: Vec<f32>,
-    twiddles: Vec<f32>,
 }
 
 impl ErrorModel {
     fn new<S: Sample>(view: &Spectrum<'_, S>) -> Result<Self, String> {
         let n = view.n();
+        let cells = (n as u64).pow(3);
+        crate::budget::Budget::new()
+            .hold("adaptive samples and error field (f32)", 2 * cells, 4)
+            .hold(
+                "adaptive transform half spectrum",
+                half_spectrum_bytes::<f32>(n),
+                1,
+            )
+            .check(crate::budget::limit(), "use --adaptive-bound paper")
+            .map_err(|e| e.to_string())?;
         let large = *view.filter();
-        let values: Vec<f32> = (0..n * n * n).map(|i| view.value(i) as f32).collect();
+        let mut values = vec![0f32; n * n * n];
+        values
+            .par_chunks_mut(n * n)
+            .enumerate()
+            .for_each(|(z, plane)| {
+                for (i, v) in plane.iter_mut().enumerate() {
+                    *v = view.value(z * n * n + i) as f32;
+                }
+            });
+        let (bins, lowest) = magnitude_bins(&values);
         let large_response = Self::responses(&large, n);
         let mut model = Self {
             n,
             values,
             large_response,
             reference: 0.0,
+            bins,
+            lowest,
             work: vec![0.0; n * n * n],
-            scratch: vec![0.0; dht_3d_scratch_len([n; 3])],
-            twiddles: vec![0.0; Twiddles::<f32>::buffer_len(n)],
         };
         let ones = model.large_response.clone();
         model.reference =
@@ -129,119 +153,112 @@ impl ErrorModel {
 
     /// `Σ_x (f_τ(x)·weight(x))²`, `f_τ` the inverse transform of the
     /// samples below `tau` (unnormalized: the transform is its own inverse
-    /// up to `n³`, and every energy here carries the same factor).
+    /// up to `n³`, and every energy here carries the same factor), through
+    /// the host's FFT-based transform on all cores.
     fn field_energy(
         &mut self,
         tau: f64,
-        weight: impl Fn([usize; 3]) -> f64,
+        weight: impl Fn([usize; 3]) -> f64 + Sync,
     ) -> Result<f64, String> {
         let n = self.n;
         let tau = tau as f32;
-        for (w, &v) in self.work.iter_mut().zip(&self.values) {
-            *w = if v.abs() < tau { v } else { 0.0 };
-        }
-        let tw = Twiddles::new(&mut self.twiddles, n).map_err(|e| e.to_string())?;
-        dht_3d::<f32, f32>(&mut self.work, [n; 3], &mut self.scratch, &tw)
-            .map_err(|e| e.to_string())?;
-        let mut energy = 0.0f64;
-        for z in 0..n {
-            for y in 0..n {
-                let row = &self.work[(z * n + y) * n..][..n];
-                let mut line = 0.0f64;
-                for (x, &f) in row.iter().enumerate() {
-                    let e = f as f64 * weight([x, y, z]);
-                    line += e * e;
-                }
-                energy += line;
+        let (values, all) = (&self.values, vec![true; n]);
+        let fill = move |y: usize, z: usize, line: &mut [f32]| {
+            let row = &values[(z * n + y) * n..][..n];
+            for (w, &v) in line.iter_mut().zip(row) {
+                *w = if v.abs() < tau { v } else { 0.0 };
             }
-        }
-        Ok(energy)
+        };
+        let cube = SparseCube {
+            n,
+            rows_y: &all,
+            planes_z: &all,
+            fill: &fill,
+        };
+        dht_3d_real::<f32, f32>(&cube, &mut self.work).map_err(|e| e.to_string())?;
+        Ok(self
+            .work
+            .par_chunks(n * n)
+            .enumerate()
+            .map(|(z, plane)| {
+                let mut energy = 0.0f64;
+                for (y, row) in plane.chunks_exact(n).enumerate() {
+                    let mut line = 0.0f64;
+                    for (x, &f) in row.iter().enumerate() {
+                        let e = f as f64 * weight([x, y, z]);
+                        line += e * e;
+                    }
+                    energy += line;
+                }
+                energy
+            })
+            .sum())
+    }
+
+    /// The error energy of threshold bin `b` as if the weight were its mean
+    /// square everywhere (Parseval: `n³·mean(w²)·Σ_{|F|<τ} F²`): exact for
+    /// a constant weight, and a guide for where to start the exact search.
+    fn estimate(&self, b: i64, mean_square_weight: f64) -> f64 {
+        // Bins `k ≤ b` hold the samples below `2^(b/8)`.
+        let below = (b - self.lowest + 1).clamp(0, self.bins.len() as i64) as usize;
+        let sum: f64 = self.bins[..below].iter().sum();
+        (self.n as f64).powi(3) * mean_square_weight * sum
     }
 
     /// The largest candidate threshold whose error energy for the pair
     /// (large, `small` with gain `gain`) stays within `budget` of the
     /// reference, and the relative energy it was verified at. Candidates are
-    /// ⅛-octave steps `2^(b/8)`; the search starts at `start` (the paper's
-    /// threshold, usually 1–2 octaves below the answer), gallops by whole
-    /// octaves until it brackets the answer, then bisects, about 6
-    /// transforms in all. It returns only thresholds it evaluated.
-    fn threshold(
-        &mut self,
-        small: &Filter,
-        gain: f64,
-        budget: f64,
-        start: f64,
-    ) -> Result<(f64, f64), String> {
-        let hs = Self::responses(small, self.n);
+    /// ⅛-octave steps `2^(b/8)`, and the answer is bracketed between an
+    /// accepted step and a refused one (at first the empty weak set, which
+    /// has no error, and "no limit"). Each probe is one exact evaluation of
+    /// the error field. The first three probes go where the Parseval
+    /// estimate ([`ErrorModel::estimate`]) puts the answer, rescaled by the
+    /// ratio of exact to estimated energy at the last probe (the weight is
+    /// far from constant, so the raw estimate is off by octaves, but the
+    /// ratio varies slowly with `τ`); the rest bisect. It returns only
+    /// thresholds it evaluated.
+    fn threshold(&mut self, small: &Filter, gain: f64, budget: f64) -> Result<(f64, f64), String> {
+        let n = self.n;
+        let hs = Self::responses(small, n);
         let hl = self.large_response.clone();
         let weight =
             |x: [usize; 3]| gain * hs[x[0]] * hs[x[1]] * hs[x[2]] - hl[x[0]] * hl[x[1]] * hl[x[2]];
-        let hi_mag = self
-            .values
-            .iter()
-            .fold(0.0f64, |m, v| m.max(v.abs() as f64));
-        if hi_mag == 0.0 || self.reference <= 0.0 {
+        if self.bins.is_empty() || self.reference <= 0.0 {
             return Ok((0.0, 0.0));
         }
+        // mean(w²) of the separable weight, from per-axis sums of products.
+        let axis_mean = |f: &dyn Fn(usize) -> f64| (0..n).map(f).sum::<f64>() / n as f64;
+        let mean_square = gain * gain * axis_mean(&|i| hs[i] * hs[i]).powi(3)
+            - 2.0 * gain * axis_mean(&|i| hs[i] * hl[i]).powi(3)
+            + axis_mean(&|i| hl[i] * hl[i]).powi(3);
         let tau_of = |b: i64| 2f64.powf(b as f64 / 8.0);
-        // Above `top` every sample is weak: no larger threshold changes the set.
-        let top = (hi_mag.log2() * 8.0).ceil() as i64 + 1;
         let allowed = budget * self.reference;
-        let mut probe = |b: i64| -> Result<Option<f64>, String> {
+        // Below step `lowest` no sample is weak: the empty set, accepted.
+        let mut good: (i64, Option<f64>) = (self.lowest - 1, None);
+        // From `top` on every sample is weak: no larger threshold changes the set.
+        let top = self.lowest + self.bins.len() as i64 - 1;
+        let mut bad = top + 1;
+        let mut scale = 1.0;
+        let mut probes = 0;
+        while bad - good.0 > 1 {
+            let b = if probes < 3 {
+                (good.0 + 1..bad)
+                    .rev()
+                    .find(|&b| scale * self.estimate(b, mean_square) <= allowed)
+                    .unwrap_or(good.0 + 1)
+            } else {
+                good.0 + (bad - good.0) / 2
+            };
             let e = self.field_energy(tau_of(b), weight)?;
-            Ok((e <= allowed).then_some(e / self.reference))
-        };
-        let first = if start > 0.0 {
-            ((start.log2() * 8.0).round() as i64).min(top)
-        } else {
-            top - 8
-        };
-        // Invariant: `good` is accepted (`None` is the empty set, always
-        // accepted), `bad` is not (`top + 1` stands for "no limit found").
-        let (mut good, mut bad): ((i64, Option<f64>), i64);
-        match probe(first)? {
-            Some(r) => {
-                good = (first, Some(r));
-                bad = top + 1;
-                let mut step = 8;
-                while good.0 < top {
-                    let b = (good.0 + step).min(top);
-                    match probe(b)? {
-                        Some(r) => good = (b, Some(r)),
-                        None => {
-                            bad = b;
-                            break;
-                        }
-                    }
-                    step *= 2;
-                }
+            probes += 1;
+            let estimate = self.estimate(b, mean_square);
+            if estimate > 0.0 && e > 0.0 {
+                scale = e / estimate;
             }
-            None => {
-                bad = first;
-                let mut step = 8;
-                loop {
-                    let b = first - step;
-                    if b < first - 8 * 64 {
-                        // 64 octaves below the paper's threshold: nothing fits.
-                        good = (b, None);
-                        break;
-                    }
-                    match probe(b)? {
-                        Some(r) => {
-                            good = (b, Some(r));
-                            break;
-                        }
-                        None => bad = b,
-                    }
-                    step *= 2;
-                }
-            }
-        }
-        while bad - good.0 > 1 && good.1.is_some() {
-            let mid = good.0 + (bad - good.0) / 2;
-            match probe(mid)? {
-                Some(r) => good = (mid, Some(r)),
-                None => bad = mid,
+            if e <= allowed {
+                good = (b, Some(e / self.reference));
+            } else {
+                bad = b;
             }
         }
         Ok(match good.1 {
@@ -249,6 +266,66 @@ impl ErrorModel {
             None => (0.0, 0.0),
         })
     }
+}
+
+/// `2^(j/8)` for `j = 1 … 7` in f32: a mantissa in `[1, 2)` is in eighth
+/// `j` when it reaches the `j`-th entry (the estimate only guides the
+/// search, so the last bit of these does not matter).
+const EIGHTH_OCTAVES: [f32; 7] = [
+    1.090_507_8,
+    1.189_207_1,
+    1.296_839_6,
+    1.414_213_6,
+    1.542_210_8,
+    1.681_792_9,
+    1.834_008_1,
+];
+
+/// `Σ F²` per ⅛-octave magnitude bin (`2^((b−1)/8) ≤ |F| < 2^(b/8)` in bin
+/// `b`), from the lowest occupied bin, and that bin; zeros are left out
+/// (they add nothing to any energy).
+fn magnitude_bins(values: &[f32]) -> (Vec<f64>, i64) {
+    let bin = |v: f32| {
+        // ⌊8·log₂|v|⌋ + 1 from the exponent and mantissa bits (normal
+        // numbers; subnormals through log₂).
+        let bits = v.abs().to_bits();
+        let exponent = (bits >> 23) as i64;
+        if exponent == 0 {
+            return ((v.abs() as f64).log2() * 8.0).floor() as i64 + 1;
+        }
+        let mantissa = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
+        let eighths = EIGHTH_OCTAVES.iter().filter(|t| mantissa >= **t).count() as i64;
+        8 * (exponent - 127) + eighths + 1
+    };
+    let occupied = values.par_iter().filter(|v| **v != 0.0).map(|&v| bin(v));
+    let (lo, hi) = occupied
+        .fold(|| (i64::MAX, i64::MIN), |(a, b), k| (a.min(k), b.max(k)))
+        .reduce(|| (i64::MAX, i64::MIN), |x, y| (x.0.min(y.0), x.1.max(y.1)));
+    if lo > hi {
+        return (Vec::new(), 0);
+    }
+    let len = (hi - lo + 1) as usize;
+    let bins = values
+        .par_chunks(1 << 16)
+        .fold(
+            || vec![0f64; len],
+            |mut acc, chunk| {
+                for &v in chunk.iter().filter(|v| **v != 0.0) {
+                    acc[(bin(v) - lo) as usize] += v as f64 * v as f64;
+                }
+                acc
+            },
+        )
+        .reduce(
+            || vec![0f64; len],
+            |mut a, b| {
+                for (x, y) in a.iter_mut().zip(b) {
+                    *x += y;
+                }
+                a
+            },
+        );
+    (bins, lo)
 }
 
 /// What the user asked of adaptive filtering.
@@ -386,8 +463,7 @@ impl AdaptiveMarks {
             let gain = large.response(0.0) / small.response(0.0);
             let (threshold, error_ratio) = match model.as_mut() {
                 Some(model) => {
-                    let start = threshold_for(total, |i| view.value(i), h_d, budget);
-                    let (tau, ratio) = model.threshold(&small, gain, budget, start)?;
+                    let (tau, ratio) = model.threshold(&small, gain, budget)?;
                     (tau, Some(ratio))
                 }
                 None => (threshold_for(total, |i| view.value(i), h_d, budget), None),
