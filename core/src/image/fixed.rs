@@ -12,6 +12,10 @@ use crate::dht::fixed::{idht_2d, FixedTwiddles};
 use crate::dht::{neg_mod, signed_index};
 use crate::error::{check_len, require_len, Result};
 
+#[cfg(test)]
+#[path = "fixed_tests.rs"]
+mod tests;
+
 /// Auxiliary `i32` scratch [`finish_fixed`] needs for an `m × m` grid: `4m`
 /// (the shift's cosines and sines per axis).
 pub const fn fixed_aux_len(m: usize) -> usize {

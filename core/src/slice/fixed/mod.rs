@@ -42,6 +42,8 @@
 
 mod axes;
 mod phases;
+#[cfg(test)]
+mod tests;
 
 pub use phases::FixedPhases;
 

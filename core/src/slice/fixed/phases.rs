@@ -2,8 +2,11 @@
 //! (or fewer fraction bits), read with an integer interpolation.
 
 use crate::error::{mismatch, Error, Result};
-use crate::filter::{phase_entry, Filter, KernelTable, TABLE_RESOLUTION};
+use crate::filter::{phase_entry, Filter, KernelTable, MAX_WIDTH, TABLE_RESOLUTION};
 use crate::num::Real;
+
+/// Entries of the widest kernel table: `MAX_WIDTH·1024/2 + 1`.
+const ENTRIES_CAP: usize = MAX_WIDTH * TABLE_RESOLUTION / 2 + 1;
 
 /// Bits of the phase fraction the weights are interpolated with.
 const FRACTION_BITS: u32 = 14;
@@ -26,9 +29,8 @@ pub(super) const MAX_ABS_SUM: i64 = (1 << 16) - 1;
 /// position's fraction in 14 bits, rounded down: it lies between the two
 /// rows' weights, so its magnitude sum obeys the same bound.
 ///
-/// Built once per filter: the kernel's entries are rounded from `T` (soft
-/// float on a core without an FPU, `W·1024/2 + 1` conversions), the rest
-/// is integer.
+/// Built once per filter: the kernel's `W·1024/2 + 1` entries are rounded
+/// in `T` (soft float on a core without an FPU), the rest is integer.
 #[derive(Clone, Debug)]
 pub struct FixedPhases<const W: usize> {
     filter: Filter,
@@ -62,20 +64,27 @@ impl<const W: usize> FixedPhases<W> {
         }
         self.filter = *kernel.filter();
         let values = kernel.values();
-        // The magnitude sum of a row in units of the kernel's values, read
-        // once in f64 per entry: rows are gathered in fixed point below.
+        // The kernel's entries rounded once per try (half up, in `T`: the
+        // product by a power of two is exact and the entries are at most 1
+        // in magnitude here, so `floor(x + ½)` is the rounding of x), then
+        // gathered in integers.
+        let mut rounded = [0i32; ENTRIES_CAP];
         for bits in (8..=15).rev() {
-            let scale = (1u32 << bits) as f64;
-            let round = |v: T| {
-                let r = libm::round(v.to_f64() * scale);
-                // Entries are finite (the kernel table checks); magnitudes
-                // above 1 (none here) saturate, and the bound check below
-                // then asks for fewer bits.
-                r.clamp(-(1 << 30) as f64, (1 << 30) as f64) as i32
-            };
+            let scale = T::from_f64((1u32 << bits) as f64);
+            for (r, v) in rounded.iter_mut().zip(values) {
+                // Saturates (never wraps) for entries beyond 2^15 (none
+                // here): the bound check below then asks for fewer bits.
+                *r = (*v * scale + T::HALF)
+                    .floor_i64()
+                    .clamp(-(1 << 29), 1 << 29) as i32;
+            }
             let entry = |i: usize, m: usize| {
                 let index = phase_entry::<W>(i, m).unsigned_abs() as usize;
-                values.get(index).copied().map_or(0, round)
+                if index < values.len() {
+                    rounded.get(index).copied().unwrap_or(0)
+                } else {
+                    0
+                }
             };
             let mut worst = 0i64;
             for m in 0..W {
