@@ -26,8 +26,10 @@
 //!
 //! So the grid's exponent is `E − 15 − 3F + 32`; with `F = 15`, `E − 28`,
 //! and a point's value keeps about 30 bits while the stored mantissas have
-//! 16. The shifts round down (a bias of half a unit of the last place, at
-//! least 2^14 times below the Q15 rounding the finish applies). Nothing
+//! 16. The shifts round down: a bias of half a unit of the last place,
+//! far below the Q15 rounding the finish applies to the slice, whose peak
+//! (at or near the DC term every slice passes through) is about the
+//! spectrum's largest coefficient, `2^28` units. Nothing
 //! can overflow, whatever the mantissas (the overflow flag −32768 reads as
 //! −1) and exponents (−128 … 127), so the extraction never panics on data.
 //!
