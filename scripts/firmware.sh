@@ -11,8 +11,9 @@
 #  5. prints the instruction counts and the flash/RAM footprint;
 #  6. the same for the Cortex-M3 (no FPU): builds fvr-fixed-bench for
 #     thumbv7m-none-eabi, runs it under QEMU mps2-an385, checks its integer
-#     transforms against the host bit for bit (firmware/tests/qemu_fixed.rs)
-#     and prints its counts and footprint;
+#     transforms and its whole plain kb3 view (integer and soft-float f32)
+#     against the host bit for bit (firmware/tests/qemu_fixed.rs) and prints
+#     its counts and footprint;
 #  7. checks that a scene over the flash budget fails to build, naming the
 #     excess (build.rs for the tables alone, the linker for tables + code).
 # Usage: bash scripts/firmware.sh
@@ -55,6 +56,19 @@ target_dir=$(cargo metadata --format-version 1 --no-deps --locked \
     | python3 -c 'import json, sys; print(json.load(sys.stdin)["target_directory"])')
 bin_dir="$target_dir/$TARGET/release"
 run_dir="$target_dir/fvr-firmware-run"
+
+# The Cortex-M3's whole plain kb3 64x64 view (fvr-fixed-bench): integer
+# (set-up, extraction, finish) against soft-float f32, from its log.
+m3_view_counts() {
+    local log="$run_dir/$M3_PROGRAM.log" view soft
+    echo "== firmware: Cortex-M3 whole view (plain kb3 64x64, exact to +-40)"
+    grep -h '^fixed phases-q15:' "$log" || fail "$M3_PROGRAM: no phase-table count"
+    grep -h '^fixed view-q15:' "$log" || fail "$M3_PROGRAM: no integer view count"
+    grep -h '^fixed view-f32:' "$log" || fail "$M3_PROGRAM: no soft-float view count"
+    view=$(sed -n 's/^fixed view-q15: \([0-9]*\) .*/\1/p' "$log")
+    soft=$(sed -n 's/^fixed view-f32: \([0-9]*\) .*/\1/p' "$log")
+    echo "soft-float f32 view / integer view: $(python3 -c "print(f'{$soft / $view:.2f}')")"
+}
 
 echo "== firmware: build ($TARGET, release)"
 cargo clippy --locked -p fvr-firmware --target "$TARGET" --release -- -D warnings
@@ -143,6 +157,7 @@ q15=$(sed -n 's/^fixed idht-2d-q15: \([0-9]*\) .*/\1/p' "$run_dir/$M3_PROGRAM.lo
 soft=$(sed -n 's/^fixed idht-2d-f32: \([0-9]*\) .*/\1/p' "$run_dir/$M3_PROGRAM.log")
 [ -n "$q15" ] && [ -n "$soft" ] || fail "$M3_PROGRAM: no transform counts in its log"
 echo "soft-float f32 / Q15: $(python3 -c "print(f'{$soft / $q15:.2f}')")"
+m3_view_counts
 echo "== firmware: Cortex-M3 footprint (bytes)"
 footprint_header
 footprint "$m3_elf" "$M3_PROGRAM"

@@ -208,6 +208,12 @@ pub enum Error {
         /// Index of the first bad entry.
         index: usize,
     },
+    /// A value outside the range the fixed-point pipeline's overflow proof
+    /// covers (e.g. a slice axis component beyond ±16 index units).
+    FixedPointRange {
+        /// What was out of range, and the range.
+        what: &'static str,
+    },
 }
 
 /// Shorthand for results of this crate.
@@ -350,6 +356,9 @@ impl fmt::Display for Error {
             ),
             Error::TableEntryOutOfRange { what, index } => {
                 write!(f, "{what} entry {index} is out of range")
+            }
+            Error::FixedPointRange { what } => {
+                write!(f, "out of the fixed-point pipeline's range: {what}")
             }
         }
     }

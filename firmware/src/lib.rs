@@ -18,10 +18,12 @@
 
 pub mod capture;
 pub mod display;
+pub mod fixed_view;
 pub mod frame;
 pub mod nrrd;
 pub mod scene;
 pub mod stored;
+pub mod stored_q15;
 
 #[cfg(target_os = "none")]
 pub mod device;

@@ -6,19 +6,30 @@
 //! tests): `6.02·(F − 3) + 7.78 − 10·log10 L − 20·log10 κ` dB for `F`
 //! fraction bits, `L` rounded stages and crest factor `κ`.
 //!
+//! The whole plain kb3 view too: the integer one
+//! (`fvr_firmware::fixed_view`, exponent and Q15 mantissas) and the
+//! soft-float f32 one (`fvr_firmware::frame::render_frame`) must equal the
+//! host's bit for bit; their dB against the f64 pipeline are printed, and
+//! the integer one must meet the floor `tests/fixed_view.rs` asserts on the
+//! host's (the same bits).
+//!
 //! Needs the QEMU outputs, so it is ignored in `cargo test` and run by
 //! `scripts/firmware.sh` as
 //! `FVR_QEMU_OUT=<dir> cargo test -p fvr-firmware --test qemu_fixed -- --ignored`.
 
+mod common;
 #[allow(dead_code)]
 #[path = "../src/fixed_input.rs"]
 mod fixed_input;
 
 use std::path::{Path, PathBuf};
 
+use common::fixed::{f64_view, integer_floor_db, integer_view, snr, values};
+use common::{exact_image, host_image};
 use fixed_input::{f32_from_q15, q15_block, q31_from_q15, LEN, SIDE};
 use fvr_core::dht::fixed::{self, FixedSample, FixedTwiddles};
 use fvr_core::dht::{self, Twiddles};
+use fvr_firmware::scene::SCENE_FRAMES;
 
 /// The input block, as Q15 mantissas.
 fn input() -> Vec<i16> {
@@ -194,5 +205,68 @@ fn qemu_fixed_transforms_equal_host_bit_for_bit() {
     if differing != 0 {
         failures.push("f32: not bit-identical to the host".to_string());
     }
+    failures.extend(check_views(&dir).err());
     assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// The two whole views against the host's, bit for bit, and their dB.
+fn check_views(dir: &Path) -> Result<(), String> {
+    let (f64_image, f64_slice) = f64_view();
+    let exact = exact_image(&SCENE_FRAMES[0]);
+
+    let (exp, host) = integer_view();
+    let bytes = read(dir, "fvr-fixed-bench-view-q15.bin");
+    assert_eq!(bytes.len(), 4 + 2 * host.len(), "view-q15");
+    let device_exp = i32::from_le_bytes(bytes[..4].try_into().unwrap());
+    let device: Vec<i16> = bytes[4..]
+        .chunks_exact(2)
+        .map(|b| i16::from_le_bytes([b[0], b[1]]))
+        .collect();
+    let differing = host.iter().zip(&device).filter(|(a, b)| a != b).count();
+    let image = values(device_exp, &device);
+    let (against_f64, floor) = (
+        snr(&f64_image, &image),
+        integer_floor_db(&f64_slice, &f64_image),
+    );
+    println!(
+        "fvr-fixed-bench-view-q15.bin: exponent {device_exp} (host {exp}), {differing} of {} \
+         pixels differ from the host; {against_f64:.1} dB against the f64 pipeline (floor \
+         {floor:.1} dB), {:.1} dB against exact line integrals",
+        host.len(),
+        snr(&exact, &image)
+    );
+
+    let host32 = host_image(&SCENE_FRAMES[0]);
+    let bytes = read(dir, "fvr-fixed-bench-view-f32.bin");
+    assert_eq!(bytes.len(), 4 * host32.len(), "view-f32");
+    let device32: Vec<f32> = bytes
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect();
+    let differing32 = host32
+        .iter()
+        .zip(&device32)
+        .filter(|(a, b)| a.to_bits() != b.to_bits())
+        .count();
+    let image32: Vec<f64> = device32.iter().map(|&v| v as f64).collect();
+    println!(
+        "fvr-fixed-bench-view-f32.bin: {differing32} of {} pixels differ from the host; \
+         {:.1} dB against the f64 pipeline, {:.1} dB against exact line integrals (soft float, \
+         f16 spectrum)",
+        host32.len(),
+        snr(&f64_image, &image32),
+        snr(&exact, &image32)
+    );
+    if differing != 0 || device_exp != exp {
+        return Err("view-q15: not bit-identical to the host".to_string());
+    }
+    if differing32 != 0 {
+        return Err("view-f32: not bit-identical to the host".to_string());
+    }
+    if against_f64 < floor {
+        return Err(format!(
+            "view-q15: {against_f64:.1} dB is below the floor {floor:.1} dB"
+        ));
+    }
+    Ok(())
 }

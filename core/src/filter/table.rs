@@ -235,9 +235,8 @@ impl<T: Real, const W: usize> PhaseTable<T, W> {
     /// Row `i`, weight `m`: the entry at `i + (W−2)·512 − 1024·m`.
     fn gather(&mut self, samples: &Samples<T>, odd: bool) {
         let values = &samples.values;
-        let centre = (W as i64 - 2) * (TABLE_RESOLUTION as i64 / 2);
         let entry = |i: usize, m: usize| {
-            let signed = i as i64 + centre - (m * TABLE_RESOLUTION) as i64;
+            let signed = phase_entry::<W>(i, m);
             // |index| ≤ W·512 < the table's length; 0 beyond, like `lerp`.
             let v = values
                 .get(signed.unsigned_abs() as usize)
@@ -302,6 +301,15 @@ impl<T: Real, const W: usize> PhaseTable<T, W> {
         let weights = core::array::from_fn(|m| p0[m] + f * dp[m]);
         ((floor >> TABLE_RESOLUTION.trailing_zeros()) + 1, weights)
     }
+}
+
+/// The signed kernel-table index of weight `m` of phase row `i` of a
+/// width-`W` [`PhaseTable`]: `i + (W−2)·512 − 1024·m` (the kernel at
+/// `|index|/1024`, negated for an odd table below zero).
+#[inline(always)]
+pub(crate) const fn phase_entry<const W: usize>(i: usize, m: usize) -> i64 {
+    let centre = (W as i64 - 2) * (TABLE_RESOLUTION as i64 / 2);
+    i as i64 + centre - (m * TABLE_RESOLUTION) as i64
 }
 
 /// One in the 32.32 fixed point of [`PhaseTable::fixed_position`].

@@ -6,6 +6,7 @@
 //! by the 2D DHT, and the `W × H` image is cut from the grid around the
 //! centre, times the gain.
 
+pub mod fixed;
 mod placement;
 
 pub use placement::{placement, placement_at_pitch, placement_on_axes, Placement};

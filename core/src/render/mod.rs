@@ -23,6 +23,7 @@
 //! coarsely in frequency, and `m = n/2^L` makes `n/(m·2^L·p) = 1/p`).
 //! [`Sampling::UNIT`] gives the voxel-unit image bit for bit.
 
+pub mod fixed;
 mod scene;
 
 use crate::dht::Twiddles;

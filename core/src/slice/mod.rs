@@ -16,6 +16,7 @@
 //! orthonormal.
 
 pub mod adaptive;
+pub mod fixed;
 mod reads;
 mod rows;
 mod taps;

@@ -3,8 +3,13 @@
 //! 64 × 64 block (`src/fixed_input.rs`) it counts the instructions of the
 //! inverse 2D transform in Q15, in Q31 and in soft-float f32, and of making
 //! the Q15 twiddle table on the device (soft-float `sin`) against taking it
-//! from flash (made by `build.rs`). It writes every result to the host
-//! (`fvr-fixed-bench-{q15,q31,f32}.bin`) for `tests/qemu_fixed.rs`
+//! from flash (made by `build.rs`). Then the whole plain kb3 64² view of
+//! the scene: in integers from the Q15 spectrum in flash
+//! (`fvr_firmware::fixed_view`, with its set-up, extraction and finish
+//! counted apart), and by the f32 core path in soft float from the f16
+//! spectrum (`fvr_firmware::frame::render_frame`, as on the M4F). It
+//! writes every result to the host (`fvr-fixed-bench-{q15,q31,f32}.bin`,
+//! `fvr-fixed-bench-view-{q15,f32}.bin`) for `tests/qemu_fixed.rs`
 //! (`bash scripts/firmware.sh`).
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
@@ -17,9 +22,15 @@ mod fixed_input;
 mod device {
     use fvr_core::dht::fixed::{idht_2d, FixedTwiddles};
     use fvr_core::dht::{self, Twiddles};
+    use fvr_core::slice::fixed::FixedPhases;
     use fvr_firmware::capture::ByteSink;
     use fvr_firmware::device::{HostFile, RunError, SysTickClock};
-    use fvr_firmware::frame::{FrameError, InstructionClock};
+    use fvr_firmware::fixed_view::{render_view, ViewBuffers, ViewError, WIDTH};
+    use fvr_firmware::frame::{
+        render_frame, tables_for, FrameBuffers, FrameError, InstructionClock,
+    };
+    use fvr_firmware::scene::SCENE_FRAMES;
+    use fvr_firmware::stored::{twiddles, DENSITY_KB3};
 
     use crate::fixed_input::{f32_from_q15, q15_block, q31_from_q15, LEN, SIDE};
 
@@ -35,8 +46,26 @@ mod device {
         pub f32: &'static mut [f32; LEN],
     }
 
-    pub fn run(blocks: Blocks) -> ! {
-        let status = match measure(blocks) {
+    /// The buffers of the two whole views, in `.bss`.
+    pub struct Views {
+        pub phases: &'static mut FixedPhases<WIDTH>,
+        pub grid: &'static mut [i32; LEN],
+        pub aux: &'static mut [i32; AUX],
+        pub block: &'static mut [i16; LEN],
+        pub image: &'static mut [i16; LEN],
+        pub staged: &'static mut [i16; LEN],
+        pub float_aux: &'static mut [f32; FLOAT_AUX],
+        pub float_image: &'static mut [f32; LEN],
+        pub float_staged: &'static mut [f32; LEN],
+    }
+
+    /// Elements of the integer view's auxiliary scratch.
+    pub const AUX: usize = fvr_firmware::fixed_view::AUX_LEN;
+    /// Elements of the f32 view's auxiliary scratch.
+    pub const FLOAT_AUX: usize = fvr_firmware::frame::AUX_LEN;
+
+    pub fn run(blocks: Blocks, views: Views) -> ! {
+        let status = match measure(blocks, views) {
             Ok(()) => 0,
             Err(e) => {
                 defmt::error!("{=str}: {}", PROGRAM, defmt::Debug2Format(&e));
@@ -72,7 +101,7 @@ mod device {
         Ok(())
     }
 
-    fn measure(blocks: Blocks) -> Result<(), RunError> {
+    fn measure(blocks: Blocks, views: Views) -> Result<(), RunError> {
         let peripherals =
             cortex_m::Peripherals::take().ok_or(RunError::Host("peripherals taken"))?;
         let mut clock = SysTickClock::start(peripherals.SYST);
@@ -156,7 +185,84 @@ mod device {
             blocks.f32.iter().map(|v| v.to_le_bytes()),
         )?;
 
+        whole_views(&clock, &tw, blocks.f32, views)?;
         clock.finish()
+    }
+
+    /// The plain kb3 64² view in integers and in soft-float f32.
+    fn whole_views(
+        clock: &SysTickClock,
+        tw: &FixedTwiddles<'_, i16>,
+        float_grid: &mut [f32; LEN],
+        views: Views,
+    ) -> Result<(), RunError> {
+        // Per filter, once: the Q15 phase table from the f32 kernel table
+        // in flash (soft-float roundings).
+        let kernel = DENSITY_KB3.kernel_table().map_err(core_error)?;
+        let (table, filled) = count(clock, || views.phases.fill(&kernel));
+        filled.map_err(core_error)?;
+        defmt::println!(
+            "fixed phases-q15: {=u64} instructions (kb3 phase table from the f32 kernel, once per filter; {=u32} fraction bits)",
+            table,
+            views.phases.fraction_bits()
+        );
+        let view_error = |e: ViewError| match e {
+            ViewError::Core(e) => core_error(e),
+            ViewError::StagedDiffers => {
+                RunError::Host("the staged integer view differs from render_fixed")
+            }
+        };
+        let (exp, counts) = render_view(
+            views.phases,
+            tw,
+            ViewBuffers {
+                grid: &mut views.grid[..],
+                aux: &mut views.aux[..],
+                block: &mut views.block[..],
+                image: &mut views.image[..],
+                staged: &mut views.staged[..],
+            },
+            clock,
+        )
+        .map_err(view_error)?;
+        defmt::println!(
+            "fixed view-q15: {=u64} instructions = set-up {=u64} + extraction {=u64} + finish {=u64} (staged; image exponent {=i32})",
+            counts.render,
+            counts.setup,
+            counts.extract,
+            counts.finish,
+            exp
+        );
+        send(
+            "fvr-fixed-bench-view-q15.bin",
+            &exp.to_le_bytes(),
+            views.image.iter().map(|m| m.to_le_bytes()),
+        )?;
+
+        let spec = &SCENE_FRAMES[0];
+        let tables = tables_for(spec, &[&DENSITY_KB3], &[]).map_err(RunError::Frame)?;
+        let ftw = twiddles().map_err(core_error)?;
+        let mut bufs = FrameBuffers {
+            fields: &mut float_grid[..],
+            aux: &mut views.float_aux[..],
+            image: &mut views.float_image[..],
+            staged: &mut views.float_staged[..],
+        };
+        let rendered =
+            render_frame(spec, &tables, &ftw, &mut bufs, clock).map_err(RunError::Frame)?;
+        let c = rendered.counts;
+        defmt::println!(
+            "fixed view-f32: {=u64} instructions = extraction {=u64} + inverse {=u64} (soft float, f16 spectrum, {=str})",
+            c.render,
+            c.extract,
+            c.inverse,
+            spec.name
+        );
+        send(
+            "fvr-fixed-bench-view-f32.bin",
+            &[],
+            views.float_image.iter().map(|v| v.to_le_bytes()),
+        )
     }
 }
 
@@ -171,7 +277,59 @@ fn main() -> ! {
     let (Some(q15), Some(q31), Some(f32)) = (q15, q31, f32) else {
         fvr_firmware::device::abort("blocks taken twice")
     };
-    device::run(device::Blocks { q15, q31, f32 })
+    use device::{AUX, FLOAT_AUX};
+    use fvr_core::slice::fixed::FixedPhases;
+    use fvr_firmware::fixed_view::WIDTH;
+    let Some(kernel) = fvr_firmware::stored::DENSITY_KB3.filter().ok() else {
+        fvr_firmware::device::abort("the kb3 filter in flash")
+    };
+    let phases = cortex_m::singleton!(PHASES: FixedPhases<WIDTH> = FixedPhases::zeroed(kernel));
+    let grid = cortex_m::singleton!(GRID: [i32; LEN] = [0; LEN]);
+    let aux = cortex_m::singleton!(AUX_I32: [i32; AUX] = [0; AUX]);
+    let block = cortex_m::singleton!(BLOCK: [i16; LEN] = [0; LEN]);
+    let image = cortex_m::singleton!(IMAGE: [i16; LEN] = [0; LEN]);
+    let staged = cortex_m::singleton!(STAGED: [i16; LEN] = [0; LEN]);
+    let float_aux = cortex_m::singleton!(FLOAT_AUX_F32: [f32; FLOAT_AUX] = [0.0; FLOAT_AUX]);
+    let float_image = cortex_m::singleton!(FLOAT_IMAGE: [f32; LEN] = [0.0; LEN]);
+    let float_staged = cortex_m::singleton!(FLOAT_STAGED: [f32; LEN] = [0.0; LEN]);
+    let (
+        Some(phases),
+        Some(grid),
+        Some(aux),
+        Some(block),
+        Some(image),
+        Some(staged),
+        Some(float_aux),
+        Some(float_image),
+        Some(float_staged),
+    ) = (
+        phases,
+        grid,
+        aux,
+        block,
+        image,
+        staged,
+        float_aux,
+        float_image,
+        float_staged,
+    )
+    else {
+        fvr_firmware::device::abort("view buffers taken twice")
+    };
+    device::run(
+        device::Blocks { q15, q31, f32 },
+        device::Views {
+            phases,
+            grid,
+            aux,
+            block,
+            image,
+            staged,
+            float_aux,
+            float_image,
+            float_staged,
+        },
+    )
 }
 
 #[cfg(target_os = "none")]

@@ -1,6 +1,8 @@
 //! Host-side helpers shared by the firmware's integration tests.
 #![allow(dead_code)] // each test binary uses a different part
 
+pub mod fixed;
+
 use fvr_core::geometry::{center, Frame};
 use fvr_core::image::{aux_len, grid_len};
 use fvr_core::render::{render, Buffers, Request, Source};

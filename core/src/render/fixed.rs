@@ -1,0 +1,74 @@
+//! A view in integers, for cores without an FPU: the X-ray projection of
+//! a Q15 block-floating-point spectrum as a Q15 image with one exponent.
+//!
+//! Per view, only the set-up is floating point: the camera frame
+//! ([`View::frame`]), the image's placement, the axes rounded to fixed
+//! point, and, when the image has a sub-pixel shift, two cosines and two
+//! sines. Extraction ([`crate::slice::fixed`]) and finish
+//! ([`crate::image::fixed`]) are integer.
+
+use crate::dht::fixed::FixedTwiddles;
+use crate::error::{Error, Result};
+use crate::geometry::View;
+use crate::image::fixed::{finish_fixed, FixedBuffers};
+use crate::image::placement;
+use crate::num::Q15;
+use crate::slice::fixed::{extract_slice_fixed, FixedPhases};
+use crate::spectrum::{CubeSide, Spectrum};
+
+/// What a fixed-point view is rendered from.
+#[derive(Clone, Copy, Debug)]
+pub struct FixedSource<'a, Z, const W: usize> {
+    /// The Q15 spectrum, with per-line block exponents or none.
+    pub spectrum: &'a Spectrum<'a, Q15, Z>,
+    /// The kernel weights of the spectrum's filter.
+    pub phases: &'a FixedPhases<W>,
+    /// Q15 twiddles serving the spectrum's side.
+    pub twiddles: &'a FixedTwiddles<'a, i16>,
+}
+
+/// Render the `width × height` X-ray projection along `view` (voxel units,
+/// level 0) into `buffers.out`; returns the exponent `e`: pixel `i` is
+/// `out[i]·2^e`, `∫ f dt` in voxel units of the input volume. The buffers
+/// are those of [`finish_fixed`] for the spectrum's side.
+///
+/// # Errors
+/// Bad view vectors, and those of [`extract_slice_fixed`] and
+/// [`finish_fixed`]; a spectrum scale that is not a power of two within
+/// ±2^30 ([`Error::FixedPointRange`]).
+pub fn render_fixed<Z: CubeSide, const W: usize>(
+    source: &FixedSource<'_, Z, W>,
+    view: &View,
+    (width, height): (usize, usize),
+    buffers: FixedBuffers<'_>,
+) -> Result<i32> {
+    let spec = source.spectrum;
+    let frame = view.frame()?;
+    let axes = frame.slice_axes();
+    let place = placement(spec.dims(), &frame, width, height);
+    let scale = scale_exponent(spec.scale())?;
+    let exponent = extract_slice_fixed(spec, source.phases, &axes, buffers.grid)?;
+    let image = finish_fixed(
+        buffers,
+        exponent,
+        spec.n(),
+        &place,
+        (width, height),
+        source.twiddles,
+    )?;
+    Ok(image - scale)
+}
+
+/// `k` for a scale `2^k` (the spectrum's scale is a power of two).
+///
+/// # Errors
+/// Not a power of two within ±2^30 ([`Error::FixedPointRange`]).
+pub fn scale_exponent(scale: f64) -> Result<i32> {
+    let (mantissa, k) = libm::frexp(scale);
+    if mantissa != 0.5 || !(-30..=32).contains(&k) {
+        return Err(Error::FixedPointRange {
+            what: "spectrum scale (a power of two within 2^±30)",
+        });
+    }
+    Ok(k - 1)
+}
