@@ -20,8 +20,12 @@ pub mod capture;
 pub mod display;
 pub mod frame;
 pub mod nrrd;
+pub mod prep_volume;
+pub mod prepare;
 pub mod scene;
 pub mod stored;
 
 #[cfg(target_os = "none")]
 pub mod device;
+#[cfg(all(target_os = "none", target_abi = "eabihf"))]
+pub mod prepare_device;
