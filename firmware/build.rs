@@ -1,6 +1,7 @@
 //! Build script of the firmware:
 //! 1. copies `memory.x` (`memory-m3.x` for the Cortex-M3 target
-//!    `thumbv7m-none-eabi`) to `OUT_DIR` as `memory.x`, puts that on the
+//!    `thumbv7m-none-eabi`, `memory-m7.x` with `--features m7`) to `OUT_DIR`
+//!    as `memory.x`, puts that on the
 //!    link path and, for the thumb targets, links with `link.x` and
 //!    `defmt.x`. (No `memory.x` may sit in the workspace root: the linker
 //!    runs there and would take it before the one in `OUT_DIR`.)
@@ -9,7 +10,9 @@
 //!    `|∇f|` if a stored spectrum needs it, prepares the f16 spectra listed
 //!    in `STORED`, tabulates the kernels, the kernel derivatives listed in
 //!    `DERIVATIVES` and the twiddles, and writes them to
-//!    `OUT_DIR` (the spectra as little-endian f16 files, the rest as Rust);
+//!    `OUT_DIR` (the spectra as little-endian f16 files, the rest as Rust).
+//!    For the device-preparation programs it writes u8 volumes, the filters
+//!    fitted to them and their kernel tables (`make_prep_tables`);
 //! 3. refuses a scene whose tables do not fit the flash in `memory.x`, saying
 //!    by how many bytes it is over.
 //!
