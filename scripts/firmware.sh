@@ -14,7 +14,11 @@
 #     transforms and its whole plain kb3 view (integer and soft-float f32)
 #     against the host bit for bit (firmware/tests/qemu_fixed.rs) and prints
 #     its counts and footprint;
-#  7. checks that a scene over the flash budget fails to build, naming the
+#  7. the transform on the device: builds fvr-prepare-m7 (--features m7),
+#     runs fvr-prepare on mps2-an386 and fvr-prepare-m7 on mps2-an500
+#     (Cortex-M7), checks their spectra and views against the host
+#     (firmware/tests/qemu_prepare.rs) and prints counts and RAM;
+#  8. checks that a scene over the flash budget fails to build, naming the
 #     excess (build.rs for the tables alone, the linker for tables + code).
 # Usage: bash scripts/firmware.sh
 set -euo pipefail
@@ -161,6 +165,45 @@ m3_view_counts
 echo "== firmware: Cortex-M3 footprint (bytes)"
 footprint_header
 footprint "$m3_elf" "$M3_PROGRAM"
+
+# ---- The transform on the device: fvr-prepare (Cortex-M4F, 32^3) and
+# fvr-prepare-m7 (Cortex-M7 with 1 MiB of RAM, 64^3) prepare a spectrum in
+# place in RAM from a u8 volume in flash and render the kb3 view from it.
+PREP_M4F_PROGRAM=fvr-prepare
+PREP_M7_PROGRAM=fvr-prepare-m7
+device_preparation() {
+    echo "== firmware: device preparation ($PREP_M4F_PROGRAM built above; $PREP_M7_PROGRAM with --features m7, memory-m7.x)"
+    # No clippy run of its own: the library and the program's macro are
+    # linted above, through fvr-prepare; the feature only swaps memory.x.
+    cargo build --locked -p fvr-firmware --target "$TARGET" --release --features m7 --bin "$PREP_M7_PROGRAM"
+    run_in_qemu mps2-an386 cortex-m4 "$bin_dir/$PREP_M4F_PROGRAM" "$PREP_M4F_PROGRAM"
+    run_in_qemu mps2-an500 cortex-m7 "$bin_dir/$PREP_M7_PROGRAM" "$PREP_M7_PROGRAM"
+    local program
+    for program in "$PREP_M4F_PROGRAM" "$PREP_M7_PROGRAM"; do
+        grep -q '^calibration: delay loop of 2000002 instructions counted as 2000000$' "$run_dir/$program.log" \
+            || fail "$program: the SysTick calibration is off"
+    done
+    echo "== firmware: device-prepared spectra and views against the host (bit for bit, dB)"
+    FVR_QEMU_OUT="$run_dir" cargo test --locked -p fvr-firmware --test qemu_prepare -- --ignored --nocapture
+    echo "== firmware: device preparation, instruction counts (exact to +-40) and RAM (bytes)"
+    printf '%-16s %5s %12s %12s %10s %10s %10s %8s %10s\n' \
+        program side preparation "(3D DHT)" render spectrum "RAM beyond" stack flash
+    for program in "$PREP_M4F_PROGRAM" "$PREP_M7_PROGRAM"; do
+        read -r side prep dht render < <(sed -n \
+            's/^prepare [^:]*: side \([0-9]*\), .*; preparation \([0-9]*\) instructions (3D DHT alone on a test signal \([0-9]*\)); render [0-9x]* view \([0-9]*\)$/\1 \2 \3 \4/p' \
+            "$run_dir/$program.log")
+        [ -n "${render:-}" ] || fail "$program: no preparation counts in its log"
+        read -r text rodata data bss vt < <(size -A "$bin_dir/$program" | awk '
+            $1==".text"{t=$2} $1==".rodata"{r=$2} $1==".data"{d=$2} $1==".bss"{b=$2} $1==".vector_table"{v=$2}
+            END{print t+0, r+0, d+0, b+0, v+0}')
+        stack=$(sed -n 's/^stack: peak \([0-9]*\) bytes.*/\1/p' "$run_dir/$program.log")
+        [ -n "$stack" ] || fail "$program: no stack measurement in its log"
+        spectrum=$((2 * side * side * side))
+        printf '%-16s %5s %12s %12s %10s %10s %10s %8s %10s\n' "$program" "$side" "$prep" "$dht" "$render" \
+            "$spectrum" $((data + bss + stack - spectrum)) "$stack" $((vt + text + rodata + data))
+    done
+}
+device_preparation
 
 echo "== firmware: a scene over the flash budget fails to build, naming the excess"
 # In a copy of the workspace whose firmware/memory.x is smaller, with its own

@@ -21,9 +21,13 @@ pub mod display;
 pub mod fixed_view;
 pub mod frame;
 pub mod nrrd;
+pub mod prep_volume;
+pub mod prepare;
 pub mod scene;
 pub mod stored;
 pub mod stored_q15;
 
 #[cfg(target_os = "none")]
 pub mod device;
+#[cfg(all(target_os = "none", target_abi = "eabihf"))]
+pub mod prepare_device;
