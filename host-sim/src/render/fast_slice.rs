@@ -332,7 +332,7 @@ impl<const W: usize, S: Sample, T: Real> Taps<'_, W, S, T> {
         let planes: [usize; W] = core::array::from_fn(|c| z0.wrapping_add(c * nn) & (nn * n - nn));
         let x0 = jx as usize & mask;
         let mut acc = T::ZERO;
-        if x0 + W <= n {
+        if x0 + W <= n && W <= 4 {
             for c in 0..W {
                 let mut acc_y = T::ZERO;
                 for b in 0..W {
@@ -346,6 +346,32 @@ impl<const W: usize, S: Sample, T: Real> Taps<'_, W, S, T> {
                     acc_y += wy[b] * acc_x;
                 }
                 acc += wz[c] * acc_y;
+            }
+        } else if x0 + W <= n {
+            // Wide filters: every plane's sums side by side (lanes `c`),
+            // each in the core's order: the same operations per plane,
+            // interleaved, which the compiler vectorizes (kb6 about 1.1 to
+            // 1.5× less CPU time a view; kb4 compiles slower this way).
+            let mut acc_y = [T::ZERO; W];
+            for b in 0..W {
+                let runs: [[S; W]; W] = core::array::from_fn(|c| {
+                    let start = planes[c] + lines[b] + x0;
+                    data.get(start..start + W)
+                        .and_then(|s| <[S; W]>::try_from(s).ok())
+                        .unwrap_or([S::default(); W])
+                });
+                let mut acc_x = [T::ZERO; W];
+                for t in 0..W {
+                    for c in 0..W {
+                        acc_x[c] += wx[t] * T::load_raw(runs[c][t]);
+                    }
+                }
+                for c in 0..W {
+                    acc_y[c] += wy[b] * acc_x[c];
+                }
+            }
+            for c in 0..W {
+                acc += wz[c] * acc_y[c];
             }
         } else {
             let xs: [usize; W] = core::array::from_fn(|t| (jx + t as i32) as usize & mask);
