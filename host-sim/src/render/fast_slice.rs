@@ -11,10 +11,13 @@
 //!   the Nyquist cube, and stealing evens that out, as well as a core taken
 //!   by another process.
 //! - **Tiles.** Inside a band the points are visited in chunks of `C`
-//!   columns, every pair of the band per chunk, instead of whole rows: the
-//!   `B + W − 1` planes (or lines) a chunk touches are read while they are
-//!   still in the first-level cache, where row by row each line comes back
-//!   from farther `W` times (once per row whose taps cover it).
+//!   columns, every pair of the band per chunk, instead of whole rows, so
+//!   that the lines a chunk's taps share between neighbouring rows are read
+//!   while they are still close. On the 2-core AMD EPYC machine of
+//!   docs/performance.md this measured within the run-to-run spread of
+//!   whole rows (`cargo bench -p fvr-host --bench view_cpu`); the tiling is
+//!   a tunable ([`Tiling`]).
+//! - **Wide filters** sum every plane of a point side by side.
 //!
 //! A point's fixed-point position is the row's anchor plus `(k − anchor)`
 //! steps, exactly the integer the core's running sum reaches, so the visit
