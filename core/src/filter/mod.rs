@@ -15,7 +15,7 @@ mod table;
 
 pub use kernel::{Filter, FilterKind, MAX_WIDTH};
 pub use special::{bessel_i0, bessel_i1_over_x};
-pub use table::{DerivativeTable, KernelTable, TABLE_RESOLUTION};
+pub use table::{DerivativeTable, KernelTable, PhaseTable, TABLE_RESOLUTION};
 
 pub(crate) use special::gauss_legendre_16;
-pub(crate) use table::{phase_entry, PhaseTable};
+pub(crate) use table::phase_entry;

@@ -186,7 +186,7 @@ impl<T: Real> KernelTable<T> {
 /// fractions (to the rounding of the fraction: `ε·1024·|q|` in index units
 /// for the position, `2^−42` for the fixed point).
 #[derive(Clone, Debug)]
-pub(crate) struct PhaseTable<T, const W: usize> {
+pub struct PhaseTable<T, const W: usize> {
     /// Row `i`: the weights at phase `i/1024` and their differences to
     /// row `i + 1` (the same `p1 − p0` the interpolation would compute),
     /// so that a weight is one multiply-add.
@@ -196,7 +196,7 @@ pub(crate) struct PhaseTable<T, const W: usize> {
 impl<T: Real, const W: usize> PhaseTable<T, W> {
     /// An all-zero table, to be [`PhaseTable::fill`]ed in place (the table
     /// is up to 48 KiB in f32: built where it stays, it is not copied).
-    pub(crate) fn zeroed() -> Self {
+    pub fn zeroed() -> Self {
         Self {
             rows: [[[T::ZERO; W]; 2]; TABLE_RESOLUTION],
         }
@@ -206,7 +206,7 @@ impl<T: Real, const W: usize> PhaseTable<T, W> {
     ///
     /// # Errors
     /// A kernel of another width ([`Error::LengthMismatch`]).
-    pub(crate) fn fill(&mut self, kernel: &KernelTable<T>) -> Result<()> {
+    pub fn fill(&mut self, kernel: &KernelTable<T>) -> Result<()> {
         let width = kernel.filter().width();
         if width != W {
             return Err(crate::error::mismatch("phase table width", width, W));
@@ -268,7 +268,7 @@ impl<T: Real, const W: usize> PhaseTable<T, W> {
     /// (exact in `T`) times `2^32`, truncated. Rows of the slice start from
     /// this and add [`PhaseTable::fixed_step`] per pixel.
     #[inline(always)]
-    pub(crate) fn fixed_position(q: T) -> i64 {
+    pub fn fixed_position(q: T) -> i64 {
         let y = q * T::from_usize(TABLE_RESOLUTION) - T::from_usize(W * TABLE_RESOLUTION / 2);
         let t = y.trunc_i32();
         let floor = t - (T::from_i32(t) > y) as i32;
@@ -284,7 +284,7 @@ impl<T: Real, const W: usize> PhaseTable<T, W> {
     /// pixels its rounding (≤ 2^−33 of a phase step a pixel) moves a sample
     /// by at most `m·2^−43` index units, far below `T`'s own rounding of
     /// `q` in f32 (`2^−24·|q|`).
-    pub(crate) fn fixed_step(r: T) -> i64 {
+    pub fn fixed_step(r: T) -> i64 {
         (r * T::from_f64(FIXED_ONE * TABLE_RESOLUTION as f64) + T::HALF).floor_i64()
     }
 
@@ -293,7 +293,7 @@ impl<T: Real, const W: usize> PhaseTable<T, W> {
     /// weights `k(q − j0 − m)`, `m = 0 … W−1`, interpolated between phase
     /// rows `F mod 1024` and the next by the 32-bit fraction.
     #[inline(always)]
-    pub(crate) fn taps_fixed_point(&self, y: i64) -> (i32, [T; W]) {
+    pub fn taps_fixed_point(&self, y: i64) -> (i32, [T; W]) {
         let floor = (y >> 32) as i32;
         let f = T::from_usize(y as u32 as usize) * T::from_f64(1.0 / FIXED_ONE);
         let row = (floor & (TABLE_RESOLUTION as i32 - 1)) as usize;

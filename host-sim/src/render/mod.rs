@@ -4,6 +4,7 @@
 pub mod adaptive;
 pub mod fast_dht;
 pub mod fast_prepare;
+pub mod fast_slice;
 pub mod fast_store;
 #[cfg(test)]
 mod fast_tests;

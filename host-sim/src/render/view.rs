@@ -10,6 +10,7 @@ use fvr_core::render::{render, Buffers, Request, Source};
 use fvr_core::slice::extract_slice_rows;
 use fvr_core::spectrum::Spectrum;
 
+use super::fast_slice::{self, Tiling};
 use super::spectrum::OwnedSpectrum;
 
 /// Reusable per-view buffers and tables for arithmetic `T`.
@@ -21,6 +22,8 @@ pub struct ViewRenderer<T> {
     aux: Vec<T>,
     n: usize,
     threads: usize,
+    pool: Option<rayon::ThreadPool>,
+    tiling: Tiling,
 }
 
 impl<T: Real> ViewRenderer<T> {
@@ -35,6 +38,8 @@ impl<T: Real> ViewRenderer<T> {
             aux: vec![T::ZERO; aux_len(n)],
             n,
             threads: 0,
+            pool: None,
+            tiling: Tiling::default(),
         }
     }
 
@@ -42,6 +47,21 @@ impl<T: Real> ViewRenderer<T> {
     /// core). The image is the same bit for bit whatever the count.
     pub fn with_threads(mut self, threads: usize) -> Self {
         self.threads = threads;
+        self.pool = (threads > 1)
+            .then(|| {
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .ok()
+            })
+            .flatten();
+        self
+    }
+
+    /// Walk plain power-of-two spectra with `tiling`
+    /// ([`fast_slice::extract`]; the image is the same whatever it is).
+    pub fn with_tiling(mut self, tiling: Tiling) -> Self {
+        self.tiling = tiling;
         self
     }
 
@@ -81,6 +101,29 @@ impl<T: Real> ViewRenderer<T> {
         let tw = Twiddles::from_table(&self.tw, self.n)?;
         let spec = spec.view();
         let n = spec.n();
+        if self.grid.len() == grid_len(n) && fast_slice::supports(&spec) {
+            let axes = sampling.slice_axes(&view.frame()?);
+            check_image(width, height, n)?;
+            let (kernel, tiling, grid) = (&self.kernel, self.tiling, &mut self.grid);
+            let filled = match (&self.pool, self.threads) {
+                (_, 1) => fast_slice::extract(&spec, kernel, &axes, tiling, false, grid),
+                (Some(pool), _) => {
+                    pool.install(|| fast_slice::extract(&spec, kernel, &axes, tiling, true, grid))
+                }
+                (None, _) => fast_slice::extract(&spec, kernel, &axes, tiling, true, grid),
+            };
+            if filled {
+                let place = placement_on_axes(spec.dims(), &axes, width, height, 1.0);
+                return finish(
+                    &mut self.grid,
+                    n,
+                    &Crop::new(place, sampling.gain() / spec.scale(), width, height),
+                    &tw,
+                    &mut self.aux,
+                    out,
+                );
+            }
+        }
         let threads = match self.threads {
             0 => std::thread::available_parallelism().map_or(1, |t| t.get()),
             t => t,

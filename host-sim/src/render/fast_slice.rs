@@ -1,0 +1,397 @@
+//! The host's slice extraction for plain spectra of power-of-two side: the
+//! core's phase-table extraction (`fvr_core::slice`), point for point the
+//! same arithmetic in the same order, so the slice is the same bit for bit,
+//! but walked for the host's caches and cores.
+//!
+//! - **Mirror pairs stay together.** Row `p` and row `−p` share every
+//!   point's setup (taps reflected through the origin, same weights), so
+//!   the unit of work is a *band* of consecutive pairs `p = p0 … p0 + B − 1`
+//!   with both of their rows, and the bands go to the threads by work
+//!   stealing (rayon): rows near `ky = 0` have the longest intervals inside
+//!   the Nyquist cube, and stealing evens that out, as well as a core taken
+//!   by another process.
+//! - **Tiles.** Inside a band the points are visited in chunks of `C`
+//!   columns, every pair of the band per chunk, instead of whole rows, so
+//!   that the lines a chunk's taps share between neighbouring rows are read
+//!   while they are still close. On the 2-core AMD EPYC machine of
+//!   docs/performance.md this measured within the run-to-run spread of
+//!   whole rows (`cargo bench -p fvr-host --bench view_cpu`); the tiling is
+//!   a tunable ([`Tiling`]).
+//! - **Wide filters** sum every plane of a point side by side.
+//!
+//! A point's fixed-point position is the row's anchor plus `(k − anchor)`
+//! steps, exactly the integer the core's running sum reaches, so the visit
+//! order changes nothing in the values.
+
+use fvr_core::filter::{KernelTable, PhaseTable, MAX_WIDTH};
+use fvr_core::geometry::SliceAxes;
+use fvr_core::num::{Real, Sample};
+use fvr_core::spectrum::Spectrum;
+use rayon::prelude::*;
+
+/// How the host extraction walks the slice: `band` mirror pairs per unit
+/// of work, `chunk` columns per tile.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tiling {
+    /// Mirror pairs (rows `p` and `−p`) per unit of work (≥ 1).
+    pub band: usize,
+    /// Columns per tile inside a band (≥ 1).
+    pub chunk: usize,
+}
+
+impl Default for Tiling {
+    /// 8 pairs by 32 columns (`cargo bench -p fvr-host --bench view`).
+    fn default() -> Self {
+        Self { band: 8, chunk: 32 }
+    }
+}
+
+/// Whether [`extract`] serves `spec`: plain coefficients (no block
+/// exponents), a power-of-two side and exactly `n³` of them.
+pub fn supports<S: Sample>(spec: &Spectrum<'_, S>) -> bool {
+    let n = spec.n();
+    n.is_power_of_two() && spec.blocks().is_none() && spec.data().len() == n * n * n
+}
+
+/// Fill the `n × n` slice `grid` (`kx` fastest, natural DHT order) on
+/// `axes`, as `fvr_core::slice::extract_slice_rows` over all rows would,
+/// bit for bit: on the current rayon pool's threads when `parallel`, else
+/// on this thread. `false` (grid untouched)
+/// when [`supports`] does not hold, the grid is not `n²` or `kernel`
+/// is not the spectrum's filter.
+pub fn extract<S: Sample, T: Real + Send + Sync>(
+    spec: &Spectrum<'_, S>,
+    kernel: &KernelTable<T>,
+    axes: &SliceAxes,
+    tiling: Tiling,
+    parallel: bool,
+    grid: &mut [T],
+) -> bool {
+    let n = spec.n();
+    if !supports(spec) || grid.len() != n * n || kernel.filter() != spec.filter() {
+        return false;
+    }
+    let geometry = Geometry {
+        right: axes.right.map(T::from_f64),
+        up: axes.up.map(T::from_f64),
+        n,
+        tiling: Tiling {
+            band: tiling.band.max(1),
+            chunk: tiling.chunk.max(1),
+        },
+        parallel,
+    };
+    let data = spec.data();
+    match kernel.filter().width() {
+        1 => walk::<1, S, T>(data, kernel, &geometry, grid),
+        2 => walk::<2, S, T>(data, kernel, &geometry, grid),
+        3 => walk::<3, S, T>(data, kernel, &geometry, grid),
+        4 => walk::<4, S, T>(data, kernel, &geometry, grid),
+        5 => walk::<5, S, T>(data, kernel, &geometry, grid),
+        _ => walk::<MAX_WIDTH, S, T>(data, kernel, &geometry, grid),
+    }
+}
+
+/// The slice's axes in `T`, the cube side and the walk.
+struct Geometry<T> {
+    right: [T; 3],
+    up: [T; 3],
+    n: usize,
+    tiling: Tiling,
+    parallel: bool,
+}
+
+/// One mirror pair of a band: row `p` (`plus`, absent for `p = n/2`) and
+/// row `−p` (`minus`; row 0 is its own mirror and holds both halves), the
+/// pair's interval of `kx` inside the Nyquist cube and its anchor's
+/// fixed-point position.
+struct Pair<'g, T> {
+    p: usize,
+    plus: Option<&'g mut [T]>,
+    minus: Option<&'g mut [T]>,
+    low: i32,
+    high: i32,
+    anchor: i32,
+    base: [i64; 3],
+}
+
+/// The walk for filter width `W`: rows split into bands of pairs, each
+/// band set up, then filled tile by tile.
+#[inline(never)]
+fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
+    data: &[S],
+    kernel: &KernelTable<T>,
+    g: &Geometry<T>,
+    grid: &mut [T],
+) -> bool {
+    let mut phases = Box::new(PhaseTable::<T, W>::zeroed());
+    if phases.fill(kernel).is_err() {
+        return false;
+    }
+    let n = g.n;
+    let mask = n - 1;
+    let mut rows: Vec<Option<&mut [T]>> = grid.chunks_exact_mut(n).map(Some).collect();
+    // Signed frequencies of a row: −n/2 … n/2 − 1; row `p` holds `ky = p`
+    // for `p ≤ k_max`, row `(n − p) mod n` holds `ky = −p`.
+    let k_max = (n - 1) / 2;
+    let pairs: Vec<Pair<'_, T>> = (0..=n / 2)
+        .map(|p| {
+            let plus = if p <= k_max { rows[p].take() } else { None };
+            let minus = if p == 0 {
+                None
+            } else {
+                rows[(n - p) & mask].take()
+            };
+            Pair {
+                p,
+                plus,
+                minus,
+                low: 1,
+                high: 0,
+                anchor: 0,
+                base: [0; 3],
+            }
+        })
+        .collect();
+    let mut bands: Vec<Vec<Pair<'_, T>>> = Vec::new();
+    let mut pairs = pairs.into_iter().peekable();
+    while pairs.peek().is_some() {
+        bands.push(pairs.by_ref().take(g.tiling.band).collect());
+    }
+    let taps = Taps::<W, S, T> {
+        data,
+        n,
+        phases: &phases,
+        raw_gain: T::exp2i(T::raw_exponent::<S>()),
+        step: g.right.map(PhaseTable::<T, W>::fixed_step),
+    };
+    let fill = |band: &mut Vec<Pair<'_, T>>| fill_band(&taps, g, band);
+    if g.parallel {
+        bands.par_iter_mut().for_each(fill);
+    } else {
+        bands.iter_mut().for_each(fill);
+    }
+    true
+}
+
+/// Set up and fill one band of pairs.
+fn fill_band<const W: usize, S: Sample, T: Real>(
+    taps: &Taps<'_, W, S, T>,
+    g: &Geometry<T>,
+    band: &mut [Pair<'_, T>],
+) {
+    let n = g.n;
+    let half = (n / 2) as i32;
+    let (mut first, mut last) = (i32::MAX, i32::MIN);
+    for pair in band.iter_mut() {
+        for row in [&mut pair.plus, &mut pair.minus].into_iter().flatten() {
+            row.fill(T::ZERO);
+        }
+        let ky = T::from_usize(pair.p);
+        let kyu = g.up.map(|c| ky * c);
+        let (low, high) = row_interval(n, &g.right, kyu);
+        let k_low = if pair.p == 0 { 0 } else { -half };
+        let (low, high) = (low.max(k_low), high.min(half));
+        if low > high {
+            continue;
+        }
+        let anchor = 0.clamp(low, high);
+        let kx = T::from_i32(anchor);
+        pair.base =
+            core::array::from_fn(|a| PhaseTable::<T, W>::fixed_position(kx * g.right[a] + kyu[a]));
+        (pair.low, pair.high, pair.anchor) = (low, high, anchor);
+        first = first.min(low);
+        last = last.max(high);
+    }
+    let chunk = g.tiling.chunk.min(n) as i32;
+    let mut start = first;
+    while start <= last {
+        let end = start.saturating_add(chunk - 1).min(last);
+        for pair in band.iter_mut() {
+            fill_pair(taps, pair, start.max(pair.low), end.min(pair.high), n);
+        }
+        start = end.saturating_add(1);
+    }
+}
+
+/// Points `k = from … to` of one pair, with their mirrors.
+#[inline(always)]
+fn fill_pair<const W: usize, S: Sample, T: Real>(
+    taps: &Taps<'_, W, S, T>,
+    pair: &mut Pair<'_, T>,
+    from: i32,
+    to: i32,
+    n: usize,
+) {
+    let k_max = ((n - 1) / 2) as i32;
+    let mask = n - 1;
+    let p = pair.p;
+    let has_plus = pair.plus.is_some();
+    // Row 0's mirrors land in row 0 itself.
+    let has_minus = pair.minus.is_some() || p == 0;
+    for k in from..=to {
+        let plus = has_plus && k <= k_max;
+        let minus = has_minus && -k <= k_max && (p > 0 || k > 0);
+        if !(plus || minus) {
+            continue;
+        }
+        let steps = (k - pair.anchor) as i64;
+        let y: [i64; 3] = core::array::from_fn(|a| pair.base[a] + steps * taps.step[a]);
+        let (value, mirror) = taps.point(y, plus, minus);
+        if plus {
+            if let Some(g) = pair
+                .plus
+                .as_deref_mut()
+                .and_then(|r| r.get_mut(k as usize & mask))
+            {
+                *g = value;
+            }
+        }
+        if minus {
+            let row = match pair.minus.as_deref_mut() {
+                Some(r) => Some(r),
+                None => pair.plus.as_deref_mut(),
+            };
+            if let Some(g) = row.and_then(|r| r.get_mut(k.wrapping_neg() as usize & mask)) {
+                *g = mirror;
+            }
+        }
+    }
+}
+
+/// The integers `kx` with `|kx·r_a + c_a| ≤ n/2` on every axis, as the
+/// core's row interval computes them (the same operations in `T`, so the
+/// same interval).
+fn row_interval<T: Real>(n: usize, right: &[T; 3], c: [T; 3]) -> (i32, i32) {
+    let half = T::from_usize(n) * T::HALF;
+    let (mut low, mut high) = (-T::from_usize(n), T::from_usize(n));
+    for a in 0..3 {
+        let (r, c) = (right[a], c[a]);
+        if r == T::ZERO {
+            if c > half || -c > half {
+                return (1, 0);
+            }
+            continue;
+        }
+        let (t1, t2) = ((-half - c) / r, (half - c) / r);
+        let (t_low, t_high) = if t1 < t2 { (t1, t2) } else { (t2, t1) };
+        if t_low > low {
+            low = t_low;
+        }
+        if t_high < high {
+            high = t_high;
+        }
+    }
+    (-((-low).floor_i64() as i32), high.floor_i64() as i32)
+}
+
+/// The tap sums of one point and its mirror from the phase table.
+struct Taps<'a, const W: usize, S, T> {
+    data: &'a [S],
+    n: usize,
+    phases: &'a PhaseTable<T, W>,
+    raw_gain: T,
+    step: [i64; 3],
+}
+
+impl<const W: usize, S: Sample, T: Real> Taps<'_, W, S, T> {
+    /// The value at fixed-point position `y` (when `plus`) and at its
+    /// mirror `−q` (when `minus`): taps `−j − t`, the run from
+    /// `−j − (W − 1)` with the weights reversed.
+    #[inline(always)]
+    fn point(&self, y: [i64; 3], plus: bool, minus: bool) -> (T, T) {
+        let (jx, wx) = self.phases.taps_fixed_point(y[0]);
+        let (jy, wy) = self.phases.taps_fixed_point(y[1]);
+        let (jz, wz) = self.phases.taps_fixed_point(y[2]);
+        let wx = wx.map(|w| w * self.raw_gain);
+        let value = if plus {
+            self.value(jx, &wx, jy, &wy, jz, &wz)
+        } else {
+            T::ZERO
+        };
+        let mirrored = if minus {
+            let mirror = |j: i32| -j - (W as i32 - 1);
+            let reversed = |w: &[T; W]| -> [T; W] { core::array::from_fn(|t| w[W - 1 - t]) };
+            let (rx, ry, rz) = (reversed(&wx), reversed(&wy), reversed(&wz));
+            self.value(mirror(jx), &rx, mirror(jy), &ry, mirror(jz), &rz)
+        } else {
+            T::ZERO
+        };
+        (value, mirrored)
+    }
+
+    /// `Σ_c wz_c Σ_b wy_b Σ_t wx_t·c[z + c, y + b, x + t]` (indices wrapping
+    /// around the cube), summed in the core's order: each x-line from
+    /// zero, tap by tap, then lines into planes, planes into the value.
+    #[inline(always)]
+    fn value(&self, jx: i32, wx: &[T; W], jy: i32, wy: &[T; W], jz: i32, wz: &[T; W]) -> T {
+        let (data, n) = (self.data, self.n);
+        let (nn, mask) = (n * n, n - 1);
+        let (y0, z0) = (
+            (jy as usize).wrapping_mul(n),
+            (jz as usize).wrapping_mul(nn),
+        );
+        let lines: [usize; W] = core::array::from_fn(|b| y0.wrapping_add(b * n) & (nn - n));
+        let planes: [usize; W] = core::array::from_fn(|c| z0.wrapping_add(c * nn) & (nn * n - nn));
+        let x0 = jx as usize & mask;
+        let mut acc = T::ZERO;
+        if x0 + W <= n && W <= 4 {
+            for c in 0..W {
+                let mut acc_y = T::ZERO;
+                for b in 0..W {
+                    let start = planes[c] + lines[b] + x0;
+                    let mut acc_x = T::ZERO;
+                    if let Some(run) = data.get(start..start + W) {
+                        for t in 0..W {
+                            acc_x += wx[t] * T::load_raw(run[t]);
+                        }
+                    }
+                    acc_y += wy[b] * acc_x;
+                }
+                acc += wz[c] * acc_y;
+            }
+        } else if x0 + W <= n {
+            // Wide filters: every plane's sums side by side (lanes `c`),
+            // each in the core's order: the same operations per plane,
+            // interleaved, which the compiler vectorizes (kb6 about 1.1 to
+            // 1.5× less CPU time a view; kb4 compiles slower this way).
+            let mut acc_y = [T::ZERO; W];
+            for b in 0..W {
+                let runs: [[S; W]; W] = core::array::from_fn(|c| {
+                    let start = planes[c] + lines[b] + x0;
+                    data.get(start..start + W)
+                        .and_then(|s| <[S; W]>::try_from(s).ok())
+                        .unwrap_or([S::default(); W])
+                });
+                let mut acc_x = [T::ZERO; W];
+                for t in 0..W {
+                    for c in 0..W {
+                        acc_x[c] += wx[t] * T::load_raw(runs[c][t]);
+                    }
+                }
+                for c in 0..W {
+                    acc_y[c] += wy[b] * acc_x[c];
+                }
+            }
+            for c in 0..W {
+                acc += wz[c] * acc_y[c];
+            }
+        } else {
+            let xs: [usize; W] = core::array::from_fn(|t| (jx + t as i32) as usize & mask);
+            for c in 0..W {
+                let mut acc_y = T::ZERO;
+                for b in 0..W {
+                    let line = planes[c] + lines[b];
+                    let mut acc_x = T::ZERO;
+                    for t in 0..W {
+                        let v = data.get(line + xs[t]).copied().unwrap_or_default();
+                        acc_x += wx[t] * T::load_raw(v);
+                    }
+                    acc_y += wy[b] * acc_x;
+                }
+                acc += wz[c] * acc_y;
+            }
+        }
+        acc
+    }
+}

@@ -1,0 +1,163 @@
+//! The host extraction (`fvr_host::render::fast_slice`) against the
+//! core's (`fvr_core::slice::extract_slice_rows`): the same slice bit for
+//! bit, for every filter width, f16 and f32 storage, f32 and f64
+//! arithmetic, axis-aligned, oblique and wrap-heavy directions (slices
+//! whose taps wrap around the cube at its faces, and near-axis ones whose
+//! runs straddle x = n − 1 → 0), physical-unit axes that are not
+//! orthonormal, and every tiling and thread split.
+
+use fvr_core::filter::{Filter, FilterKind, KernelTable};
+use fvr_core::geometry::{Sampling, SliceAxes, View};
+use fvr_core::num::{Real, Sample};
+use fvr_core::render::Request;
+use fvr_core::slice::extract_slice_rows;
+use fvr_host::render::fast_slice::{extract, supports, Tiling};
+use fvr_host::render::spectrum::{OwnedSpectrum, ViewRenderer};
+use fvr_host::render::view::render_once;
+use fvr_host::volume::Volume;
+use half::f16;
+
+/// Uniform values in `[−0.5, 1.5)` from a fixed-seed LCG: white noise, so
+/// the spectrum has energy up to the cube's faces and the wrapped taps
+/// carry weight.
+fn noise_volume(n: usize, seed: u64) -> Volume {
+    let mut state = seed;
+    let data = (0..n * n * n)
+        .map(|_| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            0.5 + ((state >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0)
+        })
+        .collect();
+    Volume::new([n, n, n], data)
+}
+
+const DIRECTIONS: [[f64; 3]; 6] = [
+    [0.0, -1.0, 0.0],
+    [1.0, 0.0, 0.0],
+    [1.0, 0.3, 0.2],
+    [1.0, -1.0, 0.0],
+    // Near-axis: rows run almost along x, so many x-runs straddle the
+    // wrap from n − 1 to 0.
+    [0.02, -1.0, 0.01],
+    [-0.4, 0.7, -0.6],
+];
+
+fn axes_for(dir: [f64; 3], sampling: &Sampling) -> SliceAxes {
+    sampling.slice_axes(&View::along(dir).frame().unwrap())
+}
+
+/// The core's slice over all rows, then the host's with `tiling`, compared
+/// bit for bit (as f64 bit patterns: exact for f32 and f64 alike).
+fn check<S: Sample, T: Real + Send + Sync>(
+    spec: &OwnedSpectrum<S>,
+    axes: &SliceAxes,
+    tilings: &[Tiling],
+    what: &str,
+) {
+    let view = spec.view();
+    let n = view.n();
+    let kernel = KernelTable::<T>::new(*view.filter());
+    let mut core = vec![T::ZERO; n * n];
+    extract_slice_rows(&view, &kernel, axes, 0, &mut core).unwrap();
+    assert!(
+        core.iter().filter(|v| v.to_f64() != 0.0).count() > n * n / 4,
+        "{what}: the slice is mostly zero"
+    );
+    for &tiling in tilings {
+        for parallel in [false, true] {
+            // Garbage first: every point must be written.
+            let mut host = vec![T::from_f64(7.0); n * n];
+            assert!(extract(&view, &kernel, axes, tiling, parallel, &mut host));
+            let differ = core
+                .iter()
+                .zip(&host)
+                .filter(|(a, b)| a.to_f64().to_bits() != b.to_f64().to_bits())
+                .count();
+            assert_eq!(differ, 0, "{what}, {tiling:?}, parallel {parallel}");
+        }
+    }
+}
+
+const TILINGS: [Tiling; 4] = [
+    Tiling { band: 1, chunk: 1 },
+    Tiling { band: 3, chunk: 5 },
+    Tiling { band: 8, chunk: 32 },
+    Tiling {
+        band: 1000,
+        chunk: 1000,
+    },
+];
+
+#[test]
+fn every_filter_and_direction_bit_identical_f16() {
+    let n = 32;
+    let volume = noise_volume(n, 7);
+    for kind in FilterKind::ALL {
+        let filter = Filter::new(kind, 1).unwrap();
+        let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+        assert!(supports(&spec.view()));
+        for dir in DIRECTIONS {
+            let axes = axes_for(dir, &Sampling::UNIT);
+            check::<f16, f32>(&spec, &axes, &TILINGS, &format!("{kind:?} f16 {dir:?}"));
+        }
+    }
+}
+
+#[test]
+fn f32_storage_and_f64_arithmetic_bit_identical() {
+    let n = 16;
+    let volume = noise_volume(n, 11);
+    for kind in [FilterKind::Kb3, FilterKind::Kb4, FilterKind::Kb6] {
+        let filter = Filter::new(kind, 1).unwrap();
+        let spec32 = OwnedSpectrum::<f32>::prepare::<f32>(&volume, filter).unwrap();
+        let spec64 = OwnedSpectrum::<f64>::prepare::<f64>(&volume, filter).unwrap();
+        for dir in DIRECTIONS {
+            let axes = axes_for(dir, &Sampling::UNIT);
+            check::<f32, f32>(&spec32, &axes, &TILINGS, &format!("{kind:?} f32 {dir:?}"));
+            check::<f64, f64>(&spec64, &axes, &TILINGS, &format!("{kind:?} f64 {dir:?}"));
+        }
+    }
+}
+
+#[test]
+fn physical_units_and_larger_cube_bit_identical() {
+    let n = 64;
+    let volume = noise_volume(n, 3);
+    let sampling = Sampling::new([0.7, 1.0, 1.9], 1.3).unwrap();
+    for kind in [FilterKind::Kb3, FilterKind::Kb4, FilterKind::Kb6] {
+        let filter = Filter::new(kind, 1).unwrap();
+        let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+        for dir in [[1.0, 0.3, 0.2], [0.0, -1.0, 0.0], [0.3, -0.9, 0.5]] {
+            let axes = axes_for(dir, &sampling);
+            check::<f16, f32>(&spec, &axes, &TILINGS[1..3], &format!("{kind:?} {dir:?}"));
+        }
+    }
+}
+
+/// The renderer's whole view (host extraction, then the core's finish)
+/// equals the core's single-threaded render, pixel for pixel.
+#[test]
+fn renderer_image_equals_core_render() {
+    let n = 32;
+    let volume = noise_volume(n, 5);
+    for kind in [FilterKind::Kb3, FilterKind::Kb4, FilterKind::Kb6] {
+        let filter = Filter::new(kind, 1).unwrap();
+        let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+        for dir in DIRECTIONS {
+            let view = View::along(dir);
+            let core = render_once::<f16, f32>(&spec.view(), &Request::new(view, 24, 20)).unwrap();
+            for threads in [0, 1, 3] {
+                let mut out = vec![0.0f32; 24 * 20];
+                ViewRenderer::<f32>::new(n, filter)
+                    .with_threads(threads)
+                    .render_into(&spec, &view, 24, 20, &mut out)
+                    .unwrap();
+                for (a, b) in core.iter().zip(&out) {
+                    assert_eq!(a.to_bits(), (*b as f64).to_bits(), "{kind:?} {dir:?}");
+                }
+            }
+        }
+    }
+}
