@@ -66,7 +66,10 @@ impl<T: Real> SliceRows<T> {
     /// [`PhaseTable::fixed_step`]`(r)`: two integer additions an axis
     /// instead of a product, a sum and a floor in floating point.
     #[inline(always)]
-    pub(super) fn for_each_fixed_pair<const W: usize>(
+    ///
+    /// `POW2`: `m` is a power of two, and `k mod m` is a mask; otherwise a
+    /// comparison (mixed-radix sides).
+    pub(super) fn for_each_fixed_pair<const W: usize, const POW2: bool>(
         &self,
         n: usize,
         grid: &mut [T],
@@ -83,7 +86,7 @@ impl<T: Real> SliceRows<T> {
         let local = |r: usize| r.checked_sub(self.first_row).filter(|&i| i < rows);
         for p in 0..=m / 2 {
             let plus_row = if p as i32 <= k_max { local(p) } else { None };
-            let minus_row = local((m - p) & mask);
+            let minus_row = local(if POW2 { (m - p) & mask } else { (m - p) % m });
             if plus_row.is_none() && minus_row.is_none() {
                 continue;
             }
@@ -115,14 +118,24 @@ impl<T: Real> SliceRows<T> {
                 let minus = minus_row.is_some() && -k <= k_max && (p > 0 || k > 0);
                 if plus || minus {
                     let (value, mirror) = pixel(y, plus, minus);
-                    // `m` is a power of two: `k mod m` by a mask.
+                    // `k mod m`: by a mask for a power of two, else
+                    // `k + m` for negative `k` (`|k| ≤ m/2`).
+                    let modulo = |k: i32| {
+                        if POW2 {
+                            k as usize & mask
+                        } else if k < 0 {
+                            (k + m as i32) as usize
+                        } else {
+                            k as usize
+                        }
+                    };
                     if let (true, Some(r)) = (plus, plus_row) {
-                        if let Some(g) = grid.get_mut(r * m + (k as usize & mask)) {
+                        if let Some(g) = grid.get_mut(r * m + modulo(k)) {
                             *g = value;
                         }
                     }
                     if let (true, Some(r)) = (minus, minus_row) {
-                        if let Some(g) = grid.get_mut(r * m + (k.wrapping_neg() as usize & mask)) {
+                        if let Some(g) = grid.get_mut(r * m + modulo(k.wrapping_neg())) {
                             *g = mirror;
                         }
                     }
