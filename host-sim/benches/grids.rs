@@ -1,6 +1,6 @@
 //! Criterion benchmarks: 2× padding against the mixed-radix grids
-//! σ = 1.25 and 1.5 on real heads, kb4 in f16 (f32 arithmetic), filter
-//! fitted to the volume: per-view time (one oblique view on all cores) and
+//! σ = 1.25 and 1.5 on real heads ([`CONFIGS`]), f16 (f32 arithmetic),
+//! filter fitted to the volume: per-view time (one oblique view on all cores) and
 //! preparation time. Before timing, each grid's spectrum size and its SNR
 //! against the exact axis projections (voxel sums, x, y and z views) are
 //! printed, so that one run gives the whole table of docs/accuracy.md.
@@ -24,10 +24,14 @@ use fvr_host::sources::datasets::load_dataset;
 use fvr_host::volume::Volume;
 use half::f16;
 
-const GRIDS: [GridOversampling; 3] = [
-    GridOversampling::X2,
-    GridOversampling::X1_5,
-    GridOversampling::X1_25,
+/// Filter and grid: 2× padding with kb4, then the mixed-radix grids with
+/// kb4 and, at σ = 1.25, the wider kb5 and kb6.
+const CONFIGS: [(FilterKind, GridOversampling); 5] = [
+    (FilterKind::Kb4, GridOversampling::X2),
+    (FilterKind::Kb4, GridOversampling::X1_5),
+    (FilterKind::Kb4, GridOversampling::X1_25),
+    (FilterKind::Kb5, GridOversampling::X1_25),
+    (FilterKind::Kb6, GridOversampling::X1_25),
 ];
 
 /// `volume` without its last slice along odd axes, so that the pixels of
@@ -61,10 +65,11 @@ fn volumes() -> Vec<(&'static str, Volume)> {
 fn benches(c: &mut Criterion) {
     let view = View::along([1.0, 0.35, 0.2]);
     for (name, volume) in volumes() {
-        let mut group = c.benchmark_group(format!("grids_{name}_kb4_f16"));
+        let mut group = c.benchmark_group(format!("grids_{name}_f16"));
         group.sample_size(10);
-        for grid in GRIDS {
-            let filter = grid_filter(&volume, FilterKind::Kb4, grid, KbDesign::Auto).unwrap();
+        for (kind, grid) in CONFIGS {
+            let filter = grid_filter(&volume, kind, grid, KbDesign::Auto).unwrap();
+            let id = format!("{}_{}", kind.name(), grid.name());
             let spec = OwnedSpectrum::<f16>::prepare_on::<f32>(
                 &volume,
                 filter,
@@ -84,15 +89,16 @@ fn benches(c: &mut Criterion) {
                 snr_db(&exact, &image)
             });
             println!(
-                "{name} {:?} σ={} n={n}: {:.1} MiB, x/y/z {:.1}/{:.1}/{:.1} dB, image {side}²",
+                "{name} {:?} {} σ={} n={n}: {:.1} MiB, x/y/z {:.1}/{:.1}/{:.1} dB, image {side}²",
                 volume.dims,
+                kind.name(),
                 grid.name(),
                 spec.bytes() as f64 / (1 << 20) as f64,
                 db[0],
                 db[1],
                 db[2]
             );
-            group.bench_function(BenchmarkId::new("view", grid.name()), |b| {
+            group.bench_function(BenchmarkId::new("view", &id), |b| {
                 b.iter(|| {
                     renderer
                         .render_into(&spec, black_box(&view), side, side, &mut out)
@@ -100,7 +106,7 @@ fn benches(c: &mut Criterion) {
                 })
             });
             drop(spec);
-            group.bench_function(BenchmarkId::new("prepare", grid.name()), |b| {
+            group.bench_function(BenchmarkId::new("prepare", &id), |b| {
                 b.iter(|| {
                     OwnedSpectrum::<f16>::prepare_on::<f32>(
                         black_box(&volume),

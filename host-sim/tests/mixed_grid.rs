@@ -199,3 +199,70 @@ fn scenes_refuse_mixed_sides_by_name() {
         "scene through render: {err}"
     );
 }
+
+/// Predicted (with its edge, kernel and storage parts) and measured SNR of
+/// kb4, kb5 and kb6 in f16 on σ = 1.25, 1.5 and 2 for the CT head at 256,
+/// against the voxel sums along x, y and z.
+///
+/// `FVR_CT_HEAD=$(bash scripts/fetch-ct-head.sh) cargo test -p fvr-host
+/// --release --test mixed_grid -- --ignored --nocapture`
+#[test]
+#[ignore = "needs FVR_CT_HEAD; prints the CT head's mixed-grid candidates"]
+fn ct_head_on_mixed_grids() {
+    use fvr_host::reference::axis::axis_projection;
+    use fvr_host::render::plan::{image_side, predict_grid, Candidate, AXIS_VIEWS};
+    let ct = fvr_host::sources::datasets::load_dataset("ct-head")
+        .unwrap()
+        .unwrap()
+        .resample_isotropic(256)
+        .unwrap();
+    // Even sizes put the axis views' pixels on voxels.
+    let dims = ct.dims.map(|d| d - d % 2);
+    let mut volume = fvr_host::volume::Volume::zeros(dims);
+    for k in 0..dims[2] {
+        for j in 0..dims[1] {
+            for i in 0..dims[0] {
+                let at = volume.index(i, j, k);
+                volume.data[at] = ct.get(i, j, k);
+            }
+        }
+    }
+    println!("| config | MiB | predicted dB (edge, kernel, storage) | measured dB (x, y, z) |");
+    println!("|---|---|---|---|");
+    for kind in [FilterKind::Kb4, FilterKind::Kb5, FilterKind::Kb6] {
+        for grid in [
+            GridOversampling::X1_25,
+            GridOversampling::X1_5,
+            GridOversampling::X2,
+        ] {
+            let c = Candidate {
+                filter: kind,
+                oversample: grid.integer(),
+                precision: Precision::F16,
+            };
+            let p = predict_grid(&volume, c, grid, KbDesign::Auto).unwrap();
+            let filter = grid_filter(&volume, kind, grid, KbDesign::Auto).unwrap();
+            let spec = AnySpectrum::prepare_grid(&volume, filter, Precision::F16, grid).unwrap();
+            let side = image_side(volume.dims, spec.n()).unwrap();
+            let m = AXIS_VIEWS.map(|v| {
+                let image = spec.render(&v, side, side).unwrap();
+                let exact = axis_projection(&volume, &v, side, side).unwrap().unwrap();
+                snr_db(&exact, &image)
+            });
+            println!(
+                "| {} σ{} f16 (n = {}) | {:.1} | {:.1} ({:.1}, {:.1}, {:.1}) | {:.1}, {:.1}, {:.1} |",
+                kind.name(),
+                grid.name(),
+                spec.n(),
+                spec.bytes() as f64 / (1 << 20) as f64,
+                p.db,
+                p.parts_db[0],
+                p.parts_db[1],
+                p.parts_db[2],
+                m[0],
+                m[1],
+                m[2]
+            );
+        }
+    }
+}

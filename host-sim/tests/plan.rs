@@ -126,6 +126,7 @@ fn candidates() -> Vec<(Candidate, GridOversampling)> {
         FilterKind::Cubic,
         FilterKind::Kb3,
         FilterKind::Kb4,
+        FilterKind::Kb5,
         FilterKind::Kb6,
     ] {
         for grid in ALL_GRIDS {

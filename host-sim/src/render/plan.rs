@@ -561,10 +561,11 @@ pub fn cost_grid(
 }
 
 /// Filters the planner considers, cheapest first.
-pub const CANDIDATE_FILTERS: [FilterKind; 4] = [
+pub const CANDIDATE_FILTERS: [FilterKind; 5] = [
     FilterKind::Cubic,
     FilterKind::Kb3,
     FilterKind::Kb4,
+    FilterKind::Kb5,
     FilterKind::Kb6,
 ];
 
