@@ -9,10 +9,14 @@
 //! `FVR_CT_HEAD` names the CT head).
 
 use fvr_core::filter::FilterKind;
+use fvr_core::volume::GridOversampling;
 use fvr_host::reference::axis::axis_projection;
 use fvr_host::reference::snr_db;
-use fvr_host::render::filter::{choose_filter, KbDesign};
-use fvr_host::render::plan::{choose, predict, Candidate, Constraints, AXIS_VIEWS};
+use fvr_host::render::filter::KbDesign;
+use fvr_host::render::plan::{
+    choose, choose_among, cost_grid, grid_filter, image_side, predict_grid, Candidate, Constraints,
+    ALL_GRIDS, AXIS_VIEWS,
+};
 use fvr_host::render::spectrum::{AnySpectrum, Precision};
 use fvr_host::sources::datasets::load_dataset;
 use fvr_host::sources::phantom_by_name;
@@ -82,11 +86,18 @@ fn noise_box() -> Volume {
     Volume::new([32, 32, 32], data)
 }
 
-/// Measured SNR of each axis view against the voxel sums.
+/// Measured SNR of each axis view against the voxel sums, on the
+/// power-of-two grid of the candidate's oversampling.
 fn measure(volume: &Volume, c: Candidate) -> [f64; 3] {
-    let filter = choose_filter(volume, c.filter, c.oversample, KbDesign::Auto).unwrap();
-    let spec = AnySpectrum::prepare(volume, filter, c.precision).unwrap();
-    let side = spec.n() / c.oversample as usize;
+    let grid = GridOversampling::from_integer(c.oversample).unwrap();
+    measure_grid(volume, c, grid)
+}
+
+/// [`measure`] on the grid `grid` (mixed radix for σ = 1.25 and 1.5).
+fn measure_grid(volume: &Volume, c: Candidate, grid: GridOversampling) -> [f64; 3] {
+    let filter = grid_filter(volume, c.filter, grid, KbDesign::Auto).unwrap();
+    let spec = AnySpectrum::prepare_grid(volume, filter, c.precision, grid).unwrap();
+    let side = image_side(volume.dims, spec.n()).unwrap();
     AXIS_VIEWS.map(|view| {
         let image = spec.render(&view, side, side).unwrap();
         let exact = axis_projection(volume, &view, side, side)
@@ -107,21 +118,25 @@ fn volumes() -> Vec<(&'static str, Volume)> {
     ]
 }
 
-fn candidates() -> Vec<Candidate> {
+/// Every filter × grid (σ = 1, 1.25, 1.5, 2) × precision the planner
+/// considers.
+fn candidates() -> Vec<(Candidate, GridOversampling)> {
     let mut out = Vec::new();
     for filter in [
         FilterKind::Cubic,
         FilterKind::Kb3,
         FilterKind::Kb4,
+        FilterKind::Kb5,
         FilterKind::Kb6,
     ] {
-        for oversample in [1, 2] {
+        for grid in ALL_GRIDS {
             for precision in [Precision::F16, Precision::F32] {
-                out.push(Candidate {
+                let c = Candidate {
                     filter,
-                    oversample,
+                    oversample: grid.integer(),
                     precision,
-                });
+                };
+                out.push((c, grid));
             }
         }
     }
@@ -132,17 +147,21 @@ fn name(c: Candidate) -> String {
     format!("{} os{} {}", c.filter.name(), c.oversample, c.precision)
 }
 
+fn grid_name(c: Candidate, grid: GridOversampling) -> String {
+    format!("{} σ{} {}", c.filter.name(), grid.name(), c.precision)
+}
+
 #[test]
 fn prediction_is_never_optimistic_by_more_than_3_db() {
     let mut failures = Vec::new();
     for (vname, volume) in volumes() {
-        for c in candidates() {
-            let p = predict(&volume, c, KbDesign::Auto).unwrap();
-            let m = measure(&volume, c);
+        for (c, grid) in candidates() {
+            let p = predict_grid(&volume, c, grid, KbDesign::Auto).unwrap();
+            let m = measure_grid(&volume, c, grid);
             for (v, axis) in ["x", "y", "z"].iter().enumerate() {
                 let line = format!(
                     "{vname} {axis} {}: predicted {:.1} dB, measured {:.1} dB",
-                    name(c),
+                    grid_name(c, grid),
                     p.views_db[v],
                     m[v]
                 );
@@ -182,6 +201,46 @@ fn chooser_meets_40_and_50_db_on_edge_touching_volumes() {
                 name(c),
                 plan.prediction.db
             );
+        }
+    }
+}
+
+/// With the mixed-radix grids among the candidates, the chooser still
+/// meets the target when measured, at no more cost than the power-of-two
+/// grids alone; on content touching the faces at 50 dB it takes a
+/// mixed-radix grid (σ = 1 leaks at the faces, σ = 2 costs more).
+#[test]
+fn chooser_among_mixed_grids_meets_the_target_for_less() {
+    for (vname, volume) in [
+        ("brainsmall/2", brain64()),
+        ("rolled gaussians", rolled_gaussians()),
+    ] {
+        for target in [40.0, 50.0] {
+            let constraints = Constraints::default();
+            let plan =
+                choose_among(&volume, KbDesign::Auto, target, constraints, &ALL_GRIDS).unwrap();
+            let pow2 = choose(&volume, KbDesign::Auto, target, constraints).unwrap();
+            let (c, grid) = (plan.prediction.candidate, plan.prediction.grid);
+            let m = measure_grid(&volume, c, grid);
+            let worst = m.iter().copied().fold(f64::INFINITY, f64::min);
+            let cost = cost_grid(c, grid, volume.dims).unwrap();
+            let pow2_cost =
+                cost_grid(pow2.prediction.candidate, pow2.prediction.grid, volume.dims).unwrap();
+            println!(
+                "{vname} target {target}: {} predicted {:.1} dB, measured {worst:.1} dB; \
+                 cost {:.3e} against {:.3e} for {}",
+                grid_name(c, grid),
+                plan.prediction.db,
+                cost.0,
+                pow2_cost.0,
+                grid_name(pow2.prediction.candidate, pow2.prediction.grid)
+            );
+            assert!(plan.met, "{vname}: nothing predicted to reach {target} dB");
+            assert!(worst >= target, "{vname}: measured {worst:.1} dB");
+            assert!(cost <= pow2_cost, "{vname}: the wider choice costs more");
+            if target == 50.0 && vname == "rolled gaussians" {
+                assert!(!grid.is_pow2(), "{vname} at 50 dB: {}", grid.name());
+            }
         }
     }
 }
@@ -259,21 +318,28 @@ fn predicted_against_measured_table() {
             oversample: 1,
             precision: Precision::F16,
         };
-        let mut configs = vec![(plain, "given".to_string())];
+        let pow2 = |c: Candidate| (c, GridOversampling::from_integer(c.oversample).unwrap());
+        let mut configs = vec![(pow2(plain), "given".to_string())];
         for (target, note) in [(40.0, ""), (50.0, ", the default")] {
             let plan = choose(volume, KbDesign::Auto, target, Constraints::default()).unwrap();
             configs.push((
-                plan.prediction.candidate,
+                pow2(plan.prediction.candidate),
                 format!("--accuracy {target}{note}"),
             ));
         }
-        for (c, why) in configs {
-            let p = predict(volume, c, KbDesign::Auto).unwrap();
-            let m = measure(volume, c);
+        for target in [40.0, 50.0] {
+            let d = Constraints::default();
+            let plan = choose_among(volume, KbDesign::Auto, target, d, &ALL_GRIDS).unwrap();
+            let chosen = (plan.prediction.candidate, plan.prediction.grid);
+            configs.push((chosen, format!("{target} dB, mixed grids too")));
+        }
+        for ((c, grid), why) in configs {
+            let p = predict_grid(volume, c, grid, KbDesign::Auto).unwrap();
+            let m = measure_grid(volume, c, grid);
             println!(
                 "| {vname} {:?} | {} ({why}) | {:.1} | {:.1}, {:.1}, {:.1} | {} |",
                 volume.dims,
-                name(c),
+                grid_name(c, grid),
                 p.db,
                 m[0],
                 m[1],

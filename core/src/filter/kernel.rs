@@ -5,7 +5,7 @@ use super::special::{
     bessel_i0, bessel_i1_over_x, gauss_legendre_16, keys_cubic, keys_cubic_derivative, sinc,
 };
 use crate::error::{Error, Result};
-use crate::volume::VoxelSource;
+use crate::volume::{GridOversampling, VoxelSource};
 
 /// The interpolation filters offered.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -169,16 +169,53 @@ impl Filter {
         oversample: u32,
         volume: &V,
     ) -> Result<(Self, f64)> {
-        let base = Self::new(kind, oversample)?;
+        let n = crate::volume::padded_size(volume.dims(), oversample)?;
+        Self::fit_on(kind, oversample, oversample as f64, volume, n)
+    }
+
+    /// The filter `kind` for a grid oversampled by `grid`: integer
+    /// oversampling [`GridOversampling::integer`], the Kaiser–Bessel shape
+    /// designed for `σ = grid.factor()` (Beatty's β, as
+    /// [`Filter::with_design_oversampling`]).
+    ///
+    /// # Errors
+    /// None in practice (the factors are all supported).
+    pub fn for_grid(kind: FilterKind, grid: GridOversampling) -> Result<Self> {
+        Self::with_design_oversampling(kind, grid.integer(), grid.factor())
+    }
+
+    /// [`Filter::fit`] on the grid of `grid`: design oversamplings from
+    /// `σ = grid.factor()` to 4, the energy profile taken on the cube of
+    /// side [`GridOversampling::side`]. The same as [`Filter::fit`] for
+    /// σ = 1 and 2.
+    ///
+    /// # Errors
+    /// As [`Filter::fit`].
+    pub fn fit_grid<V: VoxelSource>(
+        kind: FilterKind,
+        grid: GridOversampling,
+        volume: &V,
+    ) -> Result<(Self, f64)> {
+        let n = grid.side(volume.dims())?;
+        Self::fit_on(kind, grid.integer(), grid.factor(), volume, n)
+    }
+
+    /// [`Filter::fit`] with designs from `low` to 4 on a cube of side `n`.
+    fn fit_on<V: VoxelSource>(
+        kind: FilterKind,
+        oversample: u32,
+        low: f64,
+        volume: &V,
+        n: usize,
+    ) -> Result<(Self, f64)> {
+        let base = Self::with_design_oversampling(kind, oversample, low)?;
         if !kind.is_kaiser_bessel() {
-            return Ok((base, oversample as f64));
+            return Ok((base, low));
         }
-        let dims = volume.dims();
-        let n = crate::volume::padded_size(dims, oversample)?;
         let energy = axis_energy_profile(volume, n)?;
-        let mut best = (base, oversample as f64, f64::INFINITY);
+        let mut best = (base, low, f64::INFINITY);
         for step in 0..=16 {
-            let design = oversample as f64 * libm::pow(4.0 / oversample as f64, step as f64 / 16.0);
+            let design = low * libm::pow(4.0 / low, step as f64 / 16.0);
             let f = Self::with_design_oversampling(kind, oversample, design)?;
             let mut cost = 0.0;
             for (b, e) in energy.iter().enumerate() {

@@ -3,7 +3,8 @@
 //! The slice is shifted by the sub-pixel offsets of its [`Placement`]
 //! (exactly, as a phase ramp: in Hartley form, shifting by `t` maps `H(k)`
 //! to `cos φ·H(k) + sin φ·H(−k)` with `φ = −2π k·t/n`), inverse-transformed
-//! by the 2D DHT, and the `W × H` image is cut from the grid around the
+//! by the 2D DHT (radix 2, or mixed radix for sides `2^a·3^b·5^c`:
+//! [`Inverse`]), and the `W × H` image is cut from the grid around the
 //! centre, times the gain.
 
 pub mod fixed;
@@ -11,7 +12,8 @@ mod placement;
 
 pub use placement::{placement, placement_at_pitch, placement_on_axes, Placement};
 
-use crate::dht::{dht_2d, neg_mod, signed_index, Twiddles};
+use crate::dht::{dht_2d, dht_2d_mixed, dht_2d_mixed_scratch_len, neg_mod, signed_index};
+use crate::dht::{MixedPlan, Twiddles};
 use crate::error::{require_len, Error, Result};
 use crate::num::Real;
 
@@ -20,9 +22,45 @@ pub const fn grid_len(m: usize) -> usize {
     m * m
 }
 
-/// Auxiliary scratch elements [`finish`] needs for an `m × m` grid: `4m`.
+/// Auxiliary scratch elements [`finish`] needs for an `m × m` grid: `4m`
+/// (also enough for [`Inverse::Mixed`] on even `m`).
 pub const fn aux_len(m: usize) -> usize {
     4 * m
+}
+
+/// The 2D inverse transform a view is finished with.
+#[derive(Clone, Copy, Debug)]
+pub enum Inverse<'a, T> {
+    /// Radix 2, for power-of-two sides (the device's).
+    Radix2(&'a Twiddles<'a, T>),
+    /// Mixed radix, for sides `2^a·3^b·5^c`: a plan for the grid's side.
+    Mixed(&'a MixedPlan<'a, T>),
+}
+
+impl<T: Real> Inverse<'_, T> {
+    /// `Ok` if this transform serves side `m`.
+    ///
+    /// # Errors
+    /// Twiddles too short or not a power of two side, or a plan for
+    /// another length ([`Error::LengthMismatch`]).
+    pub fn check(&self, m: usize) -> Result<()> {
+        match self {
+            Inverse::Radix2(tw) => tw.check(m),
+            Inverse::Mixed(plan) => crate::error::check_len("mixed-radix plan", plan.len(), m),
+        }
+    }
+
+    /// The unnormalized 2D DHT of the `m × m` grid in place.
+    fn transform(&self, grid: &mut [T], m: usize, aux: &mut [T]) -> Result<()> {
+        match self {
+            Inverse::Radix2(tw) => dht_2d(grid, m, m, &mut aux[..m], tw),
+            Inverse::Mixed(plan) => {
+                let need = dht_2d_mixed_scratch_len(m, m);
+                require_len("auxiliary scratch (mixed radix)", need, aux.len())?;
+                dht_2d_mixed(grid, m, m, &mut aux[..need], [plan, plan])
+            }
+        }
+    }
 }
 
 /// `Ok` if `1 ≤ width, height ≤ n`.
@@ -95,6 +133,23 @@ pub fn finish<T: Real>(
     aux: &mut [T],
     out: &mut [T],
 ) -> Result<()> {
+    finish_with(grid, m, crop, Inverse::Radix2(tw), aux, out)
+}
+
+/// [`finish`] with the 2D inverse transform `inverse`: [`Inverse::Mixed`]
+/// for a grid whose side `m` is not a power of two (the crop then wraps by
+/// comparison instead of masks).
+///
+/// # Errors
+/// As [`finish`]; also a transform for another side.
+pub fn finish_with<T: Real>(
+    grid: &mut [T],
+    m: usize,
+    crop: &Crop,
+    inverse: Inverse<'_, T>,
+    aux: &mut [T],
+    out: &mut [T],
+) -> Result<()> {
     let Crop {
         place,
         gain,
@@ -114,9 +169,18 @@ pub fn finish<T: Real>(
     require_len("slice grid", grid_len(m), grid.len())?;
     require_len("auxiliary scratch", aux_len(m), aux.len())?;
     require_len("output image", width * height * channels, out.len())?;
-    apply_shift(grid, m, place.shift, aux);
-    dht_2d(grid, m, m, &mut aux[..m], tw)?;
+    let pow2 = m.is_power_of_two();
+    if pow2 {
+        apply_shift::<true, T>(grid, m, place.shift, aux);
+    } else {
+        apply_shift::<false, T>(grid, m, place.shift, aux);
+    }
+    inverse.transform(grid, m, aux)?;
     let g = T::from_f64(gain / (m * m) as f64);
+    if !pow2 {
+        crop_any(grid, m, crop, g, out);
+        return Ok(());
+    }
     // Grid indices modulo m (a power of two), in wrapping usize arithmetic:
     // the same residues as the signed i64 ones, without 64-bit adds on a
     // 32-bit core, and the row is sliced once.
@@ -144,11 +208,46 @@ pub fn finish<T: Real>(
     Ok(())
 }
 
+/// The crop of [`finish_with`] for any side `m`: grid indices `i mod m`
+/// by a remainder per row and a comparison per pixel.
+fn crop_any<T: Real>(grid: &[T], m: usize, crop: &Crop, g: T, out: &mut [T]) {
+    let (width, channels, channel) = (crop.width, crop.channels, crop.channel);
+    let modulo = |v: i64| v.rem_euclid(m as i64) as usize;
+    let col0 = modulo(crop.place.col0);
+    for (row, line) in out
+        .chunks_exact_mut(width * channels)
+        .take(crop.height)
+        .enumerate()
+    {
+        let gy = modulo(crop.place.row0 - row as i64);
+        let grid_row = &grid[gy * m..(gy + 1) * m];
+        let mut gx = col0;
+        for o in line.chunks_exact_mut(channels) {
+            o[channel] = grid_row[gx] * g;
+            gx += 1;
+            if gx == m {
+                gx = 0;
+            }
+        }
+    }
+}
+
 /// Shift the projection by `t = (ta, tb)` pixels (`R(x) = Q(x + t)`) on its
 /// Hartley slice: `H'(k) = cos φ·H(k) + sin φ·H(−k)`, `φ = −2π k·t/m`.
 /// Nyquist components get no phase (a real signal cannot hold a shifted
 /// Nyquist cosine), which keeps `φ(−k) = −φ(k)` for every pair.
-fn apply_shift<T: Real>(grid: &mut [T], m: usize, t: [f64; 2], aux: &mut [T]) {
+///
+/// `POW2`: `m` is a power of two (`−k mod m` by a mask).
+fn apply_shift<const POW2: bool, T: Real>(grid: &mut [T], m: usize, t: [f64; 2], aux: &mut [T]) {
+    let neg = |k: usize| {
+        if POW2 {
+            neg_mod(k, m)
+        } else if k == 0 {
+            0
+        } else {
+            m - k
+        }
+    };
     if t == [0.0, 0.0] {
         return;
     }
@@ -170,9 +269,9 @@ fn apply_shift<T: Real>(grid: &mut [T], m: usize, t: [f64; 2], aux: &mut [T]) {
         sy[k] = T::from_f64(libm::sin(phy));
     }
     for iy in 0..m {
-        let my = neg_mod(iy, m);
+        let my = neg(iy);
         for ix in 0..m {
-            let (a, b) = (iy * m + ix, my * m + neg_mod(ix, m));
+            let (a, b) = (iy * m + ix, my * m + neg(ix));
             if a >= b {
                 continue;
             }

@@ -30,7 +30,7 @@ use crate::dht::Twiddles;
 use crate::error::{require_len, Error, Result};
 use crate::filter::{DerivativeTable, KernelTable};
 use crate::geometry::{Sampling, View};
-use crate::image::{aux_len, check_image, finish, grid_len, placement_on_axes, Crop};
+use crate::image::{aux_len, check_image, finish_with, grid_len, placement_on_axes, Crop, Inverse};
 use crate::num::{Real, Sample};
 use crate::shading::Scene;
 use crate::slice::extract_central_slice_on;
@@ -169,24 +169,55 @@ pub fn render<S: Sample, Z: CubeSide, T: Real>(
                     what: "physical units",
                 });
             }
+            if !source.spectrum.n().is_power_of_two() {
+                return Err(Error::SceneUnsupported {
+                    what: "a cube side that is not a power of two (mixed-radix grid)",
+                });
+            }
             render_scene(source, scene, request, buffers)
         }
-        None => render_projection(source, request, buffers).map(|()| 1),
+        None => render_projection(
+            source.spectrum,
+            source.kernel,
+            Inverse::Radix2(source.twiddles),
+            request,
+            buffers,
+        )
+        .map(|()| 1),
     }
+}
+
+/// The X-ray projection of `request` (whose scene must be `None`) from
+/// `spectrum` with the 2D inverse transform `inverse`: as [`render`], and
+/// the way to render a spectrum of mixed-radix side ([`Inverse::Mixed`],
+/// a plan for the slice's side `n >> level`).
+///
+/// # Errors
+/// As [`render`]; a scene ([`Error::SceneUnsupported`]); a transform for
+/// another side.
+pub fn render_projection_with<S: Sample, Z: CubeSide, T: Real>(
+    spectrum: &Spectrum<'_, S, Z>,
+    kernel: &KernelTable<T>,
+    inverse: Inverse<'_, T>,
+    request: &Request<'_>,
+    buffers: Buffers<'_, T>,
+) -> Result<()> {
+    if request.scene.is_some() {
+        return Err(Error::SceneUnsupported {
+            what: "a given 2D inverse transform (scenes take Source, and no mixed-radix grid)",
+        });
+    }
+    render_projection(spectrum, kernel, inverse, request, buffers)
 }
 
 /// The X-ray projection at `request.level`.
 fn render_projection<S: Sample, Z: CubeSide, T: Real>(
-    source: &Source<'_, S, Z, T>,
+    spec: &Spectrum<'_, S, Z>,
+    kernel: &KernelTable<T>,
+    inverse: Inverse<'_, T>,
     request: &Request<'_>,
     buffers: Buffers<'_, T>,
 ) -> Result<()> {
-    let Source {
-        spectrum: spec,
-        kernel,
-        twiddles: tw,
-        ..
-    } = *source;
     let Request {
         view,
         sampling,
@@ -214,7 +245,7 @@ fn render_projection<S: Sample, Z: CubeSide, T: Real>(
     require_len("auxiliary scratch", aux_len(m), aux.len())?;
     require_len("output image", width * height, out.len())?;
     // Checked before the extraction, which is the bulk of the work.
-    tw.check(m)?;
+    inverse.check(m)?;
     let pitch = (1u64 << level) as f64;
     extract_central_slice_on(spec, kernel, &axes, m, grid);
     let crop = Crop::new(
@@ -223,5 +254,5 @@ fn render_projection<S: Sample, Z: CubeSide, T: Real>(
         width,
         height,
     );
-    finish(&mut grid[..m * m], m, &crop, tw, aux, out)
+    finish_with(&mut grid[..m * m], m, &crop, inverse, aux, out)
 }

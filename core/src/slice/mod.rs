@@ -128,13 +128,23 @@ fn extract_width<const W: usize, S: Sample, Z: CubeSide, T: Real>(
         first_row,
     };
     let mut phases = PhaseTable::<T, W>::zeroed();
-    match (phases.fill(kernel), LineReads::of(spec)) {
+    let filled = phases.fill(kernel);
+    // Selected once per view; a compile-time side folds it away.
+    if !spec.n().is_power_of_two() {
+        return match (filled, LineReads::of(spec)) {
+            (Ok(()), LineReads::Plain) => {
+                extract_lines::<W, false, false, S, Z, T>(spec, &phases, &geometry, &[], grid)
+            }
+            _ => extract_general::<W, false, S, Z, T>(spec, kernel, &geometry, grid),
+        };
+    }
+    match (filled, LineReads::of(spec)) {
         (Ok(()), LineReads::Plain) => {
-            extract_lines::<W, false, S, Z, T>(spec, &phases, &geometry, &[], grid)
+            extract_lines::<W, false, true, S, Z, T>(spec, &phases, &geometry, &[], grid)
         }
         (Ok(()), LineReads::LineExponents(e)) => {
-            extract_lines::<W, true, S, Z, T>(spec, &phases, &geometry, e, grid)
+            extract_lines::<W, true, true, S, Z, T>(spec, &phases, &geometry, e, grid)
         }
-        _ => extract_general::<W, S, Z, T>(spec, kernel, &geometry, grid),
+        _ => extract_general::<W, true, S, Z, T>(spec, kernel, &geometry, grid),
     }
 }

@@ -44,14 +44,16 @@ impl<T: Real> SliceRows<T> {
     }
 
     /// [`walk_pairs`] over this slice's rows, with the positions in `T`.
+    /// `POW2`: `m` is a power of two, and `k mod m` is a mask; otherwise a
+    /// comparison (mixed-radix sides).
     #[inline(always)]
-    pub(super) fn for_each_fixed_pair<const W: usize>(
+    pub(super) fn for_each_fixed_pair<const W: usize, const POW2: bool>(
         &self,
         n: usize,
         grid: &mut [T],
         pixel: impl FnMut([i64; 3], bool, bool) -> (T, T),
     ) {
-        walk_pairs::<W, T, Self>(self, self.m, self.first_row, n, grid, pixel);
+        walk_pairs::<W, POW2, T, Self>(self, self.m, self.first_row, n, grid, pixel);
     }
 
     /// [`SliceRows::row_interval`] as the walks of filter width `W` call
@@ -169,7 +171,12 @@ impl<T: Real, const W: usize> RowPositions<W> for SliceRows<T> {
 /// and a floor in floating point. The grid holds `m` columns and
 /// `grid.len()/m` rows from row `first_row`.
 #[inline(always)]
-pub(super) fn walk_pairs<const W: usize, G: Copy + Default, P: RowPositions<W>>(
+pub(super) fn walk_pairs<
+    const W: usize,
+    const POW2: bool,
+    G: Copy + Default,
+    P: RowPositions<W>,
+>(
     positions: &P,
     m: usize,
     first_row: usize,
@@ -187,7 +194,7 @@ pub(super) fn walk_pairs<const W: usize, G: Copy + Default, P: RowPositions<W>>(
     let local = |r: usize| r.checked_sub(first_row).filter(|&i| i < rows);
     for p in 0..=m / 2 {
         let plus_row = if p as i32 <= k_max { local(p) } else { None };
-        let minus_row = local((m - p) & mask);
+        let minus_row = local(if POW2 { (m - p) & mask } else { (m - p) % m });
         if plus_row.is_none() && minus_row.is_none() {
             continue;
         }
@@ -215,14 +222,24 @@ pub(super) fn walk_pairs<const W: usize, G: Copy + Default, P: RowPositions<W>>(
             let minus = minus_row.is_some() && -k <= k_max && (p > 0 || k > 0);
             if plus || minus {
                 let (value, mirror) = pixel(y, plus, minus);
-                // `m` is a power of two: `k mod m` by a mask.
+                // `k mod m`: by a mask for a power of two, else `k + m` for
+                // negative `k` (`|k| ≤ m/2`).
+                let modulo = |k: i32| {
+                    if POW2 {
+                        k as usize & mask
+                    } else if k < 0 {
+                        (k + m as i32) as usize
+                    } else {
+                        k as usize
+                    }
+                };
                 if let (true, Some(r)) = (plus, plus_row) {
-                    if let Some(g) = grid.get_mut(r * m + (k as usize & mask)) {
+                    if let Some(g) = grid.get_mut(r * m + modulo(k)) {
                         *g = value;
                     }
                 }
                 if let (true, Some(r)) = (minus, minus_row) {
-                    if let Some(g) = grid.get_mut(r * m + (k.wrapping_neg() as usize & mask)) {
+                    if let Some(g) = grid.get_mut(r * m + modulo(k.wrapping_neg())) {
                         *g = mirror;
                     }
                 }

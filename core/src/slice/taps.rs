@@ -10,14 +10,18 @@ use crate::spectrum::{CubeSide, Spectrum};
 
 /// The tap reads of [`extract_lines`]: a spectrum of side `n` stored as
 /// `data` (exactly `n³` values), with one block exponent per x-line in
-/// `exponents` when `LINE_EXP`.
-struct TapSums<'a, const W: usize, const LINE_EXP: bool, S> {
+/// `exponents` when `LINE_EXP`. `POW2`: `n` is a power of two, and tap
+/// indices wrap by masks; otherwise (mixed-radix sides) by a remainder
+/// per axis and a conditional subtraction per tap.
+struct TapSums<'a, const W: usize, const LINE_EXP: bool, const POW2: bool, S> {
     data: &'a [S],
     n: usize,
     exponents: &'a [i8],
 }
 
-impl<const W: usize, const LINE_EXP: bool, S: Sample> TapSums<'_, W, LINE_EXP, S> {
+impl<const W: usize, const LINE_EXP: bool, const POW2: bool, S: Sample>
+    TapSums<'_, W, LINE_EXP, POW2, S>
+{
     /// An x-line's sum `acc_x` times the line's power of two, if lines
     /// carry one.
     #[inline(always)]
@@ -45,15 +49,27 @@ impl<const W: usize, const LINE_EXP: bool, S: Sample> TapSums<'_, W, LINE_EXP, S
     ) -> T {
         let (data, n) = (self.data, self.n);
         let (nn, mask) = (n * n, n - 1);
-        // `((j + b) mod n)·n` as `(j·n + b·n) mod n²`, in wrapping usize:
-        // the offsets of the taps' lines and planes with one product an axis.
-        let (y0, z0) = (
-            (jy as usize).wrapping_mul(n),
-            (jz as usize).wrapping_mul(nn),
-        );
-        let lines: [usize; W] = core::array::from_fn(|b| y0.wrapping_add(b * n) & (nn - n));
-        let planes: [usize; W] = core::array::from_fn(|c| z0.wrapping_add(c * nn) & (nn * n - nn));
-        let x0 = jx as usize & mask;
+        let (lines, planes, x0): ([usize; W], [usize; W], usize) = if POW2 {
+            // `((j + b) mod n)·n` as `(j·n + b·n) mod n²`, in wrapping usize:
+            // the offsets of the taps' lines and planes with one product an
+            // axis.
+            let (y0, z0) = (
+                (jy as usize).wrapping_mul(n),
+                (jz as usize).wrapping_mul(nn),
+            );
+            (
+                core::array::from_fn(|b| y0.wrapping_add(b * n) & (nn - n)),
+                core::array::from_fn(|c| z0.wrapping_add(c * nn) & (nn * n - nn)),
+                jx as usize & mask,
+            )
+        } else {
+            let (y0, z0) = (wrap(jy as i64, n), wrap(jz as i64, n));
+            (
+                core::array::from_fn(|b| step(y0, b, n) * n),
+                core::array::from_fn(|c| step(z0, c, n) * nn),
+                wrap(jx as i64, n),
+            )
+        };
         let mut acc = T::ZERO;
         if x0 + W <= n {
             for c in 0..W {
@@ -86,7 +102,13 @@ impl<const W: usize, const LINE_EXP: bool, S: Sample> TapSums<'_, W, LINE_EXP, S
                 acc += wz[c] * acc_y;
             }
         } else {
-            let xs: [usize; W] = core::array::from_fn(|t| (jx + t as i32) as usize & mask);
+            let xs: [usize; W] = core::array::from_fn(|t| {
+                if POW2 {
+                    (jx + t as i32) as usize & mask
+                } else {
+                    step(x0, t, n)
+                }
+            });
             for c in 0..W {
                 let mut acc_y = T::ZERO;
                 for b in 0..W {
@@ -117,6 +139,7 @@ impl<const W: usize, const LINE_EXP: bool, S: Sample> TapSums<'_, W, LINE_EXP, S
 pub(super) fn extract_lines<
     const W: usize,
     const LINE_EXP: bool,
+    const POW2: bool,
     S: Sample,
     Z: CubeSide,
     T: Real,
@@ -137,12 +160,12 @@ pub(super) fn extract_lines<
         return;
     };
     let raw_gain = T::exp2i(T::raw_exponent::<S>());
-    let taps = TapSums::<W, LINE_EXP, S> { data, n, exponents };
+    let taps = TapSums::<W, LINE_EXP, POW2, S> { data, n, exponents };
     // The mirror `−q` of a point: taps `−j − t`, i.e. the run from
     // `−j − (W − 1)` with the weights reversed.
     let mirror = |j: i32| -j - (W as i32 - 1);
     let reversed = |w: &[T; W]| -> [T; W] { core::array::from_fn(|t| w[W - 1 - t]) };
-    geometry.for_each_fixed_pair::<W>(n, grid, |y, plus, minus| {
+    geometry.for_each_fixed_pair::<W, POW2>(n, grid, |y, plus, minus| {
         let (jx, wx) = phases.taps_fixed_point(y[0]);
         let (jy, wy) = phases.taps_fixed_point(y[1]);
         let (jz, wz) = phases.taps_fixed_point(y[2]);
@@ -165,7 +188,7 @@ pub(super) fn extract_lines<
 /// The extraction for any storage (e.g. bricked block exponents): taps
 /// through [`LineReads::sums`], weights from the kernel table.
 #[inline(always)]
-pub(super) fn extract_general<const W: usize, S: Sample, Z: CubeSide, T: Real>(
+pub(super) fn extract_general<const W: usize, const POW2: bool, S: Sample, Z: CubeSide, T: Real>(
     spec: &Spectrum<'_, S, Z>,
     kernel: &KernelTable<T>,
     geometry: &SliceRows<T>,
@@ -175,13 +198,21 @@ pub(super) fn extract_general<const W: usize, S: Sample, Z: CubeSide, T: Real>(
     let nn = n * n;
     let reads = LineReads::of(spec);
     let mask = n - 1;
+    // `j mod n`, by the mask for a power-of-two side.
+    let wrapped = |j: i64| {
+        if POW2 {
+            j as usize & mask
+        } else {
+            wrap(j, n)
+        }
+    };
     geometry.for_each::<W>(n, grid, |g, q| {
         let (mut wx, mut wy, mut wz) = ([T::ZERO; W], [T::ZERO; W], [T::ZERO; W]);
         let jx = kernel.taps_fixed(q[0], &mut wx);
         let jy = kernel.taps_fixed(q[1], &mut wy);
         let jz = kernel.taps_fixed(q[2], &mut wz);
-        let x0 = jx as usize & mask;
-        let xs: [usize; W] = core::array::from_fn(|t| (jx + t as i64) as usize & mask);
+        let x0 = wrapped(jx);
+        let xs: [usize; W] = core::array::from_fn(|t| wrapped(jx + t as i64));
         let run = XRun {
             first: x0,
             contiguous: reads.contiguous::<W>(x0, n),
@@ -189,10 +220,10 @@ pub(super) fn extract_general<const W: usize, S: Sample, Z: CubeSide, T: Real>(
         };
         let mut acc = T::ZERO;
         for (c, wzc) in wz.iter().enumerate() {
-            let z = ((jz + c as i64) as usize & mask) * nn;
+            let z = wrapped(jz + c as i64) * nn;
             let mut acc_y = T::ZERO;
             for (b, wyb) in wy.iter().enumerate() {
-                let line = z + ((jy + b as i64) as usize & mask) * n;
+                let line = z + wrapped(jy + b as i64) * n;
                 let [acc_x] = reads.sums::<W, 1, false, S, Z, T>(spec, line, &run, [&wx]);
                 acc_y += *wyb * acc_x;
             }
@@ -200,4 +231,21 @@ pub(super) fn extract_general<const W: usize, S: Sample, Z: CubeSide, T: Real>(
         }
         *g = acc;
     });
+}
+
+/// `j mod n` for any side `n ≥ 1` (one remainder).
+#[inline(always)]
+fn wrap(j: i64, n: usize) -> usize {
+    j.rem_euclid(n as i64) as usize
+}
+
+/// `(i + t) mod n` for `i < n` and a tap offset `t < W ≤` [`crate::filter::MAX_WIDTH`]:
+/// a conditional subtraction, repeated only on sides below the width.
+#[inline(always)]
+fn step(i: usize, t: usize, n: usize) -> usize {
+    let mut v = i + t;
+    while v >= n {
+        v -= n;
+    }
+    v
 }

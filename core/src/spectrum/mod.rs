@@ -1,7 +1,8 @@
 //! The stored 3D Hartley spectrum and its one-time preparation.
 //!
 //! # Layout
-//! A cube of side `n` (a power of two), `x` fastest. Index `k` on an axis
+//! A cube of side `n` (a power of two, or on the host an even
+//! `2^a·3^b·5^c`: [`crate::volume::GridOversampling`]), `x` fastest. Index `k` on an axis
 //! holds the signed frequency `k` for `k < n/2` and `k − n` above (DC at
 //! index 0). The spatial origin of the transform is the volume's centre: the
 //! volume is stored circularly shifted so that voxel `⌊n_a/2⌋` lands at index

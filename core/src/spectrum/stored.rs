@@ -3,7 +3,7 @@
 use crate::error::{mismatch, require_pow2, Error, Result};
 use crate::filter::Filter;
 use crate::num::{BlockExponents, BlockLayout, Real, Sample};
-use crate::volume::padded_size;
+use crate::volume::check_side;
 
 /// The side `n` of a spectrum's cube: known at run time (`usize`, what
 /// every constructor makes) or at compile time ([`Side`]).
@@ -52,8 +52,12 @@ impl<'a, S: Sample> Spectrum<'a, S> {
     /// Rebuild a spectrum from stored parts, e.g. a table in flash made at
     /// build time by [`Spectrum::prepare`].
     ///
+    /// `n` is [`crate::volume::padded_size`] of the dims for the filter's
+    /// oversampling (a power of two), or a mixed-radix side
+    /// ([`crate::volume::check_side`], [`crate::volume::GridOversampling`]).
+    ///
     /// # Errors
-    /// `n` not a power of two, `data.len() != n³`, dims that do not fit, or
+    /// A side that is neither, `data.len() != n³`, dims that do not fit, or
     /// a scale that is not a positive finite number.
     ///
     /// `data` is not scanned (this runs once per view on the host): it must
@@ -68,11 +72,7 @@ impl<'a, S: Sample> Spectrum<'a, S> {
         filter: Filter,
         dims: [usize; 3],
     ) -> Result<Self> {
-        require_pow2("spectrum side", n)?;
-        let expected = padded_size(dims, filter.oversample())?;
-        if expected != n {
-            return Err(Error::VolumeTooLarge { dims, grid: n });
-        }
+        check_side(dims, filter.oversample(), n)?;
         if n * n * n != data.len() {
             return Err(mismatch("spectrum storage", n * n * n, data.len()));
         }
@@ -96,8 +96,9 @@ impl<'a, S: Sample> Spectrum<'a, S> {
     /// [`crate::num::encode_blocks`]).
     ///
     /// # Errors
-    /// As [`Spectrum::from_parts`]; also `S` not a block mantissa format, or
-    /// exponents that do not match `n` and their layout.
+    /// As [`Spectrum::from_parts`]; also a side that is not a power of two,
+    /// `S` not a block mantissa format, or exponents that do not match `n`
+    /// and their layout.
     pub fn from_blocks(
         data: &'a [S],
         blocks: BlockExponents<'a>,
@@ -106,6 +107,8 @@ impl<'a, S: Sample> Spectrum<'a, S> {
         filter: Filter,
         dims: [usize; 3],
     ) -> Result<Self> {
+        // Block layouts and their tables are for power-of-two sides.
+        require_pow2("block-floating-point spectrum side", n)?;
         if !S::BLOCK_MANTISSA {
             return Err(Error::UnsupportedFormat {
                 format: S::NAME,

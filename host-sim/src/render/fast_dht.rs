@@ -31,7 +31,8 @@ use super::fast_store::FastStore;
 pub trait FastReal: Real + FftNum {}
 impl<T: Real + FftNum> FastReal for T {}
 
-/// A real cube of side `n` (a power of two, at least 2) that is zero except
+/// A real cube of even side `n` (a power of two or any even length rustfft
+/// plans, e.g. `2^a·3^b·5^c`) that is zero except
 /// on the rows `(y, z)` with `rows_y[y] && planes_z[z]`, whose x-lines
 /// `fill(y, z, line)` writes (all `n` values).
 pub struct SparseCube<'a, T> {
@@ -73,14 +74,14 @@ pub fn tile_bytes<T>(n: usize) -> u64 {
 /// A coefficient not finite in `S` ([`Error::Overflow`]).
 ///
 /// # Panics
-/// If `n` is not a power of two at least 2, or `out` or the row masks have
-/// the wrong length.
+/// If `n` is odd or below 2, or `out` or the row masks have the wrong
+/// length.
 pub fn dht_3d_real<T: FastReal, S: FastStore>(
     cube: &SparseCube<'_, T>,
     out: &mut [S],
 ) -> Result<(), Error> {
     let n = cube.n;
-    assert!(n >= 2 && n.is_power_of_two(), "side {n}");
+    assert!(n >= 2 && n % 2 == 0, "side {n}");
     assert_eq!(out.len(), n * n * n);
     assert_eq!(cube.rows_y.len(), n);
     assert_eq!(cube.planes_z.len(), n);
@@ -202,7 +203,7 @@ fn hartley_rows<T: FastReal, S: FastStore>(
             *o = c.re - c.im;
         }
         // u = h + i takes F(n − u, −v, −w): index h − 2 − i of row −w.
-        let wm = (n - w) & (n - 1);
+        let wm = (n - w) % n;
         let mirror = &at_m[wm * h + 1..wm * h + h - 1];
         for (o, c) in high.iter_mut().zip(mirror.iter().rev()) {
             *o = c.re + c.im;

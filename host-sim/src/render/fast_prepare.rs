@@ -57,8 +57,23 @@ pub fn prepare_fast<T: FastReal, S: FastStore>(
     volume: &Volume,
     filter: Filter,
 ) -> Result<FastSpectrum<S>, PipelineError> {
+    let n = padded_size(volume.dims, filter.oversample())?;
+    prepare_fast_on::<T, S>(volume, filter, n)
+}
+
+/// [`prepare_fast`] into a cube of side `n`: a power of two as there, or a
+/// mixed-radix side ([`fvr_core::volume::check_side`]) such as
+/// [`fvr_core::volume::GridOversampling::side`] gives.
+///
+/// # Errors
+/// As [`prepare_fast`]; also a side `n` the volume and filter do not allow.
+pub fn prepare_fast_on<T: FastReal, S: FastStore>(
+    volume: &Volume,
+    filter: Filter,
+    n: usize,
+) -> Result<FastSpectrum<S>, PipelineError> {
     let dims = volume.dims;
-    let n = padded_size(dims, filter.oversample())?;
+    fvr_core::volume::check_side(dims, filter.oversample(), n)?;
     fvr_core::volume::DenseVolume::new(dims, &volume.data)?;
     if let Err(e) = fast_budget::<T, S>(n).check(budget::limit(), "use a smaller --resample") {
         return Err(PipelineError::OutOfMemory {
@@ -69,9 +84,8 @@ pub fn prepare_fast<T: FastReal, S: FastStore>(
     }
     let mut premul = vec![<T as Real>::ZERO; n];
     premultiplier_table(&filter, n, &mut premul);
-    let mask = n - 1;
     let offs = dims.map(|d| d / 2);
-    let shifted = |idx: usize, axis: usize| (idx + n - offs[axis]) & mask;
+    let shifted = |idx: usize, axis: usize| (idx + n - offs[axis]) % n;
     let [nx, ny, nz] = dims;
 
     // Σ|g| in f64 (in another order than the core's, which can change the
@@ -130,7 +144,7 @@ pub fn prepare_fast<T: FastReal, S: FastStore>(
     }
     let premul = &premul;
     let fill = move |py: usize, pz: usize, line: &mut [T]| {
-        let (j, k) = ((py + offs[1]) & mask, (pz + offs[2]) & mask);
+        let (j, k) = ((py + offs[1]) % n, (pz + offs[2]) % n);
         let src = &volume.data[nx * (j + ny * k)..][..nx];
         line.fill(<T as Real>::ZERO);
         // The core's products, in its order: v·p(x)·(p(y)·p(z)·s).

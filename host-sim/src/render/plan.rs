@@ -65,7 +65,7 @@ use std::f64::consts::PI;
 
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
-use fvr_core::volume::padded_size;
+use fvr_core::volume::{padded_size, DenseVolume, GridOversampling};
 
 use super::filter::{choose_filter, KbDesign};
 use super::spectrum::{check_memory, Precision};
@@ -112,11 +112,19 @@ pub const AXIS_VIEWS: [View; 3] = [
 pub struct Candidate {
     /// Interpolation filter.
     pub filter: FilterKind,
-    /// Grid oversampling, 1 or 2.
+    /// The filter's integer oversampling, 1 or 2: with [`Prediction::grid`]
+    /// σ = 1 or 2 the grid's, and 1 for the mixed-radix grids σ = 1.25
+    /// and 1.5 ([`GridOversampling::integer`]).
     pub oversample: u32,
     /// Spectrum storage.
     pub precision: Precision,
 }
+
+/// The grids [`choose`] considers: the power-of-two ones.
+pub const POW2_GRIDS: [GridOversampling; 2] = [GridOversampling::X1, GridOversampling::X2];
+
+/// Every grid [`choose_among`] can consider, mixed radix included.
+pub const ALL_GRIDS: [GridOversampling; 4] = GridOversampling::ALL;
 
 /// The error term that limits a prediction.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -155,6 +163,10 @@ impl Term {
 pub struct Prediction {
     /// The configuration predicted.
     pub candidate: Candidate,
+    /// The grid predicted ([`GridOversampling::side`]): what to prepare
+    /// with [`super::spectrum::AnySpectrum::prepare_grid`] and the filter
+    /// [`grid_filter`] makes.
+    pub grid: GridOversampling,
     /// Kaiser–Bessel β of the fitted filter (0 for other kernels).
     pub beta: f64,
     /// SNR of the worst axis view, dB.
@@ -266,9 +278,43 @@ struct Interpolation {
     pixels: f64,
 }
 
-fn interpolation(volume: &Volume, filter: &Filter) -> Result<Interpolation, fvr_core::Error> {
+/// The default image side on the grid of side `n`: the power of two the
+/// volume fills at σ = 1 ([`padded_size`]`(dims, 1)`, `n/oversample` on the
+/// power-of-two grids), at most `n`.
+pub fn image_side(dims: [usize; 3], n: usize) -> Result<usize, fvr_core::Error> {
+    Ok(padded_size(dims, 1)?.min(n))
+}
+
+/// The filter of kind `kind` for `grid`, fitted as `design` asks: on the
+/// power-of-two grids as [`choose_filter`]; on the mixed-radix ones
+/// [`Filter::fit_grid`] (or Beatty's β at the design given).
+///
+/// # Errors
+/// As [`choose_filter`].
+pub fn grid_filter(
+    volume: &Volume,
+    kind: FilterKind,
+    grid: GridOversampling,
+    design: KbDesign,
+) -> Result<Filter, fvr_core::Error> {
+    if grid.is_pow2() {
+        return choose_filter(volume, kind, grid.integer(), design);
+    }
+    match design {
+        KbDesign::Auto => {
+            let src = DenseVolume::new(volume.dims, &volume.data)?;
+            Ok(Filter::fit_grid(kind, grid, &src)?.0)
+        }
+        KbDesign::Sigma(s) => Filter::with_design_oversampling(kind, grid.integer(), s),
+    }
+}
+
+fn interpolation(
+    volume: &Volume,
+    filter: &Filter,
+    n: usize,
+) -> Result<Interpolation, fvr_core::Error> {
     let dims = volume.dims;
-    let n = padded_size(dims, filter.oversample())?;
     let weights = axis_weights(filter, n);
     let grid = |i: usize, a: usize| (i + n - dims[a] / 2 % n) % n;
     let mut sums = [ViewSums::new(n), ViewSums::new(n), ViewSums::new(n)];
@@ -303,7 +349,7 @@ fn interpolation(volume: &Volume, filter: &Filter) -> Result<Interpolation, fvr_
             }
         }
     }
-    let side = n / filter.oversample() as usize;
+    let side = image_side(dims, n)?;
     let mut energies = [[0.0; 4]; 3];
     for (a, e) in energies.iter_mut().enumerate() {
         *e = view_energies(&sums[a], &weights, dims, n, a, side)?;
@@ -402,7 +448,12 @@ fn db(signal: f64, noise: f64) -> f64 {
     10.0 * (signal / noise).log10()
 }
 
-fn combine(interp: &Interpolation, candidate: Candidate, beta: f64) -> Prediction {
+fn combine(
+    interp: &Interpolation,
+    candidate: Candidate,
+    grid: GridOversampling,
+    beta: f64,
+) -> Prediction {
     let u = storage_roundoff(candidate.precision);
     // f32 arithmetic for f16 and f32 storage: log₂n roundings in each of the
     // five transform passes (three forward, two inverse).
@@ -429,6 +480,7 @@ fn combine(interp: &Interpolation, candidate: Candidate, beta: f64) -> Predictio
     }
     Prediction {
         candidate,
+        grid,
         beta,
         db: worst.0,
         views_db,
@@ -446,26 +498,74 @@ pub fn predict(
     candidate: Candidate,
     design: KbDesign,
 ) -> Result<Prediction, fvr_core::Error> {
-    let filter = choose_filter(volume, candidate.filter, candidate.oversample, design)?;
-    let interp = interpolation(volume, &filter)?;
-    Ok(combine(&interp, candidate, filter.beta()))
+    let grid = GridOversampling::from_integer(candidate.oversample)?;
+    predict_grid(volume, candidate, grid, design)
+}
+
+/// [`predict`] on the grid `grid` (whose [`GridOversampling::integer`] is
+/// taken as the candidate's oversampling), filter from [`grid_filter`].
+///
+/// # Errors
+/// As [`predict`].
+pub fn predict_grid(
+    volume: &Volume,
+    candidate: Candidate,
+    grid: GridOversampling,
+    design: KbDesign,
+) -> Result<Prediction, fvr_core::Error> {
+    let candidate = Candidate {
+        oversample: grid.integer(),
+        ..candidate
+    };
+    let filter = grid_filter(volume, candidate.filter, grid, design)?;
+    let interp = interpolation(volume, &filter, grid.side(volume.dims)?)?;
+    Ok(combine(&interp, candidate, grid, filter.beta()))
 }
 
 /// Relative cost of a candidate: time per view first (`n²` slice samples of
 /// `W³` taps, then a 2D transform of `2·n²·log₂n` butterflies), memory
 /// (`n³` stored coefficients) second.
 pub fn cost(candidate: Candidate, dims: [usize; 3]) -> Result<(f64, f64), fvr_core::Error> {
-    let n = padded_size(dims, candidate.oversample)? as f64;
+    cost_grid(
+        candidate,
+        GridOversampling::from_integer(candidate.oversample)?,
+        dims,
+    )
+}
+
+/// The weight of a mixed-radix 2D transform per `n²·log₂n` against the
+/// radix-2 one: an allowance for its strided column gathers and radix-3
+/// and -5 stages (the extraction's `W³` taps dominate either way).
+const MIXED_TRANSFORM_FACTOR: f64 = 2.0;
+
+/// [`cost`] on the grid `grid`: the side [`GridOversampling::side`], the
+/// 2D transform weighted by [`MIXED_TRANSFORM_FACTOR`] on mixed-radix sides.
+///
+/// # Errors
+/// As [`GridOversampling::side`].
+pub fn cost_grid(
+    candidate: Candidate,
+    grid: GridOversampling,
+    dims: [usize; 3],
+) -> Result<(f64, f64), fvr_core::Error> {
+    let side = grid.side(dims)?;
+    let n = side as f64;
     let w = candidate.filter.width() as f64;
-    let time = n * n * (w * w * w + 2.0 * n.log2());
+    let radix = if side.is_power_of_two() {
+        1.0
+    } else {
+        MIXED_TRANSFORM_FACTOR
+    };
+    let time = n * n * (w * w * w + 2.0 * radix * n.log2());
     Ok((time, n * n * n * candidate.precision.bytes() as f64))
 }
 
 /// Filters the planner considers, cheapest first.
-pub const CANDIDATE_FILTERS: [FilterKind; 4] = [
+pub const CANDIDATE_FILTERS: [FilterKind; 5] = [
     FilterKind::Cubic,
     FilterKind::Kb3,
     FilterKind::Kb4,
+    FilterKind::Kb5,
     FilterKind::Kb6,
 ];
 
@@ -506,17 +606,38 @@ pub fn choose(
     target_db: f64,
     constraints: Constraints,
 ) -> Result<Plan, fvr_core::Error> {
+    choose_among(volume, design, target_db, constraints, &POW2_GRIDS)
+}
+
+/// [`choose`] among the grids `grids` ([`ALL_GRIDS`] adds the mixed-radix
+/// σ = 1.25 and 1.5, costed by [`cost_grid`]); a constraint on the
+/// oversampling keeps the grids of that integer oversampling (1: σ = 1,
+/// 1.25, 1.5; 2: σ = 2). The chosen grid is [`Prediction::grid`].
+///
+/// # Errors
+/// As [`choose`].
+pub fn choose_among(
+    volume: &Volume,
+    design: KbDesign,
+    target_db: f64,
+    constraints: Constraints,
+    grids: &[GridOversampling],
+) -> Result<Plan, fvr_core::Error> {
     let filters: Vec<FilterKind> = match constraints.filter {
         Some(f) => vec![f],
         None => CANDIDATE_FILTERS.to_vec(),
     };
-    let oversamples: Vec<u32> = constraints.oversample.map_or(vec![1, 2], |o| vec![o]);
+    let grids: Vec<GridOversampling> = grids
+        .iter()
+        .copied()
+        .filter(|g| constraints.oversample.is_none_or(|o| o == g.integer()))
+        .collect();
     let precisions: Vec<Precision> = constraints
         .precision
         .map_or(vec![Precision::F16, Precision::F32], |p| vec![p]);
     let mut jobs = Vec::new();
-    for &oversample in &oversamples {
-        let n = padded_size(volume.dims, oversample)?;
+    for &grid in &grids {
+        let n = grid.side(volume.dims)?;
         if crate::volume::check_padding(volume.dims, n).is_err() {
             continue;
         }
@@ -526,26 +647,26 @@ pub fn choose(
             .filter(|p| check_memory(n, p.bytes()).is_ok())
             .collect();
         if !fits.is_empty() {
-            jobs.extend(filters.iter().map(|&kind| (kind, oversample, fits.clone())));
+            jobs.extend(filters.iter().map(|&kind| (kind, grid, n, fits.clone())));
         }
     }
     // One pass over the volume per filter and oversampling, on their own threads.
     let results: Vec<Result<Vec<Prediction>, fvr_core::Error>> = std::thread::scope(|scope| {
         let handles: Vec<_> = jobs
             .iter()
-            .map(|(kind, oversample, fits)| {
+            .map(|(kind, grid, n, fits)| {
                 scope.spawn(move || {
-                    let filter = choose_filter(volume, *kind, *oversample, design)?;
-                    let interp = interpolation(volume, &filter)?;
+                    let filter = grid_filter(volume, *kind, *grid, design)?;
+                    let interp = interpolation(volume, &filter, *n)?;
                     Ok(fits
                         .iter()
                         .map(|&precision| {
                             let candidate = Candidate {
                                 filter: *kind,
-                                oversample: *oversample,
+                                oversample: grid.integer(),
                                 precision,
                             };
-                            combine(&interp, candidate, filter.beta())
+                            combine(&interp, candidate, *grid, filter.beta())
                         })
                         .collect())
                 })
@@ -562,7 +683,7 @@ pub fn choose(
     }
     let costs: Vec<(f64, f64)> = predictions
         .iter()
-        .map(|p| cost(p.candidate, volume.dims))
+        .map(|p| cost_grid(p.candidate, p.grid, volume.dims))
         .collect::<Result<_, _>>()?;
     let cheapest_meeting = predictions
         .iter()

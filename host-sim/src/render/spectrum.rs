@@ -16,11 +16,11 @@ use fvr_core::geometry::{Sampling, View};
 use fvr_core::num::{Real, Sample};
 use fvr_core::render::Request;
 use fvr_core::spectrum::{prepare_scratch_len, Spectrum};
-use fvr_core::volume::{padded_size, DenseVolume};
+use fvr_core::volume::{padded_size, DenseVolume, GridOversampling};
 use half::f16;
 
 use super::fast_dht::FastReal;
-use super::fast_prepare::prepare_fast;
+use super::fast_prepare::prepare_fast_on;
 use super::fast_store::FastStore;
 use crate::volume::Volume;
 
@@ -106,7 +106,27 @@ impl<S: Sample> OwnedSpectrum<S> {
         if n < 2 {
             return Self::prepare_in_place::<T>(volume, filter);
         }
-        let spec = prepare_fast::<T, S>(volume, filter)?;
+        Self::prepare_on::<T>(volume, filter, n)
+    }
+
+    /// [`OwnedSpectrum::prepare`] into a cube of side `n`: the power of two
+    /// it picks, or a mixed-radix side such as
+    /// [`fvr_core::volume::GridOversampling::side`] gives (the
+    /// filter's integer oversampling must match,
+    /// [`fvr_core::volume::check_side`]).
+    ///
+    /// # Errors
+    /// As [`OwnedSpectrum::prepare`]; also a side the volume and filter do
+    /// not allow.
+    pub fn prepare_on<T: FastReal>(
+        volume: &Volume,
+        filter: Filter,
+        n: usize,
+    ) -> Result<Self, PipelineError>
+    where
+        S: FastStore,
+    {
+        let spec = prepare_fast_on::<T, S>(volume, filter, n)?;
         Ok(Self {
             data: spec.data,
             n: spec.n,
@@ -291,6 +311,36 @@ impl AnySpectrum {
         precision: Precision,
     ) -> Result<Self, PipelineError> {
         Self::prepare_by(volume, filter, precision, Preparation::Fast)
+    }
+
+    /// [`AnySpectrum::prepare`] on the grid oversampled by `grid`: the cube
+    /// of side [`GridOversampling::side`] (mixed radix for σ = 1.25 and
+    /// 1.5), for a filter made for that grid ([`Filter::for_grid`],
+    /// [`Filter::fit_grid`]).
+    ///
+    /// # Errors
+    /// As [`OwnedSpectrum::prepare_on`].
+    pub fn prepare_grid(
+        volume: &Volume,
+        filter: Filter,
+        precision: Precision,
+        grid: GridOversampling,
+    ) -> Result<Self, PipelineError> {
+        let n = grid.side(volume.dims)?;
+        if n < 2 {
+            return Self::prepare(volume, filter, precision);
+        }
+        Ok(match precision {
+            Precision::F16 => {
+                AnySpectrum::F16(OwnedSpectrum::prepare_on::<f32>(volume, filter, n)?)
+            }
+            Precision::F32 => {
+                AnySpectrum::F32(OwnedSpectrum::prepare_on::<f32>(volume, filter, n)?)
+            }
+            Precision::F64 => {
+                AnySpectrum::F64(OwnedSpectrum::prepare_on::<f64>(volume, filter, n)?)
+            }
+        })
     }
 
     /// [`AnySpectrum::prepare`] by the path `how`.

@@ -1,12 +1,13 @@
 //! Reusable per-view buffers: one extraction and one 2D inverse transform
 //! per view, no allocation after the first.
 
-use fvr_core::dht::Twiddles;
+use fvr_core::dht::{mixed_table_len, MixedPlan, Twiddles};
 use fvr_core::filter::{Filter, KernelTable};
 use fvr_core::geometry::{Sampling, View};
-use fvr_core::image::{aux_len, check_image, finish, grid_len, placement_on_axes, Crop};
+use fvr_core::image::{aux_len, check_image, finish_with, grid_len, placement_on_axes};
+use fvr_core::image::{Crop, Inverse};
 use fvr_core::num::{Real, Sample};
-use fvr_core::render::{render, Buffers, Request, Source};
+use fvr_core::render::{render, render_projection_with, Buffers, Request, Source};
 use fvr_core::slice::extract_slice_rows;
 use fvr_core::spectrum::Spectrum;
 
@@ -27,10 +28,10 @@ pub struct ViewRenderer<T> {
 }
 
 impl<T: Real> ViewRenderer<T> {
-    /// Buffers for spectra of side `n` and `filter`.
+    /// Buffers for spectra of side `n` and `filter`: radix-2 twiddles for
+    /// a power of two, else a mixed-radix plan's table.
     pub fn new(n: usize, filter: Filter) -> Self {
-        let mut tw = vec![T::ZERO; Twiddles::<T>::buffer_len(n)];
-        Twiddles::new(&mut tw, n).expect("n is a power of two");
+        let tw = inverse_table::<T>(n);
         Self {
             kernel: KernelTable::new(filter),
             tw,
@@ -98,7 +99,14 @@ impl<T: Real> ViewRenderer<T> {
         height: usize,
         out: &mut [T],
     ) -> Result<(), fvr_core::Error> {
-        let tw = Twiddles::from_table(&self.tw, self.n)?;
+        let (radix2, mixed);
+        let inverse = if self.n.is_power_of_two() {
+            radix2 = Twiddles::from_table(&self.tw, self.n)?;
+            Inverse::Radix2(&radix2)
+        } else {
+            mixed = MixedPlan::from_table(&self.tw, self.n)?;
+            Inverse::Mixed(&mixed)
+        };
         let spec = spec.view();
         let n = spec.n();
         if self.grid.len() == grid_len(n) && fast_slice::supports(&spec) {
@@ -114,11 +122,11 @@ impl<T: Real> ViewRenderer<T> {
             };
             if filled {
                 let place = placement_on_axes(spec.dims(), &axes, width, height, 1.0);
-                return finish(
+                return finish_with(
                     &mut self.grid,
                     n,
                     &Crop::new(place, sampling.gain() / spec.scale(), width, height),
-                    &tw,
+                    inverse,
                     &mut self.aux,
                     out,
                 );
@@ -131,8 +139,10 @@ impl<T: Real> ViewRenderer<T> {
         // Blocks of at least 16 rows: below that a thread costs more than it saves.
         let blocks = threads.min(n / 16).max(1);
         if blocks == 1 || self.grid.len() != grid_len(n) || self.kernel.filter() != spec.filter() {
-            return render(
-                &Source::new(&spec, &self.kernel, &tw),
+            return render_projection_with(
+                &spec,
+                &self.kernel,
+                inverse,
                 &Request {
                     sampling: *sampling,
                     ..Request::new(*view, width, height)
@@ -142,8 +152,7 @@ impl<T: Real> ViewRenderer<T> {
                     aux: &mut self.aux,
                     out,
                 },
-            )
-            .map(|_| ());
+            );
         }
         let axes = sampling.slice_axes(&view.frame()?);
         check_image(width, height, n)?;
@@ -167,11 +176,11 @@ impl<T: Real> ViewRenderer<T> {
                 .try_for_each(|w| w.join().expect("an extraction thread panicked"))
         })?;
         let place = placement_on_axes(spec.dims(), &axes, width, height, 1.0);
-        finish(
+        finish_with(
             &mut self.grid,
             n,
             &Crop::new(place, sampling.gain() / spec.scale(), width, height),
-            &tw,
+            inverse,
             &mut self.aux,
             out,
         )
@@ -190,15 +199,38 @@ pub fn render_once<S: Sample, T: Real>(
     let n = spec.n();
     let m = (n >> request.level.min(usize::BITS - 1)).max(1);
     let kernel = KernelTable::<T>::new(*spec.filter());
-    let mut tw_buf = vec![T::ZERO; Twiddles::<T>::buffer_len(n)];
-    let tw = Twiddles::new(&mut tw_buf, n)?;
     let mut grid = vec![T::ZERO; grid_len(m)];
     let mut aux = vec![T::ZERO; aux_len(m)];
     let mut out = vec![T::ZERO; request.width * request.height];
-    render(
-        &Source::new(spec, &kernel, &tw),
-        request,
-        Buffers::new(&mut grid, &mut aux, &mut out),
-    )?;
+    let buffers = Buffers::new(&mut grid, &mut aux, &mut out);
+    if n.is_power_of_two() {
+        let mut tw_buf = vec![T::ZERO; Twiddles::<T>::buffer_len(n)];
+        let tw = Twiddles::new(&mut tw_buf, n)?;
+        render(&Source::new(spec, &kernel, &tw), request, buffers)?;
+    } else {
+        // A mixed-radix side: a plan for the slice's side (X-ray only).
+        let mut table = vec![T::ZERO; mixed_table_len(m)];
+        let plan = MixedPlan::new(&mut table, m)?;
+        render_projection_with(spec, &kernel, Inverse::Mixed(&plan), request, buffers)?;
+    }
     Ok(out.into_iter().map(T::to_f64).collect())
+}
+
+/// The inverse transform's table for side `n`: radix-2 twiddles for a
+/// power of two, else a mixed-radix plan's table (empty for a side
+/// neither serves; rendering then reports the error).
+fn inverse_table<T: Real>(n: usize) -> Vec<T> {
+    if n.is_power_of_two() {
+        let mut tw = vec![T::ZERO; Twiddles::<T>::buffer_len(n)];
+        match Twiddles::new(&mut tw, n) {
+            Ok(_) => tw,
+            Err(_) => Vec::new(),
+        }
+    } else {
+        let mut table = vec![T::ZERO; mixed_table_len(n)];
+        match MixedPlan::new(&mut table, n) {
+            Ok(_) => table,
+            Err(_) => Vec::new(),
+        }
+    }
 }

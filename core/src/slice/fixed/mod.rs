@@ -130,7 +130,7 @@ fn walk<const W: usize, const LINE_EXP: bool>(
     };
     let mirror = |j: i32| -j - (W as i32 - 1);
     let reversed = |w: &[i32; W]| -> [i32; W] { core::array::from_fn(|t| w[W - 1 - t]) };
-    walk_pairs::<W, i32, _>(axes, n, 0, n, grid, |y, plus, minus| {
+    walk_pairs::<W, true, i32, _>(axes, n, 0, n, grid, |y, plus, minus| {
         let (jx, wx) = phases.taps(y[0]);
         let (jy, wy) = phases.taps(y[1]);
         let (jz, wz) = phases.taps(y[2]);
