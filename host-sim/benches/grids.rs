@@ -34,30 +34,20 @@ const CONFIGS: [(FilterKind, GridOversampling); 5] = [
     (FilterKind::Kb6, GridOversampling::X1_25),
 ];
 
-/// `volume` without its last slice along odd axes, so that the pixels of
-/// axis views fall on voxels (the exact reference is then the voxel sum).
-fn even(volume: &Volume) -> Volume {
-    let dims = volume.dims.map(|d| d - d % 2);
-    let mut out = Volume::zeros(dims);
-    for k in 0..dims[2] {
-        for j in 0..dims[1] {
-            for i in 0..dims[0] {
-                let at = out.index(i, j, k);
-                out.data[at] = volume.get(i, j, k);
-            }
-        }
-    }
-    out
-}
-
 fn volumes() -> Vec<(&'static str, Volume)> {
     let mut out = vec![(
         "brainsmall",
-        even(&load_dataset("brainsmall").unwrap().unwrap()),
+        load_dataset("brainsmall")
+            .unwrap()
+            .unwrap()
+            .cropped_to_even(),
     )];
     if std::env::var_os("FVR_CT_HEAD").is_some() {
         let ct = load_dataset("ct-head").unwrap().unwrap();
-        out.push(("ct-head@256", even(&ct.resample_isotropic(256).unwrap())));
+        out.push((
+            "ct-head@256",
+            ct.resample_isotropic(256).unwrap().cropped_to_even(),
+        ));
     }
     out
 }

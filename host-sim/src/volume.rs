@@ -119,6 +119,23 @@ impl Volume {
         self.data[self.index(i, j, k)]
     }
 
+    /// This volume without its last slice along odd axes, so that the
+    /// pixels of axis views fall on voxels (the exact reference is then the
+    /// voxel sum), in voxel units ([`DEFAULT_SPACING`]).
+    pub fn cropped_to_even(&self) -> Volume {
+        let dims = self.dims.map(|d| d - d % 2);
+        let mut out = Volume::zeros(dims);
+        for k in 0..dims[2] {
+            for j in 0..dims[1] {
+                for i in 0..dims[0] {
+                    let at = out.index(i, j, k);
+                    out.data[at] = self.get(i, j, k);
+                }
+            }
+        }
+        out
+    }
+
     /// Make `background` the zero of the volume: every sample becomes
     /// `max(x − background, 0)`.
     ///

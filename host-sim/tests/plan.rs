@@ -56,22 +56,6 @@ fn rolled_gaussians() -> Volume {
     out
 }
 
-/// `volume` without its last slice along odd axes, so that the pixels of
-/// axis views fall on voxels.
-fn even(volume: &Volume) -> Volume {
-    let dims = volume.dims.map(|d| d - d % 2);
-    let mut out = Volume::zeros(dims);
-    for k in 0..dims[2] {
-        for j in 0..dims[1] {
-            for i in 0..dims[0] {
-                let at = out.index(i, j, k);
-                out.data[at] = volume.get(i, j, k);
-            }
-        }
-    }
-    out
-}
-
 /// Uniform noise in [0, 1) filling a 32³ box (fixed seed).
 fn noise_box() -> Volume {
     let mut state = 0x2545_f491_4f6c_dd1du64;
@@ -307,7 +291,7 @@ fn predicted_against_measured_table() {
         let ct = load_dataset("ct-head").unwrap().unwrap();
         rows.push((
             "ct-head at 256".into(),
-            even(&ct.resample_isotropic(256).unwrap()),
+            ct.resample_isotropic(256).unwrap().cropped_to_even(),
         ));
     }
     println!("| volume | config | predicted dB | measured dB (x, y, z) | dominant |");
