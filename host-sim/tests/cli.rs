@@ -71,7 +71,7 @@ fn zero_and_parallel_view_vectors_are_named() {
 fn oversized_image_unknown_filter_and_bad_output_are_errors() {
     let (dir, out) = fvr_in(
         "args",
-        "render sphere@16 --dir 1,0,0 --size 40x8 --out x.png",
+        "render sphere@16 --oversample 1 --dir 1,0,0 --size 40x8 --out x.png",
     );
     assert_error(&out, &["40x8", "padded grid size 16"]);
     let out = fvr_line(

@@ -37,7 +37,7 @@ fn accuracy_chooses_a_configuration_predicted_to_meet_the_target() {
     assert_eq!(acc["target_db"], 45.0, "{stats}");
     assert!(acc["predicted_db"].as_f64().unwrap() >= 45.0, "{stats}");
     // The MRI head touches its box: oversampling 1 cannot reach 45 dB.
-    assert_eq!(stats["oversample"], 2, "{stats}");
+    assert!(stats["oversample"].as_f64().unwrap() > 1.0, "{stats}");
     assert_eq!(stats["filter"], acc["filter"], "{stats}");
     assert_eq!(stats["precision"], acc["precision"], "{stats}");
 }
@@ -98,7 +98,7 @@ fn the_default_target_is_50_db_and_a_touching_head_gets_oversampled() {
     assert_eq!(acc["target_db"], 50.0, "{stats}");
     assert_eq!(acc["target_is_default"], true, "{stats}");
     assert!(acc["predicted_db"].as_f64().unwrap() >= 50.0, "{stats}");
-    assert_eq!(stats["oversample"], 2, "{stats}");
+    assert!(stats["oversample"].as_f64().unwrap() > 1.0, "{stats}");
 }
 
 #[test]

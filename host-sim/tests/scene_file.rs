@@ -106,7 +106,7 @@ fn wrong_type_names_the_key_and_the_type() {
     let (_, out) = render_edited_scene("scenefile-type", "oversample = 2", "oversample = \"two\"");
     assert_error(
         &out,
-        &["bad.toml: `spectrum.oversample` must be an integer from 1 to 2, got string \"two\""],
+        &["bad.toml: `spectrum.oversample` must be 1, 1.25, 1.5 or 2, got string \"two\""],
     );
 }
 

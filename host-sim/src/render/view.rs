@@ -44,6 +44,12 @@ impl<T: Real> ViewRenderer<T> {
         }
     }
 
+    /// Bytes of per-view working memory (slice grid, auxiliary, tables).
+    pub fn bytes(&self) -> usize {
+        (self.tw.len() + self.grid.len() + self.aux.len()) * std::mem::size_of::<T>()
+            + std::mem::size_of::<KernelTable<T>>()
+    }
+
     /// Extract the slice on `threads` threads (0, the default: one per
     /// core). The image is the same bit for bit whatever the count.
     pub fn with_threads(mut self, threads: usize) -> Self {

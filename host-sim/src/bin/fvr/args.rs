@@ -5,13 +5,15 @@ use clap::Args;
 use fvr_core::filter::FilterKind;
 use fvr_core::geometry::Sampling;
 use fvr_core::shading::Scene;
+use fvr_core::volume::GridOversampling;
 use fvr_host::image::output::{Bits, Colormap, Style, Window};
 use fvr_host::io::nrrd::{Endian, SampleType};
 use fvr_host::io::FORMATS_HELP;
 use fvr_host::progress;
+use fvr_host::render::plan::grid_filter;
 use fvr_host::render::scene_file::parse_endian;
 use fvr_host::render::shaded::SceneSpectra;
-use fvr_host::render::spectrum::{choose_filter, AnySpectrum, KbDesign, Precision};
+use fvr_host::render::spectrum::{AnySpectrum, KbDesign, Precision};
 use fvr_host::sources::datasets::DATASETS_HELP;
 use fvr_host::sources::{load_volume_with_progress, RawLayout, PHANTOM_HELP};
 
@@ -131,15 +133,16 @@ pub(crate) struct SpectrumArgs {
     /// Default: chosen for --accuracy.
     #[arg(long, value_parser = parse_filter, default_value = "kb4", hide_default_value = true)]
     pub(crate) filter: FilterKind,
-    /// Oversampling of the spectrum grid: 1 or 2. Default: chosen for
+    /// Oversampling of the spectrum grid: 1, 1.25, 1.5 or 2 (1.25 and 1.5
+    /// are mixed-radix grids, for plain X-ray views). Default: chosen for
     /// --accuracy.
     #[arg(
         long,
-        default_value_t = 1,
+        default_value = "1",
         hide_default_value = true,
-        value_parser = clap::value_parser!(u32).range(1..=2)
+        value_parser = parse_oversample
     )]
-    pub(crate) oversample: u32,
+    pub(crate) oversample: GridOversampling,
     /// Spectrum storage and arithmetic: f16 (f32 arithmetic), f32 or f64.
     /// Default: chosen for --accuracy.
     #[arg(long, default_value = "f16", hide_default_value = true)]
@@ -167,7 +170,7 @@ impl Default for SpectrumArgs {
     fn default() -> Self {
         Self {
             filter: FilterKind::Kb4,
-            oversample: 1,
+            oversample: GridOversampling::X1,
             precision: Precision::F16,
             kb_design: KbDesign::Auto,
             accuracy: None,
@@ -175,6 +178,14 @@ impl Default for SpectrumArgs {
             outcome: None,
         }
     }
+}
+
+pub(crate) fn parse_oversample(s: &str) -> Result<GridOversampling, String> {
+    let x = s.trim().parse::<f64>().ok();
+    GridOversampling::ALL
+        .into_iter()
+        .find(|g| Some(g.factor()) == x)
+        .ok_or_else(|| format!("expected 1, 1.25, 1.5 or 2, got `{s}`"))
 }
 
 pub(crate) fn parse_accuracy(s: &str) -> Result<f64, String> {
@@ -301,24 +312,35 @@ pub(crate) fn load_with_progress(
 pub(crate) fn prepare_scene_with_progress(
     volume: &fvr_host::volume::Volume,
     kind: FilterKind,
-    oversample: u32,
+    grid: GridOversampling,
     design: KbDesign,
     precision: Precision,
     scene: &Scene,
 ) -> Result<(SceneSpectra, fvr_core::filter::Filter), Error> {
     let bar = progress::spinner("fitting filter");
     let result = (|| -> Result<_, Error> {
-        check_padding(volume, oversample)?;
-        let filter = choose_filter(volume, kind, oversample, design)?;
+        check_padding(volume, grid)?;
+        let filter = grid_filter(volume, kind, grid, design)?;
         bar.set_message(if scene.needs_gradient_spectrum() {
             "preprocess (density and |grad f| spectra)"
         } else {
             "preprocess"
         });
-        Ok((
-            SceneSpectra::prepare(volume, filter, precision, scene)?,
-            filter,
-        ))
+        let spectra = if grid.is_pow2() {
+            SceneSpectra::prepare(volume, filter, precision, scene)?
+        } else if scene.needs_gradient_spectrum() {
+            return Err(format!(
+                "--oversample {} works on plain X-ray views: lights need --oversample 1 or 2",
+                grid.name()
+            )
+            .into());
+        } else {
+            SceneSpectra {
+                density: AnySpectrum::prepare_grid(volume, filter, precision, grid)?,
+                gradient: None,
+            }
+        };
+        Ok((spectra, filter))
     })();
     bar.finish_and_clear();
     result
@@ -329,46 +351,49 @@ pub(crate) fn prepare_scene_with_progress(
 pub(crate) fn prepare_with_progress(
     volume: &fvr_host::volume::Volume,
     kind: FilterKind,
-    oversample: u32,
+    grid: GridOversampling,
     design: KbDesign,
     precision: Precision,
 ) -> Result<AnySpectrum, Error> {
     let bar = progress::spinner("fitting filter");
     let result = (|| -> Result<_, Error> {
-        check_padding(volume, oversample)?;
-        let filter = choose_filter(volume, kind, oversample, design)?;
+        check_padding(volume, grid)?;
+        let filter = grid_filter(volume, kind, grid, design)?;
         bar.set_message("preprocess");
-        Ok(AnySpectrum::prepare(volume, filter, precision)?)
+        Ok(AnySpectrum::prepare_grid(volume, filter, precision, grid)?)
     })();
     bar.finish_and_clear();
     result
 }
 
 /// [`fvr_host::volume::check_padding`] for the grid `volume` gets at
-/// `oversample`.
-fn check_padding(volume: &fvr_host::volume::Volume, oversample: u32) -> Result<(), Error> {
-    let n = fvr_core::volume::padded_size(volume.dims, oversample)?;
+/// `grid`.
+fn check_padding(volume: &fvr_host::volume::Volume, grid: GridOversampling) -> Result<(), Error> {
+    let n = grid.side(volume.dims)?;
     Ok(fvr_host::volume::check_padding(volume.dims, n)?)
 }
 
 /// Declare, before loading, what the job builds from its volume: `spectra`
 /// spectra (2 with a `|∇f|` spectrum, which also needs a gradient volume),
 /// on the grid of `resample` (or of the volume's longest side) at the
-/// flags' oversampling and precision, and `per_grid(n)` bytes of images or
-/// frames (named `label`) for a grid of side `n`. Readers check it before decoding
+/// flags' oversampling and precision, and `per_grid(n, side)` bytes of
+/// images or frames (named `label`) for a grid of side `n` and the default
+/// image side `side`. Readers check it before decoding
 /// ([`fvr_host::budget::check_load`]).
 pub(crate) fn plan_job(
     spectrum: &SpectrumArgs,
     resample: Option<usize>,
     spectra: u64,
-    (label, per_grid): (&'static str, impl Fn(u64) -> u64 + Send + Sync + 'static),
+    (label, per_grid): (
+        &'static str,
+        impl Fn(u64, u64) -> u64 + Send + Sync + 'static,
+    ),
     hint: &'static str,
 ) {
-    let (oversample, bytes) = (spectrum.oversample, spectrum.precision.bytes() as u64);
+    let (grid, bytes) = (spectrum.oversample, spectrum.precision.bytes() as u64);
     fvr_host::budget::set_plan(hint, move |dims| {
         let largest = resample.unwrap_or_else(|| dims.iter().copied().max().unwrap_or(1));
-        let n = fvr_core::volume::padded_size([largest, 1, 1], oversample)
-            .map_or(u64::MAX, |n| n as u64);
+        let n = grid.side([largest, 1, 1]).map_or(u64::MAX, |n| n as u64);
         // A grid too large for the volume's shape is refused later, by name.
         let thin = resample.is_none() && fvr_host::volume::check_padding(dims, n as usize).is_err();
         let cells = if thin { 0 } else { n.saturating_pow(3) };
@@ -393,7 +418,12 @@ pub(crate) fn plan_job(
         if let Some(r) = resample {
             budget.hold("resampled volume", (r as u64).saturating_pow(3), 4);
         }
-        budget.hold(label, per_grid(n), 1);
+        // fvr_host::render::plan::image_side, from the largest side.
+        let side = (largest as u64)
+            .checked_next_power_of_two()
+            .unwrap_or(u64::MAX)
+            .min(n);
+        budget.hold(label, per_grid(n, side), 1);
         budget
     });
 }

@@ -7,8 +7,10 @@ use crate::render::RenderArgs;
 use crate::turntable::TurntableArgs;
 use crate::Error;
 
-use fvr_core::volume::padded_size;
-use fvr_host::render::plan::{choose, predict, Candidate, Constraints, Prediction};
+use fvr_core::volume::GridOversampling;
+use fvr_host::render::plan::{
+    choose_among, predict_grid, Candidate, Constraints, Prediction, ALL_GRIDS, POW2_GRIDS,
+};
 use fvr_host::volume::Volume;
 use serde::Serialize;
 
@@ -73,31 +75,61 @@ impl Planned for TurntableArgs {
     }
 }
 
+/// Which grids the planner may choose: every one for plain X-ray views, the
+/// power-of-two ones for what needs them (cued and lit scenes, adaptive
+/// filtering).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Grids {
+    All,
+    PowersOfTwo,
+}
+
+impl Grids {
+    fn list(self) -> &'static [GridOversampling] {
+        match self {
+            Grids::All => &ALL_GRIDS,
+            Grids::PowersOfTwo => &POW2_GRIDS,
+        }
+    }
+}
+
 /// `args` with the spectrum settings `--accuracy` chooses for `volume`
-/// (or as given, with a warning when they are predicted below
-/// [`PREDICTION_WARNING_DB`]), the outcome recorded for `--stats`.
-pub(crate) fn planned<A: Planned>(args: &A, volume: &Volume) -> Result<A, Error> {
+/// among `grids` (or as given, with a warning when they are predicted
+/// below [`PREDICTION_WARNING_DB`]), the outcome recorded for `--stats`.
+pub(crate) fn planned<A: Planned>(args: &A, volume: &Volume, grids: Grids) -> Result<A, Error> {
     let mut out = args.clone();
-    apply(out.spectrum_mut(), volume)?;
+    apply(out.spectrum_mut(), volume, grids)?;
     Ok(out)
 }
 
-fn apply(s: &mut SpectrumArgs, volume: &Volume) -> Result<(), Error> {
+fn apply(s: &mut SpectrumArgs, volume: &Volume, grids: Grids) -> Result<(), Error> {
+    if s.given.oversample && !s.oversample.is_pow2() && grids == Grids::PowersOfTwo {
+        return Err(format!(
+            "--oversample {} works on plain X-ray views: depth cues, lights and --adaptive \
+             need --oversample 1 or 2",
+            s.oversample.name()
+        )
+        .into());
+    }
     // A volume too thin for the smallest grid allowed gets its own message
     // before any prediction.
-    let least = if s.given.oversample { s.oversample } else { 1 };
-    fvr_host::volume::check_padding(volume.dims, padded_size(volume.dims, least)?)?;
+    let least = if s.given.oversample {
+        s.oversample
+    } else {
+        GridOversampling::X1
+    };
+    fvr_host::volume::check_padding(volume.dims, least.side(volume.dims)?)?;
     let explicit = s.accuracy.is_some();
     let target = s.accuracy.unwrap_or(DEFAULT_ACCURACY_DB);
     if !explicit && s.given.all() {
         // Everything fixed by the user: nothing to choose, only to predict.
         let candidate = Candidate {
             filter: s.filter,
-            oversample: s.oversample,
+            oversample: s.oversample.integer(),
             precision: s.precision,
         };
-        let prediction = predict(volume, candidate, s.kb_design)?;
-        warn_low(candidate, &prediction);
+        let prediction = predict_grid(volume, candidate, s.oversample, s.kb_design)?;
+        warn_low(&prediction);
         s.outcome = Some(Outcome {
             target_db: None,
             explicit: false,
@@ -110,12 +142,12 @@ fn apply(s: &mut SpectrumArgs, volume: &Volume) -> Result<(), Error> {
         oversample: s.given.oversample.then_some(s.oversample),
         precision: s.given.precision.then_some(s.precision),
     };
-    let plan = choose(volume, s.kb_design, target, constraints)?;
+    let plan = choose_among(volume, s.kb_design, target, constraints, grids.list())?;
     let p = plan.prediction;
     if !explicit && constraints != Constraints::default() {
         // The default target with some settings given: they win, and only a
         // prediction below the warning level is worth a line.
-        warn_low(p.candidate, &p);
+        warn_low(&p);
     } else if !plan.met {
         eprintln!(
             "fvr: warning: no configuration is predicted to reach {target} dB{}; using the best, \
@@ -125,13 +157,13 @@ fn apply(s: &mut SpectrumArgs, volume: &Volume) -> Result<(), Error> {
             } else {
                 " with the settings given"
             },
-            describe(p.candidate),
+            describe(&p),
             p.db,
             p.dominant().why()
         );
     }
     s.filter = p.candidate.filter;
-    s.oversample = p.candidate.oversample;
+    s.oversample = p.grid;
     s.precision = p.candidate.precision;
     s.outcome = Some(Outcome {
         target_db: Some(target),
@@ -143,24 +175,24 @@ fn apply(s: &mut SpectrumArgs, volume: &Volume) -> Result<(), Error> {
 
 /// The warning for settings the user gave that are predicted below
 /// [`PREDICTION_WARNING_DB`].
-fn warn_low(candidate: Candidate, prediction: &Prediction) {
+fn warn_low(prediction: &Prediction) {
     if prediction.db < PREDICTION_WARNING_DB {
         eprintln!(
             "fvr: warning: {} is predicted to reach only {:.1} dB on this volume ({}); \
              --accuracy 50 chooses a configuration predicted to reach 50 dB.",
-            describe(candidate),
+            describe(prediction),
             prediction.db,
             prediction.dominant().why()
         );
     }
 }
 
-fn describe(c: Candidate) -> String {
+fn describe(p: &Prediction) -> String {
     format!(
         "--filter {} --oversample {} --precision {}",
-        c.filter.name(),
-        c.oversample,
-        c.precision
+        p.candidate.filter.name(),
+        p.grid.name(),
+        p.candidate.precision
     )
 }
 
@@ -177,7 +209,7 @@ pub(crate) fn print_human(s: &SpectrumArgs) {
         println!(
             "  accuracy      {:.1} dB predicted for {} ({how}; limited by the {} term: {})",
             p.db,
-            describe(p.candidate),
+            describe(&p),
             p.dominant().name(),
             p.dominant().why()
         );
@@ -192,7 +224,7 @@ pub(crate) struct AccuracyJson {
     predicted_db: Option<f64>,
     predicted_views_db: [Option<f64>; 3],
     filter: &'static str,
-    oversample: u32,
+    oversample: serde_json::Value,
     precision: &'static str,
     limited_by: &'static str,
     edge_db: Option<f64>,
@@ -212,7 +244,7 @@ pub(crate) fn json(s: &SpectrumArgs) -> Option<AccuracyJson> {
             predicted_db: finite(p.db),
             predicted_views_db: p.views_db.map(finite),
             filter: p.candidate.filter.name(),
-            oversample: p.candidate.oversample,
+            oversample: oversample_json(p.grid),
             precision: p.candidate.precision.name(),
             limited_by: p.dominant().name(),
             edge_db: finite(p.parts_db[0]),
@@ -220,4 +252,13 @@ pub(crate) fn json(s: &SpectrumArgs) -> Option<AccuracyJson> {
             storage_db: finite(p.parts_db[2]),
         }
     })
+}
+
+/// σ in `--stats-json`: an integer for 1 and 2, else a float.
+pub(crate) fn oversample_json(grid: GridOversampling) -> serde_json::Value {
+    if grid.is_pow2() {
+        grid.integer().into()
+    } else {
+        grid.factor().into()
+    }
 }

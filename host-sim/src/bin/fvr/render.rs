@@ -31,6 +31,7 @@ use fvr_host::render::shaded::{
     SceneRenderer, DEFAULT_PROFILE_HARMONICS, DEPTH_CUE_HELP,
 };
 use fvr_host::render::spectrum::Precision;
+use fvr_host::render::view::ViewRenderer;
 use fvr_host::sources::phantom_by_name;
 
 /// Below this estimated storage SNR the renderer warns (see
@@ -171,9 +172,11 @@ fn declare_job(args: &RenderArgs, scene: &Scene) {
             1
         },
         // Per-view grids (slice, scratch, output) and the RGB image.
-        ("view buffers and image", move |n| {
+        ("view buffers and image", move |n, side| {
             // A size beyond the grid is refused later, by name.
-            let (w, h) = size.map_or((n, n), |(w, h)| ((w as u64).min(n), (h as u64).min(n)));
+            let (w, h) = size.map_or((side, side), |(w, h)| {
+                ((w as u64).min(n), (h as u64).min(n))
+            });
             n.saturating_mul(n)
                 .saturating_mul(24)
                 .saturating_add(w.saturating_mul(h).saturating_mul(32))
@@ -205,7 +208,13 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     }
     fvr_host::budget::check_plan(volume.dims)?;
     let t_load = t0.elapsed();
-    let args = &crate::plan::planned(args, &volume)?;
+    let plain_view = scene.channels() == 1 && !scene.has_partner_terms();
+    let grids = if plain_view && args.adaptive.is_none() {
+        crate::plan::Grids::All
+    } else {
+        crate::plan::Grids::PowersOfTwo
+    };
+    let args = &crate::plan::planned(args, &volume, grids)?;
     // The planner may have changed the spectrum's settings.
     declare_job(args, &scene);
     fvr_host::budget::check_plan(volume.dims)?;
@@ -227,7 +236,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
              the {} spectrum is estimated to hold only {storage_snr:.1} dB. \
              Use --oversample 2, --filter cubic, or --precision f32.",
             args.frame.spectrum.filter.name(),
-            args.frame.spectrum.oversample,
+            args.frame.spectrum.oversample.name(),
             args.frame.spectrum.precision
         );
     }
@@ -242,11 +251,10 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         );
     }
     let n = spectra.density.n();
-    let default_side = n / args.frame.spectrum.oversample as usize;
+    let default_side = fvr_host::render::plan::image_side(volume.dims, n)?;
     let (w, h) = args.frame.size.unwrap_or((default_side, default_side));
     fvr_core::image::check_image(w, h, n)?;
     let sampling = args.frame.units.sampling(&volume, n, default_side)?;
-    let plain_view = scene.channels() == 1 && !scene.has_partner_terms();
     if (args.preview_level > 0 || args.adaptive.is_some()) && !plain_view {
         return Err(
             "--preview-level and --adaptive work on plain X-ray views: leave out --depth-cue, \
@@ -407,7 +415,7 @@ struct RenderStats<'a> {
     spectrum_bytes: usize,
     gradient_spectrum_bytes: Option<usize>,
     filter: &'a str,
-    oversample: u32,
+    oversample: serde_json::Value,
     storage_snr_db: f64,
     load_ms: f64,
     preprocess_ms: f64,
@@ -497,10 +505,14 @@ impl Rendered<'_> {
             ),
             None => println!("  |grad f|      not built (no light needs it)"),
         }
-        let working = match args.frame.spectrum.precision {
-            Precision::F64 => SceneRenderer::<f64>::new(n, filter, scene).map(|r| r.bytes()),
-            _ => SceneRenderer::<f32>::new(n, filter, scene).map(|r| r.bytes()),
-        }?;
+        // Plain X-ray views go through the view renderer (any grid side).
+        let plain = scene.channels() == 1 && !scene.has_partner_terms();
+        let working = match (args.frame.spectrum.precision, plain) {
+            (Precision::F64, true) => ViewRenderer::<f64>::new(n, filter).bytes(),
+            (_, true) => ViewRenderer::<f32>::new(n, filter).bytes(),
+            (Precision::F64, false) => SceneRenderer::<f64>::new(n, filter, scene)?.bytes(),
+            (_, false) => SceneRenderer::<f32>::new(n, filter, scene)?.bytes(),
+        };
         println!(
             "  per view      {working} bytes ({} slice fields, tables, twiddles)",
             scene.field_count()
@@ -511,14 +523,14 @@ impl Rendered<'_> {
             println!(
                 "  filter        {} (oversample {}, beta {:.3})",
                 f.kind().name(),
-                f.oversample(),
+                args.frame.spectrum.oversample.name(),
                 f.beta()
             );
         } else {
             println!(
                 "  filter        {} (oversample {})",
                 f.kind().name(),
-                f.oversample()
+                args.frame.spectrum.oversample.name()
             );
         }
         println!("  storage SNR   {storage_snr:.1} dB (estimate, against the f64 pipeline)");
@@ -577,7 +589,7 @@ impl Rendered<'_> {
             spectrum_bytes: spectra.density.bytes(),
             gradient_spectrum_bytes: spectra.gradient.as_ref().map(|g| g.bytes()),
             filter: filter.kind().name(),
-            oversample: filter.oversample(),
+            oversample: crate::plan::oversample_json(args.frame.spectrum.oversample),
             storage_snr_db: storage_snr,
             load_ms: t_load.as_secs_f64() * 1e3,
             preprocess_ms: t_prep.as_secs_f64() * 1e3,

@@ -6,6 +6,7 @@ use crate::scene::{given_on_command_line, FromScene};
 use clap::ArgMatches;
 use fvr_core::filter::FilterKind;
 use fvr_core::shading::Light;
+use fvr_core::volume::GridOversampling;
 use fvr_host::io::nrrd::{Endian, SampleType};
 use fvr_host::render::spectrum::{KbDesign, Precision};
 use std::path::PathBuf;
@@ -60,7 +61,7 @@ fn scene_fills_every_render_setting() {
     assert_eq!(a.frame.units.pixel_size, Some(0.5));
     assert!(!a.frame.units.ignore_spacing);
     assert_eq!(a.frame.spectrum.filter, FilterKind::Cubic);
-    assert_eq!(a.frame.spectrum.oversample, 2);
+    assert_eq!(a.frame.spectrum.oversample, GridOversampling::X2);
     assert_eq!(a.frame.spectrum.precision, Precision::F32);
     assert_eq!(a.frame.spectrum.kb_design, KbDesign::Sigma(1.5));
     assert_eq!(a.ambient, Some([0.1; 3]));
@@ -117,7 +118,9 @@ fn each_flag_overrides_its_scene_key() {
         (&["--filter", "kb3"], |a| {
             a.frame.spectrum.filter == FilterKind::Kb3
         }),
-        (&["--oversample", "1"], |a| a.frame.spectrum.oversample == 1),
+        (&["--oversample", "1.25"], |a| {
+            a.frame.spectrum.oversample == GridOversampling::X1_25
+        }),
         (&["--precision", "f16"], |a| {
             a.frame.spectrum.precision == Precision::F16
         }),

@@ -65,13 +65,12 @@ const SAMPLE_FRAMES: usize = 16;
 /// What a turntable of `frames` frames builds from its volume
 /// ([`crate::args::plan_job`]).
 fn declare_job(args: &TurntableArgs, frames: usize) {
-    let (size, oversample) = (args.frame.size, args.frame.spectrum.oversample);
+    let size = args.frame.size;
     crate::args::plan_job(
         &args.frame.spectrum,
         None,
         1,
-        ("frames and view buffers", move |n| {
-            let side = n / oversample as u64;
+        ("frames and view buffers", move |n, side| {
             // A size beyond the grid is refused later, by name.
             let (w, h) = size.map_or((side, side), |(w, h)| {
                 ((w as u64).min(n), (h as u64).min(n))
@@ -103,7 +102,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     let _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
     fvr_host::budget::check_plan(volume.dims)?;
     let t_load = t0.elapsed();
-    let args = &crate::plan::planned(args, &volume)?;
+    let args = &crate::plan::planned(args, &volume, crate::plan::Grids::All)?;
     // The planner may have changed the spectrum's settings.
     declare_job(args, views.len());
     fvr_host::budget::check_plan(volume.dims)?;
@@ -117,7 +116,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     )?;
     let t_prep = t1.elapsed();
     let n = spec.n();
-    let side = n / args.frame.spectrum.oversample as usize;
+    let side = fvr_host::render::plan::image_side(volume.dims, n)?;
     let (w, h) = args.frame.size.unwrap_or((side, side));
     fvr_core::image::check_image(w, h, n)?;
     let sampling = args.frame.units.sampling(&volume, n, side)?;
@@ -154,7 +153,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
             precision: args.frame.spectrum.precision.name(),
             spectrum_bytes: spec.bytes(),
             filter: args.frame.spectrum.filter.name(),
-            oversample: args.frame.spectrum.oversample,
+            oversample: crate::plan::oversample_json(args.frame.spectrum.oversample),
             load_ms: t_load.as_secs_f64() * 1e3,
             preprocess_ms: t_prep.as_secs_f64() * 1e3,
             views_ms: secs * 1e3,
@@ -237,7 +236,7 @@ struct TurntableStats<'a> {
     precision: &'a str,
     spectrum_bytes: usize,
     filter: &'a str,
-    oversample: u32,
+    oversample: serde_json::Value,
     load_ms: f64,
     preprocess_ms: f64,
     views_ms: f64,

@@ -9,9 +9,8 @@ use crate::render::filter::KbDesign;
 use crate::render::spectrum::{check_memory, Precision};
 use crate::volume::Volume;
 
-/// Relative cost of a candidate: time per view first (`n²` slice samples of
-/// `W³` taps, then a 2D transform of `2·n²·log₂n` butterflies), memory
-/// (`n³` stored coefficients) second.
+/// Relative cost of a candidate: time per view first
+/// ([`cost_grid`]), memory (`n³` stored coefficients) second.
 pub fn cost(candidate: Candidate, dims: [usize; 3]) -> Result<(f64, f64), fvr_core::Error> {
     cost_grid(
         candidate,
@@ -20,13 +19,34 @@ pub fn cost(candidate: Candidate, dims: [usize; 3]) -> Result<(f64, f64), fvr_co
     )
 }
 
-/// The weight of a mixed-radix 2D transform per `n²·log₂n` against the
-/// radix-2 one: an allowance for its strided column gathers and radix-3
-/// and -5 stages (the extraction's `W³` taps dominate either way).
-const MIXED_TRANSFORM_FACTOR: f64 = 2.0;
+/// CPU ms of one view on one thread with a grid of side 256, by filter:
+/// the fit of `cargo bench -p fvr-host --bench plan_cost` on the CT head
+/// (f16; views of `image_side` pixels over an orbit). Even widths cost
+/// more per tap than odd ones (kb4 as much as cubic, 2.2× kb3), so the
+/// weights are measured rather than `W³`. Nearest and linear, never
+/// candidates, are kb3's weight scaled by their taps.
+fn view_weight(kind: FilterKind) -> f64 {
+    match kind {
+        FilterKind::Nearest => 2.85 / 27.0,
+        FilterKind::Linear => 2.85 * 8.0 / 27.0,
+        FilterKind::Kb3 => 2.85,
+        FilterKind::Cubic | FilterKind::Kb4 => 6.3,
+        FilterKind::Kb5 => 7.6,
+        FilterKind::Kb6 => 10.9,
+    }
+}
 
-/// [`cost`] on the grid `grid`: the side [`GridOversampling::side`], the
-/// 2D transform weighted by [`MIXED_TRANSFORM_FACTOR`] on mixed-radix sides.
+/// How the time per view grows with the grid side `n` (`n^2.1`: the
+/// slice's `n²` samples, their taps missing the cache more on larger
+/// spectra, and the `n² log n` 2D transform), and the factor of a
+/// mixed-radix side over a power of two at the same `n`; both fitted with
+/// [`view_weight`].
+const SIDE_EXPONENT: f64 = 2.1;
+const MIXED_FACTOR: f64 = 1.28;
+
+/// [`cost`] on the grid `grid`: time per view `w·(n/256)^2.1`, times
+/// 1.28 on mixed-radix sides (`w` from a measured table of the filters),
+/// then memory.
 ///
 /// # Errors
 /// As [`GridOversampling::side`].
@@ -37,13 +57,12 @@ pub fn cost_grid(
 ) -> Result<(f64, f64), fvr_core::Error> {
     let side = grid.side(dims)?;
     let n = side as f64;
-    let w = candidate.filter.width() as f64;
-    let radix = if side.is_power_of_two() {
+    let mixed = if side.is_power_of_two() {
         1.0
     } else {
-        MIXED_TRANSFORM_FACTOR
+        MIXED_FACTOR
     };
-    let time = n * n * (w * w * w + 2.0 * radix * n.log2());
+    let time = view_weight(candidate.filter) * (n / 256.0).powf(SIDE_EXPONENT) * mixed;
     Ok((time, n * n * n * candidate.precision.bytes() as f64))
 }
 
@@ -62,8 +81,8 @@ pub const CANDIDATE_FILTERS: [FilterKind; 5] = [
 pub struct Constraints {
     /// A filter given explicitly.
     pub filter: Option<FilterKind>,
-    /// An oversampling given explicitly.
-    pub oversample: Option<u32>,
+    /// A grid oversampling given explicitly.
+    pub oversample: Option<GridOversampling>,
     /// A precision given explicitly.
     pub precision: Option<Precision>,
 }
@@ -80,7 +99,14 @@ pub struct Plan {
     pub met: bool,
 }
 
-/// The cheapest candidate ([`cost`]) predicted to reach `target_db`, among
+/// The planner prefers configurations predicted at least this far above
+/// the target: the bound the tests hold every prediction to (never more
+/// than 3 dB optimistic on the worst view), so that the measured SNR
+/// reaches the target.
+pub const MARGIN_DB: f64 = 3.0;
+
+/// The cheapest candidate ([`cost`]) predicted to reach `target_db` +
+/// [`MARGIN_DB`] (or, if none does, `target_db`), among
 /// [`CANDIDATE_FILTERS`] × oversampling 1, 2 × f16, f32 restricted by
 /// `constraints`; if none does, the best predicted. Candidates whose grid
 /// would not fit in memory or be too thin are skipped.
@@ -98,8 +124,8 @@ pub fn choose(
 
 /// [`choose`] among the grids `grids` ([`ALL_GRIDS`] adds the mixed-radix
 /// σ = 1.25 and 1.5, costed by [`cost_grid`]); a constraint on the
-/// oversampling keeps the grids of that integer oversampling (1: σ = 1,
-/// 1.25, 1.5; 2: σ = 2). The chosen grid is [`Prediction::grid`].
+/// oversampling keeps that grid only, whether or not `grids` lists it.
+/// The chosen grid is [`Prediction::grid`].
 ///
 /// # Errors
 /// As [`choose`].
@@ -114,34 +140,39 @@ pub fn choose_among(
         Some(f) => vec![f],
         None => CANDIDATE_FILTERS.to_vec(),
     };
-    let grids: Vec<GridOversampling> = grids
-        .iter()
-        .copied()
-        .filter(|g| constraints.oversample.is_none_or(|o| o == g.integer()))
-        .collect();
+    let grids: Vec<GridOversampling> = match constraints.oversample {
+        Some(g) => vec![g],
+        None => grids.to_vec(),
+    };
     let precisions: Vec<Precision> = constraints
         .precision
         .map_or(vec![Precision::F16, Precision::F32], |p| vec![p]);
+    let shadows = super::wrap::Shadows::new(volume);
     let mut jobs = Vec::new();
     for &grid in &grids {
         let n = grid.side(volume.dims)?;
         if crate::volume::check_padding(volume.dims, n).is_err() {
             continue;
         }
+        let wrap = shadows.worst_ratio(n, super::image_side(volume.dims, n)?);
         let fits: Vec<Precision> = precisions
             .iter()
             .copied()
             .filter(|p| check_memory(n, p.bytes()).is_ok())
             .collect();
         if !fits.is_empty() {
-            jobs.extend(filters.iter().map(|&kind| (kind, grid, n, fits.clone())));
+            jobs.extend(
+                filters
+                    .iter()
+                    .map(|&kind| (kind, grid, n, wrap, fits.clone())),
+            );
         }
     }
     // One pass over the volume per filter and oversampling, on their own threads.
     let results: Vec<Result<Vec<Prediction>, fvr_core::Error>> = std::thread::scope(|scope| {
         let handles: Vec<_> = jobs
             .iter()
-            .map(|(kind, grid, n, fits)| {
+            .map(|(kind, grid, n, wrap, fits)| {
                 scope.spawn(move || {
                     let filter = grid_filter(volume, *kind, *grid, design)?;
                     let interp = interpolation(volume, &filter, *n)?;
@@ -153,7 +184,7 @@ pub fn choose_among(
                                 oversample: grid.integer(),
                                 precision,
                             };
-                            combine(&interp, candidate, *grid, filter.beta())
+                            combine(&interp, candidate, *grid, filter.beta(), *wrap)
                         })
                         .collect())
                 })
@@ -172,12 +203,17 @@ pub fn choose_among(
         .iter()
         .map(|p| cost_grid(p.candidate, p.grid, volume.dims))
         .collect::<Result<_, _>>()?;
-    let cheapest_meeting = predictions
-        .iter()
-        .zip(&costs)
-        .filter(|(p, _)| p.db >= target_db)
-        .min_by(|a, b| a.1.partial_cmp(b.1).unwrap_or(std::cmp::Ordering::Equal));
-    if let Some((p, _)) = cheapest_meeting {
+    let cheapest_above = |floor: f64| {
+        predictions
+            .iter()
+            .zip(&costs)
+            .filter(|(p, _)| p.db >= floor)
+            .min_by(|a, b| a.1.partial_cmp(b.1).unwrap_or(std::cmp::Ordering::Equal))
+    };
+    // With the margin if any candidate allows it, else without.
+    if let Some((p, _)) =
+        cheapest_above(target_db + MARGIN_DB).or_else(|| cheapest_above(target_db))
+    {
         return Ok(Plan {
             target_db,
             prediction: *p,

@@ -150,7 +150,10 @@ impl Term {
     /// Why this term limits the accuracy, in a few words.
     pub fn why(self) -> &'static str {
         match self {
-            Term::Edge => "content near the faces of the grid meets the neighbouring replica",
+            Term::Edge => {
+                "content near the faces of the grid meets the neighbouring replica, or an \
+                 oblique view's shadow wraps around the image"
+            }
             Term::Kernel => "the kernel's stopband leaks on the volume's interior",
             Term::Storage => "rounding of the stored spectrum",
         }
@@ -158,7 +161,8 @@ impl Term {
 }
 
 /// A predicted accuracy: SNR in dB against the exact projection of the
-/// band-limited interpolant, worst of the three axis views.
+/// band-limited interpolant, worst of the three axis views and the oblique
+/// views whose shadow wraps around the image (`wrap.rs`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Prediction {
     /// The configuration predicted.
@@ -453,6 +457,7 @@ fn combine(
     candidate: Candidate,
     grid: GridOversampling,
     beta: f64,
+    wrap: f64,
 ) -> Prediction {
     let u = storage_roundoff(candidate.precision);
     // f32 arithmetic for f16 and f32 storage: log₂n roundings in each of the
@@ -466,6 +471,7 @@ fn combine(
     let spread = interp.pixels / (interp.n * interp.n) as f64 * interp.k2.powi(3) * interp.g2;
     let mut views_db = [0.0; 3];
     let mut worst = (f64::INFINITY, [f64::INFINITY; 3]);
+    let mut worst_energies = [0.0; 5];
     for (v, e) in interp.energies.iter().enumerate() {
         let [signal, edge, kernel, total] = *e;
         let late = LATE_ROUNDINGS * u * u + 5.0 * log_n * ua * ua;
@@ -476,7 +482,22 @@ fn combine(
                 views_db[v],
                 [db(signal, edge), db(signal, kernel), db(signal, storage)],
             );
+            worst_energies = [signal, edge, kernel, total, storage];
         }
+    }
+    // The oblique views: the worst axis view's error with the wrapped
+    // shadow added to its edge term.
+    let [signal, edge, kernel, total, storage] = worst_energies;
+    let oblique = db(signal, total + storage + wrap * signal);
+    if wrap > 0.0 && oblique < worst.0 {
+        worst = (
+            oblique,
+            [
+                db(signal, edge + wrap * signal),
+                db(signal, kernel),
+                db(signal, storage),
+            ],
+        );
     }
     Prediction {
         candidate,
@@ -518,9 +539,14 @@ pub fn predict_grid(
         ..candidate
     };
     let filter = grid_filter(volume, candidate.filter, grid, design)?;
-    let interp = interpolation(volume, &filter, grid.side(volume.dims)?)?;
-    Ok(combine(&interp, candidate, grid, filter.beta()))
+    let n = grid.side(volume.dims)?;
+    let interp = interpolation(volume, &filter, n)?;
+    let wrap = wrap::Shadows::new(volume).worst_ratio(n, image_side(volume.dims, n)?);
+    Ok(combine(&interp, candidate, grid, filter.beta(), wrap))
 }
 
 mod choose;
-pub use choose::{choose, choose_among, cost, cost_grid, Constraints, Plan, CANDIDATE_FILTERS};
+mod wrap;
+pub use choose::{
+    choose, choose_among, cost, cost_grid, Constraints, Plan, CANDIDATE_FILTERS, MARGIN_DB,
+};

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use fvr_core::filter::FilterKind;
 use fvr_core::shading::{Light, MAX_LIGHTS};
+use fvr_core::volume::GridOversampling;
 use toml::{Table, Value};
 
 use crate::image::output::{Bits, Colormap, Window};
@@ -143,6 +144,18 @@ impl Checker<'_> {
                 None
             }
         }
+    }
+
+    /// `oversample`: one of the grid factors, as an integer or a float.
+    fn oversample(&mut self, t: &Table, prefix: &str) -> Option<GridOversampling> {
+        let path = join(prefix, "oversample");
+        let v = t.get("oversample")?;
+        let found =
+            as_number(v).and_then(|x| GridOversampling::ALL.into_iter().find(|g| g.factor() == x));
+        if found.is_none() {
+            self.wrong(&path, "1, 1.25, 1.5 or 2", v);
+        }
+        found
     }
 
     fn boolean(&mut self, t: &Table, prefix: &str, key: &str) -> Option<bool> {
@@ -415,7 +428,7 @@ impl Checker<'_> {
                     )
                 })
             }),
-            oversample: self.integer(t, p, "oversample", 1, 2).map(|v| v as u32),
+            oversample: self.oversample(t, p),
             precision: self.parsed(t, p, "precision", str::parse::<Precision>),
             kb_design: match t.get("kb_design") {
                 Some(v @ (Value::Integer(_) | Value::Float(_))) => {

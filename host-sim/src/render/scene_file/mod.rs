@@ -23,7 +23,7 @@
 //!
 //! [spectrum]
 //! accuracy = 50                 # dB: the planner chooses what is not given below
-//! # filter = "kb4"              # oversample = 2, precision = "f16", kb_design = "auto"
+//! # filter = "kb4"              # oversample = 1.25, precision = "f16", kb_design = "auto"
 //!
 //! [shading]
 //! ambient = 0.05                # or [r, g, b]
@@ -70,6 +70,7 @@ use std::path::{Path, PathBuf};
 
 use fvr_core::filter::FilterKind;
 use fvr_core::shading::Light;
+use fvr_core::volume::GridOversampling;
 use toml::Table;
 
 use crate::image::output::{Bits, Colormap};
@@ -119,8 +120,8 @@ pub struct CameraSection {
 pub struct SpectrumSection {
     /// Interpolation filter.
     pub filter: Option<FilterKind>,
-    /// Oversampling, 1 or 2.
-    pub oversample: Option<u32>,
+    /// Grid oversampling σ: 1, 1.25, 1.5 or 2.
+    pub oversample: Option<GridOversampling>,
     /// Storage and arithmetic.
     pub precision: Option<Precision>,
     /// Kaiser–Bessel design.

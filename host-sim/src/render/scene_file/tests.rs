@@ -34,7 +34,7 @@ fn full_scene_parses_every_key() {
     assert_eq!(s.camera.pixel_size, Some(0.5));
     assert_eq!(s.volume.ignore_spacing, Some(false));
     assert_eq!(s.spectrum.filter, Some(FilterKind::Cubic));
-    assert_eq!(s.spectrum.oversample, Some(2));
+    assert_eq!(s.spectrum.oversample, Some(GridOversampling::X2));
     assert_eq!(s.spectrum.precision, Some(Precision::F32));
     assert_eq!(s.spectrum.kb_design, Some(KbDesign::Sigma(1.5)));
     assert_eq!(s.shading.ambient, Some([0.1; 3]));
@@ -102,11 +102,11 @@ fn wrong_types_name_the_key_and_the_expected_type() {
     for (text, needle) in [
         (
             "[spectrum]\noversample = \"2\"",
-            "`spectrum.oversample` must be an integer from 1 to 2, got string \"2\"",
+            "`spectrum.oversample` must be 1, 1.25, 1.5 or 2, got string \"2\"",
         ),
         (
             "[spectrum]\noversample = 3",
-            "`spectrum.oversample`: must be from 1 to 2, got 3",
+            "`spectrum.oversample` must be 1, 1.25, 1.5 or 2, got integer 3",
         ),
         (
             "[output]\nbits = 12",
