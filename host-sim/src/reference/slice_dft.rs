@@ -14,9 +14,9 @@
 //! volume wraps onto its first voxel); for oblique views `m` at twice the
 //! volume keeps the repeats off the box's shadow, as the 2× pipeline does.
 //!
-//! Cost `O(m²·N³)`, halved by the Hermitian symmetry of real samples,
-//! spread over threads with rayon: about a second for a 64³ volume at
-//! `m = 128` in release builds.
+//! Cost `O(m²·N³)` multiply-adds, halved by the Hermitian symmetry of real
+//! samples and spread over threads with rayon: 64³ volumes at `m = 128`
+//! and `256` are practical in release builds.
 
 use std::f64::consts::PI;
 
