@@ -11,6 +11,10 @@ echo "== data: the InVesalius CT head (GPL-2: installed from Debian, never commi
 FVR_CT_HEAD="$(bash scripts/fetch-ct-head.sh)"
 export FVR_CT_HEAD
 
+echo "== data: an MRI head (MNI152 T1 from nilearn's PyPI wheel: fetched into target/, never committed)"
+FVR_MRI_HEAD="$(bash scripts/fetch-mri-head.sh)"
+export FVR_MRI_HEAD
+
 echo "== no_std core for thumbv7em-none-eabihf"
 cargo build --locked -p fvr-core --target thumbv7em-none-eabihf --release
 

@@ -9,10 +9,14 @@
 //! 5. [`spatial_projection`]: a spatial-domain ray integrator.
 //! 6. [`axis::axis_projection`]: the exact image of the band-limited
 //!    interpolant for views along an axis with pixels on voxels.
+//! 7. [`slice_dft::slice_dft_projection`]: [`ideal_projection`] threaded,
+//!    on a slice of any power-of-two side, for any view of volumes up to
+//!    about 64³.
 
 pub mod axis;
 pub mod raycast;
 pub mod shaded;
+pub mod slice_dft;
 
 use std::f64::consts::PI;
 

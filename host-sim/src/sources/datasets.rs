@@ -1,4 +1,5 @@
-//! Named real data sets: `brainsmall` (embedded) and `ct-head` (installed).
+//! Named real data sets: `brainsmall` (embedded), `ct-head` (installed) and
+//! `mri-head` (fetched).
 //!
 //! - `brainsmall`: VolPack's 128 × 128 × 84 MRI head (BSD-3, see
 //!   `host-sim/tests/data/README.md`), embedded in the binary as `.den.gz`.
@@ -6,6 +7,10 @@
 //!   0.957 × 0.957 × 1.5 mm voxels (GPL-2, never committed). It is found at
 //!   `$FVR_CT_HEAD` if set, else where Debian's `invesalius-examples`
 //!   installs it; `scripts/fetch-ct-head.sh` installs it.
+//! - `mri-head`: the MNI152 2009a symmetric T1 template, 197 × 233 × 189
+//!   uint8 NIfTI at 1 mm, as nilearn's PyPI wheel ships it (never
+//!   committed). It is read from `$FVR_MRI_HEAD`, which
+//!   `scripts/fetch-mri-head.sh` prints after fetching it into `target/`.
 //!
 //! Other modules get either with [`crate::sources::load_volume`]`("ct-head", None)`,
 //! or [`load_dataset`].
@@ -23,6 +28,12 @@ pub const CT_HEAD_ENV: &str = "FVR_CT_HEAD";
 
 /// Where Debian's `invesalius-examples` installs the CT head.
 pub const CT_HEAD_DEBIAN_PATH: &str = "/usr/share/doc/invesalius-examples/examples/Cranium.inv3";
+
+/// Environment variable that points at the MRI head's `.nii.gz` file.
+pub const MRI_HEAD_ENV: &str = "FVR_MRI_HEAD";
+
+/// Sizes `[x, y, z]` of the MRI head (MNI152 2009a, 1 mm).
+pub const MRI_HEAD_DIMS: [usize; 3] = [197, 233, 189];
 
 /// Sizes `[x, y, z]` of the CT head.
 pub const CT_HEAD_DIMS: [usize; 3] = [256, 256, 108];
@@ -46,11 +57,16 @@ pub const DATASETS: &[(&str, &str)] = &[
         "ct-head",
         "InVesalius' 256x256x108 CT head, 0.957x0.957x1.5 mm (installed by scripts/fetch-ct-head.sh)",
     ),
+    (
+        "mri-head",
+        "the MNI152 197x233x189 T1 head, 1 mm (fetched by scripts/fetch-mri-head.sh, read from $FVR_MRI_HEAD)",
+    ),
 ];
 
 /// Help text listing the data sets.
 pub const DATASETS_HELP: &str = "data sets: `brainsmall` (VolPack's 128x128x84 MRI head, embedded) and \
-`ct-head` (InVesalius' 256x256x108 CT head, installed by scripts/fetch-ct-head.sh or found at $FVR_CT_HEAD)";
+`ct-head` (InVesalius' 256x256x108 CT head, installed by scripts/fetch-ct-head.sh or found at $FVR_CT_HEAD) and \
+`mri-head` (the MNI152 197x233x189 T1 head, fetched by scripts/fetch-mri-head.sh, read from $FVR_MRI_HEAD)";
 
 /// The CT head's file: `$FVR_CT_HEAD` if set, else Debian's install path.
 ///
@@ -79,6 +95,29 @@ pub fn ct_head_path() -> Result<PathBuf, String> {
     ))
 }
 
+/// The MRI head's file, from `$FVR_MRI_HEAD`.
+///
+/// # Errors
+/// `$FVR_MRI_HEAD` is unset or names a missing file; the message says how
+/// to fetch it.
+pub fn mri_head_path() -> Result<PathBuf, String> {
+    let fetch = "run `export FVR_MRI_HEAD=\"$(bash scripts/fetch-mri-head.sh)\"` (it fetches the MNI152 T1 head from nilearn's PyPI wheel into target/)";
+    let Some(p) = std::env::var_os(MRI_HEAD_ENV) else {
+        return Err(format!(
+            "the MRI head is not fetched: {MRI_HEAD_ENV} is unset; {fetch}"
+        ));
+    };
+    let path = PathBuf::from(p);
+    if path.is_file() {
+        Ok(path)
+    } else {
+        Err(format!(
+            "{MRI_HEAD_ENV} is set to `{}`, which is not a file; {fetch}",
+            path.display()
+        ))
+    }
+}
+
 /// Load a named data set, or `None` if `name` is not one.
 ///
 /// # Errors
@@ -99,6 +138,10 @@ pub fn load_dataset_with_progress(
         "brainsmall" => Some(parse_den(BRAINSMALL_DEN_GZ).map_err(|e| format!("brainsmall: {e}"))),
         "ct-head" => Some(
             ct_head_path()
+                .and_then(|p| read_volume_with_progress(&p, progress).map_err(|e| e.to_string())),
+        ),
+        "mri-head" => Some(
+            mri_head_path()
                 .and_then(|p| read_volume_with_progress(&p, progress).map_err(|e| e.to_string())),
         ),
         _ => None,
