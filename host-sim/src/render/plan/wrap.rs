@@ -128,3 +128,44 @@ impl Shadows {
             .fold(0.0, f64::max)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cube(side: usize) -> Volume {
+        Volume::new([side; 3], vec![1.0; side * side * side])
+    }
+
+    #[test]
+    fn a_full_box_wraps_on_its_diagonals_and_not_on_twice_its_side() {
+        let volume = cube(32);
+        let shadows = Shadows::new(&volume);
+        // The face diagonal's shadow is 32·√2 ≈ 45 wide: beyond ±16 on
+        // the grid of side 32, within ±32 on the grid of side 64.
+        let tight = shadows.worst_ratio(32, 32);
+        assert!(tight > 1e-2, "{tight}");
+        assert_eq!(shadows.worst_ratio(64, 32), 0.0);
+    }
+
+    #[test]
+    fn a_ball_inside_the_sphere_of_the_grid_never_wraps() {
+        let n = 32;
+        let mut data = vec![0.0f32; n * n * n];
+        for k in 0..n {
+            for j in 0..n {
+                for i in 0..n {
+                    let r2 = [i, j, k]
+                        .iter()
+                        .map(|&v| (v as f64 - 16.0).powi(2))
+                        .sum::<f64>();
+                    if r2 < 14.0f64.powi(2) {
+                        data[(k * n + j) * n + i] = 1.0;
+                    }
+                }
+            }
+        }
+        let volume = Volume::new([n; 3], data);
+        assert_eq!(Shadows::new(&volume).worst_ratio(32, 32), 0.0);
+    }
+}
