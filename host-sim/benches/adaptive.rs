@@ -1,6 +1,15 @@
 //! Criterion benchmarks: one view with the full filter against the adaptive
-//! one (paper §4), kb3 → 1³ at 40 dB, oversampling 2, on a 128³ Gaussian
-//! mixture (f16). Compare as ratios within one run.
+//! one (paper §4), both with reusable buffers on all cores (the host's
+//! extractions, then the same 2D inverse transform):
+//!
+//! - `adaptive_kb3_os2_128`: kb3 → 1³ at 40 dB, oversampling 2, on a 128³
+//!   Gaussian mixture (f16);
+//! - `adaptive_kb6_256`: kb6 → 1³ at 40 dB, oversampling 1, on the 256³
+//!   Gaussian mixture of `fvr render gaussians@256` (f16), along the oblique
+//!   direction (1, 0.3, 0.2);
+//!
+//! each also with the core's single-threaded adaptive extraction
+//! (`adaptive_40db_core`). Compare as ratios within one run.
 //!
 //! Run: `cargo bench -p fvr-host --bench adaptive`.
 
@@ -10,36 +19,67 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
 use fvr_host::render::adaptive::{AdaptiveMarks, AdaptiveSettings};
+use fvr_host::render::adaptive_view::AdaptiveRenderer;
 use fvr_host::render::spectrum::{OwnedSpectrum, ViewRenderer};
 use fvr_host::sources::phantom::{sample, GaussianMixture};
+use fvr_host::volume::Volume;
 use half::f16;
 
-fn benches(c: &mut Criterion) {
-    let n = 128;
-    let volume = sample(&GaussianMixture::random(1, n, 8), [n; 3]);
-    let filter = Filter::new(FilterKind::Kb3, 2).unwrap();
-    let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+/// The full and adaptive views of `volume` with `filter`, in group `name`.
+fn group(c: &mut Criterion, name: &str, volume: &Volume, filter: Filter) {
+    let spec = OwnedSpectrum::<f16>::prepare::<f32>(volume, filter).unwrap();
+    let n = spec.n();
+    let side = volume.dims[0];
     let marks = AdaptiveMarks::build(&spec, &AdaptiveSettings::new(40.0)).unwrap();
     let view = View::along([1.0, 0.3, 0.2]);
-    let mut renderer = ViewRenderer::<f32>::new(spec.n(), filter);
-    let mut out = vec![0.0f32; n * n];
-    let mut group = c.benchmark_group("adaptive_kb3_os2_128");
+    let mut renderer = ViewRenderer::<f32>::new(n, filter);
+    let mut adaptive = AdaptiveRenderer::<f32>::new(&marks, &spec).unwrap();
+    let mut out = vec![0.0f32; side * side];
+    let mut group = c.benchmark_group(name);
     group.sample_size(20);
     group.bench_function("full", |b| {
         b.iter(|| {
             renderer
-                .render_into(&spec, black_box(&view), n, n, &mut out)
+                .render_into(&spec, black_box(&view), side, side, &mut out)
                 .unwrap()
         })
     });
     group.bench_function("adaptive_40db", |b| {
         b.iter(|| {
-            marks
-                .render::<f16, f32>(&spec, black_box(&view), n, n)
+            adaptive
+                .render_into(&spec, black_box(&view), side, side, &mut out)
+                .unwrap()
+        })
+    });
+    let mut core = AdaptiveRenderer::<f32>::new(&marks, &spec)
+        .unwrap()
+        .with_core(true);
+    group.bench_function("adaptive_40db_core", |b| {
+        b.iter(|| {
+            core.render_into(&spec, black_box(&view), side, side, &mut out)
                 .unwrap()
         })
     });
     group.finish();
+}
+
+fn benches(c: &mut Criterion) {
+    let n = 128;
+    let volume = sample(&GaussianMixture::random(1, n, 8), [n; 3]);
+    group(
+        c,
+        "adaptive_kb3_os2_128",
+        &volume,
+        Filter::new(FilterKind::Kb3, 2).unwrap(),
+    );
+    let n = 256;
+    let volume = sample(&GaussianMixture::random(1, n, 8), [n; 3]);
+    group(
+        c,
+        "adaptive_kb6_256",
+        &volume,
+        Filter::new(FilterKind::Kb6, 1).unwrap(),
+    );
 }
 
 criterion_group!(adaptive, benches);

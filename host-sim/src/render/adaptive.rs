@@ -2,16 +2,16 @@
 //! spectrum for a tolerance in dB, then views that read the cheaper filters
 //! wherever the marks allow, with statistics.
 
+use crate::render::adaptive_view::AdaptiveRenderer;
 use crate::render::fast_dht::{dht_3d_real, half_spectrum_bytes, SparseCube};
+use crate::render::fast_marks;
 use crate::render::spectrum::OwnedSpectrum;
-use fvr_core::dht::{signed_index, Twiddles};
-use fvr_core::filter::{Filter, FilterKind, KernelTable};
+use fvr_core::dht::signed_index;
+use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
-use fvr_core::image::{aux_len, check_image, finish, placement, Crop};
 use fvr_core::num::{Real, Sample};
 use fvr_core::slice::adaptive::{
-    extract_slice_adaptive, mark, marks_words, response_difference, threshold_for, AdaptiveLevel,
-    AdaptiveStats, Marks, MAX_LEVELS,
+    marks_words, response_difference, threshold_for, AdaptiveStats, MAX_LEVELS,
 };
 use fvr_core::spectrum::Spectrum;
 use rayon::prelude::*;
@@ -439,7 +439,6 @@ impl AdaptiveMarks {
         let total = n * n * n;
         let budget = 10f64.powf(-tolerance_db / 10.0) / (chain.len() * chain.len()) as f64;
         let radius = large.width().div_ceil(2);
-        let mut line = vec![false; n];
         let mut levels = Vec::with_capacity(chain.len());
         let mut model = match bound {
             Bound::Exact => Some(ErrorModel::new(view)?),
@@ -469,15 +468,8 @@ impl AdaptiveMarks {
                 None => (threshold_for(total, |i| view.value(i), h_d, budget), None),
             };
             let mut words = vec![0u32; marks_words(n)];
-            let marked = mark(
-                n,
-                |i| view.value(i),
-                threshold,
-                radius,
-                &mut words,
-                &mut line,
-            )
-            .map_err(|e| e.to_string())?;
+            let marked = fast_marks::mark(n, |i| view.value(i), threshold, radius, &mut words)
+                .map_err(|e| e.to_string())?;
             levels.push(Level {
                 filter: small,
                 h_d,
@@ -496,12 +488,18 @@ impl AdaptiveMarks {
         })
     }
 
+    /// Side of the spectrum the marks were built for.
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
     /// Bytes of marks held (1 bit per voxel per level).
     pub fn bytes(&self) -> usize {
         self.levels.iter().map(|l| l.words.len() * 4).sum()
     }
 
     /// Render one view adaptively; returns the image (f64) and statistics.
+    /// For many views, keep an [`AdaptiveRenderer`] instead.
     ///
     /// # Errors
     /// As [`fvr_core::render::render`].
@@ -512,43 +510,9 @@ impl AdaptiveMarks {
         width: usize,
         height: usize,
     ) -> Result<(Vec<f64>, AdaptiveStats), fvr_core::Error> {
-        let n = spec.n();
-        let frame = view.frame()?;
-        check_image(width, height, n)?;
-        let kernel = KernelTable::<T>::new(spec.filter());
-        let tables: Vec<KernelTable<T>> = self
-            .levels
-            .iter()
-            .map(|l| KernelTable::new(l.filter))
-            .collect();
-        let levels: Vec<AdaptiveLevel<'_, '_, T>> = self
-            .levels
-            .iter()
-            .zip(&tables)
-            .map(|(l, t)| {
-                Ok(AdaptiveLevel {
-                    kernel: t,
-                    marks: Marks::new(&l.words, self.n)?,
-                    gain: T::from_f64(l.gain),
-                })
-            })
-            .collect::<Result<_, fvr_core::Error>>()?;
-        let core_spec = spec.view();
-        let mut grid = vec![T::ZERO; n * n];
-        let stats = extract_slice_adaptive(&core_spec, &kernel, &levels, &frame, &mut grid)?;
-        let mut tw_buf = vec![T::ZERO; Twiddles::<T>::buffer_len(n)];
-        let tw = Twiddles::new(&mut tw_buf, n)?;
-        let mut aux = vec![T::ZERO; aux_len(n)];
         let mut out = vec![T::ZERO; width * height];
-        let place = placement(core_spec.dims(), &frame, width, height);
-        finish(
-            &mut grid,
-            n,
-            &Crop::new(place, 1.0 / core_spec.scale(), width, height),
-            &tw,
-            &mut aux,
-            &mut out,
-        )?;
+        let stats = AdaptiveRenderer::<T>::new(self, spec)?
+            .render_into(spec, view, width, height, &mut out)?;
         Ok((out.into_iter().map(T::to_f64).collect(), stats))
     }
 

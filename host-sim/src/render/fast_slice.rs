@@ -262,7 +262,7 @@ fn fill_pair<const W: usize, S: Sample, T: Real>(
 /// The integers `kx` with `|kx·r_a + c_a| ≤ n/2` on every axis, as the
 /// core's row interval computes them (the same operations in `T`, so the
 /// same interval).
-fn row_interval<T: Real>(n: usize, right: &[T; 3], c: [T; 3]) -> (i32, i32) {
+pub(super) fn row_interval<T: Real>(n: usize, right: &[T; 3], c: [T; 3]) -> (i32, i32) {
     let half = T::from_usize(n) * T::HALF;
     let (mut low, mut high) = (-T::from_usize(n), T::from_usize(n));
     for a in 0..3 {
@@ -320,78 +320,90 @@ impl<const W: usize, S: Sample, T: Real> Taps<'_, W, S, T> {
         (value, mirrored)
     }
 
-    /// `Σ_c wz_c Σ_b wy_b Σ_t wx_t·c[z + c, y + b, x + t]` (indices wrapping
-    /// around the cube), summed in the core's order: each x-line from
-    /// zero, tap by tap, then lines into planes, planes into the value.
+    /// [`tap_sum`] on this spectrum.
     #[inline(always)]
     fn value(&self, jx: i32, wx: &[T; W], jy: i32, wy: &[T; W], jz: i32, wz: &[T; W]) -> T {
-        let (data, n) = (self.data, self.n);
-        let (nn, mask) = (n * n, n - 1);
-        let (y0, z0) = (
-            (jy as usize).wrapping_mul(n),
-            (jz as usize).wrapping_mul(nn),
-        );
-        let lines: [usize; W] = core::array::from_fn(|b| y0.wrapping_add(b * n) & (nn - n));
-        let planes: [usize; W] = core::array::from_fn(|c| z0.wrapping_add(c * nn) & (nn * n - nn));
-        let x0 = jx as usize & mask;
-        let mut acc = T::ZERO;
-        if x0 + W <= n && W <= 4 {
-            for c in 0..W {
-                let mut acc_y = T::ZERO;
-                for b in 0..W {
-                    let start = planes[c] + lines[b] + x0;
-                    let mut acc_x = T::ZERO;
-                    if let Some(run) = data.get(start..start + W) {
-                        for t in 0..W {
-                            acc_x += wx[t] * T::load_raw(run[t]);
-                        }
-                    }
-                    acc_y += wy[b] * acc_x;
-                }
-                acc += wz[c] * acc_y;
-            }
-        } else if x0 + W <= n {
-            // Wide filters: every plane's sums side by side (lanes `c`),
-            // each in the core's order: the same operations per plane,
-            // interleaved, which the compiler vectorizes (kb6 about 1.1 to
-            // 1.5× less CPU time a view; kb4 compiles slower this way).
-            let mut acc_y = [T::ZERO; W];
+        tap_sum(self.data, self.n, [jx, jy, jz], [wx, wy, wz])
+    }
+}
+
+/// `Σ_c wz_c Σ_b wy_b Σ_t wx_t·c[z + c, y + b, x + t]` (indices wrapping
+/// around the cube), summed in the core's order: each x-line from
+/// zero, tap by tap, then lines into planes, planes into the value. The
+/// samples are read raw ([`Real::load_raw`]): `wx` carries `2^e`
+/// ([`Real::raw_exponent`]), which leaves every product as the core's.
+#[inline(always)]
+pub(super) fn tap_sum<const W: usize, S: Sample, T: Real>(
+    data: &[S],
+    n: usize,
+    [jx, jy, jz]: [i32; 3],
+    [wx, wy, wz]: [&[T; W]; 3],
+) -> T {
+    let (nn, mask) = (n * n, n - 1);
+    let (y0, z0) = (
+        (jy as usize).wrapping_mul(n),
+        (jz as usize).wrapping_mul(nn),
+    );
+    let lines: [usize; W] = core::array::from_fn(|b| y0.wrapping_add(b * n) & (nn - n));
+    let planes: [usize; W] = core::array::from_fn(|c| z0.wrapping_add(c * nn) & (nn * n - nn));
+    let x0 = jx as usize & mask;
+    let mut acc = T::ZERO;
+    if x0 + W <= n && W <= 4 {
+        for c in 0..W {
+            let mut acc_y = T::ZERO;
             for b in 0..W {
-                let runs: [[S; W]; W] = core::array::from_fn(|c| {
-                    let start = planes[c] + lines[b] + x0;
-                    data.get(start..start + W)
-                        .and_then(|s| <[S; W]>::try_from(s).ok())
-                        .unwrap_or([S::default(); W])
-                });
-                let mut acc_x = [T::ZERO; W];
-                for t in 0..W {
-                    for c in 0..W {
-                        acc_x[c] += wx[t] * T::load_raw(runs[c][t]);
-                    }
-                }
-                for c in 0..W {
-                    acc_y[c] += wy[b] * acc_x[c];
-                }
-            }
-            for c in 0..W {
-                acc += wz[c] * acc_y[c];
-            }
-        } else {
-            let xs: [usize; W] = core::array::from_fn(|t| (jx + t as i32) as usize & mask);
-            for c in 0..W {
-                let mut acc_y = T::ZERO;
-                for b in 0..W {
-                    let line = planes[c] + lines[b];
-                    let mut acc_x = T::ZERO;
+                let start = planes[c] + lines[b] + x0;
+                let mut acc_x = T::ZERO;
+                if let Some(run) = data.get(start..start + W) {
                     for t in 0..W {
-                        let v = data.get(line + xs[t]).copied().unwrap_or_default();
-                        acc_x += wx[t] * T::load_raw(v);
+                        acc_x += wx[t] * T::load_raw(run[t]);
                     }
-                    acc_y += wy[b] * acc_x;
                 }
-                acc += wz[c] * acc_y;
+                acc_y += wy[b] * acc_x;
+            }
+            acc += wz[c] * acc_y;
+        }
+    } else if x0 + W <= n {
+        // Wide filters: every plane's sums side by side (lanes `c`),
+        // each in the core's order: the same operations per plane,
+        // interleaved, which the compiler vectorizes (kb6 about 1.1 to
+        // 1.5× less CPU time a view; kb4 compiles slower this way).
+        let mut acc_y = [T::ZERO; W];
+        for b in 0..W {
+            let runs: [[S; W]; W] = core::array::from_fn(|c| {
+                let start = planes[c] + lines[b] + x0;
+                data.get(start..start + W)
+                    .and_then(|s| <[S; W]>::try_from(s).ok())
+                    .unwrap_or([S::default(); W])
+            });
+            let mut acc_x = [T::ZERO; W];
+            for t in 0..W {
+                for c in 0..W {
+                    acc_x[c] += wx[t] * T::load_raw(runs[c][t]);
+                }
+            }
+            for c in 0..W {
+                acc_y[c] += wy[b] * acc_x[c];
             }
         }
-        acc
+        for c in 0..W {
+            acc += wz[c] * acc_y[c];
+        }
+    } else {
+        let xs: [usize; W] = core::array::from_fn(|t| (jx + t as i32) as usize & mask);
+        for c in 0..W {
+            let mut acc_y = T::ZERO;
+            for b in 0..W {
+                let line = planes[c] + lines[b];
+                let mut acc_x = T::ZERO;
+                for t in 0..W {
+                    let v = data.get(line + xs[t]).copied().unwrap_or_default();
+                    acc_x += wx[t] * T::load_raw(v);
+                }
+                acc_y += wy[b] * acc_x;
+            }
+            acc += wz[c] * acc_y;
+        }
     }
+    acc
 }

@@ -2,7 +2,10 @@
 //! renderer, shaded renders, adaptive filtering, turntables and scene files.
 
 pub mod adaptive;
+pub mod adaptive_view;
+pub mod fast_adaptive;
 pub mod fast_dht;
+pub mod fast_marks;
 pub mod fast_prepare;
 pub mod fast_slice;
 pub mod fast_store;

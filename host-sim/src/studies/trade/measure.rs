@@ -16,6 +16,8 @@ use half::f16;
 
 use crate::reference::snr_db;
 use crate::render::adaptive::{AdaptiveMarks, AdaptiveSettings, Bound};
+use crate::render::fast_adaptive;
+use crate::render::fast_slice::Tiling;
 use crate::render::spectrum::{choose_filter, KbDesign};
 use crate::sources::phantom::{sample, Phantom};
 use crate::studies::precision::StoredSpectrum;
@@ -188,8 +190,16 @@ impl<'s, 'm, S: Sample> Renderer<'s, 'm, S> {
                 })
                 .collect::<Result<_, fvr_core::Error>>()?;
             let frame = view.frame()?;
-            let stats =
-                extract_slice_adaptive(self.spec, &self.kernel, &levels, &frame, &mut self.grid)?;
+            // On this thread, as the plain points' core render: the host's
+            // walk where it serves the spectrum, else the core's.
+            let (kernel, grid) = (&self.kernel, &mut self.grid);
+            let tiling = Tiling::default();
+            let stats = match fast_adaptive::extract(
+                self.spec, kernel, &levels, &frame, tiling, false, grid,
+            ) {
+                Some(stats) => stats,
+                None => extract_slice_adaptive(self.spec, kernel, &levels, &frame, grid)?,
+            };
             self.taps += stats.taps;
             self.full_taps += stats.full_taps;
             let place = placement(self.spec.dims(), &frame, side, side);

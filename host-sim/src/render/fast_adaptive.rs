@@ -1,0 +1,282 @@
+//! The host's adaptive slice extraction (paper §4): the core's
+//! `fvr_core::slice::adaptive::extract_slice_adaptive`, point for point
+//! the same arithmetic in the same order, so the slice and the statistics
+//! are the same bit for bit, but walked as the plain host extraction
+//! ([`super::fast_slice`]) walks:
+//!
+//! - **Bands of mirror pairs on rayon threads.** Rows `p` and `−p` cut the
+//!   Nyquist cube to intervals of the same length, so a band of consecutive
+//!   pairs is a balanced unit of work, and the bands go to the threads by
+//!   work stealing.
+//! - **Row intervals.** Each row is walked only over its interval of `kx`
+//!   inside the cube (the plain path's, one column wider on each side),
+//!   and every point in it is tested as the core tests it, so the points
+//!   within rounding of the faces fall on the core's side.
+//! - **Tiles** of columns across the band's rows, as in the plain path.
+//! - **Tap loops per filter width**, unrolled, the wide ones with every
+//!   plane summed side by side (the plain path's [`super::fast_slice`]
+//!   loop).
+//!
+//! What stays the core's: each point's position `q = kx·r + ky·u` in `T`,
+//! the spectrum sample nearest to it looked up in the marks, and the
+//! weights from the kernel table ([`KernelTable::taps_fixed`]). The plain
+//! path's fixed-point stepping and phase tables would move the nearest
+//! sample at half-integers (so a point could change filter) and the weights
+//! in their last bits, for little: where the marks hold, a point reads a
+//! handful of taps, and its cost is the position, the lookup and one
+//! sample; the wide filter's weights are looked up only where the marks do
+//! not hold.
+
+use fvr_core::filter::{KernelTable, MAX_WIDTH};
+use fvr_core::geometry::Frame;
+use fvr_core::num::{Real, Sample};
+use fvr_core::slice::adaptive::{AdaptiveLevel, AdaptiveStats, Marks, MAX_LEVELS};
+use fvr_core::spectrum::Spectrum;
+use rayon::prelude::*;
+
+use super::fast_slice::{row_interval, supports, tap_sum, Tiling};
+
+/// One filter of the chain as the walk applies it.
+#[derive(Clone, Copy)]
+struct Applied<'k, T> {
+    table: &'k KernelTable<T>,
+    width: usize,
+    /// Taps a point reads, `W³`.
+    taps: u64,
+    /// The level's DC gain (one for the large filter, as in the core).
+    gain: T,
+}
+
+/// `table` with `gain`, if its width is one the walk unrolls.
+fn applied<T: Real>(table: &KernelTable<T>, gain: T) -> Option<Applied<'_, T>> {
+    let width = table.filter().width();
+    (width <= MAX_WIDTH).then_some(Applied {
+        table,
+        width,
+        taps: (width * width * width) as u64,
+        gain,
+    })
+}
+
+/// Everything a band reads.
+struct Walk<'a, S, T> {
+    data: &'a [S],
+    n: usize,
+    right: [T; 3],
+    /// `filters[0]` the large filter, then the levels in order.
+    filters: [Option<Applied<'a, T>>; 1 + MAX_LEVELS],
+    marks: [Option<Marks<'a>>; MAX_LEVELS],
+    raw_gain: T,
+    chunk: i32,
+}
+
+/// One row of the slice: its points, `ky·u` for its signed frequency `ky`,
+/// and the interval of `kx` walked.
+struct Row<'g, T> {
+    cells: &'g mut [T],
+    kyu: [T; 3],
+    low: i32,
+    high: i32,
+}
+
+/// Fill the `n × n` slice `grid` (`kx` fastest, natural DHT order) as
+/// `extract_slice_adaptive(spec, kernel, levels, frame, grid)` would, bit
+/// for bit, with the same statistics: on the current rayon pool's threads
+/// when `parallel`, else on this thread. `None` (grid untouched) when
+/// [`supports`] does not hold for `spec`, the grid is not `n²`, `kernel`
+/// is not the spectrum's filter, or the levels are more than
+/// [`MAX_LEVELS`] or have marks of another side: the core's function
+/// reports those.
+pub fn extract<S: Sample, T: Real>(
+    spec: &Spectrum<'_, S>,
+    kernel: &KernelTable<T>,
+    levels: &[AdaptiveLevel<'_, '_, T>],
+    frame: &Frame,
+    tiling: Tiling,
+    parallel: bool,
+    grid: &mut [T],
+) -> Option<AdaptiveStats> {
+    let n = spec.n();
+    if !supports(spec)
+        || grid.len() != n * n
+        || kernel.filter() != spec.filter()
+        || levels.len() > MAX_LEVELS
+        || levels.iter().any(|l| l.marks.n() != n)
+    {
+        return None;
+    }
+    let mut filters = [None; 1 + MAX_LEVELS];
+    let mut marks = [None; MAX_LEVELS];
+    filters[0] = Some(applied(kernel, T::ONE)?);
+    for (i, level) in levels.iter().enumerate() {
+        filters[i + 1] = Some(applied(level.kernel, level.gain)?);
+        marks[i] = Some(level.marks);
+    }
+    let right = frame.right.map(T::from_f64);
+    let up = frame.up.map(T::from_f64);
+    let walk = Walk {
+        data: spec.data(),
+        n,
+        right,
+        filters,
+        marks,
+        raw_gain: T::exp2i(T::raw_exponent::<S>()),
+        chunk: tiling.chunk.clamp(1, n) as i32,
+    };
+    let bands = bands(grid, n, &right, up, tiling.band.max(1));
+    let fill = |band: Vec<Row<'_, T>>| walk.fill_band(band);
+    let stats = if parallel {
+        bands
+            .into_par_iter()
+            .map(fill)
+            .reduce(AdaptiveStats::default, merged)
+    } else {
+        bands
+            .into_iter()
+            .map(fill)
+            .fold(AdaptiveStats::default(), merged)
+    };
+    Some(stats)
+}
+
+/// The rows of `grid` in bands of `band` mirror pairs (`p` and `−p`,
+/// `p = 0 … n/2`), each row with its walked interval of `kx`.
+fn bands<'g, T: Real>(
+    grid: &'g mut [T],
+    n: usize,
+    right: &[T; 3],
+    up: [T; 3],
+    band: usize,
+) -> Vec<Vec<Row<'g, T>>> {
+    let mask = n - 1;
+    let (half, k_max) = ((n / 2) as i32, ((n - 1) / 2) as i32);
+    let mut rows: Vec<Option<&'g mut [T]>> = grid.chunks_exact_mut(n).map(Some).collect();
+    let mut row = |index: usize, ky: i32| -> Option<Row<'g, T>> {
+        let cells = rows[index].take()?;
+        let k = T::from_i32(ky);
+        let kyu = up.map(|c| k * c);
+        // One column beyond the plain path's interval on each side: the
+        // points within rounding of the faces are then tested point by
+        // point, as the core tests them.
+        let (low, high) = row_interval(n, right, kyu);
+        Some(Row {
+            cells,
+            kyu,
+            low: low.saturating_sub(1).max(-half),
+            high: high.saturating_add(1).min(k_max),
+        })
+    };
+    let mut bands = Vec::new();
+    for first in (0..=n / 2).step_by(band) {
+        let mut rows = Vec::with_capacity(2 * band);
+        for p in first..(first + band).min(n / 2 + 1) {
+            if p as i32 <= k_max {
+                rows.extend(row(p, p as i32));
+            }
+            if p > 0 {
+                rows.extend(row((n - p) & mask, -(p as i32)));
+            }
+        }
+        bands.push(rows);
+    }
+    bands
+}
+
+/// The sums of two statistics.
+fn merged(a: AdaptiveStats, b: AdaptiveStats) -> AdaptiveStats {
+    AdaptiveStats {
+        samples: a.samples + b.samples,
+        per_filter: core::array::from_fn(|i| a.per_filter[i] + b.per_filter[i]),
+        taps: a.taps + b.taps,
+        full_taps: a.full_taps + b.full_taps,
+    }
+}
+
+impl<S: Sample, T: Real> Walk<'_, S, T> {
+    /// Zero one band's rows, then fill their points inside the cube tile by
+    /// tile; its statistics.
+    fn fill_band(&self, mut band: Vec<Row<'_, T>>) -> AdaptiveStats {
+        let mut stats = AdaptiveStats::default();
+        let (mut first, mut last) = (i32::MAX, i32::MIN);
+        for row in band.iter_mut() {
+            row.cells.fill(T::ZERO);
+            if row.low <= row.high {
+                first = first.min(row.low);
+                last = last.max(row.high);
+            }
+        }
+        let mut start = first;
+        while start <= last {
+            let end = start.saturating_add(self.chunk - 1).min(last);
+            for row in band.iter_mut() {
+                self.fill_row(row, start.max(row.low), end.min(row.high), &mut stats);
+            }
+            start = end.saturating_add(1);
+        }
+        stats
+    }
+
+    /// Points `kx = from … to` of `row`, each as the core computes it.
+    #[inline(always)]
+    fn fill_row(&self, row: &mut Row<'_, T>, from: i32, to: i32, stats: &mut AdaptiveStats) {
+        let n = self.n;
+        let mask = n - 1;
+        let nyquist = T::from_usize(n) * T::HALF;
+        let large = match self.filters[0] {
+            Some(f) => f,
+            None => return,
+        };
+        for k in from..=to {
+            let kx = T::from_i32(k);
+            let q: [T; 3] = core::array::from_fn(|a| kx * self.right[a] + row.kyu[a]);
+            if q.iter().any(|&c| c > nyquist || -c > nyquist) {
+                continue;
+            }
+            stats.samples += 1;
+            stats.full_taps += large.taps;
+            let nearest: [usize; 3] =
+                core::array::from_fn(|a| (q[a] + T::HALF).floor_i64() as usize & mask);
+            let index = nearest[0] + n * (nearest[1] + n * nearest[2]);
+            let slot = self
+                .marks
+                .iter()
+                .position(|m| m.is_some_and(|m| m.get(index)))
+                .map_or(0, |i| i + 1);
+            let filter = self.filters[slot].unwrap_or(large);
+            stats.per_filter[slot] += 1;
+            stats.taps += filter.taps;
+            if let Some(cell) = row.cells.get_mut(k as usize & mask) {
+                *cell = filter.gain * self.value(&filter, q);
+            }
+        }
+    }
+
+    /// The interpolation of the spectrum at `q` with `filter`, unrolled for
+    /// its width.
+    #[inline(always)]
+    fn value(&self, filter: &Applied<'_, T>, q: [T; 3]) -> T {
+        match filter.width {
+            1 => self.interpolate::<1>(filter.table, q),
+            2 => self.interpolate::<2>(filter.table, q),
+            3 => self.interpolate::<3>(filter.table, q),
+            4 => self.interpolate::<4>(filter.table, q),
+            5 => self.interpolate::<5>(filter.table, q),
+            _ => self.interpolate::<MAX_WIDTH>(filter.table, q),
+        }
+    }
+
+    /// The core's separable interpolation for width `W` (the table's):
+    /// weights `k(q_a − j0 − m)` from the kernel table, summed x-lines
+    /// first.
+    #[inline(always)]
+    fn interpolate<const W: usize>(&self, table: &KernelTable<T>, q: [T; 3]) -> T {
+        let mut weights = [[T::ZERO; W]; 3];
+        let mut first = [0i32; 3];
+        for a in 0..3 {
+            first[a] = table.taps_fixed::<W>(q[a], &mut weights[a]) as i32;
+        }
+        let [wx, wy, wz] = weights;
+        let wx = wx.map(|w| w * self.raw_gain);
+        tap_sum::<W, S, T>(self.data, self.n, first, [&wx, &wy, &wz])
+    }
+}

@@ -1,0 +1,241 @@
+//! The host's adaptive extraction (`fvr_host::render::fast_adaptive`)
+//! against the core's (`fvr_core::slice::adaptive::extract_slice_adaptive`):
+//! the same slice bit for bit and the same statistics, for chains of one
+//! and two cheaper filters, f16 and f32 storage, f32 and f64 arithmetic,
+//! axis-aligned, oblique and near-axis directions, volumes that are not
+//! cubes inside their power-of-two grid, oversampling 2, and every tiling
+//! and thread split; and the adaptive renderer's image against the core's
+//! extraction followed by the core's finish.
+
+use fvr_core::dht::Twiddles;
+use fvr_core::filter::{Filter, FilterKind, KernelTable};
+use fvr_core::geometry::View;
+use fvr_core::image::{aux_len, finish, placement, Crop};
+use fvr_core::num::{Real, Sample};
+use fvr_core::slice::adaptive::{extract_slice_adaptive, AdaptiveLevel, AdaptiveStats, Marks};
+use fvr_host::render::adaptive::{AdaptiveMarks, AdaptiveSettings, Bound};
+use fvr_host::render::adaptive_view::AdaptiveRenderer;
+use fvr_host::render::fast_adaptive::extract;
+use fvr_host::render::fast_slice::Tiling;
+use fvr_host::render::spectrum::OwnedSpectrum;
+use fvr_host::sources::phantom::{sample, GaussianMixture};
+use fvr_host::volume::Volume;
+use half::f16;
+
+const DIRECTIONS: [[f64; 3]; 5] = [
+    [0.0, -1.0, 0.0],
+    [1.0, 0.3, 0.2],
+    [1.0, -1.0, 0.0],
+    // Near-axis: rows run almost along x, and many taps wrap at x = n − 1.
+    [0.02, -1.0, 0.01],
+    [-0.4, 0.7, -0.6],
+];
+
+const TILINGS: [Tiling; 3] = [
+    Tiling { band: 1, chunk: 1 },
+    Tiling { band: 3, chunk: 5 },
+    Tiling {
+        band: 1000,
+        chunk: 1000,
+    },
+];
+
+/// A smooth volume of `dims` (Gaussian blobs, fixed seed), whose spectrum
+/// is weak over most of the cube, so that both filters are used.
+fn smooth(dims: [usize; 3], seed: u64) -> Volume {
+    let side = dims.iter().copied().max().unwrap_or(1);
+    sample(&GaussianMixture::random(seed, side, 6), dims)
+}
+
+/// The levels of `marks` over `tables`.
+fn levels<'a, T: Real>(
+    marks: &'a AdaptiveMarks,
+    tables: &'a [KernelTable<T>],
+) -> Vec<AdaptiveLevel<'a, 'a, T>> {
+    marks
+        .levels
+        .iter()
+        .zip(tables)
+        .map(|(l, t)| AdaptiveLevel {
+            kernel: t,
+            marks: Marks::new(&l.words, marks.n()).unwrap(),
+            gain: T::from_f64(l.gain),
+        })
+        .collect()
+}
+
+/// The core's slice and statistics, then the host's for every tiling and
+/// thread split, compared bit for bit (as f64 bit patterns: exact for f32
+/// and f64 alike). Returns the core's statistics.
+fn check<S: Sample, T: Real>(
+    spec: &OwnedSpectrum<S>,
+    marks: &AdaptiveMarks,
+    dir: [f64; 3],
+    what: &str,
+) -> AdaptiveStats {
+    let view = spec.view();
+    let n = view.n();
+    let frame = View::along(dir).frame().unwrap();
+    let kernel = KernelTable::<T>::new(*view.filter());
+    let tables: Vec<KernelTable<T>> = marks
+        .levels
+        .iter()
+        .map(|l| KernelTable::new(l.filter))
+        .collect();
+    let levels = levels(marks, &tables);
+    let mut core = vec![T::ZERO; n * n];
+    let core_stats = extract_slice_adaptive(&view, &kernel, &levels, &frame, &mut core).unwrap();
+    assert!(
+        core.iter().filter(|v| v.to_f64() != 0.0).count() > n * n / 4,
+        "{what}: the slice is mostly zero"
+    );
+    for tiling in TILINGS {
+        for parallel in [false, true] {
+            // Garbage first: every point must be written.
+            let mut host = vec![T::from_f64(7.0); n * n];
+            let stats = extract(&view, &kernel, &levels, &frame, tiling, parallel, &mut host)
+                .unwrap_or_else(|| panic!("{what}: not served"));
+            assert_eq!(stats, core_stats, "{what}, {tiling:?}, parallel {parallel}");
+            let differ = core
+                .iter()
+                .zip(&host)
+                .filter(|(a, b)| a.to_f64().to_bits() != b.to_f64().to_bits())
+                .count();
+            assert_eq!(differ, 0, "{what}, {tiling:?}, parallel {parallel}");
+        }
+    }
+    core_stats
+}
+
+/// Both the large filter and every level filtered some of the slice.
+fn assert_mixed(stats: &AdaptiveStats, levels: usize, what: &str) {
+    for (slot, &count) in stats.per_filter[..=levels].iter().enumerate() {
+        assert!(count > 0, "{what}: filter {slot} unused ({stats:?})");
+    }
+}
+
+#[test]
+fn kb6_to_nearest_bit_identical_f16() {
+    let n = 32;
+    let volume = smooth([n; 3], 1);
+    let filter = Filter::new(FilterKind::Kb6, 1).unwrap();
+    let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+    let marks = AdaptiveMarks::build(&spec, &AdaptiveSettings::new(40.0)).unwrap();
+    for dir in DIRECTIONS {
+        let stats = check::<f16, f32>(&spec, &marks, dir, &format!("kb6 → 1³ {dir:?}"));
+        assert_mixed(&stats, 1, &format!("kb6 → 1³ {dir:?}"));
+    }
+}
+
+#[test]
+fn two_level_chain_f32_and_f64_bit_identical() {
+    // `fvr render gaussians@16 --filter kb6 --adaptive 30 --adaptive-chain
+    // nearest,kb3` puts slice samples on all three filters.
+    let n = 16;
+    let volume = sample(&GaussianMixture::random(1, n, 8), [n; 3]);
+    let filter = Filter::new(FilterKind::Kb6, 1).unwrap();
+    let settings = AdaptiveSettings {
+        chain: vec![FilterKind::Nearest, FilterKind::Kb3],
+        ..AdaptiveSettings::new(30.0)
+    };
+    let spec32 = OwnedSpectrum::<f32>::prepare::<f32>(&volume, filter).unwrap();
+    let spec64 = OwnedSpectrum::<f64>::prepare::<f64>(&volume, filter).unwrap();
+    let marks32 = AdaptiveMarks::build(&spec32, &settings).unwrap();
+    let marks64 = AdaptiveMarks::build(&spec64, &settings).unwrap();
+    let mut used = [0u64; 3];
+    for dir in DIRECTIONS {
+        let s = check::<f32, f32>(&spec32, &marks32, dir, &format!("kb6 f32 {dir:?}"));
+        check::<f64, f64>(&spec64, &marks64, dir, &format!("kb6 f64 {dir:?}"));
+        for (u, c) in used.iter_mut().zip(s.per_filter) {
+            *u += c;
+        }
+    }
+    assert!(
+        used.iter().all(|&c| c > 0),
+        "a filter of the chain unused: {used:?}"
+    );
+}
+
+/// Volumes that are not cubes inside their grid, and oversampling 2 (the
+/// spectrum twice the volume's side), with both bounds.
+#[test]
+fn non_cubic_volumes_and_oversampling_bit_identical() {
+    for (dims, kind, oversample) in [
+        ([40, 28, 17], FilterKind::Kb3, 1),
+        ([12, 30, 9], FilterKind::Kb6, 1),
+        ([20, 14, 11], FilterKind::Kb4, 2),
+    ] {
+        let volume = smooth(dims, 3);
+        let filter = Filter::new(kind, oversample).unwrap();
+        let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+        for bound in [Bound::Exact, Bound::Paper] {
+            let settings = AdaptiveSettings {
+                bound,
+                ..AdaptiveSettings::new(35.0)
+            };
+            let marks = AdaptiveMarks::build(&spec, &settings).unwrap();
+            for dir in [[1.0, 0.3, 0.2], [0.1, 0.2, 1.0], [0.3, -0.9, 0.5]] {
+                let what = format!("{dims:?} {kind:?} σ={oversample} {bound:?} {dir:?}");
+                let stats = check::<f16, f32>(&spec, &marks, dir, &what);
+                // The paper's bound may mark nothing on these small volumes.
+                if bound == Bound::Exact {
+                    assert_mixed(&stats, 1, &what);
+                }
+            }
+        }
+    }
+}
+
+/// The renderer's image (host extraction, then the core's finish) equals
+/// the core's adaptive extraction followed by the same finish, and its
+/// statistics the core's; `None` where the walk does not serve.
+#[test]
+fn renderer_image_equals_core_extraction() {
+    let n = 32;
+    let (width, height) = (24, 20);
+    let volume = smooth([n, n, 20], 4);
+    let filter = Filter::new(FilterKind::Kb6, 1).unwrap();
+    let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+    let marks = AdaptiveMarks::build(&spec, &AdaptiveSettings::new(40.0)).unwrap();
+    let view_spec = spec.view();
+    let kernel = KernelTable::<f32>::new(filter);
+    let tables: Vec<KernelTable<f32>> = marks
+        .levels
+        .iter()
+        .map(|l| KernelTable::new(l.filter))
+        .collect();
+    let levels = levels(&marks, &tables);
+    let mut tw_buf = vec![0f32; Twiddles::<f32>::buffer_len(n)];
+    let tw = Twiddles::new(&mut tw_buf, n).unwrap();
+    for parallel in [false, true] {
+        let mut renderer = AdaptiveRenderer::<f32>::new(&marks, &spec)
+            .unwrap()
+            .with_parallel(parallel);
+        for dir in DIRECTIONS {
+            let view = View::along(dir);
+            let frame = view.frame().unwrap();
+            let mut grid = vec![0f32; n * n];
+            let core_stats =
+                extract_slice_adaptive(&view_spec, &kernel, &levels, &frame, &mut grid).unwrap();
+            let mut aux = vec![0f32; aux_len(n)];
+            let mut core = vec![0f32; width * height];
+            let place = placement(view_spec.dims(), &frame, width, height);
+            let crop = Crop::new(place, 1.0 / view_spec.scale(), width, height);
+            finish(&mut grid, n, &crop, &tw, &mut aux, &mut core).unwrap();
+            let mut out = vec![0f32; width * height];
+            let stats = renderer
+                .render_into(&spec, &view, width, height, &mut out)
+                .unwrap();
+            assert_eq!(stats, core_stats, "{dir:?}");
+            for (a, b) in core.iter().zip(&out) {
+                assert_eq!(a.to_bits(), b.to_bits(), "{dir:?}, parallel {parallel}");
+            }
+        }
+    }
+    // A kernel for another filter: the walk declines, the core reports it.
+    let other = KernelTable::<f32>::new(Filter::new(FilterKind::Kb4, 1).unwrap());
+    let frame = View::along([1.0, 0.3, 0.2]).frame().unwrap();
+    let mut grid = vec![0f32; n * n];
+    let tiling = Tiling::default();
+    assert!(extract(&view_spec, &other, &levels, &frame, tiling, true, &mut grid).is_none());
+}
