@@ -4,8 +4,8 @@
 //! # Format
 //! Data are signed fractions stored in place: Q15 in `i16` (products and
 //! sums in `i32`) or Q31 in `i32` (products and sums in `i64`), both through
-//! the one generic code of [`FixedSample`]. A whole line (1D) or array (2D)
-//! shares one exponent: every transform returns the power of two `e` it
+//! the one generic code of [`FixedSample`]. A whole line (1D), array (2D)
+//! or cube (3D) shares one exponent: every transform returns the power of two `e` it
 //! applied, so that the true result is `mantissas · 2^e` in the units of
 //! the input (for a Q15 input `m/2^15`, the output is `m'/2^15 · 2^e`).
 //! Normalization and order are those of [`crate::dht`]:
@@ -61,6 +61,7 @@
 //!   and the narrowing cast is exact; nothing can wrap or panic, whatever
 //!   the data.
 
+mod cube;
 mod line;
 mod plane;
 mod twiddles;
@@ -71,6 +72,7 @@ mod tests;
 use core::fmt::Debug;
 use core::ops::{Add, BitAnd, BitXor, Mul, Shl, Shr, Sub};
 
+pub use cube::{dht_3d, idht_3d};
 pub use line::{dht, idht};
 pub use plane::{dht_2d, idht_2d};
 pub use twiddles::FixedTwiddles;
