@@ -81,6 +81,7 @@ mod private {
     pub trait Sealed {}
     impl Sealed for i16 {}
     impl Sealed for i32 {}
+    impl Sealed for crate::num::Q15 {}
 }
 
 /// A fixed-point mantissa with `FRAC_BITS` fraction bits and the wider
@@ -163,6 +164,33 @@ impl FixedSample for i32 {
     #[inline(always)]
     fn to_i64(self) -> i64 {
         self as i64
+    }
+}
+
+/// The Q15 storage format of block-floating-point spectra, transformed in
+/// place as `i16` (its overflow flag, the most negative mantissa, is never
+/// an output, see the module docs).
+impl FixedSample for crate::num::Q15 {
+    type Wide = i32;
+    const FRAC_BITS: u32 = 15;
+    #[inline(always)]
+    fn widen(self) -> i32 {
+        self.0 as i32
+    }
+    #[inline(always)]
+    fn narrow(w: i32) -> Self {
+        Self(w as i16)
+    }
+    #[inline(always)]
+    fn wide_to_i64(w: i32) -> i64 {
+        w as i64
+    }
+    fn from_f64(v: f64) -> Self {
+        Self(clamp_round(v, 15) as i16)
+    }
+    #[inline(always)]
+    fn to_i64(self) -> i64 {
+        self.0 as i64
     }
 }
 
