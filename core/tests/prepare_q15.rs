@@ -111,7 +111,6 @@ fn run<V: Copy + Into<f64> + Into<u16>>(dims: [usize; 3], voxels: &[V], oversamp
     let mut input = reference.clone();
     let mut scratch = vec![0.0f64; fvr_core::dht::dht_3d_scratch_len([n; 3])];
     fvr_core::dht::dht_3d(&mut input, [n; 3], &mut scratch, &tw64).unwrap();
-    drop(spec);
     Run {
         q15,
         exponents,
