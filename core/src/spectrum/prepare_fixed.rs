@@ -1,11 +1,11 @@
 //! Preparation in integers, for cores without an FPU: premultiply an
 //! integer volume with a fixed-point table, pad, and take the Q15 3D DHT
-//! ([`crate::dht::fixed::dht_3d`]) in place, ending in the Q15 format with
+//! ([`crate::dht::fixed::dht_3d_lines`]) in place, ending in the Q15 format with
 //! one exponent per x-line that the integer view reads.
 
 use super::prepare::premultiplier;
 use super::Spectrum;
-use crate::dht::fixed::{dht_3d, FixedTwiddles};
+use crate::dht::fixed::{dht_3d_lines, FixedTwiddles};
 use crate::error::{require_len, Error, Result};
 use crate::filter::Filter;
 use crate::num::{BlockExponents, BlockLayout, Q15};
@@ -42,7 +42,8 @@ impl<'a> Spectrum<'a, Q15> {
     ///   `q = (P + 2^(k−1)) >> k` (rounded half up) with the smallest `k`
     ///   that keeps `|q| ≤ 2^15 − 1`. So the input is the premultiplied
     ///   volume times `2^(3F−k)`, rounded once to Q15 at full scale.
-    /// - *Transform*: [`dht_3d`], exponent `e` for the whole cube.
+    /// - *Transform*: [`dht_3d_lines`], exponent `e` for the cube and `e_l`
+    ///   for each x-line.
     /// - *Storage*: every x-line shifted left by the most bits that keep it
     ///   within `±(2^15 − 1)` (exact), its exponent lowered as much, as
     ///   [`crate::num::encode_blocks`] would choose it (`−128` for a line of
@@ -115,14 +116,16 @@ impl<'a> Spectrum<'a, Q15> {
         mantissas.fill(Q15(0));
         products(&mut |i, p| mantissas[i] = Q15(round_half_up(p, k) as i16));
 
-        let e = dht_3d(&mut *mantissas, [n; 3], tw)?;
+        let e = dht_3d_lines(&mut *mantissas, [n; 3], &mut *exponents, tw)?;
         // The input is `q = g·2^(3F−k)`, so `g = q/2^15 · 2^(k−3F+15)` and
-        // `H = m/2^15 · 2^whole`:
+        // line `l` of `H` is `m/2^15 · 2^(whole + e_l)`; `s = 2^σ` brings
+        // the largest line's exponent near 0.
         let whole = e + k as i32 - 3 * frac + 15;
-        let sigma = (-whole).clamp(-30, 30);
+        let largest = exponents.iter().map(|&x| x as i32).max().unwrap_or(0);
+        let sigma = (-(whole + largest)).clamp(-30, 30);
         let base = whole + sigma;
         for (line, exp) in mantissas.chunks_exact_mut(n).zip(exponents.iter_mut()) {
-            *exp = normalize_line(line, base)?;
+            *exp = normalize_line(line, base + *exp as i32)?;
         }
         let exponents: &'a [i8] = exponents;
         let blocks = BlockExponents::new(BlockLayout::Line, exponents, n)?;

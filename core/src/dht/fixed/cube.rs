@@ -22,11 +22,11 @@ use crate::error::{check_len, Result};
 /// three dimensions) with its own shift check:
 /// `H(u,v,w) = ½[T(−u,v,w) + T(u,−v,w) + T(u,v,−w) − T(−u,−v,−w)]`.
 ///
-/// Exponents per x line would help only the x pass: the y pass combines
-/// every line of a plane and the z pass every plane, so their inputs would
-/// be aligned to the largest first, and the precision at the end is set by
-/// the largest line either way. One exponent keeps the transform free of
-/// alignment passes and of scratch: the cube and a few words of stack.
+/// One exponent needs no table and no alignment: the cube and a few words
+/// of stack. A volume's spectrum concentrates its energy with every pass,
+/// and each stage's rounding noise scales with the cube's peak, so
+/// [`super::dht_3d_lines`], which ends with one exponent per x-line, keeps
+/// more there (a ball at 32³: 62.8 dB against 48.0 dB).
 ///
 /// # Errors
 /// A side not a power of two or longer than the table, or a `data` length

@@ -62,6 +62,7 @@
 //!   the data.
 
 mod cube;
+mod cube_lines;
 mod line;
 mod plane;
 mod twiddles;
@@ -73,6 +74,7 @@ use core::fmt::Debug;
 use core::ops::{Add, BitAnd, BitXor, Mul, Shl, Shr, Sub};
 
 pub use cube::{dht_3d, idht_3d};
+pub use cube_lines::dht_3d_lines;
 pub use line::{dht, idht};
 pub use plane::{dht_2d, idht_2d};
 pub use twiddles::FixedTwiddles;
