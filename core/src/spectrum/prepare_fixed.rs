@@ -34,7 +34,8 @@ impl<'a> Spectrum<'a, Q15> {
     ///
     /// # Arithmetic
     /// - *Premultipliers*: `1/ĥ(x/n)` for the `n` signed positions, in f64
-    ///   (soft float on a core without an FPU: `n` filter responses), then
+    ///   (soft float on a core without an FPU: `2n` filter responses, the
+    ///   table computed twice rather than held in f64), then
     ///   `p[x] = round(2^F/ĥ)` with the one `F` for which the largest is in
     ///   `[2^14, 2^15)`: 16-bit signed, within `2^−15` of the largest.
     /// - *Per voxel*, exactly: `P = v·p[x]·(p[y]·p[z])` in `i64` (`v` below
