@@ -18,6 +18,11 @@
 #     runs fvr-prepare on mps2-an386 and fvr-prepare-m7 on mps2-an500
 #     (Cortex-M7), checks their spectra and views against the host
 #     (firmware/tests/qemu_prepare.rs) and prints counts and RAM;
+#  7b. the Q15 transform on the device: builds fvr-prepare-q15 for the M3
+#     and fvr-prepare-q15-m7 (--features m7), runs them on mps2-an386 (M4F,
+#     32^3), mps2-an385 (M3, 64^3) and mps2-an500 (M7, 64^3), checks their
+#     spectra and integer views against the host bit for bit and in dB
+#     (firmware/tests/qemu_prepare_q15.rs) and prints counts and RAM;
 #  8. checks that a scene over the flash budget fails to build, naming the
 #     excess (build.rs for the tables alone, the linker for tables + code).
 # Usage: bash scripts/firmware.sh
@@ -204,6 +209,51 @@ device_preparation() {
     done
 }
 device_preparation
+
+# ---- The Q15 transform on the device: fvr-prepare-q15 (Cortex-M4F, 32^3;
+# Cortex-M3, 64^3) and fvr-prepare-q15-m7 (Cortex-M7, 64^3) prepare the Q15
+# spectrum in integers in RAM from the u8 volume in flash and render the
+# integer kb3 view from it.
+device_preparation_q15() {
+    local m3_elf="$target_dir/$M3_TARGET/release/fvr-prepare-q15"
+    echo "== firmware: Q15 device preparation (fvr-prepare-q15 built above for the M4F; M3 and M7 builds)"
+    cargo build --locked -p fvr-firmware --target "$TARGET" --release --features m7 --bin fvr-prepare-q15-m7
+    cargo clippy --locked -p fvr-firmware --target "$M3_TARGET" --release --lib --bin fvr-prepare-q15 -- -D warnings
+    cargo build --locked -p fvr-firmware --target "$M3_TARGET" --release --bin fvr-prepare-q15
+    run_in_qemu mps2-an386 cortex-m4 "$bin_dir/fvr-prepare-q15" fvr-prepare-q15
+    run_in_qemu mps2-an500 cortex-m7 "$bin_dir/fvr-prepare-q15-m7" fvr-prepare-q15-m7
+    run_in_qemu mps2-an385 cortex-m3 "$m3_elf" fvr-prepare-q15-m3
+    local program elf
+    for program in fvr-prepare-q15 fvr-prepare-q15-m7 fvr-prepare-q15-m3; do
+        grep -q '^calibration: delay loop of 2000002 instructions counted as 2000000$' "$run_dir/$program.log" \
+            || fail "$program: the SysTick calibration is off"
+    done
+    echo "== firmware: Q15 device-prepared spectra and views against the host (bit for bit, dB)"
+    FVR_QEMU_OUT="$run_dir" cargo test --locked -p fvr-firmware --test qemu_prepare_q15 -- --ignored --nocapture
+    echo "== firmware: Q15 device preparation, instruction counts (exact to +-40) and RAM (bytes)"
+    printf '%-20s %5s %12s %12s %10s %10s %10s %10s %8s %10s\n' \
+        program side preparation "(3D DHT)" render "phases" spectrum "RAM beyond" stack flash
+    for program in fvr-prepare-q15 fvr-prepare-q15-m7 fvr-prepare-q15-m3; do
+        case $program in
+            fvr-prepare-q15-m3) elf=$m3_elf ;;
+            *) elf="$bin_dir/$program" ;;
+        esac
+        read -r side prep dht render phases < <(sed -n \
+            's/^prepare-q15 [^:]*: side \([0-9]*\), .*; preparation \([0-9]*\) instructions (3D DHT alone on a test signal \([0-9]*\)); render [0-9x]* view \([0-9]*\); phase table \([0-9]*\)$/\1 \2 \3 \4 \5/p' \
+            "$run_dir/$program.log")
+        [ -n "${phases:-}" ] || fail "$program: no preparation counts in its log"
+        read -r text rodata data bss vt < <(size -A "$elf" | awk '
+            $1==".text"{t=$2} $1==".rodata"{r=$2} $1==".data"{d=$2} $1==".bss"{b=$2} $1==".vector_table"{v=$2}
+            END{print t+0, r+0, d+0, b+0, v+0}')
+        stack=$(sed -n 's/^stack: peak \([0-9]*\) bytes.*/\1/p' "$run_dir/$program.log")
+        [ -n "$stack" ] || fail "$program: no stack measurement in its log"
+        # The spectrum: n^3 Q15 mantissas and n^2 exponents.
+        spectrum=$((2 * side * side * side + side * side))
+        printf '%-20s %5s %12s %12s %10s %10s %10s %10s %8s %10s\n' "$program" "$side" "$prep" "$dht" "$render" \
+            "$phases" "$spectrum" $((data + bss + stack - spectrum)) "$stack" $((vt + text + rodata + data))
+    done
+}
+device_preparation_q15
 
 echo "== firmware: a scene over the flash budget fails to build, naming the excess"
 # In a copy of the workspace whose firmware/memory.x is smaller, with its own

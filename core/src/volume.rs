@@ -43,6 +43,11 @@ impl<'a, V: Copy + Into<f64>> DenseVolume<'a, V> {
         require_voxels("volume data", dims, data.len())?;
         Ok(Self { dims, data })
     }
+
+    /// The voxels, `i` fastest.
+    pub fn samples(&self) -> &'a [V] {
+        self.data
+    }
 }
 
 impl<V: Copy + Into<f64>> VoxelSource for DenseVolume<'_, V> {

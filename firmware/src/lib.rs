@@ -23,6 +23,7 @@ pub mod frame;
 pub mod nrrd;
 pub mod prep_volume;
 pub mod prepare;
+pub mod prepare_q15;
 pub mod scene;
 pub mod stored;
 pub mod stored_q15;
@@ -31,3 +32,5 @@ pub mod stored_q15;
 pub mod device;
 #[cfg(all(target_os = "none", target_abi = "eabihf"))]
 pub mod prepare_device;
+#[cfg(target_os = "none")]
+pub mod prepare_q15_device;

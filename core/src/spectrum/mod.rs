@@ -22,10 +22,12 @@
 //! is exact. Renderers divide by `s` at the end.
 
 mod prepare;
+mod prepare_fixed;
 mod stored;
 
 pub use prepare::{
     check_scale, premultiplier_table, prepare_scratch_len, scale_for, scale_for_target,
     LineBlockStorage,
 };
+pub use prepare_fixed::Q15Storage;
 pub use stored::{CubeSide, Side, Spectrum};

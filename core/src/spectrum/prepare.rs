@@ -242,15 +242,20 @@ pub fn check_scale<T: Real>(premul: &[T], bound: f64, scale: f64) -> Result<T> {
 /// Premultiplication factors `1/ĥ(x/n)` for signed positions
 /// `x ∈ [−n/2, n/2)`, stored at index `x mod n` (the same on every axis).
 pub fn premultiplier_table<T: Real>(filter: &Filter, n: usize, out: &mut [T]) {
-    let half = (n / 2) as i64;
     for (idx, v) in out[..n].iter_mut().enumerate() {
-        let x = if (idx as i64) < half || n == 1 {
-            idx as i64
-        } else {
-            idx as i64 - n as i64
-        };
-        *v = T::from_f64(1.0 / filter.response(x as f64 / n as f64));
+        *v = T::from_f64(premultiplier(filter, n, idx));
     }
+}
+
+/// Entry `idx` of [`premultiplier_table`] for side `n`, in f64.
+pub(crate) fn premultiplier(filter: &Filter, n: usize, idx: usize) -> f64 {
+    let half = (n / 2) as i64;
+    let x = if (idx as i64) < half || n == 1 {
+        idx as i64
+    } else {
+        idx as i64 - n as i64
+    };
+    1.0 / filter.response(x as f64 / n as f64)
 }
 
 /// The power of two `s` with `s·bound ∈ (2^13, 2^14]` (1 when `bound` is 0):

@@ -4,8 +4,8 @@
 //! # Format
 //! Data are signed fractions stored in place: Q15 in `i16` (products and
 //! sums in `i32`) or Q31 in `i32` (products and sums in `i64`), both through
-//! the one generic code of [`FixedSample`]. A whole line (1D) or array (2D)
-//! shares one exponent: every transform returns the power of two `e` it
+//! the one generic code of [`FixedSample`]. A whole line (1D), array (2D)
+//! or cube (3D) shares one exponent: every transform returns the power of two `e` it
 //! applied, so that the true result is `mantissas · 2^e` in the units of
 //! the input (for a Q15 input `m/2^15`, the output is `m'/2^15 · 2^e`).
 //! Normalization and order are those of [`crate::dht`]:
@@ -61,6 +61,8 @@
 //!   and the narrowing cast is exact; nothing can wrap or panic, whatever
 //!   the data.
 
+mod cube;
+mod cube_lines;
 mod line;
 mod plane;
 mod twiddles;
@@ -71,6 +73,8 @@ mod tests;
 use core::fmt::Debug;
 use core::ops::{Add, BitAnd, BitXor, Mul, Shl, Shr, Sub};
 
+pub use cube::{dht_3d, idht_3d};
+pub use cube_lines::dht_3d_lines;
 pub use line::{dht, idht};
 pub use plane::{dht_2d, idht_2d};
 pub use twiddles::FixedTwiddles;
@@ -79,6 +83,7 @@ mod private {
     pub trait Sealed {}
     impl Sealed for i16 {}
     impl Sealed for i32 {}
+    impl Sealed for crate::num::Q15 {}
 }
 
 /// A fixed-point mantissa with `FRAC_BITS` fraction bits and the wider
@@ -161,6 +166,33 @@ impl FixedSample for i32 {
     #[inline(always)]
     fn to_i64(self) -> i64 {
         self as i64
+    }
+}
+
+/// The Q15 storage format of block-floating-point spectra, transformed in
+/// place as `i16` (its overflow flag, the most negative mantissa, is never
+/// an output, see the module docs).
+impl FixedSample for crate::num::Q15 {
+    type Wide = i32;
+    const FRAC_BITS: u32 = 15;
+    #[inline(always)]
+    fn widen(self) -> i32 {
+        self.0 as i32
+    }
+    #[inline(always)]
+    fn narrow(w: i32) -> Self {
+        Self(w as i16)
+    }
+    #[inline(always)]
+    fn wide_to_i64(w: i32) -> i64 {
+        w as i64
+    }
+    fn from_f64(v: f64) -> Self {
+        Self(clamp_round(v, 15) as i16)
+    }
+    #[inline(always)]
+    fn to_i64(self) -> i64 {
+        self.0 as i64
     }
 }
 

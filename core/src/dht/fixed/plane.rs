@@ -1,6 +1,7 @@
 //! The fixed-point true 2D DHT in place with one block exponent for the
 //! whole array, and its inverse (the per-view image transform).
 
+use super::cube::axis_pass;
 use super::line::stages;
 use super::{peak, round_shift, FixedSample, FixedTwiddles, Shift};
 use crate::dht::line::for_each_bit_reversed_swap;
@@ -57,15 +58,11 @@ fn columns<S: FixedSample>(
     top: i64,
     tw: &FixedTwiddles<'_, S>,
 ) -> (i32, i64) {
-    for_each_bit_reversed_swap(ny, |i, j| {
-        let (head, tail) = data.split_at_mut(j * nx);
-        head[i * nx..(i + 1) * nx].swap_with_slice(&mut tail[..nx]);
-    });
-    stages(data, ny, nx, top, tw)
+    axis_pass(&mut data[..nx * ny], ny, nx, top, tw)
 }
 
 /// Transpose an `n × n` array in place.
-fn transpose<S: Copy>(data: &mut [S], n: usize) {
+pub(super) fn transpose<S: Copy>(data: &mut [S], n: usize) {
     for r in 1..n {
         let (above, row) = data.split_at_mut(r * n);
         for (c, v) in row[..r].iter_mut().enumerate() {

@@ -33,6 +33,7 @@
 
 extern crate std;
 
+mod cube;
 mod robustness;
 
 use std::vec;
