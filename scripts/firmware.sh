@@ -18,7 +18,10 @@
 #     runs fvr-prepare on mps2-an386 and fvr-prepare-m7 on mps2-an500
 #     (Cortex-M7), checks their spectra and views against the host
 #     (firmware/tests/qemu_prepare.rs) and prints counts and RAM;
-#  8. checks that a scene over the flash budget fails to build, naming the
+#  8. counts the per-view transcendental functions with libm and micromath
+#     (fvr-trig-bench on both cores; their cost to the image:
+#     firmware/tests/trig.rs);
+#  9. checks that a scene over the flash budget fails to build, naming the
 #     excess (build.rs for the tables alone, the linker for tables + code).
 # Usage: bash scripts/firmware.sh
 set -euo pipefail
@@ -204,6 +207,15 @@ device_preparation() {
     done
 }
 device_preparation
+
+# ---- micromath against libm (fvr-trig-bench, firmware/src/trig.rs): the
+# per-view transcendental functions counted on both cores; the image each
+# costs is measured on the host by firmware/tests/trig.rs.
+echo "== firmware: per-view transcendental functions, libm against micromath (M4F, M3)"
+cargo build --locked -p fvr-firmware --target "$M3_TARGET" --release --bin fvr-trig-bench
+run_in_qemu mps2-an386 cortex-m4 "$bin_dir/fvr-trig-bench" fvr-trig-bench-m4f
+run_in_qemu mps2-an385 cortex-m3 "$target_dir/$M3_TARGET/release/fvr-trig-bench" fvr-trig-bench-m3
+cargo test --locked -p fvr-firmware --test trig -- --nocapture
 
 echo "== firmware: a scene over the flash budget fails to build, naming the excess"
 # In a copy of the workspace whose firmware/memory.x is smaller, with its own

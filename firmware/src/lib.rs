@@ -26,6 +26,7 @@ pub mod prepare;
 pub mod scene;
 pub mod stored;
 pub mod stored_q15;
+pub mod trig;
 
 #[cfg(target_os = "none")]
 pub mod device;
