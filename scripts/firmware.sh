@@ -212,10 +212,11 @@ device_preparation
 # per-view transcendental functions counted on both cores; the image each
 # costs is measured on the host by firmware/tests/trig.rs.
 echo "== firmware: per-view transcendental functions, libm against micromath (M4F, M3)"
-cargo build --locked -p fvr-firmware --target "$M3_TARGET" --release --bin fvr-trig-bench
+cargo build --locked -p fvr-firmware --target "$TARGET" --release --features micromath --bin fvr-trig-bench
+cargo build --locked -p fvr-firmware --target "$M3_TARGET" --release --features micromath --bin fvr-trig-bench
 run_in_qemu mps2-an386 cortex-m4 "$bin_dir/fvr-trig-bench" fvr-trig-bench-m4f
 run_in_qemu mps2-an385 cortex-m3 "$target_dir/$M3_TARGET/release/fvr-trig-bench" fvr-trig-bench-m3
-cargo test --locked -p fvr-firmware --test trig -- --nocapture
+cargo test --locked -p fvr-firmware --features micromath --test trig -- --nocapture
 
 echo "== firmware: a scene over the flash budget fails to build, naming the excess"
 # In a copy of the workspace whose firmware/memory.x is smaller, with its own

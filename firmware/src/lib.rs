@@ -26,7 +26,6 @@ pub mod prepare;
 pub mod scene;
 pub mod stored;
 pub mod stored_q15;
-pub mod trig;
 
 #[cfg(target_os = "none")]
 pub mod device;

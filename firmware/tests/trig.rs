@@ -6,6 +6,8 @@
 //! counts the same functions on the device (`bash scripts/firmware.sh`).
 
 mod common;
+#[path = "../src/trig.rs"]
+mod trig;
 
 use common::{host_image, snr_db, tables};
 use fvr_core::geometry::Sampling;
@@ -13,7 +15,7 @@ use fvr_core::image::{aux_len, finish, grid_len, placement_on_axes, Crop, Placem
 use fvr_core::slice::extract_central_slice_on;
 use fvr_firmware::scene::{FrameSpec, BENCH_FRAMES, IMAGE_SIDE};
 use fvr_firmware::stored::twiddles;
-use fvr_firmware::trig::{apply_phasors, phasors_len, shift_phasors, Trig};
+use trig::{apply_phasors, phasors_len, shift_phasors, Trig};
 
 /// `micromath`'s documented bound on its `sin` and `cos` errors.
 const MICROMATH_TRIG_ERROR: f64 = 0.002;

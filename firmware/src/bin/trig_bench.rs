@@ -11,13 +11,18 @@
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
 #[cfg(target_os = "none")]
+#[allow(dead_code)] // the shift itself is applied on the host only
+#[path = "../trig.rs"]
+mod trig;
+
+#[cfg(target_os = "none")]
 mod device {
+    use crate::trig::{phasors_len, shift_phasors, Trig};
     use core::hint::black_box;
     use fvr_core::image::placement;
     use fvr_firmware::device::{RunError, SysTickClock};
     use fvr_firmware::frame::InstructionClock;
     use fvr_firmware::scene::{IMAGE_SIDE, VIEW};
-    use fvr_firmware::trig::{phasors_len, shift_phasors, Trig};
 
     const PROGRAM: &str = "fvr-trig-bench";
     const M: usize = IMAGE_SIDE;
