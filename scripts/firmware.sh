@@ -23,7 +23,10 @@
 #     32^3), mps2-an385 (M3, 64^3) and mps2-an500 (M7, 64^3), checks their
 #     spectra and integer views against the host bit for bit and in dB
 #     (firmware/tests/qemu_prepare_q15.rs) and prints counts and RAM;
-#  8. checks that a scene over the flash budget fails to build, naming the
+#  8. counts the per-view transcendental functions with libm and micromath
+#     (fvr-trig-bench on both cores; their cost to the image:
+#     firmware/tests/trig.rs);
+#  9. checks that a scene over the flash budget fails to build, naming the
 #     excess (build.rs for the tables alone, the linker for tables + code).
 # Usage: bash scripts/firmware.sh
 set -euo pipefail
@@ -254,6 +257,16 @@ device_preparation_q15() {
     done
 }
 device_preparation_q15
+
+# ---- micromath against libm (fvr-trig-bench, firmware/src/trig.rs): the
+# per-view transcendental functions counted on both cores; the image each
+# costs is measured on the host by firmware/tests/trig.rs.
+echo "== firmware: per-view transcendental functions, libm against micromath (M4F, M3)"
+cargo build --locked -p fvr-firmware --target "$TARGET" --release --features micromath --bin fvr-trig-bench
+cargo build --locked -p fvr-firmware --target "$M3_TARGET" --release --features micromath --bin fvr-trig-bench
+run_in_qemu mps2-an386 cortex-m4 "$bin_dir/fvr-trig-bench" fvr-trig-bench-m4f
+run_in_qemu mps2-an385 cortex-m3 "$target_dir/$M3_TARGET/release/fvr-trig-bench" fvr-trig-bench-m3
+cargo test --locked -p fvr-firmware --features micromath --test trig -- --nocapture
 
 echo "== firmware: a scene over the flash budget fails to build, naming the excess"
 # In a copy of the workspace whose firmware/memory.x is smaller, with its own

@@ -191,18 +191,17 @@ pub enum DecodeError {
 /// [`DecodeError`] for anything but exactly one well-formed frame.
 pub fn decode_frame(recording: &[u8], pixels: &mut [u16]) -> Result<DecodedFrame, DecodeError> {
     let (mut command, mut columns, mut rows) = (None::<u8>, None, None);
-    let mut params = [0u8; 4];
-    let mut param_len = 0usize;
+    let mut params = heapless::Vec::<u8, 4>::new();
     let mut pixel_bytes = 0usize;
     let mut pending = None::<u8>;
     let mut at = 0usize;
-    let finish_params = |command: Option<u8>, params: &[u8; 4], len: usize| {
+    let finish_params = |command: Option<u8>, params: &[u8]| {
         let cmd = command.unwrap_or(0);
-        if len != 4 {
+        let &[f0, f1, l0, l1] = params else {
             return Err(DecodeError::BadRange { command: cmd });
-        }
-        let first = u16::from_be_bytes([params[0], params[1]]);
-        let last = u16::from_be_bytes([params[2], params[3]]);
+        };
+        let first = u16::from_be_bytes([f0, f1]);
+        let last = u16::from_be_bytes([l0, l1]);
         if last < first {
             return Err(DecodeError::BadRange { command: cmd });
         }
@@ -223,8 +222,8 @@ pub fn decode_frame(recording: &[u8], pixels: &mut [u16]) -> Result<DecodedFrame
                     return Err(DecodeError::BadCommandLength { offset: at });
                 }
                 match command {
-                    Some(CASET) => columns = Some(finish_params(command, &params, param_len)?),
-                    Some(RASET) => rows = Some(finish_params(command, &params, param_len)?),
+                    Some(CASET) => columns = Some(finish_params(command, &params)?),
+                    Some(RASET) => rows = Some(finish_params(command, &params)?),
                     _ => {}
                 }
                 let cmd = body[0];
@@ -232,20 +231,16 @@ pub fn decode_frame(recording: &[u8], pixels: &mut [u16]) -> Result<DecodedFrame
                     return Err(DecodeError::UnknownCommand { command: cmd });
                 }
                 command = Some(cmd);
-                param_len = 0;
+                params.clear();
             }
             1 => match command {
                 None => return Err(DecodeError::DataWithoutCommand),
                 Some(CASET) | Some(RASET) => {
-                    for &b in body {
-                        if param_len >= 4 {
-                            return Err(DecodeError::BadRange {
-                                command: command.unwrap_or(0),
-                            });
-                        }
-                        params[param_len] = b;
-                        param_len += 1;
-                    }
+                    params
+                        .extend_from_slice(body)
+                        .map_err(|_| DecodeError::BadRange {
+                            command: command.unwrap_or(0),
+                        })?;
                 }
                 Some(_) => {
                     for &b in body {
@@ -271,8 +266,8 @@ pub fn decode_frame(recording: &[u8], pixels: &mut [u16]) -> Result<DecodedFrame
         at += 5 + len;
     }
     match command {
-        Some(CASET) => columns = Some(finish_params(command, &params, param_len)?),
-        Some(RASET) => rows = Some(finish_params(command, &params, param_len)?),
+        Some(CASET) => columns = Some(finish_params(command, &params)?),
+        Some(RASET) => rows = Some(finish_params(command, &params)?),
         _ => {}
     }
     let (Some(columns), Some(rows), Some(RAMWR)) = (columns, rows, command) else {

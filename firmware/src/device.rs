@@ -142,37 +142,18 @@ impl From<FrameError> for RunError {
 }
 
 #[cfg(target_abi = "eabihf")]
-/// A `core::fmt` buffer for file names.
-struct Name {
-    buf: [u8; 80],
-    len: usize,
-}
-
-#[cfg(target_abi = "eabihf")]
-impl core::fmt::Write for Name {
-    fn write_str(&mut self, s: &str) -> core::fmt::Result {
-        let end = self.len + s.len();
-        self.buf
-            .get_mut(self.len..end)
-            .ok_or(core::fmt::Error)?
-            .copy_from_slice(s.as_bytes());
-        self.len = end;
-        Ok(())
-    }
-}
+/// A file name, `<program>-<frame>.<ext>`, of at most 80 bytes.
+struct Name(heapless::String<80>);
 
 #[cfg(target_abi = "eabihf")]
 impl Name {
     fn new(program: &str, frame: &str, ext: &str) -> Result<Self, RunError> {
-        let mut n = Name {
-            buf: [0; 80],
-            len: 0,
-        };
+        let mut n = heapless::String::new();
         write!(n, "{program}-{frame}.{ext}").map_err(|_| RunError::Host("file name too long"))?;
-        Ok(n)
+        Ok(Name(n))
     }
     fn as_str(&self) -> &str {
-        core::str::from_utf8(&self.buf[..self.len]).unwrap_or("?")
+        &self.0
     }
 }
 

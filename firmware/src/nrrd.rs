@@ -8,10 +8,7 @@ pub const HEADER_CAP: usize = 256;
 
 /// A NRRD header in a fixed buffer.
 #[derive(Clone, Debug)]
-pub struct Header {
-    buf: [u8; HEADER_CAP],
-    len: usize,
-}
+pub struct Header(heapless::String<HEADER_CAP>);
 
 impl Header {
     /// The header of a `float` image of `width × height` pixels of
@@ -27,10 +24,7 @@ impl Header {
         height: usize,
         comment: fmt::Arguments<'_>,
     ) -> Result<Self, fmt::Error> {
-        let mut h = Self {
-            buf: [0; HEADER_CAP],
-            len: 0,
-        };
+        let mut h = heapless::String::<HEADER_CAP>::new();
         write!(h, "NRRD0004\n# {comment}\ntype: float\n")?;
         if channels == 1 {
             write!(h, "dimension: 2\nsizes: {width} {height}\n")?;
@@ -38,22 +32,12 @@ impl Header {
             write!(h, "dimension: 3\nsizes: {channels} {width} {height}\n")?;
         }
         write!(h, "endian: little\nencoding: raw\n\n")?;
-        Ok(h)
+        Ok(Self(h))
     }
 
     /// The header's bytes.
     pub fn as_bytes(&self) -> &[u8] {
-        &self.buf[..self.len]
-    }
-}
-
-impl Write for Header {
-    fn write_str(&mut self, s: &str) -> fmt::Result {
-        let end = self.len + s.len();
-        let slot = self.buf.get_mut(self.len..end).ok_or(fmt::Error)?;
-        slot.copy_from_slice(s.as_bytes());
-        self.len = end;
-        Ok(())
+        self.0.as_bytes()
     }
 }
 

@@ -10,7 +10,7 @@ use fvr_core::dht::{dht_3d, Twiddles};
 use fvr_core::f16;
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::image::{aux_len, grid_len};
-use fvr_core::render::{render, Buffers, Request};
+use fvr_core::render::{render_in_grid, Request, Source};
 use fvr_core::spectrum::{prepare_scratch_len, Spectrum};
 use fvr_core::volume::DenseVolume;
 use fvr_core::Result;
@@ -79,24 +79,23 @@ pub const fn scratch_len(n: usize) -> usize {
 }
 
 /// Everything the program holds in RAM: the spectrum and the buffers of
-/// the preparation and of one `n × n` view.
+/// the preparation and of one `n × n` view, whose image is cut into its
+/// slice grid (`render_in_grid`: no image buffer of its own).
 #[derive(Debug)]
 pub struct PrepBuffers<'a> {
     /// The cube, [`spectrum_len`]: the padded volume, then its spectrum.
     pub spectrum: &'a mut [f16],
     /// The preparation's scratch, [`scratch_len`].
     pub scratch: &'a mut [f32],
-    /// The view's slice grid, `n²`.
+    /// The view's slice grid, `n²`, and then its `n × n` image.
     pub grid: &'a mut [f32],
     /// The view's auxiliary scratch, `4n`.
     pub aux: &'a mut [f32],
-    /// The image, `n²`.
-    pub image: &'a mut [f32],
 }
 
-/// Elements of the view buffers for side `n`: `(grid, aux, image)`.
-pub const fn view_lens(n: usize) -> (usize, usize, usize) {
-    (grid_len(n), aux_len(n), n * n)
+/// Elements of the view buffers for side `n`: `(grid, aux)`.
+pub const fn view_lens(n: usize) -> (usize, usize) {
+    (grid_len(n), aux_len(n))
 }
 
 /// Instruction counts of [`prepare_and_render`].
@@ -110,7 +109,7 @@ pub struct PrepCounts {
 }
 
 /// The result of [`prepare_and_render`]: the spectrum is in
-/// [`PrepBuffers::spectrum`], the image in [`PrepBuffers::image`].
+/// [`PrepBuffers::spectrum`], the image in [`PrepBuffers::grid`]`[..n²]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Prepared {
     /// The spectrum's power-of-two scale `s`.
@@ -121,7 +120,7 @@ pub struct Prepared {
 
 /// Prepare `input`'s spectrum in place in `bufs.spectrum` (side `N`), then
 /// render the scene's view ([`VIEW`], `N × N` pixels) from it into
-/// `bufs.image`, counting instructions with `clock`.
+/// `bufs.grid[..N²]`, counting instructions with `clock`.
 ///
 /// # Errors
 /// The core's: short buffers, twiddles too short, a side other than `N`.
@@ -140,10 +139,11 @@ pub fn prepare_and_render<const N: usize, C: InstructionClock>(
     let kernel = input.kernel_table();
     let kernel = kernel.as_ref().map_err(|e| *e)?;
     let t2 = clock.now();
-    render(
-        &fvr_core::render::Source::new(&spectrum, kernel, tw),
+    render_in_grid(
+        &Source::new(&spectrum, kernel, tw),
         &Request::new(VIEW, N, N),
-        Buffers::new(bufs.grid, bufs.aux, bufs.image),
+        bufs.grid,
+        bufs.aux,
     )?;
     let t3 = clock.now();
     Ok(Prepared {

@@ -90,7 +90,7 @@ fn run_inner<const N: usize>(
     .map_err(|_| RunError::Host("NRRD header too long"))?;
     nrrd.put(header.as_bytes())
         .map_err(|_| RunError::Host("NRRD write"))?;
-    write_samples_le(&bufs.image[..N * N], |b| nrrd.put(b))
+    write_samples_le(&bufs.grid[..N * N], |b| nrrd.put(b))
         .map_err(|_| RunError::Host("NRRD write"))?;
 
     let dht = time_dht_3d::<N, _>(&tw, &mut bufs, &clock).map_err(core_error)?;
@@ -118,7 +118,7 @@ macro_rules! prepare_main {
         const SIDE: usize = $side;
         const CUBE: usize = $crate::prepare::spectrum_len(SIDE);
         const SCRATCH: usize = $crate::prepare::scratch_len(SIDE);
-        const VIEW: (usize, usize, usize) = $crate::prepare::view_lens(SIDE);
+        const VIEW: (usize, usize) = $crate::prepare::view_lens(SIDE);
 
         type Ram<T> = cortex_m::interrupt::Mutex<core::cell::RefCell<T>>;
         static SPECTRUM: Ram<[fvr_core::f16; CUBE]> =
@@ -127,7 +127,6 @@ macro_rules! prepare_main {
             Ram::new(core::cell::RefCell::new([0.0; SCRATCH]));
         static GRID: Ram<[f32; VIEW.0]> = Ram::new(core::cell::RefCell::new([0.0; VIEW.0]));
         static AUX: Ram<[f32; VIEW.1]> = Ram::new(core::cell::RefCell::new([0.0; VIEW.1]));
-        static IMAGE: Ram<[f32; VIEW.2]> = Ram::new(core::cell::RefCell::new([0.0; VIEW.2]));
 
         #[cortex_m_rt::entry]
         fn main() -> ! {
@@ -138,13 +137,11 @@ macro_rules! prepare_main {
                 let mut scratch = PREP_SCRATCH.borrow(cs).borrow_mut();
                 let mut grid = GRID.borrow(cs).borrow_mut();
                 let mut aux = AUX.borrow(cs).borrow_mut();
-                let mut image = IMAGE.borrow(cs).borrow_mut();
                 let bufs = $crate::prepare::PrepBuffers {
                     spectrum: &mut spectrum[..],
                     scratch: &mut scratch[..],
                     grid: &mut grid[..],
                     aux: &mut aux[..],
-                    image: &mut image[..],
                 };
                 $crate::prepare_device::run::<SIDE>(
                     $program,

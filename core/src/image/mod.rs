@@ -8,8 +8,10 @@
 //! centre, times the gain.
 
 pub mod fixed;
+mod in_grid;
 mod placement;
 
+pub use in_grid::finish_in_grid;
 pub use placement::{placement, placement_at_pitch, placement_on_axes, Placement};
 
 use crate::dht::{dht_2d, dht_2d_mixed, dht_2d_mixed_scratch_len, neg_mod, signed_index};

@@ -30,7 +30,9 @@ use crate::dht::Twiddles;
 use crate::error::{require_len, Error, Result};
 use crate::filter::{DerivativeTable, KernelTable};
 use crate::geometry::{Sampling, View};
-use crate::image::{aux_len, check_image, finish_with, grid_len, placement_on_axes, Crop, Inverse};
+use crate::image::{
+    aux_len, check_image, finish_in_grid, finish_with, grid_len, placement_on_axes, Crop, Inverse,
+};
 use crate::num::{Real, Sample};
 use crate::shading::Scene;
 use crate::slice::extract_central_slice_on;
@@ -181,10 +183,42 @@ pub fn render<S: Sample, Z: CubeSide, T: Real>(
             source.kernel,
             Inverse::Radix2(source.twiddles),
             request,
-            buffers,
+            buffers.grid,
+            buffers.aux,
+            Output::Image(buffers.out),
         )
         .map(|()| 1),
     }
+}
+
+/// The X-ray projection of `request` (whose scene must be `None`) from
+/// `source`, cut into the slice grid itself: afterwards
+/// `grid[..width·height]` holds the image, bit for bit the one [`render`]
+/// writes to its own buffer. A device saves the image buffer (16 KiB for a
+/// 64² f32 view).
+///
+/// # Errors
+/// As [`render`]; a scene ([`Error::SceneUnsupported`]).
+pub fn render_in_grid<S: Sample, Z: CubeSide, T: Real>(
+    source: &Source<'_, S, Z, T>,
+    request: &Request<'_>,
+    grid: &mut [T],
+    aux: &mut [T],
+) -> Result<()> {
+    if request.scene.is_some() {
+        return Err(Error::SceneUnsupported {
+            what: "an image cut into its slice grid (one channel only)",
+        });
+    }
+    render_projection(
+        source.spectrum,
+        source.kernel,
+        Inverse::Radix2(source.twiddles),
+        request,
+        grid,
+        aux,
+        Output::InGrid,
+    )
 }
 
 /// The X-ray projection of `request` (whose scene must be `None`) from
@@ -207,7 +241,24 @@ pub fn render_projection_with<S: Sample, Z: CubeSide, T: Real>(
             what: "a given 2D inverse transform (scenes take Source, and no mixed-radix grid)",
         });
     }
-    render_projection(spectrum, kernel, inverse, request, buffers)
+    let Buffers { grid, aux, out } = buffers;
+    render_projection(
+        spectrum,
+        kernel,
+        inverse,
+        request,
+        grid,
+        aux,
+        Output::Image(out),
+    )
+}
+
+/// Where a projection's image goes.
+enum Output<'a, T> {
+    /// A buffer of its own.
+    Image(&'a mut [T]),
+    /// The front of the slice grid ([`finish_in_grid`]).
+    InGrid,
 }
 
 /// The X-ray projection at `request.level`.
@@ -216,7 +267,9 @@ fn render_projection<S: Sample, Z: CubeSide, T: Real>(
     kernel: &KernelTable<T>,
     inverse: Inverse<'_, T>,
     request: &Request<'_>,
-    buffers: Buffers<'_, T>,
+    grid: &mut [T],
+    aux: &mut [T],
+    out: Output<'_, T>,
 ) -> Result<()> {
     let Request {
         view,
@@ -226,7 +279,6 @@ fn render_projection<S: Sample, Z: CubeSide, T: Real>(
         level,
         ..
     } = *request;
-    let Buffers { grid, aux, out } = buffers;
     let n = spec.n();
     if level > max_level(n) {
         return Err(Error::TooMany {
@@ -243,7 +295,9 @@ fn render_projection<S: Sample, Z: CubeSide, T: Real>(
     }
     require_len("slice grid", grid_len(m), grid.len())?;
     require_len("auxiliary scratch", aux_len(m), aux.len())?;
-    require_len("output image", width * height, out.len())?;
+    if let Output::Image(out) = &out {
+        require_len("output image", width * height, out.len())?;
+    }
     // Checked before the extraction, which is the bulk of the work.
     inverse.check(m)?;
     let pitch = (1u64 << level) as f64;
@@ -254,5 +308,8 @@ fn render_projection<S: Sample, Z: CubeSide, T: Real>(
         width,
         height,
     );
-    finish_with(&mut grid[..m * m], m, &crop, inverse, aux, out)
+    match out {
+        Output::Image(out) => finish_with(&mut grid[..m * m], m, &crop, inverse, aux, out),
+        Output::InGrid => finish_in_grid(&mut grid[..m * m], m, &crop, inverse, aux),
+    }
 }
