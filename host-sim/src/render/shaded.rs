@@ -172,6 +172,21 @@ impl SceneSpectra {
         width: usize,
         height: usize,
     ) -> Result<Image, fvr_core::Error> {
+        // A plain X-ray scene on a mixed-radix side goes through the view
+        // renderer, which has the mixed-radix inverse.
+        if !self.density.n().is_power_of_two()
+            && scene.channels() == 1
+            && !scene.has_partner_terms()
+        {
+            let grey = scene.ambient[0];
+            let data = self.density.render(view, width, height)?;
+            return Ok(Image {
+                channels: 1,
+                width,
+                height,
+                data: data.into_iter().map(|v| v * grey).collect(),
+            });
+        }
         fn go<S: Sample, T: Real>(
             d: &OwnedSpectrum<S>,
             g: Option<&OwnedSpectrum<S>>,
