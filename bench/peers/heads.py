@@ -238,7 +238,10 @@ def main():
     rows = head(args.fvr, "CT head", args.ct, -1024, args.views, work)
     if args.mri:
         rows += head(args.fvr, "MRI head", args.mri, None, args.views, work)
-    text = table(rows, f"bash bench/peers/run.sh --heads --views {args.views}")
+    command = f"bash bench/peers/run.sh --heads --views {args.views}"
+    if args.mri:
+        command = "FVR_MRI_HEAD=$(bash scripts/fetch-mri-head.sh) " + command
+    text = table(rows, command)
     print()
     print(text, end="")
     if args.out:
