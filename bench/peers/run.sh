@@ -11,6 +11,11 @@
 #
 # Usage: bash bench/peers/run.sh [--sizes 128,256] [--filters kb3,kb4,kb6]
 #                                [--precision f16] [--views 7]
+#        bash bench/peers/run.sh --heads [--views 7]
+# --heads runs bench/peers/heads.py instead: RTK against fvr at its default
+# and at 2x padding on the CT head (scripts/fetch-ct-head.sh) and, when
+# FVR_MRI_HEAD is set, the MRI head (scripts/fetch-mri-head.sh); it writes
+# docs/performance/heads.md.
 # This is a manual benchmark: it is not part of scripts/test-all.sh. Run it
 # on an idle machine; the ratios come from one run, the absolute times drift.
 set -euo pipefail
@@ -30,5 +35,20 @@ case " $* " in
 esac
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
 mkdir -p docs/performance
+case " $* " in
+    *" --heads "*)
+        rest=()
+        for arg in "$@"; do
+            [ "$arg" = "--heads" ] || rest+=("$arg")
+        done
+        mri=()
+        if [ -n "${FVR_MRI_HEAD:-}" ]; then
+            mri=(--mri "$(bash scripts/fetch-mri-head.sh)")
+        fi
+        exec "$VENV/bin/python" bench/peers/heads.py --fvr "$TARGET/release/fvr" \
+            --ct "$(bash scripts/fetch-ct-head.sh)" "${mri[@]}" \
+            --work "$TARGET/peers/work" --out docs/performance/heads.md "${rest[@]}"
+        ;;
+esac
 "$VENV/bin/python" bench/peers/peers.py --fvr "$TARGET/release/fvr" \
     --work "$TARGET/peers/work" --out docs/performance/peers.md "$@"

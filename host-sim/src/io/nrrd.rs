@@ -457,6 +457,32 @@ pub fn write_nrrd_f32(path: &Path, sizes: &[usize], data: &[f32]) -> Result<(), 
         .map_err(|e| e.in_file(path))
 }
 
+/// Write `volume` as a 3D `float` NRRD file (raw, little endian) with its
+/// voxel spacing as `spacings`, which [`read_nrrd`] reads back exactly (the
+/// numbers are written in Rust's shortest round-trip form). The samples are
+/// streamed, so no second copy of the volume is held. Errors carry the path.
+pub fn write_volume_nrrd(path: &Path, volume: &Volume) -> Result<(), IoError> {
+    use std::io::Write;
+    let write = || -> Result<(), IoError> {
+        check_sizes(&volume.dims, volume.data.len())?;
+        crate::volume::check_spacing(volume.spacing)
+            .map_err(|e| invalid_argument(e.to_string()))?;
+        let mut text = header_text(&volume.dims, SampleType::F32, Encoding::Raw, Endian::Little);
+        // The header ends with its blank line: the spacing goes before it.
+        text.truncate(text.len() - 1);
+        let [sx, sy, sz] = volume.spacing;
+        text.push_str(&format!("spacings: {sx} {sy} {sz}\n\n"));
+        let mut out = io::BufWriter::with_capacity(FILE_BUFFER_BYTES, std::fs::File::create(path)?);
+        out.write_all(text.as_bytes())?;
+        for chunk in volume.data.chunks(CHUNK_BYTES / 4) {
+            out.write_all(&samples::encode_f32_le(chunk))?;
+        }
+        out.flush()?;
+        Ok(())
+    };
+    write().map_err(|e| e.in_file(path))
+}
+
 /// Encode `data` as a `float` NRRD file, raw encoding, little endian; see
 /// [`write_nrrd_f32`].
 ///

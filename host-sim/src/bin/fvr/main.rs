@@ -9,6 +9,7 @@ mod adaptive_report;
 mod adaptive_table;
 mod args;
 mod compare;
+mod convert;
 #[cfg(fuzzing)]
 mod fuzz;
 mod growth;
@@ -105,6 +106,9 @@ pub(crate) enum Command {
     Turntable(TurntableArgs),
     /// Print the SNR in dB of image B against reference image A (NRRD files).
     Compare(crate::compare::CompareArgs),
+    /// Write a volume (after --background) as a float NRRD file with its
+    /// voxel spacing, for tools that cannot read the original format.
+    Convert(crate::convert::ConvertArgs),
     /// Measure accuracy against exact line integrals of the Gaussian-mixture
     /// phantom and print the Markdown table quoted in the README.
     Accuracy(crate::accuracy::AccuracyArgs),
@@ -175,6 +179,7 @@ where
             merge_scene(&mut args, &|id| given("turntable", id)).and_then(|()| turntable(&args))
         }
         Some(Command::Compare(args)) => compare(&args),
+        Some(Command::Convert(args)) => crate::convert::convert(&args),
         Some(Command::Accuracy(args)) => accuracy(&args),
         Some(Command::AdaptiveTable(args)) => adaptive_table(&args),
         Some(Command::Precision(args)) => crate::precision::run(&args),

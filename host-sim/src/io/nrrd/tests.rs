@@ -873,3 +873,27 @@ fn encode_rounds_and_saturates_integers() {
         vec![0.0, 2.0, 255.0, 0.0]
     );
 }
+
+#[test]
+fn volume_write_keeps_samples_and_spacing() {
+    let file = TempFile::new("spaced.nrrd");
+    let volume = Volume {
+        dims: [5, 4, 3],
+        data: (0..60).map(|n| (n as f32 - 17.0) / 3.0).collect(),
+        spacing: [0.957_031_25, 0.1 + 0.2, 1.5],
+    };
+    write_volume_nrrd(&file.0, &volume).expect("write");
+    let back = read_nrrd(&file.0).expect("read");
+    assert_eq!(back.dims, volume.dims);
+    assert_eq!(back.data, volume.data);
+    assert_eq!(back.spacing, volume.spacing);
+    let bad = Volume {
+        spacing: [1.0, 0.0, 1.0],
+        ..volume
+    };
+    let err = write_volume_nrrd(&file.0, &bad).expect_err("zero spacing");
+    assert!(
+        matches!(err.root(), IoError::InvalidArgument { .. }),
+        "{err}"
+    );
+}

@@ -1,0 +1,252 @@
+"""Peers on real heads, in one run on one machine: RTK's Joseph forward
+projector against fvr at its default settings (the planner chooses filter,
+grid and storage for --accuracy 50) and at 2x padding (kb4, oversampling 2,
+f16), on the CT head and, when given, the MRI head.
+
+Each head is converted once with `fvr convert` to a float NRRD with its
+spacing, which both programs read. Times: RTK's median ms per oblique view
+(parallel geometry, all ITK threads); fvr's preprocessing and ms per view
+from `fvr turntable --stats-json` (all cores). Accuracy: one oblique view,
+the one RTK times first, rendered by each fvr setting and scored in dB
+against fvr's own kb6 / oversampling 2 / f64 rendering of the same view.
+RTK is scored against that reference only when every RTK detector pixel
+maps exactly onto an fvr pixel (checked below); its linear interpolation
+is then compared with the band-limited interpolant, not the same model.
+
+Run through bench/peers/run.sh --heads, which installs the Python side.
+"""
+
+import argparse
+import json
+import pathlib
+import statistics
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+from peers import read_nrrd_image, snr_db
+
+MIB = 1 << 20
+
+
+def nrrd_layout(path):
+    """Sizes (x, y, z) and spacings of a NRRD written by `fvr convert`."""
+    head = pathlib.Path(path).read_bytes().split(b"\n\n", 1)[0].decode()
+    fields = dict(line.split(": ", 1) for line in head.splitlines()[1:] if ": " in line)
+    dims = [int(v) for v in fields["sizes"].split()]
+    spacing = [float(v) for v in fields["spacings"].split()]
+    return dims, spacing
+
+
+def run(cmd):
+    return subprocess.run([str(c) for c in cmd], check=True, capture_output=True,
+                          text=True).stdout
+
+
+def turntable(fvr, volume, flags, views, work, tag):
+    out = run([fvr, "turntable", volume, "--frames", views, "--stats-json", "--quiet",
+               "--out", work / f"turn-{tag}.apng", *flags])
+    return json.loads(out[out.index("{"):])
+
+
+def rtk_geometry(i):
+    from itk import RTK as rtk
+
+    geometry = rtk.ThreeDCircularProjectionGeometry.New()
+    # sid 1000, sdd 0: parallel rays; oblique gantry angle, 25 degree tilt.
+    geometry.AddProjection(1000.0, 0.0, 20.0 + 137.5 * i, 0.0, 0.0, 25.0, 0.0)
+    return geometry
+
+
+def run_rtk(path, dims, spacing, image, pixel, views):
+    """RTK's median ms per view over `views` oblique views on a W x H
+    detector of `pixel` mm, the first view's image (rows as RTK stores them)
+    and the world position (mm, centre of the volume at 0) of each of its
+    pixels, and the thread count."""
+    import itk
+    from itk import RTK as rtk
+
+    image_type = itk.Image[itk.F, 3]
+    volume = itk.imread(str(path), itk.F)
+    # fvr's centre (n/2) D at the origin: voxel i sits at (i - n/2) D.
+    volume.SetOrigin([-(dims[a] / 2.0) * spacing[a] for a in range(3)])
+    volume.SetSpacing(spacing)
+    w, h = image
+    source = rtk.ConstantImageSource[image_type].New()
+    # Column i at (i - W/2) P and row j at (j + 1 - H/2) P: fvr's pixels
+    # with the rows in the other order (checked in `pixel_map`).
+    source.SetOrigin([-(w / 2.0) * pixel, (1 - h / 2.0) * pixel, 0.0])
+    source.SetSpacing([pixel, pixel, 1.0])
+    source.SetSize([w, h, 1])
+    source.SetConstant(0.0)
+    source.Update()
+    times, first, world = [], None, None
+    for i in range(views + 1):
+        geometry = rtk_geometry(i)
+        joseph = rtk.JosephForwardProjectionImageFilter[image_type, image_type].New()
+        joseph.SetInput(0, source.GetOutput())
+        joseph.SetInput(1, volume)
+        joseph.SetGeometry(geometry)
+        t = time.perf_counter()
+        joseph.Update()
+        if i > 0:
+            times.append((time.perf_counter() - t) * 1e3)
+            continue
+        first = itk.array_from_image(joseph.GetOutput())[0].astype(np.float64)
+        m = np.array(itk.array_from_matrix(
+            geometry.GetProjectionCoordinatesToFixedSystemMatrix(0)))
+        u = -(w / 2.0) * pixel + pixel * np.arange(w)
+        v = (1 - h / 2.0) * pixel + pixel * np.arange(h)
+        world = u[None, :, None] * m[:3, 0] + v[:, None, None] * m[:3, 1] + m[:3, 3]
+    threads = itk.MultiThreaderBase.GetGlobalDefaultNumberOfThreads()
+    return statistics.median(times), first, world, threads
+
+
+def view_frame(world):
+    """The view direction (perpendicular to the detector) and an up hint
+    along the detector's rows, from RTK's pixel positions."""
+    a0 = world[0, 1] - world[0, 0]
+    a1 = world[1, 0] - world[0, 0]
+    # This sign of d makes fvr's r = normalize(d x a1) equal a0's direction.
+    d = np.cross(a1, a0)
+    return d / np.linalg.norm(d), a1 / np.linalg.norm(a1)
+
+
+def pixel_map(world, d, up, image, pixel):
+    """fvr's (row, col) of every RTK pixel when each lies on one exactly
+    (docs/geometry.md: pixel (col, row) at C + (col - W/2) P r + (H/2 - row)
+    P u, r = normalize(d x u0), u = r x d), else None."""
+    w, h = image
+    r = np.cross(d, up)
+    r /= np.linalg.norm(r)
+    u = np.cross(r, d)
+    col = world @ r / pixel + w / 2
+    row = h / 2 - world @ u / pixel
+    cols, rows = np.rint(col), np.rint(row)
+    if max(np.abs(col - cols).max(), np.abs(row - rows).max()) > 1e-6:
+        return None
+    cols, rows = cols.astype(int), rows.astype(int)
+    if cols.min() < 0 or rows.min() < 0 or cols.max() >= w or rows.max() >= h:
+        return None
+    if len(set(zip(rows.ravel(), cols.ravel()))) != w * h:
+        return None
+    return rows, cols
+
+
+def render(fvr, volume, d, up, image, pixel, flags, out):
+    run([fvr, "render", volume, "--dir", ",".join(f"{x:.17g}" for x in d),
+         "--up", ",".join(f"{x:.17g}" for x in up), "--size", f"{image[0]}x{image[1]}",
+         "--pixel-size", f"{pixel:.17g}", "--quiet", "--out", out, *flags])
+    return read_nrrd_image(out)
+
+
+def spectrum_flags(stats):
+    return ["--filter", stats["filter"], "--oversample", str(stats["oversample"]),
+            "--precision", stats["precision"]]
+
+
+def head(fvr, name, source, background, views, work):
+    """The rows of one head: RTK, fvr default, fvr 2x padding."""
+    name_slug = name.lower().replace(" ", "-")
+    volume = work / f"{name_slug}.nrrd"
+    cmd = [fvr, "convert", source, "--out", volume, "--quiet"]
+    if background is not None:
+        cmd += ["--background", str(background)]
+    run(cmd)
+    dims, spacing = nrrd_layout(volume)
+    default = turntable(fvr, volume, [], views, work, f"{name_slug}-default")
+    image = default["image"]
+    longest = max(n * s for n, s in zip(dims, spacing))
+    # fvr's default pixel size for this image (UnitArgs::sampling).
+    pixel = max(min(spacing), longest / image[0])
+    shape = ["--size", f"{image[0]}x{image[1]}", "--pixel-size", f"{pixel:.17g}"]
+    padded = turntable(fvr, volume, ["--filter", "kb4", "--oversample", "2",
+                                     "--precision", "f16", *shape], views, work, f"{name_slug}-2x")
+    rtk_ms, rtk_image, world, threads = run_rtk(volume, dims, spacing, image, pixel, views)
+    d, up = view_frame(world)
+    reference = render(fvr, volume, d, up, image, pixel,
+                       ["--filter", "kb6", "--oversample", "2", "--precision", "f64"],
+                       work / f"{name_slug}-ref.nrrd")
+    mapping = pixel_map(world, d, up, image, pixel)
+    rtk_snr = None
+    if mapping is not None:
+        mapped = np.zeros_like(reference)
+        mapped[mapping] = rtk_image
+        rtk_snr = snr_db(reference, mapped)
+    print(f"{name}: {dims} at {spacing} mm, {image[0]}x{image[1]} pixels of {pixel:.4g} mm; "
+          f"RTK {rtk_ms:.1f} ms/view ({threads} threads, median of {views}), "
+          f"{'—' if rtk_snr is None else f'{rtk_snr:.1f} dB'}", flush=True)
+    rows = [(name, "RTK Joseph (f32)", None, None, rtk_ms, rtk_snr)]
+    for label, stats in (("default", default), ("2× padding", padded)):
+        img = render(fvr, volume, d, up, image, pixel, spectrum_flags(stats),
+                     work / f"{name_slug}-{stats['filter']}-{stats['oversample']}.nrrd")
+        snr = snr_db(reference, img)
+        method = (f"fvr {label}: {stats['filter']} os{stats['oversample']} "
+                  f"{stats['precision']}")
+        print(f"{name}: {method}: spectrum {stats['spectrum_bytes'] / MIB:.0f} MiB, "
+              f"preprocess {stats['preprocess_ms']:.0f} ms, "
+              f"{stats['ms_per_view']:.2f} ms/view, {snr:.1f} dB", flush=True)
+        rows.append((name, method, stats["spectrum_bytes"], stats["preprocess_ms"],
+                     stats["ms_per_view"], snr))
+    return rows
+
+
+def table(rows, command):
+    lines = [
+        f"Command: `{command}` ({len(rows)} rows, one run).",
+        "",
+        "| volume | method | spectrum MiB | preprocess ms | preprocess in RTK views | "
+        "ms / view | RTK ÷ this | default ÷ 2× per view | SNR dB |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for name in dict.fromkeys(r[0] for r in rows):
+        mine = [r for r in rows if r[0] == name]
+        rtk_ms = mine[0][4]
+        padded_ms = mine[2][4]
+        for _, method, spectrum, prep, view, snr in mine:
+            fvr_row = spectrum is not None
+            cells = [
+                name, method,
+                f"{spectrum / MIB:.0f}" if fvr_row else "—",
+                f"{prep:.0f}" if fvr_row else "—",
+                f"{prep / rtk_ms:.1f}" if fvr_row else "—",
+                f"{view:.2f}",
+                f"{rtk_ms / view:.1f}",
+                f"{view / padded_ms:.2f}" if fvr_row else "—",
+                "—" if snr is None else f"{snr:.1f}",
+            ]
+            lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--fvr", required=True, help="the fvr binary")
+    p.add_argument("--ct", required=True, help="the CT head (Cranium.inv3)")
+    p.add_argument("--mri", help="the MRI head (NIfTI), if any")
+    p.add_argument("--views", type=int, default=7)
+    p.add_argument("--work", default="target/peers/work")
+    p.add_argument("--out", help="also write the Markdown table to this file")
+    args = p.parse_args()
+    work = pathlib.Path(args.work)
+    work.mkdir(parents=True, exist_ok=True)
+    import itk
+
+    print(f"python {sys.version.split()[0]}, numpy {np.__version__}, itk {itk.__version__}")
+    rows = head(args.fvr, "CT head", args.ct, -1024, args.views, work)
+    if args.mri:
+        rows += head(args.fvr, "MRI head", args.mri, None, args.views, work)
+    command = f"bash bench/peers/run.sh --heads --views {args.views}"
+    if args.mri:
+        command = "FVR_MRI_HEAD=$(bash scripts/fetch-mri-head.sh) " + command
+    text = table(rows, command)
+    print()
+    print(text, end="")
+    if args.out:
+        pathlib.Path(args.out).write_text(text)
+
+
+if __name__ == "__main__":
+    main()
