@@ -5,7 +5,8 @@
 //! `s.toml`), then the arguments. Every run gets `--quiet --max-memory
 //! 256M`, works in one private directory, and is confined to it: arguments
 //! with a path separator or `..` are skipped, and only `render`,
-//! `turntable` and `compare` run (the studies take minutes by design).
+//! `turntable`, `compare` and `convert` run (the studies take minutes by
+//! design).
 //! Whatever the input, `fvr` must return (never panic or abort), within
 //! the memory limit that libFuzzer's `-rss_limit_mb` enforces.
 
@@ -33,7 +34,10 @@ fn run_case(data: &[u8]) {
     let scene = parts.next().unwrap_or("");
     let args: Vec<&str> = parts.collect();
     let confined = |a: &&str| !(a.contains('/') || a.contains('\\') || a.contains(".."));
-    let allowed = matches!(args.first(), Some(&("render" | "turntable" | "compare")));
+    let allowed = matches!(
+        args.first(),
+        Some(&("render" | "turntable" | "compare" | "convert"))
+    );
     if !allowed || args.len() > 48 || !args.iter().all(confined) {
         return;
     }
