@@ -178,7 +178,7 @@ def head(fvr, name, source, background, views, work):
     print(f"{name}: {dims} at {spacing} mm, {image[0]}x{image[1]} pixels of {pixel:.4g} mm; "
           f"RTK {rtk_ms:.1f} ms/view ({threads} threads, median of {views}), "
           f"{'—' if rtk_snr is None else f'{rtk_snr:.1f} dB'}", flush=True)
-    rows = [(name, "RTK Joseph (f32)", None, None, rtk_ms, rtk_snr)]
+    rows = [(name, "RTK Joseph (f32)", None, None, None, rtk_ms, rtk_snr)]
     for label, stats in (("default", default), ("2× padding", padded)):
         img = render(fvr, volume, d, up, image, pixel, spectrum_flags(stats),
                      work / f"{name_slug}-{stats['filter']}-{stats['oversample']}.nrrd")
@@ -186,9 +186,9 @@ def head(fvr, name, source, background, views, work):
         method = (f"fvr {label}: {stats['filter']} os{stats['oversample']} "
                   f"{stats['precision']}")
         print(f"{name}: {method}: spectrum {stats['spectrum_bytes'] / MIB:.0f} MiB, "
-              f"preprocess {stats['preprocess_ms']:.0f} ms, "
+              f"plan {stats['plan_ms']:.0f} ms, preprocess {stats['preprocess_ms']:.0f} ms, "
               f"{stats['ms_per_view']:.2f} ms/view, {snr:.1f} dB", flush=True)
-        rows.append((name, method, stats["spectrum_bytes"], stats["preprocess_ms"],
+        rows.append((name, method, stats["spectrum_bytes"], stats["plan_ms"], stats["preprocess_ms"],
                      stats["ms_per_view"], snr))
     return rows
 
@@ -197,21 +197,22 @@ def table(rows, command):
     lines = [
         f"Command: `{command}` ({len(rows)} rows, one run).",
         "",
-        "| volume | method | spectrum MiB | preprocess ms | preprocess in RTK views | "
-        "ms / view | RTK ÷ this | default ÷ 2× per view | SNR dB |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "| volume | method | spectrum MiB | plan ms | preprocess ms | "
+        "plan + preprocess in RTK views | ms / view | RTK ÷ this | default ÷ 2× per view | SNR dB |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for name in dict.fromkeys(r[0] for r in rows):
         mine = [r for r in rows if r[0] == name]
-        rtk_ms = mine[0][4]
-        padded_ms = mine[2][4]
-        for _, method, spectrum, prep, view, snr in mine:
+        rtk_ms = mine[0][5]
+        padded_ms = mine[2][5]
+        for _, method, spectrum, plan, prep, view, snr in mine:
             fvr_row = spectrum is not None
             cells = [
                 name, method,
                 f"{spectrum / MIB:.0f}" if fvr_row else "—",
+                f"{plan:.0f}" if fvr_row else "—",
                 f"{prep:.0f}" if fvr_row else "—",
-                f"{prep / rtk_ms:.1f}" if fvr_row else "—",
+                f"{(plan + prep) / rtk_ms:.1f}" if fvr_row else "—",
                 f"{view:.2f}",
                 f"{rtk_ms / view:.1f}",
                 f"{view / padded_ms:.2f}" if fvr_row else "—",

@@ -208,17 +208,44 @@ impl Filter {
         volume: &V,
         n: usize,
     ) -> Result<(Self, f64)> {
+        if !kind.is_kaiser_bessel() {
+            return Ok((Self::with_design_oversampling(kind, oversample, low)?, low));
+        }
+        Self::fit_profile(kind, oversample, low, &EnergyProfile::of(volume, n)?)
+    }
+
+    /// [`Filter::fit_grid`] from the volume's [`EnergyProfile`] on the
+    /// grid's side, made once for every kind fitted on that grid: the same
+    /// filter bit for bit.
+    ///
+    /// # Errors
+    /// An unsupported oversampling.
+    pub fn fit_grid_profile(
+        kind: FilterKind,
+        grid: GridOversampling,
+        profile: &EnergyProfile,
+    ) -> Result<(Self, f64)> {
+        Self::fit_profile(kind, grid.integer(), grid.factor(), profile)
+    }
+
+    /// The design from `low` to 4 that minimizes the aliasing predicted
+    /// on `energy` ([`Filter::fit`]).
+    fn fit_profile(
+        kind: FilterKind,
+        oversample: u32,
+        low: f64,
+        energy: &EnergyProfile,
+    ) -> Result<(Self, f64)> {
         let base = Self::with_design_oversampling(kind, oversample, low)?;
         if !kind.is_kaiser_bessel() {
             return Ok((base, low));
         }
-        let energy = axis_energy_profile(volume, n)?;
         let mut best = (base, low, f64::INFINITY);
         for step in 0..=16 {
             let design = low * libm::pow(4.0 / low, step as f64 / 16.0);
             let f = Self::with_design_oversampling(kind, oversample, design)?;
             let mut cost = 0.0;
-            for (b, e) in energy.iter().enumerate() {
+            for (b, e) in energy.0.iter().enumerate() {
                 if *e > 0.0 {
                     let nu = (b as f64 + 0.5) / (2.0 * PROFILE_BINS as f64);
                     cost += e * f.aliasing_power(nu);
@@ -390,27 +417,37 @@ impl Filter {
 
 const PROFILE_BINS: usize = 32;
 
-/// Energy `Σ|f|²` of the volume binned by `|x_a|/n ∈ [0, ½]` on each axis,
-/// `x_a` being the signed distance from the transform origin `⌊n_a/2⌋`.
-fn axis_energy_profile<V: VoxelSource>(volume: &V, n: usize) -> Result<[f64; PROFILE_BINS]> {
-    let dims = volume.dims();
-    let mut energy = [0.0f64; PROFILE_BINS];
-    let bin = |i: usize, axis: usize| {
-        let x = (i as i64 - (dims[axis] / 2) as i64).unsigned_abs() as usize;
-        (x * 2 * PROFILE_BINS / n).min(PROFILE_BINS - 1)
-    };
-    for k in 0..dims[2] {
-        let bz = bin(k, 2);
-        for j in 0..dims[1] {
-            let by = bin(j, 1);
-            for i in 0..dims[0] {
-                let v = volume.finite_voxel(i, j, k)?;
-                let e = v * v;
-                energy[bin(i, 0)] += e;
-                energy[by] += e;
-                energy[bz] += e;
+/// Energy `Σ|f|²` of a volume binned by `|x_a|/n ∈ [0, ½]` on each axis,
+/// `x_a` being the signed distance from the transform origin `⌊n_a/2⌋`:
+/// what [`Filter::fit`] fits a design to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EnergyProfile([f64; PROFILE_BINS]);
+
+impl EnergyProfile {
+    /// The profile of `volume` on the cube of side `n`.
+    ///
+    /// # Errors
+    /// A NaN or infinite voxel (named).
+    pub fn of<V: VoxelSource>(volume: &V, n: usize) -> Result<Self> {
+        let dims = volume.dims();
+        let mut energy = [0.0f64; PROFILE_BINS];
+        let bin = |i: usize, axis: usize| {
+            let x = (i as i64 - (dims[axis] / 2) as i64).unsigned_abs() as usize;
+            (x * 2 * PROFILE_BINS / n).min(PROFILE_BINS - 1)
+        };
+        for k in 0..dims[2] {
+            let bz = bin(k, 2);
+            for j in 0..dims[1] {
+                let by = bin(j, 1);
+                for i in 0..dims[0] {
+                    let v = volume.finite_voxel(i, j, k)?;
+                    let e = v * v;
+                    energy[bin(i, 0)] += e;
+                    energy[by] += e;
+                    energy[bz] += e;
+                }
             }
         }
+        Ok(Self(energy))
     }
-    Ok(energy)
 }

@@ -13,7 +13,7 @@ mod kernel;
 mod special;
 mod table;
 
-pub use kernel::{Filter, FilterKind, MAX_WIDTH};
+pub use kernel::{EnergyProfile, Filter, FilterKind, MAX_WIDTH};
 pub use special::{bessel_i0, bessel_i1_over_x};
 pub use table::{DerivativeTable, KernelTable, PhaseTable, TABLE_RESOLUTION};
 

@@ -214,7 +214,9 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     } else {
         crate::plan::Grids::PowersOfTwo
     };
+    let t_planning = Instant::now();
     let args = &crate::plan::planned(args, &volume, grids)?;
+    let t_plan = t_planning.elapsed();
     // The planner may have changed the spectrum's settings.
     declare_job(args, &scene);
     fvr_host::budget::check_plan(volume.dims)?;
@@ -353,6 +355,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         h,
         n,
         t_load,
+        t_plan,
         t_prep,
         t_view,
         adaptive_report,
@@ -418,6 +421,7 @@ struct RenderStats<'a> {
     oversample: serde_json::Value,
     storage_snr_db: f64,
     load_ms: f64,
+    plan_ms: f64,
     preprocess_ms: f64,
     view_ms: f64,
     preview_level: u32,
@@ -443,6 +447,7 @@ struct Rendered<'a> {
     h: usize,
     n: usize,
     t_load: Duration,
+    t_plan: Duration,
     t_prep: Duration,
     t_view: Duration,
     adaptive_report: Option<AdaptiveReport>,
@@ -464,6 +469,7 @@ impl Rendered<'_> {
             h,
             n,
             t_load,
+            t_plan,
             t_prep,
             t_view,
             ref adaptive_report,
@@ -536,6 +542,7 @@ impl Rendered<'_> {
         println!("  storage SNR   {storage_snr:.1} dB (estimate, against the f64 pipeline)");
         crate::plan::print_human(&args.frame.spectrum);
         println!("  load          {:.1} ms", t_load.as_secs_f64() * 1e3);
+        println!("  plan          {:.1} ms", t_plan.as_secs_f64() * 1e3);
         println!("  preprocess    {:.1} ms", t_prep.as_secs_f64() * 1e3);
         println!("  view          {:.2} ms", t_view.as_secs_f64() * 1e3);
         if args.preview_level > 0 {
@@ -572,6 +579,7 @@ impl Rendered<'_> {
             h,
             n,
             t_load,
+            t_plan,
             t_prep,
             t_view,
             ref adaptive_report,
@@ -592,6 +600,7 @@ impl Rendered<'_> {
             oversample: crate::plan::oversample_json(args.frame.spectrum.oversample),
             storage_snr_db: storage_snr,
             load_ms: t_load.as_secs_f64() * 1e3,
+            plan_ms: t_plan.as_secs_f64() * 1e3,
             preprocess_ms: t_prep.as_secs_f64() * 1e3,
             view_ms: t_view.as_secs_f64() * 1e3,
             preview_level: args.preview_level,

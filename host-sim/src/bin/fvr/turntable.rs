@@ -102,7 +102,9 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     let _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
     fvr_host::budget::check_plan(volume.dims)?;
     let t_load = t0.elapsed();
+    let t_planning = Instant::now();
     let args = &crate::plan::planned(args, &volume, crate::plan::Grids::All)?;
+    let t_plan = t_planning.elapsed();
     // The planner may have changed the spectrum's settings.
     declare_job(args, views.len());
     fvr_host::budget::check_plan(volume.dims)?;
@@ -155,6 +157,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
             filter: args.frame.spectrum.filter.name(),
             oversample: crate::plan::oversample_json(args.frame.spectrum.oversample),
             load_ms: t_load.as_secs_f64() * 1e3,
+            plan_ms: t_plan.as_secs_f64() * 1e3,
             preprocess_ms: t_prep.as_secs_f64() * 1e3,
             views_ms: secs * 1e3,
             ms_per_view: secs * 1e3 / frames.max(1) as f64,
@@ -164,8 +167,9 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
         println!("{}", one_line(&stats));
     } else {
         println!(
-            "  load {:.1} ms, preprocess {:.1} ms ({n}^3 {}), {} views in {:.1} ms = {:.1} views/s",
+            "  load {:.1} ms, plan {:.1} ms, preprocess {:.1} ms ({n}^3 {}), {} views in {:.1} ms = {:.1} views/s",
             t_load.as_secs_f64() * 1e3,
+            t_plan.as_secs_f64() * 1e3,
             t_prep.as_secs_f64() * 1e3,
             args.frame.spectrum.precision,
             frames,
@@ -238,6 +242,7 @@ struct TurntableStats<'a> {
     filter: &'a str,
     oversample: serde_json::Value,
     load_ms: f64,
+    plan_ms: f64,
     preprocess_ms: f64,
     views_ms: f64,
     ms_per_view: f64,

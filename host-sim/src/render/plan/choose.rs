@@ -1,13 +1,20 @@
 //! The cheapest configuration predicted to meet a target: candidates, their
 //! costs, and the choice.
 
-use fvr_core::filter::FilterKind;
-use fvr_core::volume::{padded_size, GridOversampling};
+use std::sync::OnceLock;
+
+use fvr_core::filter::{EnergyProfile, Filter, FilterKind};
+use fvr_core::volume::{padded_size, DenseVolume, GridOversampling};
 
 use super::{combine, grid_filter, interpolation, Candidate, Prediction, POW2_GRIDS};
 use crate::render::filter::KbDesign;
 use crate::render::spectrum::{check_memory, Precision};
 use crate::volume::Volume;
+use rayon::prelude::*;
+
+/// One pass over the volume: a filter on a grid of side `n`, the grid's
+/// wrapped-shadow ratio and the precisions that fit in memory.
+type Job = (FilterKind, GridOversampling, usize, f64, Vec<Precision>);
 
 /// Relative cost of a candidate: time per view first
 /// ([`cost_grid`]), memory (`n³` stored coefficients) second.
@@ -148,7 +155,7 @@ pub fn choose_among(
         .precision
         .map_or(vec![Precision::F16, Precision::F32], |p| vec![p]);
     let shadows = super::wrap::Shadows::new(volume);
-    let mut jobs = Vec::new();
+    let mut jobs: Vec<Job> = Vec::new();
     for &grid in &grids {
         let n = grid.side(volume.dims)?;
         if crate::volume::check_padding(volume.dims, n).is_err() {
@@ -168,60 +175,96 @@ pub fn choose_among(
             );
         }
     }
-    // One pass over the volume per filter and oversampling, on their own threads.
-    let results: Vec<Result<Vec<Prediction>, fvr_core::Error>> = std::thread::scope(|scope| {
-        let handles: Vec<_> = jobs
-            .iter()
-            .map(|(kind, grid, n, wrap, fits)| {
-                scope.spawn(move || {
-                    let filter = grid_filter(volume, *kind, *grid, design)?;
-                    let interp = interpolation(volume, &filter, *n)?;
-                    Ok(fits
-                        .iter()
-                        .map(|&precision| {
-                            let candidate = Candidate {
-                                filter: *kind,
-                                oversample: grid.integer(),
-                                precision,
-                            };
-                            combine(&interp, candidate, *grid, filter.beta(), *wrap)
-                        })
-                        .collect())
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| h.join().expect("a prediction thread panicked"))
-            .collect()
-    });
-    let mut predictions = Vec::new();
-    for r in results {
-        predictions.extend(r?);
+    // Candidates in order of cost (stable: ties keep the order above, as
+    // `min_by` would), each job's pass over the volume run only when the
+    // walk reaches one of its candidates: the first predicted to reach the
+    // target with the margin is the cheapest that does, so the jobs of
+    // costlier candidates are never run. Jobs run a batch at a time, one
+    // per thread, the next ones in cost order.
+    let mut order = Vec::new();
+    for (j, (kind, grid, _, _, fits)) in jobs.iter().enumerate() {
+        for (f, &precision) in fits.iter().enumerate() {
+            let candidate = Candidate {
+                filter: *kind,
+                oversample: grid.integer(),
+                precision,
+            };
+            order.push((j, f, cost_grid(candidate, *grid, volume.dims)?));
+        }
     }
-    let costs: Vec<(f64, f64)> = predictions
-        .iter()
-        .map(|p| cost_grid(p.candidate, p.grid, volume.dims))
-        .collect::<Result<_, _>>()?;
-    let cheapest_above = |floor: f64| {
-        predictions
+    order.sort_by(|a, b| a.2.partial_cmp(&b.2).unwrap_or(std::cmp::Ordering::Equal));
+    // The energy profile a Kaiser–Bessel design is fitted to, once per
+    // grid side for all the kinds fitted on it.
+    let source = DenseVolume::new(volume.dims, &volume.data)?;
+    let mut sides: Vec<usize> = jobs.iter().map(|j| j.2).collect();
+    sides.dedup();
+    let profiles: Vec<(usize, OnceLock<Result<EnergyProfile, fvr_core::Error>>)> =
+        sides.into_iter().map(|n| (n, OnceLock::new())).collect();
+    let run = |(kind, grid, n, wrap, fits): &Job| -> Result<Vec<Prediction>, fvr_core::Error> {
+        let filter = match profiles.iter().find(|(m, _)| m == n) {
+            Some((_, profile)) if design == KbDesign::Auto && kind.is_kaiser_bessel() => {
+                let profile = profile.get_or_init(|| EnergyProfile::of(&source, *n));
+                Filter::fit_grid_profile(*kind, *grid, profile.as_ref().map_err(|e| *e)?)?.0
+            }
+            _ => grid_filter(volume, *kind, *grid, design)?,
+        };
+        let interp = interpolation(volume, &filter, *n)?;
+        Ok(fits
             .iter()
-            .zip(&costs)
-            .filter(|(p, _)| p.db >= floor)
-            .min_by(|a, b| a.1.partial_cmp(b.1).unwrap_or(std::cmp::Ordering::Equal))
+            .map(|&precision| {
+                let candidate = Candidate {
+                    filter: *kind,
+                    oversample: grid.integer(),
+                    precision,
+                };
+                combine(&interp, candidate, *grid, filter.beta(), *wrap)
+            })
+            .collect())
     };
-    // With the margin if any candidate allows it, else without.
-    if let Some((p, _)) =
-        cheapest_above(target_db + MARGIN_DB).or_else(|| cheapest_above(target_db))
-    {
+    let batch = rayon::current_num_threads().max(1);
+    let mut done: Vec<Option<Vec<Prediction>>> = vec![None; jobs.len()];
+    for (at, &(j, f, _)) in order.iter().enumerate() {
+        if done[j].is_none() {
+            let mut next: Vec<usize> = Vec::with_capacity(batch);
+            for &(k, _, _) in &order[at..] {
+                if done[k].is_none() && !next.contains(&k) {
+                    next.push(k);
+                    if next.len() == batch {
+                        break;
+                    }
+                }
+            }
+            let results: Vec<_> = next.par_iter().map(|&k| run(&jobs[k])).collect();
+            for (k, r) in next.into_iter().zip(results) {
+                done[k] = Some(r?);
+            }
+        }
+        let p = done[j].as_ref().map(|d| d[f]);
+        if let Some(p) = p.filter(|p| p.db >= target_db + MARGIN_DB) {
+            return Ok(Plan {
+                target_db,
+                prediction: p,
+                met: true,
+            });
+        }
+    }
+    // None reaches the margin: every job has run.
+    let predictions: Vec<Prediction> = order
+        .iter()
+        .filter_map(|&(j, f, _)| done[j].as_ref().map(|d| d[f]))
+        .collect();
+    if let Some(p) = predictions.iter().find(|p| p.db >= target_db) {
         return Ok(Plan {
             target_db,
             prediction: *p,
             met: true,
         });
     }
-    let best = predictions
+    // The best in the order of the jobs (`max_by` keeps the last of equals).
+    let best = done
         .iter()
+        .flatten()
+        .flatten()
         .max_by(|a, b| a.db.total_cmp(&b.db))
         .ok_or(fvr_core::Error::VolumeTooLarge {
             dims: volume.dims,

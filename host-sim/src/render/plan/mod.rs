@@ -70,6 +70,7 @@ use fvr_core::volume::{padded_size, DenseVolume, GridOversampling};
 use super::filter::{choose_filter, KbDesign};
 use super::spectrum::Precision;
 use crate::volume::Volume;
+use sums::ViewSums;
 
 /// The weights' leak `|c − 1| + |s|` above which an axis position counts
 /// towards the edge term (−40 dB), if it is also [`EDGE_OVER_CENTRE`] times
@@ -249,25 +250,6 @@ fn axis_weights(filter: &Filter, n: usize) -> AxisWeights {
     out
 }
 
-/// Per-view sums over the projection axis, split by edge (0) and interior
-/// (1) voxels, on the `n × n` grid of the two other axes (lower axis fastest).
-struct ViewSums {
-    plain: [Vec<f64>; 2],
-    cos: [Vec<f64>; 2],
-    sin: [Vec<f64>; 2],
-}
-
-impl ViewSums {
-    fn new(n: usize) -> Self {
-        let z = || [vec![0.0; n * n], vec![0.0; n * n]];
-        Self {
-            plain: z(),
-            cos: z(),
-            sin: z(),
-        }
-    }
-}
-
 /// What the interpolation of one filter does to one volume.
 struct Interpolation {
     n: usize,
@@ -320,39 +302,7 @@ fn interpolation(
 ) -> Result<Interpolation, fvr_core::Error> {
     let dims = volume.dims;
     let weights = axis_weights(filter, n);
-    let grid = |i: usize, a: usize| (i + n - dims[a] / 2 % n) % n;
-    let mut sums = [ViewSums::new(n), ViewSums::new(n), ViewSums::new(n)];
-    let mut g2 = 0.0;
-    for k in 0..dims[2] {
-        let gz = grid(k, 2);
-        for j in 0..dims[1] {
-            let gy = grid(j, 1);
-            for i in 0..dims[0] {
-                let v = volume.get(i, j, k) as f64;
-                if v == 0.0 {
-                    continue;
-                }
-                if !v.is_finite() {
-                    return Err(fvr_core::Error::NonFiniteVoxel {
-                        index: [i, j, k],
-                        value: v,
-                    });
-                }
-                let gx = grid(i, 0);
-                let b = usize::from(!(weights.edge[gx] || weights.edge[gy] || weights.edge[gz]));
-                let g = v * weights.p[gx] * weights.p[gy] * weights.p[gz];
-                g2 += g * g;
-                let g = [gx, gy, gz];
-                for (a, s) in sums.iter_mut().enumerate() {
-                    let (pa, qa) = in_plane(a);
-                    let at = g[pa] + n * g[qa];
-                    s.plain[b][at] += v;
-                    s.cos[b][at] += v * weights.c[g[a]];
-                    s.sin[b][at] += v * weights.s[g[a]];
-                }
-            }
-        }
-    }
+    let (sums, g2) = sums::view_sums(volume, &weights, n)?;
     let side = image_side(dims, n)?;
     let mut energies = [[0.0; 4]; 3];
     for (a, e) in energies.iter_mut().enumerate() {
@@ -546,6 +496,7 @@ pub fn predict_grid(
 }
 
 mod choose;
+mod sums;
 mod wrap;
 pub use choose::{
     choose, choose_among, cost, cost_grid, Constraints, Plan, CANDIDATE_FILTERS, MARGIN_DB,

@@ -63,19 +63,26 @@ impl Shadows {
                 let frame = View { dir, up }.frame().expect("fixed directions");
                 let (r, u) = (frame.right, frame.up);
                 let mut sums = vec![0.0; side * side];
+                // Pixels from the canvas corner, plus ½ so that truncation
+                // rounds to the nearest (every coordinate is non-negative).
+                let offset = half as f64 + 0.5;
                 for k in 0..d[2] {
                     let z = k as f64 - c[2];
                     for j in 0..d[1] {
                         let y = j as f64 - c[1];
-                        for i in 0..d[0] {
-                            let v = volume.get(i, j, k) as f64;
+                        let p0 = y * r[1] + z * r[2] + offset;
+                        let q0 = y * u[1] + z * u[2] + offset;
+                        let row = &volume.data[(k * d[1] + j) * d[0]..][..d[0]];
+                        for (i, &v) in row.iter().enumerate() {
                             if v == 0.0 {
                                 continue;
                             }
                             let x = i as f64 - c[0];
-                            let p = (x * r[0] + y * r[1] + z * r[2]).round() as i64 + half;
-                            let q = (x * u[0] + y * u[1] + z * u[2]).round() as i64 + half;
-                            sums[q as usize * side + p as usize] += v;
+                            let p = (x * r[0] + p0) as usize;
+                            let q = (x * u[0] + q0) as usize;
+                            if let Some(s) = sums.get_mut(q * side + p) {
+                                *s += f64::from(v);
+                            }
                         }
                     }
                 }
