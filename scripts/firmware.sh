@@ -272,13 +272,19 @@ grep -h '^trig ' "$run_dir/fvr-trig-bench-m4f.log" "$run_dir/fvr-trig-bench-m3.l
 echo "== firmware: a scene over the flash budget fails to build, naming the excess"
 # In a copy of the workspace whose firmware/memory.x is smaller, building
 # the program whose tables are largest (fvr-filter-bench) in the same
-# target directory: the registry crates are reused, the copy's own crates
-# are not (another path), and the workspace's programs are not touched.
+# target directory: the registry crates are reused. Cargo names a
+# workspace crate's build by its path within the workspace, so the copy's
+# crates get another version (and their own lock entries) to build apart
+# from the workspace's, which stay untouched.
 budget_ws="$target_dir/fvr-firmware-budget-ws"
 rm -rf "$budget_ws"
 mkdir -p "$budget_ws"
 trap 'rm -rf "$budget_ws"' EXIT
 git ls-files -z --cached --others --exclude-standard | xargs -0 cp --parents -t "$budget_ws"
+sed -i 's/^version = "\([0-9.]*\)"$/version = "\1-budget"/' "$budget_ws/Cargo.toml"
+grep -q '^version = "[0-9.]*-budget"$' "$budget_ws/Cargo.toml" || fail "could not set the copy's workspace version"
+(cd "$budget_ws" && cargo metadata --offline --format-version 1 >/dev/null) \
+    || fail "could not update the copy's Cargo.lock offline"
 expect_build_failure() { # flash-length pattern what
     sed -i "s/^\( *FLASH *: *ORIGIN = 0x00000000, LENGTH = \).*/\1$1/" "$budget_ws/firmware/memory.x"
     grep -q "LENGTH = $1\$" "$budget_ws/firmware/memory.x" || fail "could not set FLASH to $1 in the copy of firmware/memory.x"
