@@ -1,10 +1,12 @@
 //! Build script of the firmware:
-//! 1. copies `memory.x` (`memory-m3.x` for the Cortex-M3 target
-//!    `thumbv7m-none-eabi`, `memory-m7.x` with `--features m7`) to `OUT_DIR`
-//!    as `memory.x`, puts that on the
-//!    link path and, for the thumb targets, links with `link.x` and
-//!    `defmt.x`. (No `memory.x` may sit in the workspace root: the linker
-//!    runs there and would take it before the one in `OUT_DIR`.)
+//! 1. for the thumb targets, copies `memory.x` (`memory-m3.x` for the
+//!    Cortex-M3 target `thumbv7m-none-eabi`) and `memory-m7.x` to
+//!    directories of `OUT_DIR` as `memory.x`, gives each program the one of
+//!    its part as a link path (`memory-m7.x` to the programs named `*-m7`,
+//!    so that one cargo call builds them all on one library) and links
+//!    with `link.x` and `defmt.x`. (No `memory.x` may sit in the workspace
+//!    root: the linker runs there and would take it before the one in
+//!    `OUT_DIR`.)
 //! 2. runs the core **on the host** to make the flash tables: it samples the
 //!    scene's phantom (`src/scene.rs`), computes its gradient magnitude
 //!    `|∇f|` if a stored spectrum needs it, prepares the f16 spectra listed
@@ -54,15 +56,12 @@ fn main() {
     println!("cargo:rerun-if-changed=src/scene.rs");
     println!("cargo:rerun-if-changed=src/fixed_input.rs");
     let memory = manifest.join(memory_layout(&target));
-    println!("cargo:rerun-if-changed={}", memory.display());
-    let layout = fs::read_to_string(&memory)
-        .unwrap_or_else(|e| panic!("cannot read the memory layout {}: {e}", memory.display()));
-    fs::write(out.join("memory.x"), &layout).expect("write memory.x to OUT_DIR");
-    println!("cargo:rustc-link-search={}", out.display());
+    let layout = read_layout(&memory);
     if target.starts_with("thumb") {
         println!("cargo:rustc-link-arg-bins=--nmagic");
         println!("cargo:rustc-link-arg-bins=-Tlink.x");
         println!("cargo:rustc-link-arg-bins=-Tdefmt.x");
+        link_layouts(&out, &manifest, &layout);
     }
 
     let tables = make_tables(&out);
@@ -75,15 +74,66 @@ fn main() {
 /// The memory layout for `target`, in the manifest's directory: the
 /// Cortex-M3 (no FPU, QEMU mps2-an385) has its own.
 fn memory_layout(target: &str) -> &'static str {
-    // The Cortex-M7 of the device preparation (`--features m7`) shares the
-    // M4F's target triple.
-    if env::var_os("CARGO_FEATURE_M7").is_some() {
-        "memory-m7.x"
-    } else if target.starts_with("thumbv7m-") {
+    if target.starts_with("thumbv7m-") {
         "memory-m3.x"
     } else {
         "memory.x"
     }
+}
+
+/// The programs whose name ends in `-m7` run on the Cortex-M7 part with
+/// 1 MiB of RAM (QEMU mps2-an500), which shares the M4F's target triple.
+const M7_SUFFIX: &str = "-m7";
+
+fn read_layout(path: &Path) -> String {
+    println!("cargo:rerun-if-changed={}", path.display());
+    fs::read_to_string(path)
+        .unwrap_or_else(|e| panic!("cannot read the memory layout {}: {e}", path.display()))
+}
+
+/// Puts `layout` in `OUT_DIR/target/memory.x` and
+/// `memory-m7.x` in `OUT_DIR/m7/memory.x`, and hands each program the
+/// directory of its own as a link search path (`link.x` includes
+/// `memory.x`): every program of one build links in the same cargo call,
+/// with one build of the library. The programs are the `[[bin]]` names of
+/// `Cargo.toml`.
+fn link_layouts(out: &Path, manifest: &Path, layout: &str) {
+    let m7 = read_layout(&manifest.join("memory-m7.x"));
+    for (dir, text) in [("target", layout), ("m7", m7.as_str())] {
+        fs::create_dir_all(out.join(dir)).expect("a layout directory in OUT_DIR");
+        fs::write(out.join(dir).join("memory.x"), text).expect("write memory.x to OUT_DIR");
+    }
+    let cargo_toml = manifest.join("Cargo.toml");
+    println!("cargo:rerun-if-changed={}", cargo_toml.display());
+    let manifest_text = fs::read_to_string(&cargo_toml).expect("read Cargo.toml");
+    let bins = bin_names(&manifest_text);
+    assert!(!bins.is_empty(), "no [[bin]] in {}", cargo_toml.display());
+    for bin in bins {
+        let dir = if bin.ends_with(M7_SUFFIX) {
+            "m7"
+        } else {
+            "target"
+        };
+        println!(
+            "cargo:rustc-link-arg-bin={bin}=-L{}",
+            out.join(dir).display()
+        );
+    }
+}
+
+/// The `name`s of the `[[bin]]` tables of a `Cargo.toml`.
+fn bin_names(manifest: &str) -> Vec<String> {
+    let mut names = Vec::new();
+    let mut in_bin = false;
+    for line in manifest.lines().map(str::trim) {
+        if line.starts_with('[') {
+            in_bin = line == "[[bin]]";
+        } else if let Some(value) = line.strip_prefix("name").filter(|_| in_bin) {
+            let value = value.trim_start().trim_start_matches('=').trim();
+            names.push(value.trim_matches('"').to_string());
+        }
+    }
+    names
 }
 
 /// The Q15 and Q31 twiddle tables of `fvr-fixed-bench`

@@ -1,32 +1,30 @@
 #!/usr/bin/env bash
-# The firmware on a Cortex-M4F under QEMU (mps2-an386), end to end:
-#  1. installs what it needs when missing (thumb target, qemu-system-arm,
+# The firmware on a Cortex-M4F under QEMU (mps2-an386), a Cortex-M3
+# (mps2-an385) and a Cortex-M7 (mps2-an500), end to end:
+#  1. installs what it needs when missing (thumb targets, qemu-system-arm,
 #     defmt-print), and fails loudly if it cannot;
-#  2. builds fvr-scene (plain, depth-cued, shaded and both) and
-#     fvr-filter-bench for thumbv7em-none-eabihf;
+#  2. lints and builds every program in four cargo calls (the Cortex-M3
+#     and M4F libraries side by side in one; the M7 programs share the
+#     M4F's target and library, build.rs giving them memory-m7.x):
+#     fvr-scene (plain, depth-cued, shaded and both) and fvr-filter-bench
+#     (M4F), fvr-fixed-bench (M3), fvr-prepare (M4F) and fvr-prepare-m7
+#     (M7), fvr-prepare-q15 (M4F 32^3, M3 64^3) and fvr-prepare-q15-m7 (M7
+#     64^3), and fvr-trig-bench (M4F, M3; the package firmware/trig);
 #  3. runs each in QEMU with -icount shift=0 under a timeout (a HardFault
-#     would otherwise spin forever), decodes its defmt log and requires exit 0;
-#  4. checks every QEMU image against the host core bit for bit, and the
-#     display bytes against the host image (firmware/tests/qemu_agreement.rs);
-#  5. prints the instruction counts and the flash/RAM footprint;
-#  6. the same for the Cortex-M3 (no FPU): builds fvr-fixed-bench for
-#     thumbv7m-none-eabi, runs it under QEMU mps2-an385, checks its integer
-#     transforms and its whole plain kb3 view (integer and soft-float f32)
-#     against the host bit for bit (firmware/tests/qemu_fixed.rs) and prints
-#     its counts and footprint;
-#  7. the transform on the device: builds fvr-prepare-m7 (--features m7),
-#     runs fvr-prepare on mps2-an386 and fvr-prepare-m7 on mps2-an500
-#     (Cortex-M7), checks their spectra and views against the host
-#     (firmware/tests/qemu_prepare.rs) and prints counts and RAM;
-#  7b. the Q15 transform on the device: builds fvr-prepare-q15 for the M3
-#     and fvr-prepare-q15-m7 (--features m7), runs them on mps2-an386 (M4F,
-#     32^3), mps2-an385 (M3, 64^3) and mps2-an500 (M7, 64^3), checks their
-#     spectra and integer views against the host bit for bit and in dB
-#     (firmware/tests/qemu_prepare_q15.rs) and prints counts and RAM;
-#  8. counts the per-view transcendental functions with libm and micromath
-#     (fvr-trig-bench on both cores; their cost to the image:
-#     firmware/tests/trig.rs);
-#  9. checks that a scene over the flash budget fails to build, naming the
+#     would otherwise spin forever), two at a time, decodes its defmt log
+#     and requires exit 0 and the SysTick calibration;
+#  4. checks the QEMU outputs against the host in one cargo call: every
+#     M4F image bit for bit, and the display bytes against the host image
+#     (firmware/tests/qemu_agreement.rs); the M3's integer transforms and
+#     whole plain kb3 view, integer and soft-float f32
+#     (firmware/tests/qemu_fixed.rs); the spectra and views prepared on
+#     the device, f16 (firmware/tests/qemu_prepare.rs) and Q15
+#     (firmware/tests/qemu_prepare_q15.rs), bit for bit and in dB; then
+#     what the transcendental functions of libm and micromath cost the
+#     image (firmware/trig/tests/trig.rs);
+#  5. prints the instruction counts, the flash/RAM footprint, and RAM
+#     beyond the spectrum of the device preparations;
+#  6. checks that a scene over the flash budget fails to build, naming the
 #     excess (build.rs for the tables alone, the linker for tables + code).
 # Usage: bash scripts/firmware.sh
 set -euo pipefail
@@ -37,6 +35,9 @@ PROGRAMS=(fvr-scene fvr-filter-bench)
 M3_TARGET=thumbv7m-none-eabi
 M3_PROGRAM=fvr-fixed-bench
 QEMU_TIMEOUT_S=120
+# QEMU runs at a time (each is one thread; -icount makes the counts exact
+# whatever the load).
+QEMU_JOBS=2
 DEFMT_PRINT_VERSION=1.2.0
 
 fail() {
@@ -82,34 +83,79 @@ m3_view_counts() {
     echo "soft-float f32 view / integer view: $(python3 -c "print(f'{$soft / $view:.2f}')")"
 }
 
-echo "== firmware: build ($TARGET, release)"
-cargo clippy --locked -p fvr-firmware --target "$TARGET" --release -- -D warnings
-cargo build --locked -p fvr-firmware --target "$TARGET" --release
+m3_dir="$target_dir/$M3_TARGET/release"
+# Programs built for both cores (the M3 builds only these); the M4F builds
+# every program of fvr-firmware besides.
+BOTH_CORES=(--bin fvr-fixed-bench --bin fvr-prepare-q15 --bin fvr-trig-bench)
+PACKAGES=(-p fvr-firmware -p fvr-firmware-trig)
 
-echo "== firmware: run in QEMU (mps2-an386, -icount shift=0, timeout ${QEMU_TIMEOUT_S}s)"
+echo "== firmware: lint ($TARGET and $M3_TARGET, release)"
+cargo clippy --locked "${PACKAGES[@]}" --target "$TARGET" --target "$M3_TARGET" --release \
+    --lib "${BOTH_CORES[@]}" -- -D warnings
+cargo clippy --locked -p fvr-firmware --target "$TARGET" --release --bins -- -D warnings
+echo "== firmware: build ($TARGET and $M3_TARGET, release)"
+cargo build --locked "${PACKAGES[@]}" --target "$TARGET" --target "$M3_TARGET" --release \
+    "${BOTH_CORES[@]}"
+cargo build --locked -p fvr-firmware --target "$TARGET" --release --bins
+
+# Every QEMU run: name (of its log and outputs), machine, cpu, elf.
+QEMU_RUNS=(
+    "fvr-scene mps2-an386 cortex-m4 $bin_dir/fvr-scene"
+    "fvr-filter-bench mps2-an386 cortex-m4 $bin_dir/fvr-filter-bench"
+    "$M3_PROGRAM mps2-an385 cortex-m3 $m3_dir/$M3_PROGRAM"
+    "fvr-prepare mps2-an386 cortex-m4 $bin_dir/fvr-prepare"
+    "fvr-prepare-m7 mps2-an500 cortex-m7 $bin_dir/fvr-prepare-m7"
+    "fvr-prepare-q15 mps2-an386 cortex-m4 $bin_dir/fvr-prepare-q15"
+    "fvr-prepare-q15-m7 mps2-an500 cortex-m7 $bin_dir/fvr-prepare-q15-m7"
+    "fvr-prepare-q15-m3 mps2-an385 cortex-m3 $m3_dir/fvr-prepare-q15"
+    "fvr-trig-bench-m4f mps2-an386 cortex-m4 $bin_dir/fvr-trig-bench"
+    "fvr-trig-bench-m3 mps2-an385 cortex-m3 $m3_dir/fvr-trig-bench"
+)
+# The programs that must report an exact SysTick calibration.
+CALIBRATED=(fvr-fixed-bench fvr-prepare fvr-prepare-m7 fvr-prepare-q15 fvr-prepare-q15-m7 fvr-prepare-q15-m3)
+
+echo "== firmware: run in QEMU (-icount shift=0, timeout ${QEMU_TIMEOUT_S}s, $QEMU_JOBS at a time)"
 rm -rf "$run_dir"
 mkdir -p "$run_dir"
-run_in_qemu() { # machine cpu elf program
+qemu_run() { # name machine cpu elf: writes name.defmt and name.status
     set +e
     (cd "$run_dir" && timeout --kill-after=5 "$QEMU_TIMEOUT_S" qemu-system-arm \
-        -machine "$1" -cpu "$2" -nographic -monitor none -serial none \
+        -machine "$2" -cpu "$3" -nographic -monitor none -serial none \
         -semihosting-config enable=on,target=native -icount shift=0 \
-        -kernel "$3" >"$4.defmt")
-    local status=$?
-    set -e
-    defmt-print -e "$3" <"$run_dir/$4.defmt" | tee "$run_dir/$4.log"
+        -kernel "$4" >"$1.defmt" 2>"$1.stderr")
+    echo $? >"$run_dir/$1.status"
+}
+for run in "${QEMU_RUNS[@]}"; do
+    while [ "$(jobs -rp | wc -l)" -ge "$QEMU_JOBS" ]; do
+        wait -n || true
+    done
+    # shellcheck disable=SC2086 # the fields of one run
+    qemu_run $run &
+done
+wait
+for run in "${QEMU_RUNS[@]}"; do
+    read -r name _ _ elf <<<"$run"
+    echo "-- $name"
+    defmt-print -e "$elf" <"$run_dir/$name.defmt" | tee "$run_dir/$name.log"
+    cat "$run_dir/$name.stderr" >&2
+    status=$(cat "$run_dir/$name.status")
     case $status in
         0) ;;
-        124 | 137) fail "$4: QEMU timed out after ${QEMU_TIMEOUT_S}s (a HardFault loop or a hang)" ;;
-        *) fail "$4: exited with status $status (101 panic, 102 HardFault, 1 error)" ;;
+        124 | 137) fail "$name: QEMU timed out after ${QEMU_TIMEOUT_S}s (a HardFault loop or a hang)" ;;
+        *) fail "$name: exited with status $status (101 panic, 102 HardFault, 1 error)" ;;
     esac
-}
-for program in "${PROGRAMS[@]}"; do
-    run_in_qemu mps2-an386 cortex-m4 "$bin_dir/$program" "$program"
+done
+for program in "${CALIBRATED[@]}"; do
+    grep -q '^calibration: delay loop of 2000002 instructions counted as 2000000$' "$run_dir/$program.log" \
+        || fail "$program: the SysTick calibration is off"
 done
 
-echo "== firmware: QEMU images against the host core (bit for bit)"
-FVR_QEMU_OUT="$run_dir" cargo test --locked -p fvr-firmware --test qemu_agreement -- --ignored --nocapture
+echo "== firmware: QEMU outputs against the host (bit for bit, dB)"
+FVR_QEMU_OUT="$run_dir" cargo test --locked -p fvr-firmware \
+    --test qemu_agreement --test qemu_fixed --test qemu_prepare --test qemu_prepare_q15 \
+    -- --ignored --nocapture
+echo "== firmware: what libm and micromath cost the image (host)"
+cargo test --locked -p fvr-firmware-trig --test trig -- --nocapture
 
 echo "== firmware: instruction counts (64x64 view, Cortex-M4F, exact to +-40)"
 # Plain frames are split by a staged render; cued and shaded frames by
@@ -130,19 +176,32 @@ for program in "${PROGRAMS[@]}"; do
         done
 done
 grep -h '^f16 -> f32' "$run_dir/fvr-filter-bench.log" || fail "no f16 conversion report"
-grep -h '^frame' "$run_dir"/*.log >/dev/null || fail "no instruction counts in the firmware logs"
+grep -h '^frame' "$run_dir/fvr-scene.log" "$run_dir/fvr-filter-bench.log" >/dev/null \
+    || fail "no instruction counts in the firmware logs"
 grep -q 'inverse again on other data' "$run_dir/fvr-scene.log" || fail "fvr-scene: no re-timed inverse of its plain frame"
+
+# .text .rodata .data .bss .vector_table of an elf.
+sections() {
+    size -A "$1" | awk '
+        $1==".text"{t=$2} $1==".rodata"{r=$2} $1==".data"{d=$2} $1==".bss"{b=$2} $1==".vector_table"{v=$2}
+        END{print t+0, r+0, d+0, b+0, v+0}'
+}
+# The peak stack a program's log reports.
+stack_of() {
+    local stack
+    stack=$(sed -n 's/^stack: peak \([0-9]*\) bytes.*/\1/p' "$run_dir/$1.log")
+    [ -n "$stack" ] || fail "$1: no stack measurement in its log"
+    echo "$stack"
+}
 
 echo "== firmware: footprint (bytes)"
 footprint_header() {
     printf '%-18s %8s %8s %8s %8s %8s %10s %10s\n' program .text .rodata .data .bss stack flash RAM
 }
 footprint() { # elf program
-    read -r text rodata data bss vt < <(size -A "$1" | awk '
-        $1==".text"{t=$2} $1==".rodata"{r=$2} $1==".data"{d=$2} $1==".bss"{b=$2} $1==".vector_table"{v=$2}
-        END{print t+0, r+0, d+0, b+0, v+0}')
-    stack=$(sed -n 's/^stack: peak \([0-9]*\) bytes.*/\1/p' "$run_dir/$2.log")
-    [ -n "$stack" ] || fail "$2: no stack measurement in its log"
+    local text rodata data bss vt stack
+    read -r text rodata data bss vt < <(sections "$1")
+    stack=$(stack_of "$2")
     printf '%-18s %8s %8s %8s %8s %8s %10s %10s\n' "$2" "$text" "$rodata" "$data" "$bss" "$stack" \
         $((vt + text + rodata + data)) $((data + bss + stack))
 }
@@ -151,16 +210,6 @@ for program in "${PROGRAMS[@]}"; do
     footprint "$bin_dir/$program" "$program"
 done
 
-echo "== firmware: Cortex-M3 ($M3_TARGET, release, $M3_PROGRAM)"
-cargo clippy --locked -p fvr-firmware --target "$M3_TARGET" --release --lib --bin "$M3_PROGRAM" -- -D warnings
-cargo build --locked -p fvr-firmware --target "$M3_TARGET" --release --bin "$M3_PROGRAM"
-m3_elf="$target_dir/$M3_TARGET/release/$M3_PROGRAM"
-echo "== firmware: run in QEMU (mps2-an385, Cortex-M3, -icount shift=0, timeout ${QEMU_TIMEOUT_S}s)"
-run_in_qemu mps2-an385 cortex-m3 "$m3_elf" "$M3_PROGRAM"
-grep -q '^calibration: delay loop of 2000002 instructions counted as 2000000$' "$run_dir/$M3_PROGRAM.log" \
-    || fail "$M3_PROGRAM: the SysTick calibration is off on mps2-an385"
-echo "== firmware: Cortex-M3 integer transforms against the host (bit for bit)"
-FVR_QEMU_OUT="$run_dir" cargo test --locked -p fvr-firmware --test qemu_fixed -- --ignored --nocapture
 echo "== firmware: instruction counts (64x64 block, Cortex-M3, exact to +-40)"
 printf '%-20s %11s\n' item instructions
 sed -n 's/^fixed \([^:]*\): \([0-9]*\) instructions.*/\1 \2/p; s/^fixed \(twiddles-q15\): build \([0-9]*\) instructions.*, flash \([0-9]*\) .*/\1-build \2\n\1-flash \3/p' \
@@ -172,114 +221,77 @@ echo "soft-float f32 / Q15: $(python3 -c "print(f'{$soft / $q15:.2f}')")"
 m3_view_counts
 echo "== firmware: Cortex-M3 footprint (bytes)"
 footprint_header
-footprint "$m3_elf" "$M3_PROGRAM"
+footprint "$m3_dir/$M3_PROGRAM" "$M3_PROGRAM"
 
 # ---- The transform on the device: fvr-prepare (Cortex-M4F, 32^3) and
 # fvr-prepare-m7 (Cortex-M7 with 1 MiB of RAM, 64^3) prepare a spectrum in
 # place in RAM from a u8 volume in flash and render the kb3 view from it.
-PREP_M4F_PROGRAM=fvr-prepare
-PREP_M7_PROGRAM=fvr-prepare-m7
-device_preparation() {
-    echo "== firmware: device preparation ($PREP_M4F_PROGRAM built above; $PREP_M7_PROGRAM with --features m7, memory-m7.x)"
-    # No clippy run of its own: the library and the program's macro are
-    # linted above, through fvr-prepare; the feature only swaps memory.x.
-    cargo build --locked -p fvr-firmware --target "$TARGET" --release --features m7 --bin "$PREP_M7_PROGRAM"
-    run_in_qemu mps2-an386 cortex-m4 "$bin_dir/$PREP_M4F_PROGRAM" "$PREP_M4F_PROGRAM"
-    run_in_qemu mps2-an500 cortex-m7 "$bin_dir/$PREP_M7_PROGRAM" "$PREP_M7_PROGRAM"
-    local program
-    for program in "$PREP_M4F_PROGRAM" "$PREP_M7_PROGRAM"; do
-        grep -q '^calibration: delay loop of 2000002 instructions counted as 2000000$' "$run_dir/$program.log" \
-            || fail "$program: the SysTick calibration is off"
-    done
-    echo "== firmware: device-prepared spectra and views against the host (bit for bit, dB)"
-    FVR_QEMU_OUT="$run_dir" cargo test --locked -p fvr-firmware --test qemu_prepare -- --ignored --nocapture
-    echo "== firmware: device preparation, instruction counts (exact to +-40) and RAM (bytes)"
-    printf '%-16s %5s %12s %12s %10s %10s %10s %8s %10s\n' \
-        program side preparation "(3D DHT)" render spectrum "RAM beyond" stack flash
-    for program in "$PREP_M4F_PROGRAM" "$PREP_M7_PROGRAM"; do
-        read -r side prep dht render < <(sed -n \
-            's/^prepare [^:]*: side \([0-9]*\), .*; preparation \([0-9]*\) instructions (3D DHT alone on a test signal \([0-9]*\)); render [0-9x]* view \([0-9]*\)$/\1 \2 \3 \4/p' \
-            "$run_dir/$program.log")
-        [ -n "${render:-}" ] || fail "$program: no preparation counts in its log"
-        read -r text rodata data bss vt < <(size -A "$bin_dir/$program" | awk '
-            $1==".text"{t=$2} $1==".rodata"{r=$2} $1==".data"{d=$2} $1==".bss"{b=$2} $1==".vector_table"{v=$2}
-            END{print t+0, r+0, d+0, b+0, v+0}')
-        stack=$(sed -n 's/^stack: peak \([0-9]*\) bytes.*/\1/p' "$run_dir/$program.log")
-        [ -n "$stack" ] || fail "$program: no stack measurement in its log"
-        spectrum=$((2 * side * side * side))
-        printf '%-16s %5s %12s %12s %10s %10s %10s %8s %10s\n' "$program" "$side" "$prep" "$dht" "$render" \
-            "$spectrum" $((data + bss + stack - spectrum)) "$stack" $((vt + text + rodata + data))
-    done
-}
-device_preparation
+echo "== firmware: device preparation, instruction counts (exact to +-40) and RAM (bytes)"
+printf '%-16s %5s %12s %12s %10s %10s %10s %8s %10s\n' \
+    program side preparation "(3D DHT)" render spectrum "RAM beyond" stack flash
+for program in fvr-prepare fvr-prepare-m7; do
+    read -r side prep dht render < <(sed -n \
+        's/^prepare [^:]*: side \([0-9]*\), .*; preparation \([0-9]*\) instructions (3D DHT alone on a test signal \([0-9]*\)); render [0-9x]* view \([0-9]*\)$/\1 \2 \3 \4/p' \
+        "$run_dir/$program.log")
+    [ -n "${render:-}" ] || fail "$program: no preparation counts in its log"
+    read -r text rodata data bss vt < <(sections "$bin_dir/$program")
+    stack=$(stack_of "$program")
+    spectrum=$((2 * side * side * side))
+    printf '%-16s %5s %12s %12s %10s %10s %10s %8s %10s\n' "$program" "$side" "$prep" "$dht" "$render" \
+        "$spectrum" $((data + bss + stack - spectrum)) "$stack" $((vt + text + rodata + data))
+done
 
 # ---- The Q15 transform on the device: fvr-prepare-q15 (Cortex-M4F, 32^3;
 # Cortex-M3, 64^3) and fvr-prepare-q15-m7 (Cortex-M7, 64^3) prepare the Q15
 # spectrum in integers in RAM from the u8 volume in flash and render the
 # integer kb3 view from it.
-device_preparation_q15() {
-    local m3_elf="$target_dir/$M3_TARGET/release/fvr-prepare-q15"
-    echo "== firmware: Q15 device preparation (fvr-prepare-q15 built above for the M4F; M3 and M7 builds)"
-    cargo build --locked -p fvr-firmware --target "$TARGET" --release --features m7 --bin fvr-prepare-q15-m7
-    cargo clippy --locked -p fvr-firmware --target "$M3_TARGET" --release --lib --bin fvr-prepare-q15 -- -D warnings
-    cargo build --locked -p fvr-firmware --target "$M3_TARGET" --release --bin fvr-prepare-q15
-    run_in_qemu mps2-an386 cortex-m4 "$bin_dir/fvr-prepare-q15" fvr-prepare-q15
-    run_in_qemu mps2-an500 cortex-m7 "$bin_dir/fvr-prepare-q15-m7" fvr-prepare-q15-m7
-    run_in_qemu mps2-an385 cortex-m3 "$m3_elf" fvr-prepare-q15-m3
-    local program elf
-    for program in fvr-prepare-q15 fvr-prepare-q15-m7 fvr-prepare-q15-m3; do
-        grep -q '^calibration: delay loop of 2000002 instructions counted as 2000000$' "$run_dir/$program.log" \
-            || fail "$program: the SysTick calibration is off"
-    done
-    echo "== firmware: Q15 device-prepared spectra and views against the host (bit for bit, dB)"
-    FVR_QEMU_OUT="$run_dir" cargo test --locked -p fvr-firmware --test qemu_prepare_q15 -- --ignored --nocapture
-    echo "== firmware: Q15 device preparation, instruction counts (exact to +-40) and RAM (bytes)"
-    printf '%-20s %5s %12s %12s %10s %10s %10s %10s %8s %10s\n' \
-        program side preparation "(3D DHT)" render "phases" spectrum "RAM beyond" stack flash
-    for program in fvr-prepare-q15 fvr-prepare-q15-m7 fvr-prepare-q15-m3; do
-        case $program in
-            fvr-prepare-q15-m3) elf=$m3_elf ;;
-            *) elf="$bin_dir/$program" ;;
-        esac
-        read -r side prep dht render phases < <(sed -n \
-            's/^prepare-q15 [^:]*: side \([0-9]*\), .*; preparation \([0-9]*\) instructions (3D DHT alone on a test signal \([0-9]*\)); render [0-9x]* view \([0-9]*\); phase table \([0-9]*\)$/\1 \2 \3 \4 \5/p' \
-            "$run_dir/$program.log")
-        [ -n "${phases:-}" ] || fail "$program: no preparation counts in its log"
-        read -r text rodata data bss vt < <(size -A "$elf" | awk '
-            $1==".text"{t=$2} $1==".rodata"{r=$2} $1==".data"{d=$2} $1==".bss"{b=$2} $1==".vector_table"{v=$2}
-            END{print t+0, r+0, d+0, b+0, v+0}')
-        stack=$(sed -n 's/^stack: peak \([0-9]*\) bytes.*/\1/p' "$run_dir/$program.log")
-        [ -n "$stack" ] || fail "$program: no stack measurement in its log"
-        # The spectrum: n^3 Q15 mantissas and n^2 exponents.
-        spectrum=$((2 * side * side * side + side * side))
-        printf '%-20s %5s %12s %12s %10s %10s %10s %10s %8s %10s\n' "$program" "$side" "$prep" "$dht" "$render" \
-            "$phases" "$spectrum" $((data + bss + stack - spectrum)) "$stack" $((vt + text + rodata + data))
-    done
-}
-device_preparation_q15
+echo "== firmware: Q15 device preparation, instruction counts (exact to +-40) and RAM (bytes)"
+printf '%-20s %5s %12s %12s %10s %10s %10s %10s %8s %10s\n' \
+    program side preparation "(3D DHT)" render "phases" spectrum "RAM beyond" stack flash
+for program in fvr-prepare-q15 fvr-prepare-q15-m7 fvr-prepare-q15-m3; do
+    case $program in
+        fvr-prepare-q15-m3) elf="$m3_dir/fvr-prepare-q15" ;;
+        *) elf="$bin_dir/$program" ;;
+    esac
+    read -r side prep dht render phases < <(sed -n \
+        's/^prepare-q15 [^:]*: side \([0-9]*\), .*; preparation \([0-9]*\) instructions (3D DHT alone on a test signal \([0-9]*\)); render [0-9x]* view \([0-9]*\); phase table \([0-9]*\)$/\1 \2 \3 \4 \5/p' \
+        "$run_dir/$program.log")
+    [ -n "${phases:-}" ] || fail "$program: no preparation counts in its log"
+    read -r text rodata data bss vt < <(sections "$elf")
+    stack=$(stack_of "$program")
+    # The spectrum: n^3 Q15 mantissas and n^2 exponents.
+    spectrum=$((2 * side * side * side + side * side))
+    printf '%-20s %5s %12s %12s %10s %10s %10s %10s %8s %10s\n' "$program" "$side" "$prep" "$dht" "$render" \
+        "$phases" "$spectrum" $((data + bss + stack - spectrum)) "$stack" $((vt + text + rodata + data))
+done
 
-# ---- micromath against libm (fvr-trig-bench, firmware/src/trig.rs): the
-# per-view transcendental functions counted on both cores; the image each
-# costs is measured on the host by firmware/tests/trig.rs.
 echo "== firmware: per-view transcendental functions, libm against micromath (M4F, M3)"
-cargo build --locked -p fvr-firmware --target "$TARGET" --release --features micromath --bin fvr-trig-bench
-cargo build --locked -p fvr-firmware --target "$M3_TARGET" --release --features micromath --bin fvr-trig-bench
-run_in_qemu mps2-an386 cortex-m4 "$bin_dir/fvr-trig-bench" fvr-trig-bench-m4f
-run_in_qemu mps2-an385 cortex-m3 "$target_dir/$M3_TARGET/release/fvr-trig-bench" fvr-trig-bench-m3
-cargo test --locked -p fvr-firmware --features micromath --test trig -- --nocapture
+grep -h '^trig ' "$run_dir/fvr-trig-bench-m4f.log" "$run_dir/fvr-trig-bench-m3.log" \
+    || fail "fvr-trig-bench: no counts in its logs"
 
 echo "== firmware: a scene over the flash budget fails to build, naming the excess"
-# In a copy of the workspace whose firmware/memory.x is smaller, with its own
-# target directory.
-budget_ws=$(mktemp -d)
+# In a copy of the workspace whose firmware/memory.x is smaller, building
+# the program whose tables are largest (fvr-filter-bench) in the same
+# target directory: the registry crates are reused. Cargo names a
+# workspace crate's build by its path within the workspace, so the copy's
+# crates get another version (and their own lock entries) to build apart
+# from the workspace's, which stay untouched.
+budget_ws="$target_dir/fvr-firmware-budget-ws"
+rm -rf "$budget_ws"
+mkdir -p "$budget_ws"
 trap 'rm -rf "$budget_ws"' EXIT
 git ls-files -z --cached --others --exclude-standard | xargs -0 cp --parents -t "$budget_ws"
+sed -i 's/^version = "\([0-9.]*\)"$/version = "\1-budget"/' "$budget_ws/Cargo.toml"
+grep -q '^version = "[0-9.]*-budget"$' "$budget_ws/Cargo.toml" || fail "could not set the copy's workspace version"
+(cd "$budget_ws" && cargo metadata --offline --format-version 1 >/dev/null) \
+    || fail "could not update the copy's Cargo.lock offline"
 expect_build_failure() { # flash-length pattern what
     sed -i "s/^\( *FLASH *: *ORIGIN = 0x00000000, LENGTH = \).*/\1$1/" "$budget_ws/firmware/memory.x"
     grep -q "LENGTH = $1\$" "$budget_ws/firmware/memory.x" || fail "could not set FLASH to $1 in the copy of firmware/memory.x"
     set +e
-    (cd "$budget_ws" && CARGO_TARGET_DIR="$target_dir/fvr-firmware-budget" \
-        cargo build --locked -p fvr-firmware --target "$TARGET" --release) >"$budget_ws/build.log" 2>&1
+    (cd "$budget_ws" && CARGO_TARGET_DIR="$target_dir" \
+        cargo build --locked -p fvr-firmware --target "$TARGET" --release --bin fvr-filter-bench) \
+        >"$budget_ws/build.log" 2>&1
     local status=$?
     set -e
     [ $status -ne 0 ] || fail "$3: the build succeeded with FLASH = $1"

@@ -141,6 +141,66 @@ impl From<FrameError> for RunError {
     }
 }
 
+impl From<fvr_core::Error> for RunError {
+    fn from(e: fvr_core::Error) -> Self {
+        RunError::Frame(FrameError::Core(e))
+    }
+}
+
+/// Exit QEMU with status 0 if `result` is `Ok`, else log the error for
+/// `program` and exit with status 1.
+pub fn exit_with(program: &str, result: Result<(), RunError>) -> ! {
+    let status = match result {
+        Ok(()) => 0,
+        Err(e) => {
+            defmt::error!("{=str}: {}", program, defmt::Debug2Format(&e));
+            1
+        }
+    };
+    semihosting::process::exit(status)
+}
+
+/// Take SysTick as the instruction clock and log its calibration:
+/// `asm::delay(c)` runs exactly `2c + 2` instructions (`subs`/`bne`
+/// `c + 1` times), which the clock must count as `2c`, to its ±40.
+///
+/// # Errors
+/// The core peripherals were taken already.
+pub fn calibrated_clock() -> Result<SysTickClock, RunError> {
+    let peripherals = cortex_m::Peripherals::take().ok_or(RunError::Host("peripherals taken"))?;
+    let clock = SysTickClock::start(peripherals.SYST);
+    let t0 = clock.now();
+    cortex_m::asm::delay(1_000_000);
+    let calibration = clock.now() - t0;
+    defmt::println!(
+        "calibration: delay loop of 2000002 instructions counted as {=u64}",
+        calibration
+    );
+    Ok(clock)
+}
+
+/// Write `values` to `file` as the bytes `bytes` gives each (e.g.
+/// `to_le_bytes`), through a 256-byte chunk.
+///
+/// # Errors
+/// The host refused a write.
+pub fn put_all<T, const B: usize>(
+    file: &mut HostFile,
+    values: &[T],
+    bytes: impl Fn(&T) -> [u8; B],
+) -> Result<(), RunError> {
+    let mut chunk = [0u8; 256];
+    let per_chunk = chunk.len() / B;
+    for values in values.chunks(per_chunk) {
+        for (out, v) in chunk.chunks_exact_mut(B).zip(values) {
+            out.copy_from_slice(&bytes(v));
+        }
+        file.put(&chunk[..B * values.len()])
+            .map_err(|_| RunError::Host("write to the host"))?;
+    }
+    Ok(())
+}
+
 #[cfg(target_abi = "eabihf")]
 /// A file name, `<program>-<frame>.<ext>`, of at most 80 bytes.
 struct Name(heapless::String<80>);
@@ -169,14 +229,10 @@ pub fn run(
     derivatives: &[&'static StoredDerivative],
     bufs: FrameBuffers<'_>,
 ) -> ! {
-    let status = match run_inner(program, frames, spectra, derivatives, bufs) {
-        Ok(()) => 0,
-        Err(e) => {
-            defmt::error!("{=str}: {}", program, defmt::Debug2Format(&e));
-            1
-        }
-    };
-    semihosting::process::exit(status)
+    exit_with(
+        program,
+        run_inner(program, frames, spectra, derivatives, bufs),
+    )
 }
 
 #[cfg(target_abi = "eabihf")]
@@ -187,18 +243,7 @@ fn run_inner(
     derivatives: &[&'static StoredDerivative],
     mut bufs: FrameBuffers<'_>,
 ) -> Result<(), RunError> {
-    let peripherals = cortex_m::Peripherals::take().ok_or(RunError::Host("peripherals taken"))?;
-    let mut clock = SysTickClock::start(peripherals.SYST);
-
-    // Calibration: `asm::delay(c)` runs exactly 2c + 2 instructions
-    // (`subs`/`bne` c + 1 times).
-    let t0 = clock.now();
-    cortex_m::asm::delay(1_000_000);
-    let calibration = clock.now() - t0;
-    defmt::println!(
-        "calibration: delay loop of 2000002 instructions counted as {=u64}",
-        calibration
-    );
+    let mut clock = calibrated_clock()?;
 
     f16_codec_report(&clock)?;
     check_linked_tables(frames, spectra, derivatives)?;

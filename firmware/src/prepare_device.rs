@@ -9,8 +9,7 @@
 //! the counts, the scale and the spectrum's checksum go to the defmt log.
 
 use crate::capture::ByteSink;
-use crate::device::{HostFile, RunError, SysTickClock};
-use crate::frame::{FrameError, InstructionClock};
+use crate::device::{calibrated_clock, exit_with, put_all, HostFile, RunError};
 use crate::nrrd::{write_samples_le, Header};
 use crate::prepare::{
     fnv1a_f16, prepare_and_render, spectrum_len, time_dht_3d, PrepBuffers, PrepInput,
@@ -26,10 +25,6 @@ pub struct OutputFiles {
     pub image: &'static str,
 }
 
-fn core_error(e: fvr_core::Error) -> RunError {
-    RunError::Frame(FrameError::Core(e))
-}
-
 /// Prepare `input`'s spectrum of side `N` in `bufs`, render the view from
 /// it, write both to the host and log the counts; exit QEMU with status 0
 /// (1 on any error).
@@ -39,14 +34,7 @@ pub fn run<const N: usize>(
     input: &PrepInput,
     bufs: PrepBuffers<'_>,
 ) -> ! {
-    let status = match run_inner::<N>(program, files, input, bufs) {
-        Ok(()) => 0,
-        Err(e) => {
-            defmt::error!("{=str}: {}", program, defmt::Debug2Format(&e));
-            1
-        }
-    };
-    semihosting::process::exit(status)
+    exit_with(program, run_inner::<N>(program, files, input, bufs))
 }
 
 fn run_inner<const N: usize>(
@@ -55,31 +43,15 @@ fn run_inner<const N: usize>(
     input: &PrepInput,
     mut bufs: PrepBuffers<'_>,
 ) -> Result<(), RunError> {
-    let peripherals = cortex_m::Peripherals::take().ok_or(RunError::Host("peripherals taken"))?;
-    let mut clock = SysTickClock::start(peripherals.SYST);
-    let t0 = clock.now();
-    cortex_m::asm::delay(1_000_000);
-    let calibration = clock.now() - t0;
-    defmt::println!(
-        "calibration: delay loop of 2000002 instructions counted as {=u64}",
-        calibration
-    );
-
+    let mut clock = calibrated_clock()?;
     // The flash table serves every power of two up to the scene's side.
-    let tw = twiddles().map_err(core_error)?;
-    let prepared = prepare_and_render::<N, _>(input, &tw, &mut bufs, &clock).map_err(core_error)?;
+    let tw = twiddles()?;
+    let prepared = prepare_and_render::<N, _>(input, &tw, &mut bufs, &clock)?;
     let spectrum = &bufs.spectrum[..spectrum_len(N)];
     let checksum = fnv1a_f16(spectrum);
 
     let mut file = HostFile::create(files.spectrum)?;
-    let mut chunk = [0u8; 256];
-    for values in spectrum.chunks(chunk.len() / 2) {
-        for (bytes, v) in chunk.chunks_exact_mut(2).zip(values) {
-            bytes.copy_from_slice(&v.to_bits().to_le_bytes());
-        }
-        file.put(&chunk[..2 * values.len()])
-            .map_err(|_| RunError::Host("spectrum write"))?;
-    }
+    put_all(&mut file, spectrum, |v| v.to_bits().to_le_bytes())?;
     let mut nrrd = HostFile::create(files.image)?;
     let header = Header::image_f32(
         1,
@@ -93,7 +65,7 @@ fn run_inner<const N: usize>(
     write_samples_le(&bufs.grid[..N * N], |b| nrrd.put(b))
         .map_err(|_| RunError::Host("NRRD write"))?;
 
-    let dht = time_dht_3d::<N, _>(&tw, &mut bufs, &clock).map_err(core_error)?;
+    let dht = time_dht_3d::<N, _>(&tw, &mut bufs, &clock)?;
     defmt::println!(
         "prepare {=str}: side {=usize}, scale 2^{=i32}, spectrum fnv1a {=u32:#010x}; preparation {=u64} instructions (3D DHT alone on a test signal {=u64}); render {=usize}x{=usize} view {=u64}",
         program,

@@ -10,9 +10,9 @@
 //! comparison.
 
 use fvr_core::dht::fixed::{dht_3d_lines, FixedTwiddles};
-use fvr_core::image::fixed::{fixed_aux_len, FixedBuffers};
+use fvr_core::image::fixed::fixed_aux_len;
 use fvr_core::num::Q15;
-use fvr_core::render::fixed::{render_fixed, FixedSource};
+use fvr_core::render::fixed::{render_fixed_in_block, FixedSource};
 use fvr_core::slice::fixed::FixedPhases;
 use fvr_core::spectrum::{Q15Storage, Spectrum};
 use fvr_core::Result;
@@ -29,7 +29,8 @@ pub const TWIDDLES_LEN: usize = FixedTwiddles::<i16>::buffer_len(TWIDDLE_SIDE);
 
 /// Everything the program holds in RAM for side `n`: the cube, its
 /// exponents and premultipliers, and the buffers of one `n × n` integer
-/// view.
+/// view, whose image is cut into its Q15 block
+/// (`render_fixed_in_block`: no image buffer of its own).
 #[derive(Debug)]
 pub struct Q15Buffers<'a> {
     /// The cube, `n³`: the padded volume, then the spectrum's mantissas.
@@ -42,14 +43,12 @@ pub struct Q15Buffers<'a> {
     pub grid: &'a mut [i32],
     /// The view's auxiliary scratch, `4n`.
     pub aux: &'a mut [i32],
-    /// The view's Q15 block, `n²`.
+    /// The view's Q15 block, `n²`, and then its `n × n` image.
     pub block: &'a mut [i16],
-    /// The image, `n²` Q15 mantissas.
-    pub image: &'a mut [i16],
 }
 
 /// Elements of [`Q15Buffers`] for side `n`: `(cube, exponents, premul,
-/// grid, aux)`; the block and the image take `n²` like the grid.
+/// grid, aux)`; the block takes `n²` like the grid.
 pub const fn q15_lens(n: usize) -> (usize, usize, usize, usize, usize) {
     (n * n * n, n * n, n, n * n, fixed_aux_len(n))
 }
@@ -67,7 +66,7 @@ pub struct Q15Counts {
 
 /// The result of [`prepare_and_render_q15`]: the spectrum is in
 /// [`Q15Buffers::mantissas`] and [`Q15Buffers::exponents`], the image in
-/// [`Q15Buffers::image`].
+/// [`Q15Buffers::block`]`[..n²]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PreparedQ15 {
     /// The spectrum's power-of-two scale `s`.
@@ -100,8 +99,8 @@ pub fn twiddles_i16() -> Result<FixedTwiddles<'static, i16>> {
 
 /// Prepare `input`'s Q15 spectrum in place in `bufs` (side `N`), then
 /// render the scene's view ([`VIEW`], `N × N` pixels) from it in integers
-/// into `bufs.image`, counting instructions with `clock`. `phases` is the
-/// kb3 phase table of `input`'s filter.
+/// into `bufs.block[..N²]`, counting instructions with `clock`. `phases`
+/// is the kb3 phase table of `input`'s filter.
 ///
 /// # Errors
 /// The core's: short buffers, twiddles too short, a side other than `N`.
@@ -133,16 +132,13 @@ pub fn prepare_and_render_q15<const N: usize, C: InstructionClock>(
         twiddles: tw_view,
     };
     let t2 = clock.now();
-    let image_exponent = render_fixed(
+    let image_exponent = render_fixed_in_block(
         &source,
         &VIEW,
         (N, N),
-        FixedBuffers {
-            grid: &mut *bufs.grid,
-            aux: &mut *bufs.aux,
-            block: &mut *bufs.block,
-            out: &mut *bufs.image,
-        },
+        &mut *bufs.grid,
+        &mut *bufs.aux,
+        &mut *bufs.block,
     )?;
     let t3 = clock.now();
     Ok(PreparedQ15 {

@@ -72,12 +72,14 @@ fn host_run<const N: usize>(input: &PrepInput) -> (Q15Run, f64) {
     let mut exponents = vec![0i8; lines];
     let mut premul = vec![0i32; premul];
     let (mut grid, mut aux) = (vec![0i32; grid], vec![0i32; aux]);
-    let (mut block, mut image) = (vec![0i16; N * N], vec![0i16; N * N]);
+    let mut block = vec![0i16; N * N];
     let mut tw_buf = [Q15(0); TWIDDLES_LEN];
     let tw_data = twiddles_q15(&mut tw_buf).unwrap();
     let tw_view = twiddles_i16().unwrap();
-    let mut phases = Box::new(FixedPhases::<WIDTH>::zeroed(input.filter().unwrap()));
-    phases.fill(&input.kernel_table().unwrap()).unwrap();
+    let mut phases = Box::new(FixedPhases::<WIDTH>::new());
+    phases
+        .fill_from(input.filter().unwrap(), input.kernel)
+        .unwrap();
     let prepared = prepare_and_render_q15::<N, _>(
         input,
         (&tw_data, &tw_view),
@@ -89,7 +91,6 @@ fn host_run<const N: usize>(input: &PrepInput) -> (Q15Run, f64) {
             grid: &mut grid,
             aux: &mut aux,
             block: &mut block,
-            image: &mut image,
         },
         &NoClock,
     )
@@ -99,7 +100,7 @@ fn host_run<const N: usize>(input: &PrepInput) -> (Q15Run, f64) {
             exponents,
             mantissas: mantissas.iter().map(|m| m.0).collect(),
             image_exponent: prepared.image_exponent,
-            image,
+            image: block[..N * N].to_vec(),
         },
         prepared.scale,
     )

@@ -63,18 +63,8 @@ pub fn finish_fixed(
         block,
         out,
     } = buffers;
-    check_image(width, height, m)?;
-    check_len("fixed-point slice grid", m * m, grid.len())?;
-    check_len("Q15 slice block", m * m, block.len())?;
-    require_len("fixed-point auxiliary scratch", fixed_aux_len(m), aux.len())?;
     check_len("fixed-point image", width * height, out.len())?;
-    let mut exponent = exponent;
-    if place.shift != [0.0, 0.0] {
-        exponent += bring_under(grid, SHIFT_HEADROOM_LOG2);
-        apply_shift(grid, m, place.shift, aux);
-    }
-    exponent += to_q15(grid, block);
-    exponent += idht_2d(block, m, m, tw)?;
+    let exponent = to_block(grid, aux, block, exponent, m, place, (width, height), tw)?;
     let mask = m - 1;
     let (row0, col0) = (place.row0 as usize, place.col0 as usize);
     for (row, line) in out.chunks_exact_mut(width).enumerate() {
@@ -84,6 +74,78 @@ pub fn finish_fixed(
             *o = grid_row[col0.wrapping_add(col) & mask];
         }
     }
+    Ok(exponent)
+}
+
+/// [`finish_fixed`] with the image cut in place into `block`, so a device
+/// needs no image buffer beside it: afterwards `block[..width·height]`
+/// holds, bit for bit, what [`finish_fixed`] writes to its `out`.
+///
+/// As [`super::in_grid::finish_in_grid`]: image row `r` is block row
+/// `σ(r) = (row0 − r) mod m`, an involution, so the rows are put in place
+/// by swapping pairs; each row is then copied to `aux` and packed to
+/// `width` values, which only writes at or before the row being read.
+///
+/// # Errors
+/// As [`finish_fixed`].
+#[allow(clippy::too_many_arguments)]
+pub fn finish_fixed_in_block(
+    grid: &mut [i32],
+    aux: &mut [i32],
+    block: &mut [i16],
+    exponent: i32,
+    m: usize,
+    place: &Placement,
+    (width, height): (usize, usize),
+    tw: &FixedTwiddles<'_, i16>,
+) -> Result<i32> {
+    let exponent = to_block(grid, aux, block, exponent, m, place, (width, height), tw)?;
+    let mask = m - 1;
+    let (row0, col0) = (place.row0 as usize, place.col0 as usize);
+    for r in 0..height {
+        let s = row0.wrapping_sub(r) & mask;
+        if s > r {
+            let (head, tail) = block.split_at_mut(s * m);
+            head[r * m..(r + 1) * m].swap_with_slice(&mut tail[..m]);
+        }
+    }
+    let row = &mut aux[..m];
+    for r in 0..height {
+        for (a, b) in row.iter_mut().zip(&block[r * m..(r + 1) * m]) {
+            *a = *b as i32;
+        }
+        for (col, o) in block[r * width..(r + 1) * width].iter_mut().enumerate() {
+            *o = row[col0.wrapping_add(col) & mask] as i16;
+        }
+    }
+    Ok(exponent)
+}
+
+/// The steps of [`finish_fixed`] before the crop: the checks, the shift,
+/// the slice to Q15 in `block` and its inverse 2D DHT in place; returns
+/// the block's exponent.
+#[allow(clippy::too_many_arguments)]
+fn to_block(
+    grid: &mut [i32],
+    aux: &mut [i32],
+    block: &mut [i16],
+    exponent: i32,
+    m: usize,
+    place: &Placement,
+    (width, height): (usize, usize),
+    tw: &FixedTwiddles<'_, i16>,
+) -> Result<i32> {
+    check_image(width, height, m)?;
+    check_len("fixed-point slice grid", m * m, grid.len())?;
+    check_len("Q15 slice block", m * m, block.len())?;
+    require_len("fixed-point auxiliary scratch", fixed_aux_len(m), aux.len())?;
+    let mut exponent = exponent;
+    if place.shift != [0.0, 0.0] {
+        exponent += bring_under(grid, SHIFT_HEADROOM_LOG2);
+        apply_shift(grid, m, place.shift, aux);
+    }
+    exponent += to_q15(grid, block);
+    exponent += idht_2d(block, m, m, tw)?;
     Ok(exponent)
 }
 

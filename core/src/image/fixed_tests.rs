@@ -171,3 +171,69 @@ fn bad_buffers_are_refused() {
         assert!(result.is_err(), "{size:?}, short aux {short_aux}");
     }
 }
+
+/// The image cut into the block equals the one written to `out`, bit for
+/// bit and with the same exponent, for placements whose rows and columns
+/// wrap around the grid either way, with and without a shift, full and
+/// partial images; bad sizes are refused as by [`finish_fixed`].
+#[test]
+fn the_image_cut_into_the_block_is_the_image() {
+    let mut tw16 = vec![0i16; FixedTwiddles::<i16>::buffer_len(M)];
+    let tw16 = FixedTwiddles::new(&mut tw16, M).unwrap();
+    let mut state = 0x9E37_79B9u32;
+    let grid: Vec<i32> = (0..M * M)
+        .map(|_| {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (state as i32) >> 7
+        })
+        .collect();
+    let m = M as i64;
+    for (col0, row0, shift, size) in [
+        (-m / 2, m / 2, [0.0, 0.0], (M, M)),
+        (-m / 2, m / 2 - 1, [0.3, 0.75], (M, M)),
+        (5, -7, [0.0, 0.5], (M - 3, M / 2)),
+        (-40, 70, [0.25, 0.0], (7, M - 1)),
+        (0, 0, [0.0, 0.0], (1, 1)),
+    ] {
+        let place = Placement { col0, row0, shift };
+        let (mut g, mut aux) = (grid.clone(), vec![0i32; fixed_aux_len(M)]);
+        let mut block = vec![0i16; M * M];
+        let mut out = vec![0i16; size.0 * size.1];
+        let e_out = finish_fixed(
+            FixedBuffers {
+                grid: &mut g,
+                aux: &mut aux,
+                block: &mut block,
+                out: &mut out,
+            },
+            3,
+            M,
+            &place,
+            size,
+            &tw16,
+        )
+        .unwrap();
+        let (mut g, mut aux) = (grid.clone(), vec![0i32; fixed_aux_len(M)]);
+        let mut block = vec![0i16; M * M];
+        let e_block =
+            finish_fixed_in_block(&mut g, &mut aux, &mut block, 3, M, &place, size, &tw16).unwrap();
+        assert_eq!(e_block, e_out, "{place:?} {size:?}");
+        assert_eq!(&block[..size.0 * size.1], &out[..], "{place:?} {size:?}");
+    }
+    let place = Placement {
+        col0: 0,
+        row0: 0,
+        shift: [0.0, 0.0],
+    };
+    let (mut g, mut aux, mut block) = (grid.clone(), vec![0i32; M], vec![0i16; M * M]);
+    for size in [(0, M), (M + 1, M)] {
+        let mut aux4 = vec![0i32; fixed_aux_len(M)];
+        assert!(
+            finish_fixed_in_block(&mut g, &mut aux4, &mut block, 0, M, &place, size, &tw16)
+                .is_err()
+        );
+    }
+    assert!(
+        finish_fixed_in_block(&mut g, &mut aux, &mut block, 0, M, &place, (M, M), &tw16).is_err()
+    );
+}

@@ -10,8 +10,8 @@
 use crate::dht::fixed::FixedTwiddles;
 use crate::error::{Error, Result};
 use crate::geometry::View;
-use crate::image::fixed::{finish_fixed, FixedBuffers};
-use crate::image::placement;
+use crate::image::fixed::{finish_fixed, finish_fixed_in_block, FixedBuffers};
+use crate::image::{placement, Placement};
 use crate::num::Q15;
 use crate::slice::fixed::{extract_slice_fixed, FixedPhases};
 use crate::spectrum::{CubeSide, Spectrum};
@@ -42,21 +42,64 @@ pub fn render_fixed<Z: CubeSide, const W: usize>(
     (width, height): (usize, usize),
     buffers: FixedBuffers<'_>,
 ) -> Result<i32> {
-    let spec = source.spectrum;
-    let frame = view.frame()?;
-    let axes = frame.slice_axes();
-    let place = placement(spec.dims(), &frame, width, height);
-    let scale = scale_exponent(spec.scale())?;
-    let exponent = extract_slice_fixed(spec, source.phases, &axes, buffers.grid)?;
+    let (exponent, place, scale) = extract(source, view, (width, height), buffers.grid)?;
     let image = finish_fixed(
         buffers,
         exponent,
-        spec.n(),
+        source.spectrum.n(),
         &place,
         (width, height),
         source.twiddles,
     )?;
     Ok(image - scale)
+}
+
+/// [`render_fixed`] with the image cut into the Q15 block
+/// ([`finish_fixed_in_block`]): afterwards `block[..width·height]` holds
+/// the image [`render_fixed`] writes to its `out`, bit for bit, and no
+/// image buffer is needed. `grid`, `aux` and `block` are those of
+/// [`FixedBuffers`].
+///
+/// # Errors
+/// As [`render_fixed`].
+pub fn render_fixed_in_block<Z: CubeSide, const W: usize>(
+    source: &FixedSource<'_, Z, W>,
+    view: &View,
+    (width, height): (usize, usize),
+    grid: &mut [i32],
+    aux: &mut [i32],
+    block: &mut [i16],
+) -> Result<i32> {
+    let (exponent, place, scale) = extract(source, view, (width, height), grid)?;
+    let image = finish_fixed_in_block(
+        grid,
+        aux,
+        block,
+        exponent,
+        source.spectrum.n(),
+        &place,
+        (width, height),
+        source.twiddles,
+    )?;
+    Ok(image - scale)
+}
+
+/// The set-up and the extraction of a fixed-point view: the slice in
+/// `grid`, its exponent, the image's placement and the spectrum's scale
+/// exponent.
+fn extract<Z: CubeSide, const W: usize>(
+    source: &FixedSource<'_, Z, W>,
+    view: &View,
+    (width, height): (usize, usize),
+    grid: &mut [i32],
+) -> Result<(i32, Placement, i32)> {
+    let spec = source.spectrum;
+    let frame = view.frame()?;
+    let axes = frame.slice_axes();
+    let place = placement(spec.dims(), &frame, width, height);
+    let scale = scale_exponent(spec.scale())?;
+    let exponent = extract_slice_fixed(spec, source.phases, &axes, grid)?;
+    Ok((exponent, place, scale))
 }
 
 /// `k` for a scale `2^k` (the spectrum's scale is a power of two).

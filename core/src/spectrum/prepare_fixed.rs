@@ -86,36 +86,20 @@ impl<'a> Spectrum<'a, Q15> {
         );
         let frac = fixed_premultipliers(&filter, n, premul)?;
 
-        let mask = n - 1;
-        let offs = dims.map(|d| d / 2);
-        let voxels = volume.samples();
-        // Every voxel's product `v·p[x]·p[y]·p[z]`, with its cube index, in
-        // the order of the volume.
-        let products = |f: &mut dyn FnMut(usize, i64)| {
-            let mut idx = 0;
-            for k in 0..dims[2] {
-                let pz = (k + n - offs[2]) & mask;
-                for j in 0..dims[1] {
-                    let py = (j + n - offs[1]) & mask;
-                    let pyz = (premul[py] * premul[pz]) as i64;
-                    let row = n * (py + n * pz);
-                    for i in 0..dims[0] {
-                        let px = (i + n - offs[0]) & mask;
-                        let v: u16 = voxels[idx].into();
-                        f(row + px, (v as i32 * premul[px]) as i64 * pyz);
-                        idx += 1;
-                    }
-                }
-            }
+        let products = Products {
+            voxels: volume.samples(),
+            dims,
+            n,
+            premul,
         };
         let mut top = 0i64;
-        products(&mut |_, p| top = top.max(p.abs()));
+        products.for_each(|_, p| top = top.max(p.abs()));
         let mut k = 0u32;
         while round_half_up(top, k) > MAX_Q15 {
             k += 1;
         }
         mantissas.fill(Q15(0));
-        products(&mut |i, p| mantissas[i] = Q15(round_half_up(p, k) as i16));
+        products.for_each(|i, p| mantissas[i] = Q15(round_half_up(p, k) as i16));
 
         let e = dht_3d_lines(&mut *mantissas, [n; 3], &mut *exponents, tw)?;
         // The input is `q = g·2^(3F−k)`, so `g = q/2^15 · 2^(k−3F+15)` and
@@ -131,6 +115,47 @@ impl<'a> Spectrum<'a, Q15> {
         let exponents: &'a [i8] = exponents;
         let blocks = BlockExponents::new(BlockLayout::Line, exponents, n)?;
         Spectrum::from_blocks(mantissas, blocks, n, libm::scalbn(1.0, sigma), filter, dims)
+    }
+}
+
+/// Every voxel's product `v·p[x]·p[y]·p[z]` with its index in the cube
+/// (zero-padded and circularly shifted as in [`Spectrum::prepare`]), in
+/// the order of the volume.
+struct Products<'v, V> {
+    voxels: &'v [V],
+    dims: [usize; 3],
+    n: usize,
+    premul: &'v [i32],
+}
+
+impl<V: Copy + Into<u16>> Products<'_, V> {
+    /// `f(index, product)` for every voxel; generic, so each pass compiles
+    /// to its own loop with `f` inlined.
+    #[inline(always)]
+    fn for_each(&self, mut f: impl FnMut(usize, i64)) {
+        let Self {
+            voxels,
+            dims,
+            n,
+            premul,
+        } = *self;
+        let mask = n - 1;
+        let offs = dims.map(|d| d / 2);
+        let mut idx = 0;
+        for k in 0..dims[2] {
+            let pz = (k + n - offs[2]) & mask;
+            for j in 0..dims[1] {
+                let py = (j + n - offs[1]) & mask;
+                let pyz = (premul[py] * premul[pz]) as i64;
+                let row = n * (py + n * pz);
+                for i in 0..dims[0] {
+                    let px = (i + n - offs[0]) & mask;
+                    let v: u16 = voxels[idx].into();
+                    f(row + px, (v as i32 * premul[px]) as i64 * pyz);
+                    idx += 1;
+                }
+            }
+        }
     }
 }
 

@@ -280,10 +280,7 @@ fn main() -> ! {
     use device::{AUX, FLOAT_AUX};
     use fvr_core::slice::fixed::FixedPhases;
     use fvr_firmware::fixed_view::WIDTH;
-    let Some(kernel) = fvr_firmware::stored::DENSITY_KB3.filter().ok() else {
-        fvr_firmware::device::abort("the kb3 filter in flash")
-    };
-    let phases = cortex_m::singleton!(PHASES: FixedPhases<WIDTH> = FixedPhases::zeroed(kernel));
+    let phases = cortex_m::singleton!(PHASES: FixedPhases<WIDTH> = FixedPhases::new());
     let grid = cortex_m::singleton!(GRID: [i32; LEN] = [0; LEN]);
     let aux = cortex_m::singleton!(AUX_I32: [i32; AUX] = [0; AUX]);
     let block = cortex_m::singleton!(BLOCK: [i16; LEN] = [0; LEN]);

@@ -1,7 +1,7 @@
 //! `fvr-prepare-m7`: the 64³ spectrum prepared on a Cortex-M7 with 1 MiB of
 //! RAM from a 64³ u8 volume in flash (256 KiB), and the plain kb3 64² view
-//! rendered from it (`fvr_firmware::prepare`). Built with `--features m7`
-//! (memory-m7.x) for thumbv7em-none-eabihf and run under QEMU mps2-an500
+//! rendered from it (`fvr_firmware::prepare`). Linked with memory-m7.x
+//! (build.rs, for every program named `*-m7`) for thumbv7em-none-eabihf and run under QEMU mps2-an500
 //! (`bash scripts/firmware.sh`).
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
@@ -15,7 +15,7 @@ fvr_firmware::prepare_main!(
 #[cfg(not(target_os = "none"))]
 fn main() {
     eprintln!(
-        "fvr-prepare-m7 runs on thumbv7em-none-eabihf (--features m7) under QEMU mps2-an500: \
+        "fvr-prepare-m7 runs on thumbv7em-none-eabihf (memory-m7.x) under QEMU mps2-an500: \
          bash scripts/firmware.sh"
     );
     std::process::exit(2);

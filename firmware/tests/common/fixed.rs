@@ -29,7 +29,7 @@ impl InstructionClock for NoClock {
 /// from the f32 kernel table in flash, twiddles by `FixedTwiddles::new`).
 pub fn integer_view() -> (i32, Vec<i16>) {
     let kernel = DENSITY_KB3.kernel_table().unwrap();
-    let mut phases = Box::new(FixedPhases::<WIDTH>::zeroed(*kernel.filter()));
+    let mut phases = Box::new(FixedPhases::<WIDTH>::new());
     phases.fill(&kernel).unwrap();
     let mut tw_buf = vec![0i16; FixedTwiddles::<i16>::buffer_len(IMAGE_SIDE)];
     let tw = FixedTwiddles::new(&mut tw_buf, IMAGE_SIDE).unwrap();

@@ -76,7 +76,7 @@ pub fn extract_slice_fixed<const W: usize, Z: CubeSide>(
 ) -> Result<i32> {
     let n = spec.n();
     check_len("fixed-point slice grid", n * n, grid.len())?;
-    if phases.filter() != spec.filter() {
+    if phases.filter().as_ref() != Some(spec.filter()) {
         return Err(Error::FilterMismatch);
     }
     if n > MAX_SIDE {

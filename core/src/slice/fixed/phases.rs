@@ -2,7 +2,7 @@
 //! (or fewer fraction bits), read with an integer interpolation.
 
 use crate::error::{mismatch, Error, Result};
-use crate::filter::{phase_entry, Filter, KernelTable, MAX_WIDTH, TABLE_RESOLUTION};
+use crate::filter::{phase_entry, Filter, FilterKind, KernelTable, MAX_WIDTH, TABLE_RESOLUTION};
 use crate::num::Real;
 
 /// Entries of the widest kernel table: `MAX_WIDTH·1024/2 + 1`.
@@ -33,18 +33,32 @@ pub(super) const MAX_ABS_SUM: i64 = (1 << 16) - 1;
 /// in `T` (soft float on a core without an FPU), the rest is integer.
 #[derive(Clone, Debug)]
 pub struct FixedPhases<const W: usize> {
-    filter: Filter,
+    /// The filter's parts, `oversample` 0 until the table is filled: all
+    /// zero bits, so a `static` table starts in `.bss`.
+    kind: FilterKind,
+    oversample: u32,
+    beta: f64,
     fraction_bits: u32,
     rows: [[[i32; W]; 2]; TABLE_RESOLUTION],
 }
 
+impl<const W: usize> Default for FixedPhases<W> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl<const W: usize> FixedPhases<W> {
-    /// An all-zero table, to be [`FixedPhases::fill`]ed in place (24 KiB for
-    /// `W = 3`: built where it stays, it is not copied).
-    pub fn zeroed(filter: Filter) -> Self {
+    /// An empty table (no filter, all weights zero), to be
+    /// [`FixedPhases::fill`]ed in place: 24 KiB for `W = 3`, so a device
+    /// keeps it in a `static` (this is a `const fn`, and the value is all
+    /// zero bits) rather than building it on the stack.
+    pub const fn new() -> Self {
         Self {
-            filter,
-            fraction_bits: 15,
+            kind: FilterKind::Nearest,
+            oversample: 0,
+            beta: 0.0,
+            fraction_bits: 0,
             rows: [[[0; W]; 2]; TABLE_RESOLUTION],
         }
     }
@@ -54,16 +68,40 @@ impl<const W: usize> FixedPhases<W> {
     /// [`MAX_ABS_SUM`].
     ///
     /// # Errors
-    /// A kernel whose width is not `W` ([`Error::LengthMismatch`]), or one
-    /// whose weights would need fewer than 8 fraction bits
-    /// ([`Error::TableEntryOutOfRange`]).
+    /// As [`FixedPhases::fill_from`].
     pub fn fill<T: Real>(&mut self, kernel: &KernelTable<T>) -> Result<()> {
-        let width = kernel.filter().width();
+        self.fill_from(*kernel.filter(), kernel.values())
+    }
+
+    /// [`FixedPhases::fill`] from the values [`KernelTable::values`] gives
+    /// for `filter` (e.g. a table in flash, read where it is: no copy).
+    ///
+    /// # Errors
+    /// A filter whose width is not `W`, or a number of values other than
+    /// [`KernelTable::len_for`] ([`Error::LengthMismatch`]); a NaN or
+    /// infinite value ([`Error::NonFiniteTableEntry`]); weights that would
+    /// need fewer than 8 fraction bits ([`Error::TableEntryOutOfRange`]).
+    /// After an error the table has no filter (the extraction refuses it).
+    pub fn fill_from<T: Real>(&mut self, filter: Filter, values: &[T]) -> Result<()> {
+        self.oversample = 0;
+        let width = filter.width();
         if width != W {
             return Err(mismatch("fixed-point phase table width", width, W));
         }
-        self.filter = *kernel.filter();
-        let values = kernel.values();
+        let len = KernelTable::<T>::len_for(&filter);
+        if values.len() != len {
+            return Err(mismatch(
+                "fixed-point phase table's kernel",
+                len,
+                values.len(),
+            ));
+        }
+        if let Some(index) = values.iter().position(|v| !v.is_finite()) {
+            return Err(Error::NonFiniteTableEntry {
+                what: "fixed-point phase table's kernel",
+                index,
+            });
+        }
         // The kernel's entries rounded once per try (half up, in `T`: the
         // product by a power of two is exact and the entries are at most 1
         // in magnitude here, so `floor(x + ½)` is the rounding of x), then
@@ -107,6 +145,8 @@ impl<const W: usize> FixedPhases<W> {
             }
             if worst <= MAX_ABS_SUM {
                 self.fraction_bits = bits;
+                (self.kind, self.oversample, self.beta) =
+                    (filter.kind(), filter.oversample(), filter.beta());
                 return Ok(());
             }
         }
@@ -117,9 +157,12 @@ impl<const W: usize> FixedPhases<W> {
         })
     }
 
-    /// The filter the table was gathered for.
-    pub fn filter(&self) -> &Filter {
-        &self.filter
+    /// The filter the table was gathered for; `None` until it is filled.
+    pub fn filter(&self) -> Option<Filter> {
+        if self.oversample == 0 {
+            return None;
+        }
+        Filter::from_parts(self.kind, self.oversample, self.beta).ok()
     }
 
     /// `F`: a weight `w` stands for `w/2^F`.

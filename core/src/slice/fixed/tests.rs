@@ -51,7 +51,7 @@ fn axes(dir: [f64; 3]) -> SliceAxes {
 }
 
 fn phases<const W: usize>(filter: Filter) -> std::boxed::Box<FixedPhases<W>> {
-    let mut p = std::boxed::Box::new(FixedPhases::<W>::zeroed(filter));
+    let mut p = std::boxed::Box::new(FixedPhases::<W>::new());
     p.fill(&KernelTable::<f64>::new(filter)).unwrap();
     p
 }
@@ -202,11 +202,54 @@ fn refusals_name_the_problem() {
         ));
     }
 
-    let mut wrong_width = FixedPhases::<4>::zeroed(f);
+    let mut wrong_width = FixedPhases::<4>::new();
     assert!(matches!(
         wrong_width.fill(&KernelTable::<f64>::new(f)),
         Err(Error::LengthMismatch { .. })
     ));
+    assert_eq!(wrong_width.filter(), None);
+}
+
+/// An empty table matches no spectrum; one filled from a kernel's values
+/// equals one filled from the kernel table; bad values leave it empty.
+#[test]
+fn phase_tables_from_values() {
+    let f = filter(FilterKind::Kb3);
+    let n = 8;
+    let mantissas = vec![Q15(0); n * n * n];
+    let spec = Spectrum::from_parts(&mantissas[..], n, 1.0, f, [n; 3]).unwrap();
+    let mut grid = vec![0i32; n * n];
+    let empty = FixedPhases::<3>::new();
+    assert_eq!(empty.filter(), None);
+    assert!(matches!(
+        extract_slice_fixed(&spec, &empty, &axes([1.0, 0.3, 0.2]), &mut grid),
+        Err(Error::FilterMismatch)
+    ));
+
+    let kernel = KernelTable::<f32>::new(f);
+    let mut from_table = std::boxed::Box::new(FixedPhases::<3>::new());
+    from_table.fill(&kernel).unwrap();
+    let mut from_values = std::boxed::Box::new(FixedPhases::<3>::new());
+    from_values.fill_from(f, kernel.values()).unwrap();
+    assert_eq!(from_values.filter(), Some(f));
+    assert_eq!(from_values.fraction_bits(), from_table.fraction_bits());
+    for i in [0usize, 1, 600, 1023] {
+        let y = ((i as i64) << 32) + (3 << 28);
+        assert_eq!(from_values.taps(y), from_table.taps(y), "row {i}");
+    }
+
+    let mut values = kernel.values().to_vec();
+    assert!(matches!(
+        from_values.fill_from(f, &values[1..]),
+        Err(Error::LengthMismatch { .. })
+    ));
+    assert_eq!(from_values.filter(), None);
+    values[7] = f32::NAN;
+    assert!(matches!(
+        from_values.fill_from(f, &values),
+        Err(Error::NonFiniteTableEntry { index: 7, .. })
+    ));
+    assert_eq!(from_values.filter(), None);
 }
 
 /// Each filter keeps the most fraction bits its weight sums allow (15 for

@@ -1,5 +1,5 @@
 //! `fvr-trig-bench`: the instructions of the per-view transcendental
-//! functions (`fvr_firmware::trig`) with the core's `libm` f64 functions,
+//! functions (`fvr_firmware_trig`) with the core's `libm` f64 functions,
 //! `libm`'s f32 ones and `micromath`'s f32 approximations: the shift
 //! phasors of the scene's 64² view of a 63³ volume (4·64 `cos` and
 //! `sin`; the 64³ view has no sub-pixel shift), and square
@@ -11,18 +11,13 @@
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
 #[cfg(target_os = "none")]
-#[allow(dead_code)] // the shift itself is applied on the host only
-#[path = "../trig.rs"]
-mod trig;
-
-#[cfg(target_os = "none")]
 mod device {
-    use crate::trig::{phasors_len, shift_phasors, Trig};
     use core::hint::black_box;
     use fvr_core::image::placement;
     use fvr_firmware::device::{RunError, SysTickClock};
     use fvr_firmware::frame::InstructionClock;
     use fvr_firmware::scene::{IMAGE_SIDE, VIEW};
+    use fvr_firmware_trig::{phasors_len, shift_phasors, Trig};
 
     const PROGRAM: &str = "fvr-trig-bench";
     const M: usize = IMAGE_SIDE;

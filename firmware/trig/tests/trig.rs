@@ -1,13 +1,12 @@
-//! What the per-view transcendental functions (`fvr_firmware::trig`) cost
+//! What the per-view transcendental functions (`fvr_firmware_trig`) cost
 //! the image: the plain kb3 64² view of every benchmark filter, rendered by
 //! the core's steps with the sub-pixel shift's phasors from the core's
 //! `libm` f64, from `libm`'s f32 functions and from `micromath`, against
 //! the core's own image. `fvr-trig-bench`
 //! counts the same functions on the device (`bash scripts/firmware.sh`).
 
+#[path = "../../tests/common/mod.rs"]
 mod common;
-#[path = "../src/trig.rs"]
-mod trig;
 
 use common::{host_image, snr_db, tables};
 use fvr_core::geometry::Sampling;
@@ -15,7 +14,7 @@ use fvr_core::image::{aux_len, finish, grid_len, placement_on_axes, Crop, Placem
 use fvr_core::slice::extract_central_slice_on;
 use fvr_firmware::scene::{FrameSpec, BENCH_FRAMES, IMAGE_SIDE};
 use fvr_firmware::stored::twiddles;
-use trig::{apply_phasors, phasors_len, shift_phasors, Trig};
+use fvr_firmware_trig::{apply_phasors, phasors_len, shift_phasors, Trig};
 
 /// `micromath`'s documented bound on its `sin` and `cos` errors.
 const MICROMATH_TRIG_ERROR: f64 = 0.002;
