@@ -11,6 +11,7 @@ use fvr_core::render::{render, render_projection_with, Buffers, Request, Source}
 use fvr_core::slice::extract_slice_rows;
 use fvr_core::spectrum::Spectrum;
 
+use super::fast_inverse::MixedFinish;
 use super::fast_slice::{self, Tiling};
 use super::spectrum::OwnedSpectrum;
 
@@ -21,6 +22,8 @@ pub struct ViewRenderer<T> {
     tw: Vec<T>,
     grid: Vec<T>,
     aux: Vec<T>,
+    /// The threaded finish of a mixed-radix side.
+    mixed: Option<MixedFinish<T>>,
     n: usize,
     threads: usize,
     pool: Option<rayon::ThreadPool>,
@@ -37,6 +40,9 @@ impl<T: Real> ViewRenderer<T> {
             tw,
             grid: vec![T::ZERO; grid_len(n)],
             aux: vec![T::ZERO; aux_len(n)],
+            mixed: (!n.is_power_of_two())
+                .then(|| MixedFinish::new(n).ok())
+                .flatten(),
             n,
             threads: 0,
             pool: None,
@@ -46,7 +52,12 @@ impl<T: Real> ViewRenderer<T> {
 
     /// Bytes of per-view working memory (slice grid, auxiliary, tables).
     pub fn bytes(&self) -> usize {
-        (self.tw.len() + self.grid.len() + self.aux.len()) * std::mem::size_of::<T>()
+        // A mixed side's threaded finish: a table and a transposed grid.
+        let mixed = match self.n.is_power_of_two() {
+            true => 0,
+            false => self.tw.len() + grid_len(self.n),
+        };
+        (self.tw.len() + self.grid.len() + self.aux.len() + mixed) * std::mem::size_of::<T>()
             + std::mem::size_of::<KernelTable<T>>()
     }
 
@@ -128,14 +139,8 @@ impl<T: Real> ViewRenderer<T> {
             };
             if filled {
                 let place = placement_on_axes(spec.dims(), &axes, width, height, 1.0);
-                return finish_with(
-                    &mut self.grid,
-                    n,
-                    &Crop::new(place, sampling.gain() / spec.scale(), width, height),
-                    inverse,
-                    &mut self.aux,
-                    out,
-                );
+                let crop = Crop::new(place, sampling.gain() / spec.scale(), width, height);
+                return self.finish(n, &crop, out);
             }
         }
         let threads = match self.threads {
@@ -182,14 +187,40 @@ impl<T: Real> ViewRenderer<T> {
                 .try_for_each(|w| w.join().expect("an extraction thread panicked"))
         })?;
         let place = placement_on_axes(spec.dims(), &axes, width, height, 1.0);
-        finish_with(
-            &mut self.grid,
-            n,
-            &Crop::new(place, sampling.gain() / spec.scale(), width, height),
-            inverse,
-            &mut self.aux,
-            out,
-        )
+        let crop = Crop::new(place, sampling.gain() / spec.scale(), width, height);
+        self.finish(n, &crop, out)
+    }
+
+    /// Shift, inverse-transform and crop the filled grid: through
+    /// [`MixedFinish`] on the renderer's threads for a mixed-radix
+    /// side, else through the core's [`finish_with`] (the same image).
+    fn finish(&mut self, n: usize, crop: &Crop, out: &mut [T]) -> Result<(), fvr_core::Error> {
+        // The tables are for the renderer's side; the core checks `n` against it.
+        if self.n.is_power_of_two() {
+            let tw = Twiddles::from_table(&self.tw, self.n)?;
+            return finish_with(
+                &mut self.grid,
+                n,
+                crop,
+                Inverse::Radix2(&tw),
+                &mut self.aux,
+                out,
+            );
+        }
+        let (grid, mixed) = (&mut self.grid, &mut self.mixed);
+        match (self.threads, mixed) {
+            (1, _) | (_, None) => {
+                let plan = MixedPlan::from_table(&self.tw, self.n)?;
+                finish_with(grid, n, crop, Inverse::Mixed(&plan), &mut self.aux, out)
+            }
+            (_, Some(mixed)) => {
+                let mut run = || mixed.finish(grid, crop, out);
+                match &self.pool {
+                    Some(pool) => pool.install(run),
+                    None => run(),
+                }
+            }
+        }
     }
 }
 

@@ -1,0 +1,339 @@
+//! The core's mixed-radix 1D DHT of even length (`fvr_core::dht::dht_mixed`)
+//! on up to [`LANES`] lines at once, bit for bit the core's values: the
+//! lines are the lanes of every operation, so each stage's inner loop runs
+//! over contiguous lanes (which the compiler vectorizes) instead of one
+//! line's strided elements.
+//!
+//! The arithmetic is the core's, operation for operation: the even and odd
+//! samples packed as `z(x) = f(2x) + i·f(2x+1)`, a Stockham FFT of `N/2`
+//! with radices 4, 2, 3, 5 in the plan's order and the plan's twiddle
+//! table, then the pass that splits the even and odd spectra and forms
+//! `H = Re X ∓ Im X` (`core/src/dht/mixed/`).
+
+use fvr_core::num::Real;
+
+/// Lines transformed together.
+pub const LANES: usize = 16;
+
+/// A complex value as the core's stages compute it.
+#[derive(Clone, Copy)]
+struct C<T> {
+    re: T,
+    im: T,
+}
+
+impl<T: Real> C<T> {
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        C {
+            re: self.re + o.re,
+            im: self.im + o.im,
+        }
+    }
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        C {
+            re: self.re - o.re,
+            im: self.im - o.im,
+        }
+    }
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        C {
+            re: self.re * o.re - self.im * o.im,
+            im: self.re * o.im + self.im * o.re,
+        }
+    }
+    #[inline(always)]
+    fn scale(self, a: T) -> Self {
+        C {
+            re: self.re * a,
+            im: self.im * a,
+        }
+    }
+    /// `self · (−i)`.
+    #[inline(always)]
+    fn mul_neg_i(self) -> Self {
+        C {
+            re: self.im,
+            im: -self.re,
+        }
+    }
+}
+
+/// The radices of the complex FFT of a plan of length `n` (of `n/2` for
+/// even `n`), in the core's order: fours, a two, threes, fives.
+fn radices(n: usize) -> Vec<usize> {
+    let mut m = if n % 2 == 0 { n / 2 } else { n };
+    let mut out = Vec::new();
+    for r in [4usize, 2, 3, 5] {
+        while m > 1 && m % r == 0 {
+            out.push(r);
+            m /= r;
+        }
+    }
+    out
+}
+
+/// Working buffers for [`Lanes::dht_rows`]: two complex planes of
+/// `n/2 ×` [`LANES`] values, real and imaginary parts apart.
+pub struct Lanes<T> {
+    n: usize,
+    radices: Vec<usize>,
+    table: Vec<T>,
+    a: [Vec<T>; 2],
+    b: [Vec<T>; 2],
+}
+
+impl<T: Real> Lanes<T> {
+    /// Buffers for the even length `n` with its plan's twiddle `table`
+    /// (`fvr_core::dht::MixedPlan::new`'s, `2n` values).
+    ///
+    /// # Panics
+    /// If `n` is odd or the table short.
+    pub fn new(n: usize, table: &[T]) -> Self {
+        assert!(n % 2 == 0, "odd side {n}");
+        let half = n / 2 * LANES;
+        Self {
+            n,
+            radices: radices(n),
+            table: table[..2 * n].to_vec(),
+            a: [vec![T::ZERO; half], vec![T::ZERO; half]],
+            b: [vec![T::ZERO; half], vec![T::ZERO; half]],
+        }
+    }
+
+    /// The DHT in place of each row of `strip` (at most [`LANES`] rows of
+    /// `n`), each bit for bit the core's `dht_mixed` of that row.
+    pub fn dht_rows(&mut self, strip: &mut [T]) {
+        let (n, half) = (self.n, self.n / 2);
+        debug_assert!(strip.len() <= LANES * n && strip.len() % n == 0);
+        {
+            let [ar, ai] = &mut self.a;
+            for (l, row) in strip.chunks_exact(n).enumerate() {
+                for (e, pair) in row.chunks_exact(2).enumerate() {
+                    ar[e * LANES + l] = pair[0];
+                    ai[e * LANES + l] = pair[1];
+                }
+            }
+        }
+        let mut in_b = false;
+        let (mut s, mut m) = (1, half);
+        for &r in &self.radices {
+            m /= r;
+            let [ar, ai] = &mut self.a;
+            let [br, bi] = &mut self.b;
+            let (x, y) = if in_b {
+                ([&br[..], &bi[..]], [&mut ar[..], &mut ai[..]])
+            } else {
+                ([&ar[..], &ai[..]], [&mut br[..], &mut bi[..]])
+            };
+            let st = Stage {
+                m,
+                s,
+                table: &self.table,
+                step: 2 * s,
+            };
+            match r {
+                2 => st.run::<2>(x, y, radix2),
+                3 => st.run::<3>(x, y, radix3),
+                4 => st.run::<4>(x, y, radix4),
+                _ => st.run::<5>(x, y, radix5),
+            }
+            in_b = !in_b;
+            s *= r;
+        }
+        let (z, out) = if in_b {
+            (&self.b, &mut self.a)
+        } else {
+            (&self.a, &mut self.b)
+        };
+        split([&z[0], &z[1]], out, &self.table, n);
+        let [low, high] = &*out;
+        for (l, row) in strip.chunks_exact_mut(n).enumerate() {
+            let (lo, hi) = row.split_at_mut(half);
+            for (k, h) in lo.iter_mut().enumerate() {
+                *h = low[k * LANES + l];
+            }
+            for (k, h) in hi.iter_mut().enumerate() {
+                *h = high[k * LANES + l];
+            }
+        }
+    }
+}
+
+/// The core's `dht_even` pass on every lane: from `Z`, the FFT of `z`, to
+/// `H(k) = Re X(k) − Im X(k)` and `H(N−k) = Re X(k) + Im X(k)`, with
+/// `H(k)` for `k < N/2` in `out[0]` and `H(N/2 + k)` in `out[1]`.
+fn split<T: Real>([zr, zi]: [&[T]; 2], out: &mut [Vec<T>; 2], table: &[T], n: usize) {
+    let m = n / 2;
+    let [low, high] = out;
+    {
+        let (r0, i0) = (lanes(zr, 0), lanes(zi, 0));
+        let (h0, hm) = (lanes_mut(low, 0), lanes_mut(high, 0));
+        for l in 0..LANES {
+            h0[l] = r0[l] + i0[l];
+            hm[l] = r0[l] - i0[l];
+        }
+    }
+    for k in 1..m {
+        let w = C {
+            re: table[2 * k],
+            im: table[2 * k + 1],
+        };
+        let (a, b) = (k * LANES, (m - k) * LANES);
+        let (ar, ai, br, bi) = (lanes(zr, a), lanes(zi, a), lanes(zr, b), lanes(zi, b));
+        let (lo, hi) = (lanes_mut(low, a), lanes_mut(high, b));
+        for l in 0..LANES {
+            let e = C {
+                re: ar[l] + br[l],
+                im: ai[l] - bi[l],
+            };
+            let d = C {
+                re: ar[l] - br[l],
+                im: ai[l] + bi[l],
+            };
+            let o = C {
+                re: d.im,
+                im: -d.re,
+            };
+            let wo = C {
+                re: w.re * o.re - w.im * o.im,
+                im: w.re * o.im + w.im * o.re,
+            };
+            let (xr, xi) = (T::HALF * (e.re + wo.re), T::HALF * (e.im + wo.im));
+            lo[l] = xr - xi;
+            hi[l] = xr + xi;
+        }
+    }
+}
+
+/// The [`LANES`] values from `at`.
+#[inline(always)]
+fn lanes<T>(values: &[T], at: usize) -> &[T; LANES] {
+    values[at..at + LANES]
+        .try_into()
+        .expect("a whole run of lanes")
+}
+
+/// The [`LANES`] values from `at`, to write.
+#[inline(always)]
+fn lanes_mut<T>(values: &mut [T], at: usize) -> &mut [T; LANES] {
+    (&mut values[at..at + LANES])
+        .try_into()
+        .expect("a whole run of lanes")
+}
+
+/// One Stockham stage (the core's `Stage`), every complex value a run of
+/// lanes.
+struct Stage<'t, T> {
+    m: usize,
+    s: usize,
+    table: &'t [T],
+    /// Table index of `ω_ℓ^1`.
+    step: usize,
+}
+
+impl<T: Real> Stage<'_, T> {
+    /// Element `p` of input sub-transform `q`, for `j`, sits at complex
+    /// index `p·s + j·m·s + q`; the output for `k` at `p·R·s + k·s + q`.
+    #[inline(always)]
+    fn run<const R: usize>(
+        &self,
+        [xr, xi]: [&[T]; 2],
+        [yr, yi]: [&mut [T]; 2],
+        bfly: impl Fn([C<T>; R]) -> [C<T>; R],
+    ) {
+        let (m, s) = (self.m, self.s);
+        let block = R * s * LANES;
+        for (p, (out_r, out_i)) in yr
+            .chunks_exact_mut(block)
+            .zip(yi.chunks_exact_mut(block))
+            .enumerate()
+            .take(m)
+        {
+            let w: [C<T>; R] = core::array::from_fn(|k| self.twiddle(p * k));
+            let mut chunks_r = out_r.chunks_exact_mut(s * LANES);
+            let mut chunks_i = out_i.chunks_exact_mut(s * LANES);
+            let mut outs_r: [&mut [T]; R] =
+                core::array::from_fn(|_| chunks_r.next().unwrap_or_default());
+            let mut outs_i: [&mut [T]; R] =
+                core::array::from_fn(|_| chunks_i.next().unwrap_or_default());
+            for q in 0..s {
+                let at = |j: usize| (p * s + j * m * s + q) * LANES;
+                let ins_r: [&[T; LANES]; R] = core::array::from_fn(|j| lanes(xr, at(j)));
+                let ins_i: [&[T; LANES]; R] = core::array::from_fn(|j| lanes(xi, at(j)));
+                let o = q * LANES;
+                let dst_r: [&mut [T; LANES]; R] = outs_r.each_mut().map(|c| lanes_mut(c, o));
+                let dst_i: [&mut [T; LANES]; R] = outs_i.each_mut().map(|c| lanes_mut(c, o));
+                for l in 0..LANES {
+                    let v: [C<T>; R] = core::array::from_fn(|j| C {
+                        re: ins_r[j][l],
+                        im: ins_i[j][l],
+                    });
+                    let v = bfly(v);
+                    for k in 0..R {
+                        let c = if k == 0 { v[0] } else { v[k].mul(w[k]) };
+                        dst_r[k][l] = c.re;
+                        dst_i[k][l] = c.im;
+                    }
+                }
+            }
+        }
+    }
+
+    /// `ω_ℓ^e`, `e < ℓ`.
+    #[inline(always)]
+    fn twiddle(&self, e: usize) -> C<T> {
+        let i = 2 * e * self.step;
+        match self.table.get(i..i + 2) {
+            Some(t) => C { re: t[0], im: t[1] },
+            None => C {
+                re: T::ONE,
+                im: T::ZERO,
+            },
+        }
+    }
+}
+
+#[inline(always)]
+fn radix2<T: Real>([a0, a1]: [C<T>; 2]) -> [C<T>; 2] {
+    [a0.add(a1), a0.sub(a1)]
+}
+
+#[inline(always)]
+fn radix3<T: Real>([a0, a1, a2]: [C<T>; 3]) -> [C<T>; 3] {
+    let s3 = T::from_f64(0.866_025_403_784_438_6);
+    let t = a1.add(a2);
+    let d = a1.sub(a2).scale(s3).mul_neg_i();
+    let base = a0.sub(t.scale(T::HALF));
+    [a0.add(t), base.add(d), base.sub(d)]
+}
+
+#[inline(always)]
+fn radix4<T: Real>([a0, a1, a2, a3]: [C<T>; 4]) -> [C<T>; 4] {
+    let (t0, t1) = (a0.add(a2), a0.sub(a2));
+    let (t2, t3) = (a1.add(a3), a1.sub(a3).mul_neg_i());
+    [t0.add(t2), t1.add(t3), t0.sub(t2), t1.sub(t3)]
+}
+
+#[inline(always)]
+fn radix5<T: Real>([a0, a1, a2, a3, a4]: [C<T>; 5]) -> [C<T>; 5] {
+    let c1 = T::from_f64(0.309_016_994_374_947_45);
+    let c2 = T::from_f64(-0.809_016_994_374_947_5);
+    let s1 = T::from_f64(0.951_056_516_295_153_5);
+    let s2 = T::from_f64(0.587_785_252_292_473_1);
+    let (t1, d1) = (a1.add(a4), a1.sub(a4));
+    let (t2, d2) = (a2.add(a3), a2.sub(a3));
+    let e1 = a0.add(t1.scale(c1)).add(t2.scale(c2));
+    let e2 = a0.add(t1.scale(c2)).add(t2.scale(c1));
+    let o1 = d1.scale(s1).add(d2.scale(s2)).mul_neg_i();
+    let o2 = d1.scale(s2).sub(d2.scale(s1)).mul_neg_i();
+    [
+        a0.add(t1).add(t2),
+        e1.add(o1),
+        e2.add(o2),
+        e2.sub(o2),
+        e1.sub(o1),
+    ]
+}
