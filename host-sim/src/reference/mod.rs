@@ -22,7 +22,7 @@ use std::f64::consts::PI;
 
 use fvr_core::dht::signed_index;
 use fvr_core::dht::Twiddles;
-use fvr_core::geometry::{center, Sampling, View};
+use fvr_core::geometry::{center, Frame, Sampling, View};
 use fvr_core::image::{check_image, finish, placement, Crop};
 use fvr_core::volume::padded_size;
 
@@ -228,13 +228,30 @@ pub fn ideal_projection(
             grid[iy * n + ix] = re - im;
         }
     }
+    finish_f64(&mut grid, n, dims, &frame, width, height)
+}
+
+/// The pipeline's finish in f64: the `n × n` Hartley slice `grid` shifted,
+/// inverse 2D DHT'd and cropped to the `width × height` image of a volume
+/// of `dims` seen in `frame`.
+///
+/// # Errors
+/// Bad `n` or image size.
+pub(crate) fn finish_f64(
+    grid: &mut [f64],
+    n: usize,
+    dims: [usize; 3],
+    frame: &Frame,
+    width: usize,
+    height: usize,
+) -> Result<Vec<f64>, fvr_core::Error> {
     let mut tw_buf = vec![0.0f64; Twiddles::<f64>::buffer_len(n)];
     let tw = Twiddles::new(&mut tw_buf, n)?;
     let mut aux = vec![0.0f64; 4 * n];
     let mut out = vec![0.0f64; width * height];
-    let place = placement(dims, &frame, width, height);
+    let place = placement(dims, frame, width, height);
     finish(
-        &mut grid,
+        grid,
         n,
         &Crop::new(place, 1.0, width, height),
         &tw,

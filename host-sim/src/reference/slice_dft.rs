@@ -22,11 +22,12 @@ use std::f64::consts::PI;
 
 use rayon::prelude::*;
 
-use fvr_core::dht::{signed_index, Twiddles};
+use fvr_core::dht::signed_index;
 use fvr_core::geometry::View;
-use fvr_core::image::{check_image, finish, placement, Crop};
+use fvr_core::image::check_image;
 use fvr_core::volume::padded_size;
 
+use super::finish_f64;
 use crate::volume::Volume;
 
 /// The ideal `width × height` projection of `volume` along `view` on an
@@ -84,20 +85,7 @@ pub fn slice_dft_projection(
             grid[((m - iy) % m) * m + (m - ix) % m] = re + im;
         }
     }
-    let mut tw_buf = vec![0.0f64; Twiddles::<f64>::buffer_len(m)];
-    let tw = Twiddles::new(&mut tw_buf, m)?;
-    let mut aux = vec![0.0f64; 4 * m];
-    let mut out = vec![0.0f64; width * height];
-    let place = placement(dims, &frame, width, height);
-    finish(
-        &mut grid,
-        m,
-        &Crop::new(place, 1.0, width, height),
-        &tw,
-        &mut aux,
-        &mut out,
-    )?;
-    Ok(out)
+    finish_f64(&mut grid, m, dims, &frame, width, height)
 }
 
 /// Whether slice point `(ix, iy)`'s negation is on the slice too: neither

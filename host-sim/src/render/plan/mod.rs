@@ -59,7 +59,11 @@
 //! Odd sizes put the pixels half a voxel off the grid; they are predicted
 //! as if on it. Oblique views and physical units are predicted by the axis views: the
 //! weights then vary with the sub-voxel phase of each slice sample, but the
-//! edge leak, which dominates real data, has the same size.
+//! edge leak, which dominates real data, has the same size (measured: f64
+//! kb5 and kb6 agree to 0.2 dB off axis). What oblique views add is in
+//! `wrap.rs`: the shadow wider than the grid, and the band-limited tails of
+//! points projected between pixels, which the image folds with the grid's
+//! period instead of the ideal's.
 
 use std::f64::consts::PI;
 
@@ -153,7 +157,7 @@ impl Term {
         match self {
             Term::Edge => {
                 "content near the faces of the grid meets the neighbouring replica, or an \
-                 oblique view's shadow wraps around the image"
+                 oblique view's shadow or its band-limited tails wrap around the image"
             }
             Term::Kernel => "the kernel's stopband leaks on the volume's interior",
             Term::Storage => "rounding of the stored spectrum",
