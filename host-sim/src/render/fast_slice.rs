@@ -439,7 +439,10 @@ fn tap_sum_on<const W: usize, const POW2: bool, S: Sample, T: Real>(
         )
     };
     let mut acc = T::ZERO;
-    if x0 + W <= n && W <= 4 {
+    // Up to W = 5 plane by plane: kb5 side by side took 1.03 to 1.5× the
+    // CPU time (`FVR_BENCH_FILTERS=kb5 cargo bench -p fvr-host --bench
+    // view_cpu`, sides 256 and 320).
+    if x0 + W <= n && W <= 5 {
         for c in 0..W {
             let mut acc_y = T::ZERO;
             for b in 0..W {
