@@ -18,7 +18,7 @@
 //!   docs/performance.md this measured within the run-to-run spread of
 //!   whole rows (`cargo bench -p fvr-host --bench view_cpu`); the tiling is
 //!   a tunable ([`Tiling`]).
-//! - **Wide filters** sum every plane of a point side by side.
+//! - **Wide filters** (kb6) sum every plane of a point side by side.
 //!
 //! A point's fixed-point position is the row's anchor plus `(k − anchor)`
 //! steps, exactly the integer the core's running sum reaches, so the visit
@@ -458,7 +458,7 @@ fn tap_sum_on<const W: usize, const POW2: bool, S: Sample, T: Real>(
             acc += wz[c] * acc_y;
         }
     } else if x0 + W <= n {
-        // Wide filters: every plane's sums side by side (lanes `c`),
+        // kb6: every plane's sums side by side (lanes `c`),
         // each in the core's order: the same operations per plane,
         // interleaved, which the compiler vectorizes (kb6 about 1.1 to
         // 1.5× less CPU time a view; kb4 compiles slower this way).
