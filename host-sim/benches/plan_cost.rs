@@ -9,12 +9,19 @@
 //! Volume: the CT head resampled to 256 when `FVR_CT_HEAD` names
 //! `Cranium.inv3` (`bash scripts/fetch-ct-head.sh`), else `brainsmall`.
 //!
+//! Beside each whole view, the slice extraction alone
+//! (`fvr_host::render::fast_slice::extract` on one thread, the rest of
+//! the view being the 2D inverse transform and the crop).
+//!
 //! Run: `FVR_CT_HEAD=$(bash scripts/fetch-ct-head.sh) cargo bench -p fvr-host --bench plan_cost`
 //! (Linux only). `FVR_BENCH_VIEWS` sets the views per figure (default 24).
 
 use std::hint::black_box;
 
+use fvr_core::filter::KernelTable;
+use fvr_core::geometry::Sampling;
 use fvr_core::volume::GridOversampling;
+use fvr_host::render::fast_slice::{self, Tiling};
 use fvr_host::render::plan::{grid_filter, image_side, ALL_GRIDS, CANDIDATE_FILTERS};
 use fvr_host::render::spectrum::{KbDesign, OwnedSpectrum, ViewRenderer};
 use fvr_host::render::turntable::orbit;
@@ -108,6 +115,25 @@ fn main() {
                     .unwrap();
             }
             let ms = (thread_cpu_ms() - start) / views as f64;
+            let kernel = KernelTable::<f32>::new(filter);
+            let axes: Vec<_> = orbit
+                .iter()
+                .map(|v| Sampling::UNIT.slice_axes(&v.frame().unwrap()))
+                .collect();
+            let mut slice = vec![0.0f32; n * n];
+            let start = thread_cpu_ms();
+            for a in &axes {
+                let (spec, tiling) = (spec.view(), Tiling::default());
+                assert!(fast_slice::extract(
+                    &spec,
+                    &kernel,
+                    black_box(a),
+                    tiling,
+                    false,
+                    &mut slice
+                ));
+            }
+            let extract_ms = (thread_cpu_ms() - start) / views as f64;
             let w = kind.width() as f64;
             let nn = (n * n) as f64;
             let log = nn * (n as f64).log2();
@@ -121,7 +147,11 @@ fn main() {
                 ],
                 ms,
             ));
-            println!("{:5} σ={:4} n={n:4}: {ms:7.2} ms", kind.name(), grid.name());
+            println!(
+                "{:5} σ={:4} n={n:4}: {ms:7.2} ms (extraction {extract_ms:7.2} ms)",
+                kind.name(),
+                grid.name()
+            );
         }
     }
     let [a, b, c, d] = least_squares(&rows);

@@ -8,13 +8,16 @@
 //!
 //! Run: `cargo bench -p fvr-host --bench view_cpu` (Linux only).
 //! `FVR_BENCH_TILING=B,C` sets the tiling, `FVR_BENCH_VIEWS` the views
-//! per figure (default 40), `FVR_BENCH_N` the side (default 256).
+//! per figure (default 40), `FVR_BENCH_N` the volume's side (default 256),
+//! `FVR_BENCH_SIDE` the spectrum's (default `FVR_BENCH_N`; up to twice it,
+//! e.g. 320 for a mixed-radix side, with the filter of σ = 1.25).
 
 use std::hint::black_box;
 
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
 use fvr_core::render::Request;
+use fvr_core::volume::GridOversampling;
 use fvr_host::render::fast_slice::Tiling;
 use fvr_host::render::spectrum::{OwnedSpectrum, ViewRenderer};
 use fvr_host::render::view::render_once;
@@ -66,10 +69,15 @@ fn main() {
     let n = env("FVR_BENCH_N")
         .and_then(|v| v.parse().ok())
         .unwrap_or(256);
+    let side: usize = env("FVR_BENCH_SIDE")
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(n);
     let kinds = env("FVR_BENCH_FILTERS").unwrap_or_else(|| "kb4,kb6".into());
     let volume = sample(&GaussianMixture::random(1, n, 8), [n, n, n]);
     let mut out = vec![0.0f32; n * n];
-    println!("n = {n}, {views} views a figure, {tiling:?}; CPU ms per view on one thread");
+    println!(
+        "n = {n}, side {side}, {views} views a figure, {tiling:?}; CPU ms per view on one thread"
+    );
     for kind in kinds.split(',') {
         let kind = match kind {
             "kb3" => FilterKind::Kb3,
@@ -77,9 +85,14 @@ fn main() {
             "kb5" => FilterKind::Kb5,
             _ => FilterKind::Kb6,
         };
-        let filter = Filter::new(kind, 1).unwrap();
-        let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
-        let mut renderer = ViewRenderer::<f32>::new(n, filter)
+        let filter = if side == n {
+            Filter::new(kind, 1)
+        } else {
+            Filter::for_grid(kind, GridOversampling::X1_25)
+        }
+        .unwrap();
+        let spec = OwnedSpectrum::<f16>::prepare_on::<f32>(&volume, filter, side).unwrap();
+        let mut renderer = ViewRenderer::<f32>::new(side, filter)
             .with_threads(1)
             .with_tiling(tiling);
         for (name, dir) in [

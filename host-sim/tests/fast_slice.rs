@@ -4,13 +4,15 @@
 //! arithmetic, axis-aligned, oblique and wrap-heavy directions (slices
 //! whose taps wrap around the cube at its faces, and near-axis ones whose
 //! runs straddle x = n − 1 → 0), physical-unit axes that are not
-//! orthonormal, and every tiling and thread split.
+//! orthonormal, and every tiling and thread split; on power-of-two and
+//! on mixed-radix sides.
 
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::{Sampling, SliceAxes, View};
 use fvr_core::num::{Real, Sample};
 use fvr_core::render::Request;
 use fvr_core::slice::extract_slice_rows;
+use fvr_core::volume::GridOversampling;
 use fvr_host::render::fast_slice::{extract, supports, Tiling};
 use fvr_host::render::spectrum::{OwnedSpectrum, ViewRenderer};
 use fvr_host::render::view::render_once;
@@ -153,6 +155,76 @@ fn renderer_image_equals_core_render() {
                 ViewRenderer::<f32>::new(n, filter)
                     .with_threads(threads)
                     .render_into(&spec, &view, 24, 20, &mut out)
+                    .unwrap();
+                for (a, b) in core.iter().zip(&out) {
+                    assert_eq!(a.to_bits(), (*b as f64).to_bits(), "{kind:?} {dir:?}");
+                }
+            }
+        }
+    }
+}
+
+/// Even mixed-radix sides (`2^a·3^b·5^c`, the grids of σ = 1.25 and 1.5)
+/// with their filters (`Filter::for_grid`): the same slice as the core's
+/// mixed-radix walk, bit for bit, for kb3 … kb6, f16 and f32 storage, f32
+/// and f64 arithmetic, on and off axis and near-axis.
+#[test]
+fn mixed_radix_sides_bit_identical() {
+    for (n, dims, seed) in [(20, 16, 1), (40, 32, 2), (48, 32, 3), (80, 64, 4)] {
+        let volume = noise_volume(dims, seed);
+        for kind in [
+            FilterKind::Kb3,
+            FilterKind::Kb4,
+            FilterKind::Kb5,
+            FilterKind::Kb6,
+        ] {
+            let filter = Filter::for_grid(kind, GridOversampling::X1_25).unwrap();
+            let spec16 = OwnedSpectrum::<f16>::prepare_on::<f32>(&volume, filter, n).unwrap();
+            let spec32 = OwnedSpectrum::<f32>::prepare_on::<f32>(&volume, filter, n).unwrap();
+            assert_eq!(spec16.n(), n);
+            assert!(supports(&spec16.view()) && supports(&spec32.view()));
+            for dir in DIRECTIONS {
+                let axes = axes_for(dir, &Sampling::UNIT);
+                let what = format!("n {n} {kind:?} {dir:?}");
+                check::<f16, f32>(&spec16, &axes, &TILINGS, &format!("{what} f16"));
+                check::<f32, f32>(&spec32, &axes, &TILINGS[1..3], &format!("{what} f32"));
+            }
+        }
+    }
+}
+
+#[test]
+fn mixed_radix_f64_and_physical_units_bit_identical() {
+    let volume = noise_volume(32, 9);
+    let sampling = Sampling::new([0.7, 1.0, 1.9], 1.3).unwrap();
+    for kind in [FilterKind::Kb4, FilterKind::Kb6] {
+        let filter = Filter::for_grid(kind, GridOversampling::X1_5).unwrap();
+        let spec = OwnedSpectrum::<f64>::prepare_on::<f64>(&volume, filter, 48).unwrap();
+        for dir in [[1.0, 0.3, 0.2], [0.3, -0.9, 0.5]] {
+            for sampling in [Sampling::UNIT, sampling] {
+                let axes = axes_for(dir, &sampling);
+                check::<f64, f64>(&spec, &axes, &TILINGS[1..3], &format!("{kind:?} {dir:?}"));
+            }
+        }
+    }
+}
+
+/// On a mixed side the renderer's whole view (host extraction, then the
+/// core's mixed-radix finish) equals the core's single-threaded render.
+#[test]
+fn renderer_image_equals_core_render_on_mixed_sides() {
+    let (n, volume) = (40, noise_volume(32, 13));
+    for kind in [FilterKind::Kb3, FilterKind::Kb5] {
+        let filter = Filter::for_grid(kind, GridOversampling::X1_25).unwrap();
+        let spec = OwnedSpectrum::<f16>::prepare_on::<f32>(&volume, filter, n).unwrap();
+        for dir in DIRECTIONS {
+            let view = View::along(dir);
+            let core = render_once::<f16, f32>(&spec.view(), &Request::new(view, 30, 28)).unwrap();
+            for threads in [0, 1, 3] {
+                let mut out = vec![0.0f32; 30 * 28];
+                ViewRenderer::<f32>::new(n, filter)
+                    .with_threads(threads)
+                    .render_into(&spec, &view, 30, 28, &mut out)
                     .unwrap();
                 for (a, b) in core.iter().zip(&out) {
                     assert_eq!(a.to_bits(), (*b as f64).to_bits(), "{kind:?} {dir:?}");

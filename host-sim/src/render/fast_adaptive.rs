@@ -83,7 +83,8 @@ struct Row<'g, T> {
 /// `extract_slice_adaptive(spec, kernel, levels, frame, grid)` would, bit
 /// for bit, with the same statistics: on the current rayon pool's threads
 /// when `parallel`, else on this thread. `None` (grid untouched) when
-/// [`supports`] does not hold for `spec`, the grid is not `n²`, `kernel`
+/// [`supports`] does not hold for `spec` or its side is not a power of
+/// two, the grid is not `n²`, `kernel`
 /// is not the spectrum's filter, or the levels are more than
 /// [`MAX_LEVELS`] or have marks of another side: the core's function
 /// reports those.
@@ -97,7 +98,9 @@ pub fn extract<S: Sample, T: Real>(
     grid: &mut [T],
 ) -> Option<AdaptiveStats> {
     let n = spec.n();
+    // Its walk wraps by masks: power-of-two sides only.
     if !supports(spec)
+        || !n.is_power_of_two()
         || grid.len() != n * n
         || kernel.filter() != spec.filter()
         || levels.len() > MAX_LEVELS

@@ -1,7 +1,8 @@
-//! The host's slice extraction for plain spectra of power-of-two side: the
-//! core's phase-table extraction (`fvr_core::slice`), point for point the
-//! same arithmetic in the same order, so the slice is the same bit for bit,
-//! but walked for the host's caches and cores.
+//! The host's slice extraction for plain spectra, of power-of-two and of
+//! even mixed-radix side: the core's phase-table extraction
+//! (`fvr_core::slice`), point for point the same arithmetic in the same
+//! order, so the slice is the same bit for bit, but walked for the host's
+//! caches and cores.
 //!
 //! - **Mirror pairs stay together.** Row `p` and row `−p` share every
 //!   point's setup (taps reflected through the origin, same weights), so
@@ -17,11 +18,15 @@
 //!   docs/performance.md this measured within the run-to-run spread of
 //!   whole rows (`cargo bench -p fvr-host --bench view_cpu`); the tiling is
 //!   a tunable ([`Tiling`]).
-//! - **Wide filters** sum every plane of a point side by side.
+//! - **Wide filters** (kb6) sum every plane of a point side by side.
 //!
 //! A point's fixed-point position is the row's anchor plus `(k − anchor)`
 //! steps, exactly the integer the core's running sum reaches, so the visit
 //! order changes nothing in the values.
+//!
+//! Indices wrap around the cube as the core wraps them: by masks on a
+//! power-of-two side, else by one remainder per axis and a conditional
+//! subtraction per tap ([`Side`]); the sums are the same either way.
 
 use fvr_core::filter::{KernelTable, PhaseTable, MAX_WIDTH};
 use fvr_core::geometry::SliceAxes;
@@ -47,10 +52,11 @@ impl Default for Tiling {
 }
 
 /// Whether [`extract`] serves `spec`: plain coefficients (no block
-/// exponents), a power-of-two side and exactly `n³` of them.
+/// exponents), exactly `n³` of them, and a power-of-two or an even side
+/// (the sides spectra take; the walk pairs rows as the core does on both).
 pub fn supports<S: Sample>(spec: &Spectrum<'_, S>) -> bool {
     let n = spec.n();
-    n.is_power_of_two() && spec.blocks().is_none() && spec.data().len() == n * n * n
+    (n.is_power_of_two() || n % 2 == 0) && spec.blocks().is_none() && spec.data().len() == n * n * n
 }
 
 /// Fill the `n × n` slice `grid` (`kx` fastest, natural DHT order) on
@@ -82,13 +88,73 @@ pub fn extract<S: Sample, T: Real + Send + Sync>(
         parallel,
     };
     let data = spec.data();
+    if n.is_power_of_two() {
+        by_width::<true, S, T>(data, kernel, &geometry, grid)
+    } else {
+        by_width::<false, S, T>(data, kernel, &geometry, grid)
+    }
+}
+
+/// [`walk`] for the kernel's width.
+fn by_width<const POW2: bool, S: Sample, T: Real + Send + Sync>(
+    data: &[S],
+    kernel: &KernelTable<T>,
+    geometry: &Geometry<T>,
+    grid: &mut [T],
+) -> bool {
     match kernel.filter().width() {
-        1 => walk::<1, S, T>(data, kernel, &geometry, grid),
-        2 => walk::<2, S, T>(data, kernel, &geometry, grid),
-        3 => walk::<3, S, T>(data, kernel, &geometry, grid),
-        4 => walk::<4, S, T>(data, kernel, &geometry, grid),
-        5 => walk::<5, S, T>(data, kernel, &geometry, grid),
-        _ => walk::<MAX_WIDTH, S, T>(data, kernel, &geometry, grid),
+        1 => walk::<1, POW2, S, T>(data, kernel, geometry, grid),
+        2 => walk::<2, POW2, S, T>(data, kernel, geometry, grid),
+        3 => walk::<3, POW2, S, T>(data, kernel, geometry, grid),
+        4 => walk::<4, POW2, S, T>(data, kernel, geometry, grid),
+        5 => walk::<5, POW2, S, T>(data, kernel, geometry, grid),
+        _ => walk::<MAX_WIDTH, POW2, S, T>(data, kernel, geometry, grid),
+    }
+}
+
+/// `i mod n` for the indices of one cube side: a mask when `POW2` (`n` a
+/// power of two), else as the core's mixed-radix walk: a remainder per
+/// axis and, for taps, a conditional subtraction.
+#[derive(Clone, Copy)]
+struct Side<const POW2: bool> {
+    n: usize,
+}
+
+impl<const POW2: bool> Side<POW2> {
+    /// `j mod n` for any `j`.
+    #[inline(always)]
+    fn wrap(self, j: i64) -> usize {
+        if POW2 {
+            j as usize & (self.n - 1)
+        } else {
+            j.rem_euclid(self.n as i64) as usize
+        }
+    }
+
+    /// `k mod n` for a signed frequency `|k| ≤ n/2`.
+    #[inline(always)]
+    fn signed(self, k: i32) -> usize {
+        if POW2 {
+            k as usize & (self.n - 1)
+        } else if k < 0 {
+            (k + self.n as i32) as usize
+        } else {
+            k as usize
+        }
+    }
+
+    /// `(i + t) mod n` for `i < n` and a tap offset `t < W`.
+    #[inline(always)]
+    fn step(self, i: usize, t: usize) -> usize {
+        if POW2 {
+            (i + t) & (self.n - 1)
+        } else {
+            let mut v = i + t;
+            while v >= self.n {
+                v -= self.n;
+            }
+            v
+        }
     }
 }
 
@@ -118,7 +184,7 @@ struct Pair<'g, T> {
 /// The walk for filter width `W`: rows split into bands of pairs, each
 /// band set up, then filled tile by tile.
 #[inline(never)]
-fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
+fn walk<const W: usize, const POW2: bool, S: Sample, T: Real + Send + Sync>(
     data: &[S],
     kernel: &KernelTable<T>,
     g: &Geometry<T>,
@@ -129,7 +195,7 @@ fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
         return false;
     }
     let n = g.n;
-    let mask = n - 1;
+    let side = Side::<POW2> { n };
     let mut rows: Vec<Option<&mut [T]>> = grid.chunks_exact_mut(n).map(Some).collect();
     // Signed frequencies of a row: −n/2 … n/2 − 1; row `p` holds `ky = p`
     // for `p ≤ k_max`, row `(n − p) mod n` holds `ky = −p`.
@@ -140,7 +206,7 @@ fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
             let minus = if p == 0 {
                 None
             } else {
-                rows[(n - p) & mask].take()
+                rows[side.signed(-(p as i32))].take()
             };
             Pair {
                 p,
@@ -158,9 +224,9 @@ fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
     while pairs.peek().is_some() {
         bands.push(pairs.by_ref().take(g.tiling.band).collect());
     }
-    let taps = Taps::<W, S, T> {
+    let taps = Taps::<W, POW2, S, T> {
         data,
-        n,
+        side,
         phases: &phases,
         raw_gain: T::exp2i(T::raw_exponent::<S>()),
         step: g.right.map(PhaseTable::<T, W>::fixed_step),
@@ -175,8 +241,8 @@ fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
 }
 
 /// Set up and fill one band of pairs.
-fn fill_band<const W: usize, S: Sample, T: Real>(
-    taps: &Taps<'_, W, S, T>,
+fn fill_band<const W: usize, const POW2: bool, S: Sample, T: Real>(
+    taps: &Taps<'_, W, POW2, S, T>,
     g: &Geometry<T>,
     band: &mut [Pair<'_, T>],
 ) {
@@ -216,15 +282,15 @@ fn fill_band<const W: usize, S: Sample, T: Real>(
 
 /// Points `k = from … to` of one pair, with their mirrors.
 #[inline(always)]
-fn fill_pair<const W: usize, S: Sample, T: Real>(
-    taps: &Taps<'_, W, S, T>,
+fn fill_pair<const W: usize, const POW2: bool, S: Sample, T: Real>(
+    taps: &Taps<'_, W, POW2, S, T>,
     pair: &mut Pair<'_, T>,
     from: i32,
     to: i32,
     n: usize,
 ) {
     let k_max = ((n - 1) / 2) as i32;
-    let mask = n - 1;
+    let side = taps.side;
     let p = pair.p;
     let has_plus = pair.plus.is_some();
     // Row 0's mirrors land in row 0 itself.
@@ -242,7 +308,7 @@ fn fill_pair<const W: usize, S: Sample, T: Real>(
             if let Some(g) = pair
                 .plus
                 .as_deref_mut()
-                .and_then(|r| r.get_mut(k as usize & mask))
+                .and_then(|r| r.get_mut(side.signed(k)))
             {
                 *g = value;
             }
@@ -252,7 +318,7 @@ fn fill_pair<const W: usize, S: Sample, T: Real>(
                 Some(r) => Some(r),
                 None => pair.plus.as_deref_mut(),
             };
-            if let Some(g) = row.and_then(|r| r.get_mut(k.wrapping_neg() as usize & mask)) {
+            if let Some(g) = row.and_then(|r| r.get_mut(side.signed(k.wrapping_neg()))) {
                 *g = mirror;
             }
         }
@@ -286,15 +352,15 @@ pub(super) fn row_interval<T: Real>(n: usize, right: &[T; 3], c: [T; 3]) -> (i32
 }
 
 /// The tap sums of one point and its mirror from the phase table.
-struct Taps<'a, const W: usize, S, T> {
+struct Taps<'a, const W: usize, const POW2: bool, S, T> {
     data: &'a [S],
-    n: usize,
+    side: Side<POW2>,
     phases: &'a PhaseTable<T, W>,
     raw_gain: T,
     step: [i64; 3],
 }
 
-impl<const W: usize, S: Sample, T: Real> Taps<'_, W, S, T> {
+impl<const W: usize, const POW2: bool, S: Sample, T: Real> Taps<'_, W, POW2, S, T> {
     /// The value at fixed-point position `y` (when `plus`) and at its
     /// mirror `−q` (when `minus`): taps `−j − t`, the run from
     /// `−j − (W − 1)` with the weights reversed.
@@ -323,8 +389,20 @@ impl<const W: usize, S: Sample, T: Real> Taps<'_, W, S, T> {
     /// [`tap_sum`] on this spectrum.
     #[inline(always)]
     fn value(&self, jx: i32, wx: &[T; W], jy: i32, wy: &[T; W], jz: i32, wz: &[T; W]) -> T {
-        tap_sum(self.data, self.n, [jx, jy, jz], [wx, wy, wz])
+        tap_sum_on(self.data, self.side, [jx, jy, jz], [wx, wy, wz])
     }
+}
+
+/// `Σ_c wz_c Σ_b wy_b Σ_t wx_t·c[z + c, y + b, x + t]` (indices wrapping
+/// around the cube of power-of-two side `n`), as [`tap_sum_on`].
+#[inline(always)]
+pub(super) fn tap_sum<const W: usize, S: Sample, T: Real>(
+    data: &[S],
+    n: usize,
+    taps: [i32; 3],
+    weights: [&[T; W]; 3],
+) -> T {
+    tap_sum_on(data, Side::<true> { n }, taps, weights)
 }
 
 /// `Σ_c wz_c Σ_b wy_b Σ_t wx_t·c[z + c, y + b, x + t]` (indices wrapping
@@ -333,22 +411,38 @@ impl<const W: usize, S: Sample, T: Real> Taps<'_, W, S, T> {
 /// samples are read raw ([`Real::load_raw`]): `wx` carries `2^e`
 /// ([`Real::raw_exponent`]), which leaves every product as the core's.
 #[inline(always)]
-pub(super) fn tap_sum<const W: usize, S: Sample, T: Real>(
+fn tap_sum_on<const W: usize, const POW2: bool, S: Sample, T: Real>(
     data: &[S],
-    n: usize,
+    side: Side<POW2>,
     [jx, jy, jz]: [i32; 3],
     [wx, wy, wz]: [&[T; W]; 3],
 ) -> T {
-    let (nn, mask) = (n * n, n - 1);
-    let (y0, z0) = (
-        (jy as usize).wrapping_mul(n),
-        (jz as usize).wrapping_mul(nn),
-    );
-    let lines: [usize; W] = core::array::from_fn(|b| y0.wrapping_add(b * n) & (nn - n));
-    let planes: [usize; W] = core::array::from_fn(|c| z0.wrapping_add(c * nn) & (nn * n - nn));
-    let x0 = jx as usize & mask;
+    let n = side.n;
+    let nn = n * n;
+    let (lines, planes, x0): ([usize; W], [usize; W], usize) = if POW2 {
+        // `((j + b) mod n)·n` as `(j·n + b·n) mod n²`, in wrapping usize.
+        let (y0, z0) = (
+            (jy as usize).wrapping_mul(n),
+            (jz as usize).wrapping_mul(nn),
+        );
+        (
+            core::array::from_fn(|b| y0.wrapping_add(b * n) & (nn - n)),
+            core::array::from_fn(|c| z0.wrapping_add(c * nn) & (nn * n - nn)),
+            side.wrap(jx as i64),
+        )
+    } else {
+        let (y0, z0) = (side.wrap(jy as i64), side.wrap(jz as i64));
+        (
+            core::array::from_fn(|b| side.step(y0, b) * n),
+            core::array::from_fn(|c| side.step(z0, c) * nn),
+            side.wrap(jx as i64),
+        )
+    };
     let mut acc = T::ZERO;
-    if x0 + W <= n && W <= 4 {
+    // Up to W = 5 plane by plane: kb5 side by side took 1.03 to 1.5× the
+    // CPU time (`FVR_BENCH_FILTERS=kb5 cargo bench -p fvr-host --bench
+    // view_cpu`, sides 256 and 320).
+    if x0 + W <= n && W <= 5 {
         for c in 0..W {
             let mut acc_y = T::ZERO;
             for b in 0..W {
@@ -364,7 +458,7 @@ pub(super) fn tap_sum<const W: usize, S: Sample, T: Real>(
             acc += wz[c] * acc_y;
         }
     } else if x0 + W <= n {
-        // Wide filters: every plane's sums side by side (lanes `c`),
+        // kb6: every plane's sums side by side (lanes `c`),
         // each in the core's order: the same operations per plane,
         // interleaved, which the compiler vectorizes (kb6 about 1.1 to
         // 1.5× less CPU time a view; kb4 compiles slower this way).
@@ -390,7 +484,7 @@ pub(super) fn tap_sum<const W: usize, S: Sample, T: Real>(
             acc += wz[c] * acc_y[c];
         }
     } else {
-        let xs: [usize; W] = core::array::from_fn(|t| (jx + t as i32) as usize & mask);
+        let xs: [usize; W] = core::array::from_fn(|t| side.step(x0, t));
         for c in 0..W {
             let mut acc_y = T::ZERO;
             for b in 0..W {

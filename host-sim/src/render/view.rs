@@ -76,7 +76,7 @@ impl<T: Real> ViewRenderer<T> {
         self
     }
 
-    /// Walk plain power-of-two spectra with `tiling`
+    /// Walk plain spectra (power-of-two and mixed-radix sides) with `tiling`
     /// ([`fast_slice::extract`]; the image is the same whatever it is).
     pub fn with_tiling(mut self, tiling: Tiling) -> Self {
         self.tiling = tiling;
