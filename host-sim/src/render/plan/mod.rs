@@ -500,6 +500,7 @@ pub fn predict_grid(
 }
 
 mod choose;
+mod splat;
 mod sums;
 mod tails;
 mod wrap;

@@ -115,10 +115,11 @@ impl Tails {
         }
     }
 
-    /// Subtract the tails of the canvases `off` (along the image's right
-    /// and up axes, `w × w`, row `q` holding image row `q`) from the
-    /// `side × side` error image `err` (the expansion's minus sign).
-    pub(super) fn subtract(&self, off: &[Vec<f64>; 2], err: &mut [f64]) {
+    /// Subtract the tails of the canvas `cells` (`w × w`, row `q` holding
+    /// image row `q`; per pixel the plain sum, then the offsets' sums along
+    /// the image's right and up axes) from the `side × side` error image
+    /// `err` (the expansion's minus sign).
+    pub(super) fn subtract(&self, cells: &[[f64; 3]], err: &mut [f64]) {
         let (half, side) = (self.half, self.side);
         let w = 2 * half + 1;
         let lo = -side / 2;
@@ -132,7 +133,7 @@ impl Tails {
             .chain(self.c2r.make_scratch_vec())
             .collect::<Vec<_>>();
         let last = spectrum.len() - 1;
-        for (a, off) in off.iter().enumerate() {
+        for a in 0..2 {
             for image_line in lo..lo + side {
                 let l = image_line + half;
                 if !(0..w).contains(&l) {
@@ -142,12 +143,9 @@ impl Tails {
                 let w = w as usize;
                 // The canvas values along axis a on this line.
                 line.fill(0.0);
-                if a == 0 {
-                    line[..w].copy_from_slice(&off[l * w..][..w]);
-                } else {
-                    for (c, v) in line[..w].iter_mut().enumerate() {
-                        *v = off[c * w + l];
-                    }
+                for (c, v) in line[..w].iter_mut().enumerate() {
+                    let at = if a == 0 { l * w + c } else { c * w + l };
+                    *v = cells[at][1 + a];
                 }
                 if line[..w].iter().all(|&v| v == 0.0) {
                     continue;
@@ -187,7 +185,7 @@ pub(super) mod tests {
 
     /// The direct convolution the transform replaces: the reference.
     pub(in super::super) fn subtract_direct(
-        off: &[Vec<f64>; 2],
+        cells: &[[f64; 3]],
         half: i64,
         kernel: &[f64],
         n: i64,
@@ -196,18 +194,15 @@ pub(super) mod tests {
     ) {
         let w = 2 * half + 1;
         let lo = -side / 2;
-        for (a, off) in off.iter().enumerate() {
+        for a in 0..2 {
             for line in lo..lo + side {
                 let l = line + half;
                 if !(0..w).contains(&l) {
                     continue;
                 }
                 let at = |c: i64| {
-                    if a == 0 {
-                        off[(l * w + c) as usize]
-                    } else {
-                        off[(c * w + l) as usize]
-                    }
+                    let at = if a == 0 { l * w + c } else { c * w + l };
+                    cells[at as usize][1 + a]
                 };
                 for p in lo..lo + side {
                     let mut e = 0.0;
@@ -245,17 +240,18 @@ pub(super) mod tests {
         // grids below the reference and at half of it.
         for (n, reference, half, side) in [(32, 64, 24, 32), (40, 64, 10, 40), (33, 64, 30, 17)] {
             let w = (2 * half + 1) as usize;
-            let off: [Vec<f64>; 2] = core::array::from_fn(|_| {
-                (0..w * w)
-                    .map(|i| if i % 5 == 0 { 0.0 } else { next() })
-                    .collect()
-            });
+            let cells: Vec<[f64; 3]> = (0..w * w)
+                .map(|i| {
+                    let mut v = || if i % 5 == 0 { 0.0 } else { next() };
+                    [v(), v(), v()]
+                })
+                .collect();
             let tails = Tails::new(n, reference, half, side);
             let mut fast = vec![0.0; side * side];
-            tails.subtract(&off, &mut fast);
+            tails.subtract(&cells, &mut fast);
             let mut slow = vec![0.0; side * side];
             let kernel = tail_kernel(n, reference);
-            subtract_direct(&off, half, &kernel, n as i64, side as i64, &mut slow);
+            subtract_direct(&cells, half, &kernel, n as i64, side as i64, &mut slow);
             // Each pixel takes one line per axis. The transform's error on
             // a line is within ε·log₂M·‖k‖₁·‖v‖₂ times a small constant
             // (10 here); the direct sum's within w·ε·‖k‖₁·max|v|.
