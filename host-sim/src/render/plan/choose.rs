@@ -12,9 +12,9 @@ use crate::render::spectrum::{check_memory, Precision};
 use crate::volume::Volume;
 use rayon::prelude::*;
 
-/// One pass over the volume: a filter on a grid of side `n`, the grid's
-/// wrapped-shadow ratio and the precisions that fit in memory.
-type Job = (FilterKind, GridOversampling, usize, f64, Vec<Precision>);
+/// One pass over the volume: a filter on a grid of side `n` and the
+/// precisions that fit in memory.
+type Job = (FilterKind, GridOversampling, usize, Vec<Precision>);
 
 /// Relative cost of a candidate: time per view first
 /// ([`cost_grid`]), memory (`n³` stored coefficients) second.
@@ -161,18 +161,13 @@ pub fn choose_among(
         if crate::volume::check_padding(volume.dims, n).is_err() {
             continue;
         }
-        let wrap = shadows.worst_ratio(n, super::image_side(volume.dims, n)?);
         let fits: Vec<Precision> = precisions
             .iter()
             .copied()
             .filter(|p| check_memory(n, p.bytes()).is_ok())
             .collect();
         if !fits.is_empty() {
-            jobs.extend(
-                filters
-                    .iter()
-                    .map(|&kind| (kind, grid, n, wrap, fits.clone())),
-            );
+            jobs.extend(filters.iter().map(|&kind| (kind, grid, n, fits.clone())));
         }
     }
     // Candidates in order of cost (stable: ties keep the order above, as
@@ -182,7 +177,7 @@ pub fn choose_among(
     // costlier candidates are never run. Jobs run a batch at a time, one
     // per thread, the next ones in cost order.
     let mut order = Vec::new();
-    for (j, (kind, grid, _, _, fits)) in jobs.iter().enumerate() {
+    for (j, (kind, grid, _, fits)) in jobs.iter().enumerate() {
         for (f, &precision) in fits.iter().enumerate() {
             let candidate = Candidate {
                 filter: *kind,
@@ -200,7 +195,13 @@ pub fn choose_among(
     sides.dedup();
     let profiles: Vec<(usize, OnceLock<Result<EnergyProfile, fvr_core::Error>>)> =
         sides.into_iter().map(|n| (n, OnceLock::new())).collect();
-    let run = |(kind, grid, n, wrap, fits): &Job| -> Result<Vec<Prediction>, fvr_core::Error> {
+    // The wrapped-shadow ratio of each grid side, made when the walk first
+    // reaches one of its jobs.
+    let mut wraps: Vec<(usize, f64)> = Vec::new();
+    let run = |(kind, grid, n, fits): &Job,
+               wraps: &[(usize, f64)]|
+     -> Result<Vec<Prediction>, fvr_core::Error> {
+        let wrap = wraps.iter().find(|(m, _)| m == n).map_or(0.0, |&(_, w)| w);
         let filter = match profiles.iter().find(|(m, _)| m == n) {
             Some((_, profile)) if design == KbDesign::Auto && kind.is_kaiser_bessel() => {
                 let profile = profile.get_or_init(|| EnergyProfile::of(&source, *n));
@@ -217,7 +218,7 @@ pub fn choose_among(
                     oversample: grid.integer(),
                     precision,
                 };
-                combine(&interp, candidate, *grid, filter.beta(), *wrap)
+                combine(&interp, candidate, *grid, filter.beta(), wrap)
             })
             .collect())
     };
@@ -234,7 +235,16 @@ pub fn choose_among(
                     }
                 }
             }
-            let results: Vec<_> = next.par_iter().map(|&k| run(&jobs[k])).collect();
+            for &k in &next {
+                let n = jobs[k].2;
+                if !wraps.iter().any(|&(m, _)| m == n) {
+                    wraps.push((
+                        n,
+                        shadows.worst_ratio(n, super::image_side(volume.dims, n)?),
+                    ));
+                }
+            }
+            let results: Vec<_> = next.par_iter().map(|&k| run(&jobs[k], &wraps)).collect();
             for (k, r) in next.into_iter().zip(results) {
                 done[k] = Some(r?);
             }

@@ -500,7 +500,9 @@ pub fn predict_grid(
 }
 
 mod choose;
+mod splat;
 mod sums;
+mod tails;
 mod wrap;
 pub use choose::{
     choose, choose_among, cost, cost_grid, Constraints, Plan, CANDIDATE_FILTERS, MARGIN_DB,
