@@ -9,7 +9,9 @@
 //!   direction (1, 0.3, 0.2);
 //!
 //! each also with the core's single-threaded adaptive extraction
-//! (`adaptive_40db_core`). Compare as ratios within one run.
+//! (`adaptive_40db_core`); and `marks_kb6_256`: the exact bound's marks at
+//! 40 dB (`marks_exact_40db`) against the preprocessing they follow
+//! (`prepare`), on the same volume. Compare as ratios within one run.
 //!
 //! Run: `cargo bench -p fvr-host --bench adaptive`.
 
@@ -63,6 +65,20 @@ fn group(c: &mut Criterion, name: &str, volume: &Volume, filter: Filter) {
     group.finish();
 }
 
+/// Preparing `volume` with `filter` (f16) against building its exact marks.
+fn marking(c: &mut Criterion, name: &str, volume: &Volume, filter: Filter) {
+    let spec = OwnedSpectrum::<f16>::prepare::<f32>(volume, filter).unwrap();
+    let mut group = c.benchmark_group(name);
+    group.sample_size(10);
+    group.bench_function("prepare", |b| {
+        b.iter(|| OwnedSpectrum::<f16>::prepare::<f32>(black_box(volume), filter).unwrap())
+    });
+    group.bench_function("marks_exact_40db", |b| {
+        b.iter(|| AdaptiveMarks::build(black_box(&spec), &AdaptiveSettings::new(40.0)).unwrap())
+    });
+    group.finish();
+}
+
 fn benches(c: &mut Criterion) {
     let n = 128;
     let volume = sample(&GaussianMixture::random(1, n, 8), [n; 3]);
@@ -77,6 +93,12 @@ fn benches(c: &mut Criterion) {
     group(
         c,
         "adaptive_kb6_256",
+        &volume,
+        Filter::new(FilterKind::Kb6, 1).unwrap(),
+    );
+    marking(
+        c,
+        "marks_kb6_256",
         &volume,
         Filter::new(FilterKind::Kb6, 1).unwrap(),
     );

@@ -101,7 +101,12 @@ struct ErrorModel {
     bins: Vec<f64>,
     /// The bin of `bins[0]`.
     lowest: i64,
+    /// `values[i]` is the spectrum's `value(i)` exactly (no block
+    /// exponents, a format f32 holds), so the marks may test it.
+    exact: bool,
     work: Vec<f32>,
+    /// `work` holds the reference field (every sample, unweighted).
+    holds_reference: bool,
 }
 
 impl ErrorModel {
@@ -119,12 +124,21 @@ impl ErrorModel {
             .map_err(|e| e.to_string())?;
         let large = *view.filter();
         let mut values = vec![0f32; n * n * n];
+        let (data, plain) = (view.data(), view.blocks().is_none());
         values
             .par_chunks_mut(n * n)
             .enumerate()
-            .for_each(|(z, plane)| {
-                for (i, v) in plane.iter_mut().enumerate() {
-                    *v = view.value(z * n * n + i) as f32;
+            .for_each(|(z, plane)| match plain {
+                // Without block exponents a value is its stored sample.
+                true => {
+                    for (v, d) in plane.iter_mut().zip(&data[z * n * n..]) {
+                        *v = d.to_f32();
+                    }
+                }
+                false => {
+                    for (i, v) in plane.iter_mut().enumerate() {
+                        *v = view.value(z * n * n + i) as f32;
+                    }
                 }
             });
         let (bins, lowest) = magnitude_bins(&values);
@@ -136,11 +150,14 @@ impl ErrorModel {
             reference: 0.0,
             bins,
             lowest,
+            exact: plain && (S::BITS <= 16 || S::NAME == "f32"),
             work: vec![0.0; n * n * n],
+            holds_reference: false,
         };
         let ones = model.large_response.clone();
         model.reference =
             model.field_energy(f64::INFINITY, |x| ones[x[0]] * ones[x[1]] * ones[x[2]])?;
+        model.holds_reference = true;
         Ok(model)
     }
 
@@ -175,9 +192,15 @@ impl ErrorModel {
             planes_z: &all,
             fill: &fill,
         };
+        self.holds_reference = false;
         dht_3d_real::<f32, f32>(&cube, &mut self.work).map_err(|e| e.to_string())?;
-        Ok(self
-            .work
+        Ok(self.work_energy(weight))
+    }
+
+    /// `Σ_x (work(x)·weight(x))²`.
+    fn work_energy(&self, weight: impl Fn([usize; 3]) -> f64 + Sync) -> f64 {
+        let n = self.n;
+        self.work
             .par_chunks(n * n)
             .enumerate()
             .map(|(z, plane)| {
@@ -192,7 +215,7 @@ impl ErrorModel {
                 }
                 energy
             })
-            .sum())
+            .sum()
     }
 
     /// The error energy of threshold bin `b` as if the weight were its mean
@@ -217,14 +240,19 @@ impl ErrorModel {
     /// far from constant, so the raw estimate is off by octaves, but the
     /// ratio varies slowly with `τ`); the rest bisect. It returns only
     /// thresholds it evaluated.
-    fn threshold(&mut self, small: &Filter, gain: f64, budget: f64) -> Result<(f64, f64), String> {
+    fn threshold(
+        &mut self,
+        small: &Filter,
+        gain: f64,
+        budget: f64,
+    ) -> Result<(f64, f64, usize), String> {
         let n = self.n;
         let hs = Self::responses(small, n);
         let hl = self.large_response.clone();
         let weight =
             |x: [usize; 3]| gain * hs[x[0]] * hs[x[1]] * hs[x[2]] - hl[x[0]] * hl[x[1]] * hl[x[2]];
         if self.bins.is_empty() || self.reference <= 0.0 {
-            return Ok((0.0, 0.0));
+            return Ok((0.0, 0.0, 0));
         }
         // mean(w²) of the separable weight, from per-axis sums of products.
         let axis_mean = |f: &dyn Fn(usize) -> f64| (0..n).map(f).sum::<f64>() / n as f64;
@@ -238,7 +266,17 @@ impl ErrorModel {
         // From `top` on every sample is weak: no larger threshold changes the set.
         let top = self.lowest + self.bins.len() as i64 - 1;
         let mut bad = top + 1;
+        // The ratio of exact to estimated energy with every sample weak,
+        // from the reference field while it is at hand: it varies slowly
+        // with `τ`, so the first probe lands near the answer.
         let mut scale = 1.0;
+        let everything = self.estimate(top, mean_square);
+        if self.holds_reference && everything > 0.0 {
+            let all = self.work_energy(weight);
+            if all > 0.0 {
+                scale = all / everything;
+            }
+        }
         let mut probes = 0;
         while bad - good.0 > 1 {
             let b = if probes < 3 {
@@ -262,8 +300,8 @@ impl ErrorModel {
             }
         }
         Ok(match good.1 {
-            Some(r) => (tau_of(good.0), r),
-            None => (0.0, 0.0),
+            Some(r) => (tau_of(good.0), r, probes),
+            None => (0.0, 0.0, probes),
         })
     }
 }
@@ -297,27 +335,22 @@ fn magnitude_bins(values: &[f32]) -> (Vec<f64>, i64) {
         let eighths = EIGHTH_OCTAVES.iter().filter(|t| mantissa >= **t).count() as i64;
         8 * (exponent - 127) + eighths + 1
     };
-    let occupied = values.par_iter().filter(|v| **v != 0.0).map(|&v| bin(v));
-    let (lo, hi) = occupied
-        .fold(|| (i64::MAX, i64::MIN), |(a, b), k| (a.min(k), b.max(k)))
-        .reduce(|| (i64::MAX, i64::MIN), |x, y| (x.0.min(y.0), x.1.max(y.1)));
-    if lo > hi {
-        return (Vec::new(), 0);
-    }
-    let len = (hi - lo + 1) as usize;
-    let bins = values
+    // Every bin an f32 can fall in (subnormals down to 2^−149), in one pass.
+    const FIRST: i64 = -8 * 150;
+    const BINS: usize = 8 * 280;
+    let all = values
         .par_chunks(1 << 16)
         .fold(
-            || vec![0f64; len],
+            || vec![0f64; BINS],
             |mut acc, chunk| {
                 for &v in chunk.iter().filter(|v| **v != 0.0) {
-                    acc[(bin(v) - lo) as usize] += v as f64 * v as f64;
+                    acc[(bin(v) - FIRST) as usize] += v as f64 * v as f64;
                 }
                 acc
             },
         )
         .reduce(
-            || vec![0f64; len],
+            || vec![0f64; BINS],
             |mut a, b| {
                 for (x, y) in a.iter_mut().zip(b) {
                     *x += y;
@@ -325,6 +358,16 @@ fn magnitude_bins(values: &[f32]) -> (Vec<f64>, i64) {
                 a
             },
         );
+    // A nonzero f32 squared is a positive f64: occupied bins are positive.
+    let (lo, hi) = match (
+        all.iter().position(|&e| e > 0.0),
+        all.iter().rposition(|&e| e > 0.0),
+    ) {
+        (Some(lo), Some(hi)) => (lo, hi),
+        _ => return (Vec::new(), 0),
+    };
+    let bins = all[lo..=hi].to_vec();
+    let lo = lo as i64 + FIRST;
     (bins, lo)
 }
 
@@ -375,6 +418,9 @@ pub struct Level {
     /// With [`Bound::Exact`]: the 3D error energy of this level's
     /// substitution relative to the volume's, as verified for `threshold`.
     pub error_ratio: Option<f64>,
+    /// With [`Bound::Exact`]: the 3D inverse transforms the threshold
+    /// search ran for this level (the reference's not counted).
+    pub probes: Option<usize>,
 }
 
 /// Marks for adaptive filtering of one spectrum.
@@ -460,16 +506,26 @@ impl AdaptiveMarks {
                     .map_err(|e| e.to_string())?,
             };
             let gain = large.response(0.0) / small.response(0.0);
-            let (threshold, error_ratio) = match model.as_mut() {
+            let (threshold, error_ratio, probes) = match model.as_mut() {
                 Some(model) => {
-                    let (tau, ratio) = model.threshold(&small, gain, budget)?;
-                    (tau, Some(ratio))
+                    let (tau, ratio, probes) = model.threshold(&small, gain, budget)?;
+                    (tau, Some(ratio), Some(probes))
                 }
-                None => (threshold_for(total, |i| view.value(i), h_d, budget), None),
+                None => (
+                    threshold_for(total, |i| view.value(i), h_d, budget),
+                    None,
+                    None,
+                ),
             };
             let mut words = vec![0u32; marks_words(n)];
-            let marked = fast_marks::mark(n, |i| view.value(i), threshold, radius, &mut words)
-                .map_err(|e| e.to_string())?;
+            let exact = model.as_ref().filter(|m| m.exact).map(|m| &m.values[..]);
+            let marked = match exact {
+                Some(values) => {
+                    fast_marks::mark(n, |i| values[i] as f64, threshold, radius, &mut words)
+                }
+                None => fast_marks::mark(n, |i| view.value(i), threshold, radius, &mut words),
+            }
+            .map_err(|e| e.to_string())?;
             levels.push(Level {
                 filter: small,
                 h_d,
@@ -478,6 +534,7 @@ impl AdaptiveMarks {
                 marked,
                 gain,
                 error_ratio,
+                probes,
             });
         }
         Ok(Self {

@@ -6,12 +6,13 @@
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::KernelTable;
 use fvr_core::geometry::View;
-use fvr_core::image::{aux_len, check_image, finish, placement, Crop};
+use fvr_core::image::{aux_len, check_image, finish, grid_len, placement, Crop, Inverse};
 use fvr_core::num::{Real, Sample};
 use fvr_core::slice::adaptive::{extract_slice_adaptive, AdaptiveLevel, AdaptiveStats, Marks};
 
 use super::adaptive::AdaptiveMarks;
 use super::fast_adaptive;
+use super::fast_inverse::finish_threaded;
 use super::fast_slice::Tiling;
 use super::spectrum::OwnedSpectrum;
 
@@ -25,6 +26,8 @@ pub struct AdaptiveRenderer<'m, T> {
     tw: Vec<T>,
     grid: Vec<T>,
     aux: Vec<T>,
+    /// The transposed grid of the threaded finish.
+    trans: Vec<T>,
     parallel: bool,
     core: bool,
     tiling: Tiling,
@@ -53,14 +56,16 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
             tw,
             grid: vec![T::ZERO; n * n],
             aux: vec![T::ZERO; aux_len(n)],
+            trans: vec![T::ZERO; grid_len(n)],
             parallel: true,
             core: false,
             tiling: Tiling::default(),
         })
     }
 
-    /// Extract on the current rayon pool's threads (`true`, the default)
-    /// or on this one. The image is the same bit for bit either way.
+    /// Extract and finish on the current rayon pool's threads (`true`, the
+    /// default) or on this one. The image is the same bit for bit either
+    /// way.
     pub fn with_parallel(mut self, parallel: bool) -> Self {
         self.parallel = parallel;
         self
@@ -128,14 +133,16 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
         };
         let tw = Twiddles::from_table(&self.tw, n)?;
         let place = placement(core_spec.dims(), &frame, width, height);
-        finish(
-            &mut self.grid,
-            n,
-            &Crop::new(place, 1.0 / core_spec.scale(), width, height),
-            &tw,
-            &mut self.aux,
-            out,
-        )?;
+        let crop = Crop::new(place, 1.0 / core_spec.scale(), width, height);
+        // At a few % of the taps the view is bound by its finish as much
+        // as by the walk: the 2D inverse on the threads too when the walk
+        // is (`fast_inverse`, the core's image bit for bit).
+        if self.parallel && !self.core {
+            let inverse = Inverse::Radix2(&tw);
+            finish_threaded(&mut self.grid, n, &crop, inverse, &mut self.trans, out)?;
+        } else {
+            finish(&mut self.grid, n, &crop, &tw, &mut self.aux, out)?;
+        }
         Ok(stats)
     }
 }
