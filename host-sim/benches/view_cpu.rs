@@ -11,14 +11,18 @@
 //! per figure (default 40), `FVR_BENCH_N` the volume's side (default 256),
 //! `FVR_BENCH_SIDE` the spectrum's (default `FVR_BENCH_N`; up to twice it,
 //! e.g. 320 for a mixed-radix side, with the filter of σ = 1.25).
+//! `FVR_BENCH_BRICKS=4x4x4,8x4x4` times the slice alone instead, from the
+//! linear spectrum and from bricked copies of it
+//! (`fvr_host::render::fast_bricks`), alternating, one thread.
 
 use std::hint::black_box;
 
-use fvr_core::filter::{Filter, FilterKind};
-use fvr_core::geometry::View;
+use fvr_core::filter::{Filter, FilterKind, KernelTable};
+use fvr_core::geometry::{Sampling, View};
 use fvr_core::render::Request;
 use fvr_core::volume::GridOversampling;
-use fvr_host::render::fast_slice::Tiling;
+use fvr_host::render::fast_bricks::Bricked;
+use fvr_host::render::fast_slice::{extract, extract_bricked, Tiling};
 use fvr_host::render::spectrum::{OwnedSpectrum, ViewRenderer};
 use fvr_host::render::view::render_once;
 use fvr_host::sources::phantom::{sample, GaussianMixture};
@@ -92,6 +96,10 @@ fn main() {
         }
         .unwrap();
         let spec = OwnedSpectrum::<f16>::prepare_on::<f32>(&volume, filter, side).unwrap();
+        if let Some(bricks) = env("FVR_BENCH_BRICKS") {
+            slices(&spec, &bricks, tiling, views);
+            continue;
+        }
         let mut renderer = ViewRenderer::<f32>::new(side, filter)
             .with_threads(1)
             .with_tiling(tiling);
@@ -115,5 +123,62 @@ fn main() {
                 core / host
             );
         }
+    }
+}
+
+/// Slice-only CPU ms per view from the linear spectrum and from each
+/// bricked copy in `bricks` (`BXxBYxBZ`, comma-separated), two rounds
+/// alternating, with a check that the slices agree bit for bit.
+fn slices(spec: &OwnedSpectrum<f16>, bricks: &str, tiling: Tiling, views: usize) {
+    let n = spec.n();
+    let kernel = KernelTable::<f32>::new(spec.filter());
+    let copies: Vec<(String, Bricked<f16>)> = bricks
+        .split(',')
+        .filter_map(|b| {
+            let d: Vec<usize> = b.split('x').filter_map(|v| v.parse().ok()).collect();
+            let brick = [*d.first()?, *d.get(1)?, *d.get(2)?];
+            Some((b.to_string(), Bricked::from_spectrum(&spec.view(), brick)?))
+        })
+        .collect();
+    let mut grid = vec![0.0f32; n * n];
+    let mut other = vec![0.0f32; n * n];
+    for (name, dir) in [
+        ("axis", [0.0, -1.0, 0.0]),
+        ("oblique", [1.0, 0.3, 0.2]),
+        ("orbit45", [1.0, -1.0, 0.0]),
+    ] {
+        let axes = Sampling::UNIT.slice_axes(&View::along(dir).frame().unwrap());
+        let mut line = format!("{:?} {name:8}", spec.filter().kind());
+        let mut linear = Vec::new();
+        let mut bricked = vec![Vec::new(); copies.len()];
+        for _ in 0..2 {
+            linear.push(per_view(views, || {
+                assert!(extract(
+                    &spec.view(),
+                    &kernel,
+                    &axes,
+                    tiling,
+                    false,
+                    &mut grid
+                ));
+            }));
+            for (i, (_, copy)) in copies.iter().enumerate() {
+                bricked[i].push(per_view(views, || {
+                    assert!(extract_bricked(
+                        copy, &kernel, &axes, tiling, false, &mut other
+                    ));
+                }));
+                assert!(grid
+                    .iter()
+                    .zip(&other)
+                    .all(|(a, b)| a.to_bits() == b.to_bits()));
+            }
+        }
+        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+        line += &format!("  linear {:6.2}", mean(&linear));
+        for ((b, _), t) in copies.iter().zip(&bricked) {
+            line += &format!("  {b} {:6.2} ({:.2}x)", mean(t), mean(&linear) / mean(t));
+        }
+        println!("{line}");
     }
 }

@@ -5,7 +5,8 @@
 //! whose taps wrap around the cube at its faces, and near-axis ones whose
 //! runs straddle x = n − 1 → 0), physical-unit axes that are not
 //! orthonormal, and every tiling and thread split; on power-of-two and
-//! on mixed-radix sides.
+//! on mixed-radix sides; from the linear spectrum and from bricked
+//! copies of it (`fvr_host::render::fast_bricks`).
 
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::{Sampling, SliceAxes, View};
@@ -13,7 +14,8 @@ use fvr_core::num::{Real, Sample};
 use fvr_core::render::Request;
 use fvr_core::slice::extract_slice_rows;
 use fvr_core::volume::GridOversampling;
-use fvr_host::render::fast_slice::{extract, supports, Tiling};
+use fvr_host::render::fast_bricks::Bricked;
+use fvr_host::render::fast_slice::{extract, extract_bricked, supports, Tiling};
 use fvr_host::render::spectrum::{OwnedSpectrum, ViewRenderer};
 use fvr_host::render::view::render_once;
 use fvr_host::volume::Volume;
@@ -50,8 +52,13 @@ fn axes_for(dir: [f64; 3], sampling: &Sampling) -> SliceAxes {
     sampling.slice_axes(&View::along(dir).frame().unwrap())
 }
 
-/// The core's slice over all rows, then the host's with `tiling`, compared
-/// bit for bit (as f64 bit patterns: exact for f32 and f64 alike).
+/// Bricks the tests copy spectra into, where they divide the side: cubes,
+/// flat and tall ones, narrower and wider than every filter.
+const BRICKS: [[usize; 3]; 3] = [[4, 4, 4], [16, 8, 4], [2, 8, 16]];
+
+/// The core's slice over all rows, then the host's with `tiling`, from the
+/// linear spectrum and from its bricked copies, compared bit for bit (as
+/// f64 bit patterns: exact for f32 and f64 alike).
 fn check<S: Sample, T: Real + Send + Sync>(
     spec: &OwnedSpectrum<S>,
     axes: &SliceAxes,
@@ -67,17 +74,32 @@ fn check<S: Sample, T: Real + Send + Sync>(
         core.iter().filter(|v| v.to_f64() != 0.0).count() > n * n / 4,
         "{what}: the slice is mostly zero"
     );
+    let bricked: Vec<Bricked<S>> = BRICKS
+        .iter()
+        .filter_map(|&b| Bricked::from_spectrum(&view, b))
+        .collect();
+    assert!(!bricked.is_empty() || n % 4 != 0, "{what}: no bricked copy");
+    let differ = |host: &[T]| {
+        core.iter()
+            .zip(host)
+            .filter(|(a, b)| a.to_f64().to_bits() != b.to_f64().to_bits())
+            .count()
+    };
     for &tiling in tilings {
         for parallel in [false, true] {
             // Garbage first: every point must be written.
             let mut host = vec![T::from_f64(7.0); n * n];
             assert!(extract(&view, &kernel, axes, tiling, parallel, &mut host));
-            let differ = core
-                .iter()
-                .zip(&host)
-                .filter(|(a, b)| a.to_f64().to_bits() != b.to_f64().to_bits())
-                .count();
-            assert_eq!(differ, 0, "{what}, {tiling:?}, parallel {parallel}");
+            assert_eq!(differ(&host), 0, "{what}, {tiling:?}, parallel {parallel}");
+            for copy in &bricked {
+                let mut host = vec![T::from_f64(7.0); n * n];
+                assert!(extract_bricked(
+                    copy, &kernel, axes, tiling, parallel, &mut host
+                ));
+                let brick = copy.brick();
+                let d = differ(&host);
+                assert_eq!(d, 0, "{what}, {brick:?}, {tiling:?}, parallel {parallel}");
+            }
         }
     }
 }

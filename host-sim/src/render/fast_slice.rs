@@ -34,6 +34,8 @@ use fvr_core::num::{Real, Sample};
 use fvr_core::spectrum::Spectrum;
 use rayon::prelude::*;
 
+use super::fast_bricks::Bricked;
+
 /// How the host extraction walks the slice: `band` mirror pairs per unit
 /// of work, `chunk` columns per tile.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -89,26 +91,95 @@ pub fn extract<S: Sample, T: Real + Send + Sync>(
     };
     let data = spec.data();
     if n.is_power_of_two() {
-        by_width::<true, S, T>(data, kernel, &geometry, grid)
+        let source = Linear::<S, true> {
+            data,
+            side: Side { n },
+        };
+        by_width::<true, S, T, _>(&source, kernel, &geometry, grid)
     } else {
-        by_width::<false, S, T>(data, kernel, &geometry, grid)
+        let source = Linear::<S, false> {
+            data,
+            side: Side { n },
+        };
+        by_width::<false, S, T, _>(&source, kernel, &geometry, grid)
+    }
+}
+
+/// [`extract`] from a bricked copy of the spectrum: the same slice, bit
+/// for bit. `false` (grid untouched) when the grid is not `n²` or `kernel`
+/// is not the spectrum's filter.
+pub fn extract_bricked<S: Sample + Sync, T: Real + Send + Sync>(
+    spec: &Bricked<S>,
+    kernel: &KernelTable<T>,
+    axes: &SliceAxes,
+    tiling: Tiling,
+    parallel: bool,
+    grid: &mut [T],
+) -> bool {
+    let n = spec.n();
+    if grid.len() != n * n || *kernel.filter() != spec.filter() {
+        return false;
+    }
+    let geometry = Geometry {
+        right: axes.right.map(T::from_f64),
+        up: axes.up.map(T::from_f64),
+        n,
+        tiling: Tiling {
+            band: tiling.band.max(1),
+            chunk: tiling.chunk.max(1),
+        },
+        parallel,
+    };
+    // The bricked sums need no wrapping; `POW2` only picks how grid rows
+    // are indexed.
+    if n.is_power_of_two() {
+        by_width::<true, S, T, _>(spec, kernel, &geometry, grid)
+    } else {
+        by_width::<false, S, T, _>(spec, kernel, &geometry, grid)
+    }
+}
+
+/// Where a walk reads a point's tap sum from.
+trait TapSource<S>: Sync {
+    /// `Σ_c wz_c Σ_b wy_b Σ_t wx_t·c[z + c, y + b, x + t]` in the core's
+    /// order ([`tap_sum_on`]).
+    fn sum<const W: usize, T: Real>(&self, taps: [i32; 3], weights: [&[T; W]; 3]) -> T;
+}
+
+/// The linear layout (x fastest, then y, then z).
+struct Linear<'a, S, const POW2: bool> {
+    data: &'a [S],
+    side: Side<POW2>,
+}
+
+impl<S: Sample + Sync, const POW2: bool> TapSource<S> for Linear<'_, S, POW2> {
+    #[inline(always)]
+    fn sum<const W: usize, T: Real>(&self, taps: [i32; 3], weights: [&[T; W]; 3]) -> T {
+        tap_sum_on(self.data, self.side, taps, weights)
+    }
+}
+
+impl<S: Sample + Sync> TapSource<S> for Bricked<S> {
+    #[inline(always)]
+    fn sum<const W: usize, T: Real>(&self, taps: [i32; 3], weights: [&[T; W]; 3]) -> T {
+        self.tap_sum(taps, weights)
     }
 }
 
 /// [`walk`] for the kernel's width.
-fn by_width<const POW2: bool, S: Sample, T: Real + Send + Sync>(
-    data: &[S],
+fn by_width<const POW2: bool, S: Sample, T: Real + Send + Sync, Src: TapSource<S>>(
+    source: &Src,
     kernel: &KernelTable<T>,
     geometry: &Geometry<T>,
     grid: &mut [T],
 ) -> bool {
     match kernel.filter().width() {
-        1 => walk::<1, POW2, S, T>(data, kernel, geometry, grid),
-        2 => walk::<2, POW2, S, T>(data, kernel, geometry, grid),
-        3 => walk::<3, POW2, S, T>(data, kernel, geometry, grid),
-        4 => walk::<4, POW2, S, T>(data, kernel, geometry, grid),
-        5 => walk::<5, POW2, S, T>(data, kernel, geometry, grid),
-        _ => walk::<MAX_WIDTH, POW2, S, T>(data, kernel, geometry, grid),
+        1 => walk::<1, POW2, S, T, Src>(source, kernel, geometry, grid),
+        2 => walk::<2, POW2, S, T, Src>(source, kernel, geometry, grid),
+        3 => walk::<3, POW2, S, T, Src>(source, kernel, geometry, grid),
+        4 => walk::<4, POW2, S, T, Src>(source, kernel, geometry, grid),
+        5 => walk::<5, POW2, S, T, Src>(source, kernel, geometry, grid),
+        _ => walk::<MAX_WIDTH, POW2, S, T, Src>(source, kernel, geometry, grid),
     }
 }
 
@@ -184,8 +255,8 @@ struct Pair<'g, T> {
 /// The walk for filter width `W`: rows split into bands of pairs, each
 /// band set up, then filled tile by tile.
 #[inline(never)]
-fn walk<const W: usize, const POW2: bool, S: Sample, T: Real + Send + Sync>(
-    data: &[S],
+fn walk<const W: usize, const POW2: bool, S: Sample, T: Real + Send + Sync, Src: TapSource<S>>(
+    source: &Src,
     kernel: &KernelTable<T>,
     g: &Geometry<T>,
     grid: &mut [T],
@@ -224,8 +295,9 @@ fn walk<const W: usize, const POW2: bool, S: Sample, T: Real + Send + Sync>(
     while pairs.peek().is_some() {
         bands.push(pairs.by_ref().take(g.tiling.band).collect());
     }
-    let taps = Taps::<W, POW2, S, T> {
-        data,
+    let taps = Taps::<W, POW2, S, T, Src> {
+        source,
+        _sample: core::marker::PhantomData,
         side,
         phases: &phases,
         raw_gain: T::exp2i(T::raw_exponent::<S>()),
@@ -241,8 +313,8 @@ fn walk<const W: usize, const POW2: bool, S: Sample, T: Real + Send + Sync>(
 }
 
 /// Set up and fill one band of pairs.
-fn fill_band<const W: usize, const POW2: bool, S: Sample, T: Real>(
-    taps: &Taps<'_, W, POW2, S, T>,
+fn fill_band<const W: usize, const POW2: bool, S: Sample, T: Real, Src: TapSource<S>>(
+    taps: &Taps<'_, W, POW2, S, T, Src>,
     g: &Geometry<T>,
     band: &mut [Pair<'_, T>],
 ) {
@@ -282,8 +354,8 @@ fn fill_band<const W: usize, const POW2: bool, S: Sample, T: Real>(
 
 /// Points `k = from … to` of one pair, with their mirrors.
 #[inline(always)]
-fn fill_pair<const W: usize, const POW2: bool, S: Sample, T: Real>(
-    taps: &Taps<'_, W, POW2, S, T>,
+fn fill_pair<const W: usize, const POW2: bool, S: Sample, T: Real, Src: TapSource<S>>(
+    taps: &Taps<'_, W, POW2, S, T, Src>,
     pair: &mut Pair<'_, T>,
     from: i32,
     to: i32,
@@ -352,15 +424,18 @@ pub(super) fn row_interval<T: Real>(n: usize, right: &[T; 3], c: [T; 3]) -> (i32
 }
 
 /// The tap sums of one point and its mirror from the phase table.
-struct Taps<'a, const W: usize, const POW2: bool, S, T> {
-    data: &'a [S],
+struct Taps<'a, const W: usize, const POW2: bool, S, T, Src> {
+    source: &'a Src,
+    _sample: core::marker::PhantomData<S>,
     side: Side<POW2>,
     phases: &'a PhaseTable<T, W>,
     raw_gain: T,
     step: [i64; 3],
 }
 
-impl<const W: usize, const POW2: bool, S: Sample, T: Real> Taps<'_, W, POW2, S, T> {
+impl<const W: usize, const POW2: bool, S: Sample, T: Real, Src: TapSource<S>>
+    Taps<'_, W, POW2, S, T, Src>
+{
     /// The value at fixed-point position `y` (when `plus`) and at its
     /// mirror `−q` (when `minus`): taps `−j − t`, the run from
     /// `−j − (W − 1)` with the weights reversed.
@@ -389,7 +464,7 @@ impl<const W: usize, const POW2: bool, S: Sample, T: Real> Taps<'_, W, POW2, S, 
     /// [`tap_sum`] on this spectrum.
     #[inline(always)]
     fn value(&self, jx: i32, wx: &[T; W], jy: i32, wy: &[T; W], jz: i32, wz: &[T; W]) -> T {
-        tap_sum_on(self.data, self.side, [jx, jy, jz], [wx, wy, wz])
+        self.source.sum([jx, jy, jz], [wx, wy, wz])
     }
 }
 
