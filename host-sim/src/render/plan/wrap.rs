@@ -32,6 +32,7 @@
 use fvr_core::geometry::View;
 use fvr_core::volume::padded_size;
 use rayon::prelude::*;
+use std::sync::OnceLock;
 
 use super::splat::splat;
 use super::tails::Tails;
@@ -65,16 +66,19 @@ struct Shadow {
     cells: Vec<[f64; 3]>,
 }
 
-/// The volume's shadows along [`DIRECTIONS`], made once and folded for
-/// each grid side.
-pub(super) struct Shadows {
-    shadows: Vec<Shadow>,
+/// The volume's shadows along [`DIRECTIONS`], made once, when a grid side
+/// first needs them, and folded for each grid side.
+pub(super) struct Shadows<'a> {
+    volume: &'a Volume,
+    /// The canvas's half side: every voxel's pixel lies within it.
+    half: i64,
     /// The ideal image's period `N_ref`.
     reference: usize,
+    shadows: OnceLock<Vec<Shadow>>,
 }
 
-impl Shadows {
-    pub(super) fn new(volume: &Volume) -> Self {
+impl<'a> Shadows<'a> {
+    pub(super) fn new(volume: &'a Volume) -> Self {
         let d = volume.dims;
         // Voxel i sits at i − ⌊d/2⌋ from the transform origin: the
         // canvas reaches beyond the farthest corner.
@@ -85,20 +89,32 @@ impl Shadows {
             .sqrt();
         let half = reach.ceil() as i64 + 1;
         let reference = 2 * padded_size(d, 1).unwrap_or(1);
-        let shadows = DIRECTIONS
-            .par_iter()
-            .map(|&dir| {
-                let up = if dir[0] == 0.0 && dir[1] == 0.0 {
-                    [0.0, 1.0, 0.0]
-                } else {
-                    [0.0, 0.0, 1.0]
-                };
-                let frame = View { dir, up }.frame().expect("fixed directions");
-                let cells = splat(volume, frame.right, frame.up, half);
-                Shadow { half, cells }
-            })
-            .collect();
-        Self { shadows, reference }
+        Self {
+            volume,
+            half,
+            reference,
+            shadows: OnceLock::new(),
+        }
+    }
+
+    /// The shadows, splatted on first use.
+    fn splats(&self) -> &[Shadow] {
+        let (volume, half) = (self.volume, self.half);
+        self.shadows.get_or_init(|| {
+            DIRECTIONS
+                .par_iter()
+                .map(|&dir| {
+                    let up = if dir[0] == 0.0 && dir[1] == 0.0 {
+                        [0.0, 1.0, 0.0]
+                    } else {
+                        [0.0, 0.0, 1.0]
+                    };
+                    let frame = View { dir, up }.frame().expect("fixed directions");
+                    let cells = splat(volume, frame.right, frame.up, half);
+                    Shadow { half, cells }
+                })
+                .collect()
+        })
     }
 
     /// The worst share of error energy over the directions, `Σe²/Σs²`, in
@@ -111,10 +127,16 @@ impl Shadows {
 
     /// [`Self::worst_ratio`], the tails left out unless `with_tails`.
     fn ratio(&self, n: usize, side: usize, with_tails: bool) -> f64 {
-        let half = self.shadows.first().map_or(0, |s| s.half);
-        let tails =
-            (with_tails && n < self.reference).then(|| Tails::new(n, self.reference, half, side));
-        self.shadows
+        let half = self.half;
+        let with_tails = with_tails && n < self.reference;
+        // A canvas inside [−n/2, n/2) folds nothing, and without tails the
+        // error image is zero: the ratio is 0 whatever the content, so the
+        // splat is not made (σ = 2 grids).
+        if !with_tails && half < (n / 2) as i64 {
+            return 0.0;
+        }
+        let tails = with_tails.then(|| Tails::new(n, self.reference, half, side));
+        self.splats()
             .par_iter()
             .map(|s| {
                 let (mut err, signal) = folded(s, n, side);
@@ -174,6 +196,22 @@ mod tests {
     }
 
     #[test]
+    fn grids_that_cannot_wrap_skip_the_splat_and_lose_nothing() {
+        // The full box has the widest shadows; on twice its side the
+        // canvas lies inside the image and there are no tails.
+        let volume = cube(32);
+        let shadows = Shadows::new(&volume);
+        assert_eq!(shadows.worst_ratio(64, 32), 0.0);
+        assert!(shadows.shadows.get().is_none());
+        for s in shadows.splats() {
+            let (err, signal) = folded(s, 64, 32);
+            assert!(signal > 0.0);
+            assert!(err.iter().all(|&e| e == 0.0));
+        }
+        assert!(shadows.worst_ratio(32, 32) > 0.0);
+    }
+
+    #[test]
     fn a_full_box_wraps_on_its_diagonals_and_not_on_twice_its_side() {
         let volume = cube(32);
         let shadows = Shadows::new(&volume);
@@ -228,7 +266,8 @@ mod tests {
 
     #[test]
     fn tails_vanish_at_the_reference_period_and_grow_as_the_grid_shrinks() {
-        let shadows = Shadows::new(&ball(true));
+        let volume = ball(true);
+        let shadows = Shadows::new(&volume);
         // The ball's shadow never wraps; the tails are what remains.
         let (at32, at40, at48) = (
             shadows.worst_ratio(32, 32),
@@ -266,7 +305,7 @@ mod tests {
                 let k1: f64 = kernel.iter().map(|k| k.abs()).sum();
                 let mut slow = 0.0f64;
                 let mut tolerance = 0.0f64;
-                for s in &shadows.shadows {
+                for s in shadows.splats() {
                     let (mut err, signal) = folded(s, n, side);
                     subtract_direct(&s.cells, s.half, &kernel, n as i64, side as i64, &mut err);
                     let e2: f64 = err.iter().map(|e| e * e).sum();
