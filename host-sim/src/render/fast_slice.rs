@@ -79,16 +79,7 @@ pub fn extract<S: Sample, T: Real + Send + Sync>(
     if !supports(spec) || grid.len() != n * n || kernel.filter() != spec.filter() {
         return false;
     }
-    let geometry = Geometry {
-        right: axes.right.map(T::from_f64),
-        up: axes.up.map(T::from_f64),
-        n,
-        tiling: Tiling {
-            band: tiling.band.max(1),
-            chunk: tiling.chunk.max(1),
-        },
-        parallel,
-    };
+    let geometry = Geometry::new(axes, n, tiling, parallel);
     let data = spec.data();
     if n.is_power_of_two() {
         let source = Linear::<S, true> {
@@ -120,16 +111,7 @@ pub fn extract_bricked<S: Sample + Sync, T: Real + Send + Sync>(
     if grid.len() != n * n || *kernel.filter() != spec.filter() {
         return false;
     }
-    let geometry = Geometry {
-        right: axes.right.map(T::from_f64),
-        up: axes.up.map(T::from_f64),
-        n,
-        tiling: Tiling {
-            band: tiling.band.max(1),
-            chunk: tiling.chunk.max(1),
-        },
-        parallel,
-    };
+    let geometry = Geometry::new(axes, n, tiling, parallel);
     // The bricked sums need no wrapping; `POW2` only picks how grid rows
     // are indexed.
     if n.is_power_of_two() {
@@ -236,6 +218,21 @@ struct Geometry<T> {
     n: usize,
     tiling: Tiling,
     parallel: bool,
+}
+
+impl<T: Real> Geometry<T> {
+    fn new(axes: &SliceAxes, n: usize, tiling: Tiling, parallel: bool) -> Self {
+        Self {
+            right: axes.right.map(T::from_f64),
+            up: axes.up.map(T::from_f64),
+            n,
+            tiling: Tiling {
+                band: tiling.band.max(1),
+                chunk: tiling.chunk.max(1),
+            },
+            parallel,
+        }
+    }
 }
 
 /// One mirror pair of a band: row `p` (`plus`, absent for `p = n/2`) and

@@ -503,6 +503,8 @@ mod choose;
 mod splat;
 mod sums;
 mod tails;
+#[cfg(test)]
+mod test_volume;
 mod wrap;
 pub use choose::{
     choose, choose_among, cost, cost_grid, Constraints, Plan, CANDIDATE_FILTERS, MARGIN_DB,

@@ -127,20 +127,7 @@ mod tests {
     #[test]
     fn the_splat_is_the_voxel_loop_to_rounding() {
         let dims = [13, 10, 7];
-        let mut state = 0x2545_f491_u32;
-        let data: Vec<f32> = (0..dims.iter().product::<usize>())
-            .map(|i| {
-                state ^= state << 13;
-                state ^= state >> 17;
-                state ^= state << 5;
-                if i % 6 == 0 {
-                    0.0
-                } else {
-                    (state % 2001) as f32 / 1000.0 - 1.0
-                }
-            })
-            .collect();
-        let volume = Volume::new(dims, data);
+        let volume = super::super::test_volume::random(dims, 6);
         let s = 0.5f64.sqrt();
         // A generic frame and a face diagonal's, on a canvas reaching
         // beyond the box's corners (as `wrap.rs` makes it).

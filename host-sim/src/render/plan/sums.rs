@@ -206,20 +206,7 @@ mod tests {
         // A box of odd and even sides touching the grid's faces, with zeros,
         // negative values and edge positions on every axis.
         let dims = [13, 15, 11];
-        let mut state = 0x2545_f491_u32;
-        let data: Vec<f32> = (0..dims.iter().product::<usize>())
-            .map(|i| {
-                state ^= state << 13;
-                state ^= state >> 17;
-                state ^= state << 5;
-                if i % 7 == 0 {
-                    0.0
-                } else {
-                    (state % 2001) as f32 / 1000.0 - 1.0
-                }
-            })
-            .collect();
-        let volume = Volume::new(dims, data);
+        let volume = super::super::test_volume::random(dims, 7);
         for kind in [
             fvr_core::filter::FilterKind::Cubic,
             fvr_core::filter::FilterKind::Kb4,
