@@ -105,8 +105,6 @@ struct ErrorModel {
     /// exponents, a format f32 holds), so the marks may test it.
     exact: bool,
     work: Vec<f32>,
-    /// `work` holds the reference field (every sample, unweighted).
-    holds_reference: bool,
 }
 
 impl ErrorModel {
@@ -152,12 +150,10 @@ impl ErrorModel {
             lowest,
             exact: plain && (S::BITS <= 16 || S::NAME == "f32"),
             work: vec![0.0; n * n * n],
-            holds_reference: false,
         };
         let ones = model.large_response.clone();
         model.reference =
             model.field_energy(f64::INFINITY, |x| ones[x[0]] * ones[x[1]] * ones[x[2]])?;
-        model.holds_reference = true;
         Ok(model)
     }
 
@@ -192,7 +188,6 @@ impl ErrorModel {
             planes_z: &all,
             fill: &fill,
         };
-        self.holds_reference = false;
         dht_3d_real::<f32, f32>(&cube, &mut self.work).map_err(|e| e.to_string())?;
         Ok(self.work_energy(weight))
     }
@@ -266,17 +261,7 @@ impl ErrorModel {
         // From `top` on every sample is weak: no larger threshold changes the set.
         let top = self.lowest + self.bins.len() as i64 - 1;
         let mut bad = top + 1;
-        // The ratio of exact to estimated energy with every sample weak,
-        // from the reference field while it is at hand: it varies slowly
-        // with `τ`, so the first probe lands near the answer.
         let mut scale = 1.0;
-        let everything = self.estimate(top, mean_square);
-        if self.holds_reference && everything > 0.0 {
-            let all = self.work_energy(weight);
-            if all > 0.0 {
-                scale = all / everything;
-            }
-        }
         let mut probes = 0;
         while bad - good.0 > 1 {
             let b = if probes < 3 {
