@@ -1,7 +1,8 @@
 //! CPU time per view on one thread (the thread's own user + system time
 //! from `/proc/thread-self/stat`, so time the thread spends waiting for a
 //! core shared with other processes is not counted): the host extraction
-//! (`fvr_host::render::fast_slice`) against the core's render, at 256³
+//! (`fvr_host::render::fast_strip` where the rows hold a coordinate, the
+//! exact walk `fvr_host::render::fast_slice` beside it) against the core's render, at 256³
 //! f16, kb4 and kb6, along an axis, an oblique direction and the orbit
 //! direction at 45°. A companion of the `view` criterion bench for a
 //! loaded machine, where wall-clock times of threaded views mean little.
@@ -24,7 +25,7 @@ use fvr_core::volume::GridOversampling;
 use fvr_host::render::fast_bricks::Bricked;
 use fvr_host::render::fast_slice::{extract, extract_bricked, Tiling};
 use fvr_host::render::spectrum::{OwnedSpectrum, ViewRenderer};
-use fvr_host::render::view::render_once;
+use fvr_host::render::view::{render_once, Walk};
 use fvr_host::sources::phantom::{sample, GaussianMixture};
 use half::f16;
 
@@ -103,6 +104,10 @@ fn main() {
         let mut renderer = ViewRenderer::<f32>::new(side, filter)
             .with_threads(1)
             .with_tiling(tiling);
+        let mut exact_renderer = ViewRenderer::<f32>::new(side, filter)
+            .with_threads(1)
+            .with_tiling(tiling)
+            .with_walk(Walk::Exact);
         for (name, dir) in [
             ("axis", [0.0, -1.0, 0.0]),
             ("oblique", [1.0, 0.3, 0.2]),
@@ -114,12 +119,19 @@ fn main() {
                     .render_into(&spec, black_box(&view), n, n, &mut out)
                     .unwrap()
             });
+            let exact = per_view(views, || {
+                exact_renderer
+                    .render_into(&spec, black_box(&view), n, n, &mut out)
+                    .unwrap()
+            });
             let request = Request::new(view, n, n);
             let core = per_view(views, || {
                 black_box(render_once::<f16, f32>(&spec.view(), &request).unwrap());
             });
             println!(
-                "{kind:?} {name:8} host {host:6.2}  core {core:6.2}  core/host {:.2}",
+                "{kind:?} {name:8} host {host:6.2}  exact walk {exact:6.2}  core {core:6.2}  \
+                 exact/host {:.2}  core/host {:.2}",
+                exact / host,
                 core / host
             );
         }

@@ -17,7 +17,7 @@ use fvr_core::volume::GridOversampling;
 use fvr_host::render::fast_bricks::Bricked;
 use fvr_host::render::fast_slice::{extract, extract_bricked, supports, Tiling};
 use fvr_host::render::spectrum::{OwnedSpectrum, ViewRenderer};
-use fvr_host::render::view::render_once;
+use fvr_host::render::view::{render_once, Walk};
 use fvr_host::volume::Volume;
 use half::f16;
 
@@ -176,6 +176,7 @@ fn renderer_image_equals_core_render() {
                 let mut out = vec![0.0f32; 24 * 20];
                 ViewRenderer::<f32>::new(n, filter)
                     .with_threads(threads)
+                    .with_walk(Walk::Exact)
                     .render_into(&spec, &view, 24, 20, &mut out)
                     .unwrap();
                 for (a, b) in core.iter().zip(&out) {
@@ -246,6 +247,7 @@ fn renderer_image_equals_core_render_on_mixed_sides() {
                 let mut out = vec![0.0f32; 30 * 28];
                 ViewRenderer::<f32>::new(n, filter)
                     .with_threads(threads)
+                    .with_walk(Walk::Exact)
                     .render_into(&spec, &view, 30, 28, &mut out)
                     .unwrap();
                 for (a, b) in core.iter().zip(&out) {

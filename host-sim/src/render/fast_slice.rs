@@ -212,16 +212,16 @@ impl<const POW2: bool> Side<POW2> {
 }
 
 /// The slice's axes in `T`, the cube side and the walk.
-struct Geometry<T> {
-    right: [T; 3],
-    up: [T; 3],
-    n: usize,
-    tiling: Tiling,
-    parallel: bool,
+pub(super) struct Geometry<T> {
+    pub(super) right: [T; 3],
+    pub(super) up: [T; 3],
+    pub(super) n: usize,
+    pub(super) tiling: Tiling,
+    pub(super) parallel: bool,
 }
 
 impl<T: Real> Geometry<T> {
-    fn new(axes: &SliceAxes, n: usize, tiling: Tiling, parallel: bool) -> Self {
+    pub(super) fn new(axes: &SliceAxes, n: usize, tiling: Tiling, parallel: bool) -> Self {
         Self {
             right: axes.right.map(T::from_f64),
             up: axes.up.map(T::from_f64),
@@ -239,14 +239,14 @@ impl<T: Real> Geometry<T> {
 /// row `−p` (`minus`; row 0 is its own mirror and holds both halves), the
 /// pair's interval of `kx` inside the Nyquist cube and its anchor's
 /// fixed-point position.
-struct Pair<'g, T> {
-    p: usize,
-    plus: Option<&'g mut [T]>,
-    minus: Option<&'g mut [T]>,
-    low: i32,
-    high: i32,
-    anchor: i32,
-    base: [i64; 3],
+pub(super) struct Pair<'g, T> {
+    pub(super) p: usize,
+    pub(super) plus: Option<&'g mut [T]>,
+    pub(super) minus: Option<&'g mut [T]>,
+    pub(super) low: i32,
+    pub(super) high: i32,
+    pub(super) anchor: i32,
+    pub(super) base: [i64; 3],
 }
 
 /// The walk for filter width `W`: rows split into bands of pairs, each
@@ -264,6 +264,28 @@ fn walk<const W: usize, const POW2: bool, S: Sample, T: Real + Send + Sync, Src:
     }
     let n = g.n;
     let side = Side::<POW2> { n };
+    let mut bands = bands_of_pairs(grid, n, g.tiling.band);
+    let taps = Taps::<W, POW2, S, T, Src> {
+        source,
+        _sample: core::marker::PhantomData,
+        side,
+        phases: &phases,
+        raw_gain: T::exp2i(T::raw_exponent::<S>()),
+        step: g.right.map(PhaseTable::<T, W>::fixed_step),
+    };
+    let fill = |band: &mut Vec<Pair<'_, T>>| fill_band(&taps, g, band);
+    if g.parallel {
+        bands.par_iter_mut().for_each(fill);
+    } else {
+        bands.iter_mut().for_each(fill);
+    }
+    true
+}
+
+/// The grid's rows as mirror pairs (`p`, `−p`) for `p = 0 … n/2`, in
+/// bands of `band` consecutive pairs.
+pub(super) fn bands_of_pairs<T>(grid: &mut [T], n: usize, band: usize) -> Vec<Vec<Pair<'_, T>>> {
+    let side = Side::<false> { n };
     let mut rows: Vec<Option<&mut [T]>> = grid.chunks_exact_mut(n).map(Some).collect();
     // Signed frequencies of a row: −n/2 … n/2 − 1; row `p` holds `ky = p`
     // for `p ≤ k_max`, row `(n − p) mod n` holds `ky = −p`.
@@ -290,22 +312,35 @@ fn walk<const W: usize, const POW2: bool, S: Sample, T: Real + Send + Sync, Src:
     let mut bands: Vec<Vec<Pair<'_, T>>> = Vec::new();
     let mut pairs = pairs.into_iter().peekable();
     while pairs.peek().is_some() {
-        bands.push(pairs.by_ref().take(g.tiling.band).collect());
+        bands.push(pairs.by_ref().take(band.max(1)).collect());
     }
-    let taps = Taps::<W, POW2, S, T, Src> {
-        source,
-        _sample: core::marker::PhantomData,
-        side,
-        phases: &phases,
-        raw_gain: T::exp2i(T::raw_exponent::<S>()),
-        step: g.right.map(PhaseTable::<T, W>::fixed_step),
-    };
-    let fill = |band: &mut Vec<Pair<'_, T>>| fill_band(&taps, g, band);
-    if g.parallel {
-        bands.par_iter_mut().for_each(fill);
-    } else {
-        bands.iter_mut().for_each(fill);
+    bands
+}
+
+/// Zero the pair's rows and set its interval inside the Nyquist cube,
+/// anchor and anchor position; `false` when the interval is empty.
+pub(super) fn set_up_pair<const W: usize, T: Real>(
+    g: &Geometry<T>,
+    pair: &mut Pair<'_, T>,
+) -> bool {
+    let n = g.n;
+    let half = (n / 2) as i32;
+    for row in [&mut pair.plus, &mut pair.minus].into_iter().flatten() {
+        row.fill(T::ZERO);
     }
+    let ky = T::from_usize(pair.p);
+    let kyu = g.up.map(|c| ky * c);
+    let (low, high) = row_interval(n, &g.right, kyu);
+    let k_low = if pair.p == 0 { 0 } else { -half };
+    let (low, high) = (low.max(k_low), high.min(half));
+    if low > high {
+        return false;
+    }
+    let anchor = 0.clamp(low, high);
+    let kx = T::from_i32(anchor);
+    pair.base =
+        core::array::from_fn(|a| PhaseTable::<T, W>::fixed_position(kx * g.right[a] + kyu[a]));
+    (pair.low, pair.high, pair.anchor) = (low, high, anchor);
     true
 }
 
@@ -316,27 +351,12 @@ fn fill_band<const W: usize, const POW2: bool, S: Sample, T: Real, Src: TapSourc
     band: &mut [Pair<'_, T>],
 ) {
     let n = g.n;
-    let half = (n / 2) as i32;
     let (mut first, mut last) = (i32::MAX, i32::MIN);
     for pair in band.iter_mut() {
-        for row in [&mut pair.plus, &mut pair.minus].into_iter().flatten() {
-            row.fill(T::ZERO);
+        if set_up_pair::<W, T>(g, pair) {
+            first = first.min(pair.low);
+            last = last.max(pair.high);
         }
-        let ky = T::from_usize(pair.p);
-        let kyu = g.up.map(|c| ky * c);
-        let (low, high) = row_interval(n, &g.right, kyu);
-        let k_low = if pair.p == 0 { 0 } else { -half };
-        let (low, high) = (low.max(k_low), high.min(half));
-        if low > high {
-            continue;
-        }
-        let anchor = 0.clamp(low, high);
-        let kx = T::from_i32(anchor);
-        pair.base =
-            core::array::from_fn(|a| PhaseTable::<T, W>::fixed_position(kx * g.right[a] + kyu[a]));
-        (pair.low, pair.high, pair.anchor) = (low, high, anchor);
-        first = first.min(low);
-        last = last.max(high);
     }
     let chunk = g.tiling.chunk.min(n) as i32;
     let mut start = first;

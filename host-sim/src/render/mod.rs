@@ -12,6 +12,7 @@ pub mod fast_mixed;
 pub mod fast_prepare;
 pub mod fast_slice;
 pub mod fast_store;
+pub mod fast_strip;
 #[cfg(test)]
 mod fast_tests;
 pub mod filter;

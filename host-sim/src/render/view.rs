@@ -13,6 +13,7 @@ use fvr_core::spectrum::Spectrum;
 
 use super::fast_inverse::MixedFinish;
 use super::fast_slice::{self, Tiling};
+use super::fast_strip;
 use super::spectrum::OwnedSpectrum;
 
 /// Reusable per-view buffers and tables for arithmetic `T`.
@@ -28,6 +29,20 @@ pub struct ViewRenderer<T> {
     threads: usize,
     pool: Option<rayon::ThreadPool>,
     tiling: Tiling,
+    walk: Walk,
+}
+
+/// How a plain view's slice is summed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Walk {
+    /// Reduced along the axis the slice's rows hold, where there is one
+    /// ([`fast_strip`]): the core's values to within rounding, with a
+    /// third to a sixth of the products. Elsewhere as [`Walk::Exact`].
+    #[default]
+    Strip,
+    /// Tap by tap in the core's order ([`fast_slice`]): the core's
+    /// values bit for bit.
+    Exact,
 }
 
 impl<T: Real> ViewRenderer<T> {
@@ -47,6 +62,7 @@ impl<T: Real> ViewRenderer<T> {
             threads: 0,
             pool: None,
             tiling: Tiling::default(),
+            walk: Walk::default(),
         }
     }
 
@@ -80,6 +96,12 @@ impl<T: Real> ViewRenderer<T> {
     /// ([`fast_slice::extract`]; the image is the same whatever it is).
     pub fn with_tiling(mut self, tiling: Tiling) -> Self {
         self.tiling = tiling;
+        self
+    }
+
+    /// Sum plain slices by `walk` ([`Walk`]).
+    pub fn with_walk(mut self, walk: Walk) -> Self {
+        self.walk = walk;
         self
     }
 
@@ -130,12 +152,16 @@ impl<T: Real> ViewRenderer<T> {
             let axes = sampling.slice_axes(&view.frame()?);
             check_image(width, height, n)?;
             let (kernel, tiling, grid) = (&self.kernel, self.tiling, &mut self.grid);
+            let walk = self.walk;
+            let extract = |parallel: bool, grid: &mut [T]| {
+                (walk == Walk::Strip
+                    && fast_strip::extract(&spec, kernel, &axes, tiling, parallel, grid))
+                    || fast_slice::extract(&spec, kernel, &axes, tiling, parallel, grid)
+            };
             let filled = match (&self.pool, self.threads) {
-                (_, 1) => fast_slice::extract(&spec, kernel, &axes, tiling, false, grid),
-                (Some(pool), _) => {
-                    pool.install(|| fast_slice::extract(&spec, kernel, &axes, tiling, true, grid))
-                }
-                (None, _) => fast_slice::extract(&spec, kernel, &axes, tiling, true, grid),
+                (_, 1) => extract(false, grid),
+                (Some(pool), _) => pool.install(|| extract(true, grid)),
+                (None, _) => extract(true, grid),
             };
             if filled {
                 let place = placement_on_axes(spec.dims(), &axes, width, height, 1.0);
