@@ -112,6 +112,10 @@ pub struct Plan {
 /// reaches the target.
 pub const MARGIN_DB: f64 = 3.0;
 
+/// What the bound on a job passed by ([`choose_among`]) allows for the
+/// rounding of `combine`'s few operations, dB.
+const BOUND_SLACK_DB: f64 = 1e-9;
+
 /// The cheapest candidate ([`cost`]) predicted to reach `target_db` +
 /// [`MARGIN_DB`] (or, if none does, `target_db`), among
 /// [`CANDIDATE_FILTERS`] × oversampling 1, 2 × f16, f32 restricted by
@@ -224,29 +228,47 @@ pub fn choose_among(
     };
     let batch = rayon::current_num_threads().max(1);
     let mut done: Vec<Option<Vec<Prediction>>> = vec![None; jobs.len()];
+    let wrap_of = |n: usize, wraps: &mut Vec<(usize, f64)>| -> Result<f64, fvr_core::Error> {
+        if let Some(&(_, w)) = wraps.iter().find(|&&(m, _)| m == n) {
+            return Ok(w);
+        }
+        let w = shadows.worst_ratio(n, super::image_side(volume.dims, n)?);
+        wraps.push((n, w));
+        Ok(w)
+    };
+    // A job is not run while the walk can pass it by: its wrap term alone
+    // keeps every candidate below the target with the margin. `combine`
+    // adds `wrap·Σs²` to the worst axis view's error, so the SNR is at most
+    // `−10·log₁₀ wrap` once that view's `Σs²` is positive. `Σs²`, the
+    // energy of the voxel sums in the image, is the same for every job (to
+    // the order of its additions): a job already run with a finite SNR on
+    // every view shows it.
+    let mut positive = false;
+    let hopeless = |wrap: f64, positive: bool| {
+        positive && wrap > 0.0 && -10.0 * wrap.log10() + BOUND_SLACK_DB < target_db + MARGIN_DB
+    };
     for (at, &(j, f, _)) in order.iter().enumerate() {
         if done[j].is_none() {
+            if hopeless(wrap_of(jobs[j].2, &mut wraps)?, positive) {
+                continue;
+            }
             let mut next: Vec<usize> = Vec::with_capacity(batch);
             for &(k, _, _) in &order[at..] {
-                if done[k].is_none() && !next.contains(&k) {
+                if done[k].is_none()
+                    && !next.contains(&k)
+                    && !hopeless(wrap_of(jobs[k].2, &mut wraps)?, positive)
+                {
                     next.push(k);
                     if next.len() == batch {
                         break;
                     }
                 }
             }
-            for &k in &next {
-                let n = jobs[k].2;
-                if !wraps.iter().any(|&(m, _)| m == n) {
-                    wraps.push((
-                        n,
-                        shadows.worst_ratio(n, super::image_side(volume.dims, n)?),
-                    ));
-                }
-            }
             let results: Vec<_> = next.par_iter().map(|&k| run(&jobs[k], &wraps)).collect();
             for (k, r) in next.into_iter().zip(results) {
-                done[k] = Some(r?);
+                let r = r?;
+                positive |= r.iter().any(|p| p.views_db.iter().all(|d| d.is_finite()));
+                done[k] = Some(r);
             }
         }
         let p = done[j].as_ref().map(|d| d[f]);
@@ -258,7 +280,16 @@ pub fn choose_among(
             });
         }
     }
-    // None reaches the margin: every job has run.
+    // None reaches the margin: the jobs passed by run now, so that every
+    // job has run.
+    let rest: Vec<usize> = (0..jobs.len()).filter(|&k| done[k].is_none()).collect();
+    for &k in &rest {
+        wrap_of(jobs[k].2, &mut wraps)?;
+    }
+    let results: Vec<_> = rest.par_iter().map(|&k| run(&jobs[k], &wraps)).collect();
+    for (k, r) in rest.into_iter().zip(results) {
+        done[k] = Some(r?);
+    }
     let predictions: Vec<Prediction> = order
         .iter()
         .filter_map(|&(j, f, _)| done[j].as_ref().map(|d| d[f]))

@@ -36,25 +36,43 @@ impl ViewSums {
     }
 }
 
-/// The six weights of one position along a view axis: plain, `c` and `s`
-/// over edge positions, then over the others.
+/// The six sums of a pixel: plain, `c` and `s` over edge positions, then
+/// over the others.
 const SUMS: usize = 6;
 
+/// One position along a view axis: its three weights (plain, `c`, `s`)
+/// and where its sums start, 0 for an edge position and 3 for the others
+/// (the other three weights are zeros, whose additions change nothing and
+/// are skipped).
+#[derive(Clone, Copy)]
+struct Weight {
+    at: usize,
+    w: [f64; 3],
+}
+
 /// The weights of the positions `0 … len` of one axis of the volume.
-fn along(w: &AxisWeights, grid: &impl Fn(usize) -> usize, len: usize) -> Vec<[f64; SUMS]> {
+fn along(w: &AxisWeights, grid: &impl Fn(usize) -> usize, len: usize) -> Vec<Weight> {
     (0..len)
         .map(|i| {
             let g = grid(i);
-            core::array::from_fn(|t| {
-                let kind = [1.0, w.c[g], w.s[g]][t % 3];
-                if w.edge[g] == (t < 3) {
-                    kind
-                } else {
-                    0.0
-                }
-            })
+            Weight {
+                at: if w.edge[g] { 0 } else { 3 },
+                w: [1.0, w.c[g], w.s[g]],
+            }
         })
         .collect()
+}
+
+/// The runs of equal [`Weight::at`] along `weights`: `(start, end, at)`.
+fn runs(weights: &[Weight]) -> Vec<(usize, usize, usize)> {
+    let mut out: Vec<(usize, usize, usize)> = Vec::new();
+    for (i, w) in weights.iter().enumerate() {
+        match out.last_mut() {
+            Some(last) if last.2 == w.at => last.1 = i + 1,
+            _ => out.push((i, i + 1, w.at)),
+        }
+    }
+    out
 }
 
 /// Rows of `j` and of `k` per block of the pass: the pixel sums of a
@@ -88,6 +106,7 @@ pub(super) fn view_sums(
     let grid = |a: usize| move |i: usize| (i + n - volume.dims[a] / 2 % n) % n;
     let (gx, gy, gz) = (grid(0), grid(1), grid(2));
     let (wx, wy, wz) = (along(w, &gx, d0), along(w, &gy, d1), along(w, &gz, d2));
+    let x_runs = runs(&wx);
     let px: Vec<f64> = (0..d0).map(|i| w.p[gx(i)]).collect();
     // Pixel sums on the volume's own extent: x view (j, k), y view (i, k),
     // z view (i, j).
@@ -112,21 +131,21 @@ pub(super) fn view_sums(
                         }
                     }
                     let mut acc = [0.0; SUMS];
-                    for (&v, c) in row.iter().zip(&wx) {
-                        for t in 0..SUMS {
-                            acc[t] += v * c[t];
+                    for &(start, end, at) in &x_runs {
+                        let acc = &mut acc[at..at + 3];
+                        for (&v, c) in row[start..end].iter().zip(&wx[start..end]) {
+                            for t in 0..3 {
+                                acc[t] += v * c.w[t];
+                            }
                         }
                     }
                     xs[j + d1 * k] = acc;
-                    let (cy, cz) = (&wy[j], &wz[k]);
-                    for (s, &v) in ys[d0 * k..][..d0].iter_mut().zip(&row) {
-                        for t in 0..SUMS {
-                            s[t] += v * cy[t];
-                        }
-                    }
-                    for (s, &v) in zs[d0 * j..][..d0].iter_mut().zip(&row) {
-                        for t in 0..SUMS {
-                            s[t] += v * cz[t];
+                    for (sums, c, line) in [(&mut ys, wy[j], k), (&mut zs, wz[k], j)] {
+                        for (s, &v) in sums[d0 * line..][..d0].iter_mut().zip(&row) {
+                            let s = &mut s[c.at..c.at + 3];
+                            for t in 0..3 {
+                                s[t] += v * c.w[t];
+                            }
                         }
                     }
                 }

@@ -34,7 +34,7 @@ use fvr_core::volume::padded_size;
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
-use super::splat::splat;
+use super::splat::{lattice_step, splat};
 use super::tails::Tails;
 use crate::volume::Volume;
 
@@ -110,7 +110,8 @@ impl<'a> Shadows<'a> {
                         [0.0, 0.0, 1.0]
                     };
                     let frame = View { dir, up }.frame().expect("fixed directions");
-                    let cells = splat(volume, frame.right, frame.up, half);
+                    let step = lattice_step(dir);
+                    let cells = splat(volume, frame.right, frame.up, half, step);
                     Shadow { half, cells }
                 })
                 .collect()
