@@ -87,19 +87,18 @@ pub fn dht_3d_real<T: FastReal, S: FastStore>(
     assert_eq!(cube.planes_z.len(), n);
     let h = n / 2 + 1;
     let zero = Complex::new(T::ZERO, T::ZERO);
-    let mut half = Vec::new();
-    half.par_extend(rayon::iter::repeat_n(zero, h * n * n));
 
     let r2c = RealFftPlanner::<T>::new().plan_fft_forward(n);
     let fft = FftPlanner::<T>::new().plan_fft_forward(n);
     let fft_scratch = fft.get_inplace_scratch_len();
     let r2c_scratch = r2c.get_scratch_len();
 
-    // Passes 1 and 2, a z-plane at a time.
-    half.par_chunks_mut(h * n)
-        .enumerate()
-        .filter(|(z, _)| cube.planes_z[*z])
-        .for_each_init(
+    // Passes 1 and 2, a z-plane at a time, each plane allocated and written
+    // by the thread that transforms it: no separate pass zeroes the half
+    // spectrum, and planes the padding leaves zero are not stored.
+    let planes: Vec<Vec<Complex<T>>> = (0..n)
+        .into_par_iter()
+        .map_init(
             || {
                 (
                     vec![T::ZERO; n],
@@ -107,7 +106,11 @@ pub fn dht_3d_real<T: FastReal, S: FastStore>(
                     vec![zero; h * n],
                 )
             },
-            |(line, scratch, tile), (z, plane)| {
+            |(line, scratch, tile), z| {
+                if !cube.planes_z[z] {
+                    return Vec::new();
+                }
+                let mut plane = vec![zero; h * n];
                 for (y, row) in plane.chunks_exact_mut(h).enumerate() {
                     if cube.rows_y[y] {
                         (cube.fill)(y, z, line);
@@ -116,11 +119,21 @@ pub fn dht_3d_real<T: FastReal, S: FastStore>(
                     }
                 }
                 // One line per column u: tile[u·n + y] = plane[y·h + u].
-                transpose(plane, h, n, h, tile, n);
+                transpose(|y| &plane[y * h..], n, h, tile, n);
                 fft.process_with_scratch(tile, &mut scratch[..fft_scratch]);
-                transpose(tile, n, h, n, plane, h);
+                transpose(|u| &tile[u * n..], h, n, &mut plane, h);
+                plane
             },
-        );
+        )
+        .collect();
+    let zero_row = vec![zero; h];
+    // Row y of plane z of the half spectrum, `h` values.
+    let half_row = |z: usize, y: usize| -> &[Complex<T>] {
+        match planes[z].get(y * h..(y + 1) * h) {
+            Some(row) => row,
+            None => &zero_row,
+        }
+    };
 
     // Pass 3. Output rows grouped by v (row index v + n·w), in w order.
     let mut by_v: Vec<Vec<&mut [S]>> = (0..n).map(|_| Vec::with_capacity(n)).collect();
@@ -138,7 +151,7 @@ pub fn dht_3d_real<T: FastReal, S: FastStore>(
         };
         pairs.push((v, rows, rows_m));
     }
-    let half = &half;
+    let half_row = &half_row;
     let finite = pairs
         .into_par_iter()
         .map_init(
@@ -157,9 +170,9 @@ pub fn dht_3d_real<T: FastReal, S: FastStore>(
                 // tile[u·n + z] = F(u, y, z) after the FFT along z, then
                 // rows_y[z·h + u] = the same (row by row for the output).
                 let mut columns = |tile: &mut [Complex<T>], out: &mut [Complex<T>], y: usize| {
-                    transpose(&half[y * h..], n * h, n, h, tile, n);
+                    transpose(|z| half_row(z, y), n, h, tile, n);
                     fft.process_with_scratch(tile, scratch);
-                    transpose(tile, n, h, n, out, h);
+                    transpose(|u| &tile[u * n..], h, n, out, h);
                 };
                 columns(tile, rows_v, v);
                 let rows_vm: &[Complex<T>] = if vm == v {
@@ -176,6 +189,8 @@ pub fn dht_3d_real<T: FastReal, S: FastStore>(
             },
         )
         .reduce(|| true, |a, b| a && b);
+    // Freed on all cores: unmapping the planes is a large part too.
+    planes.into_par_iter().for_each(drop);
     if finite {
         Ok(())
     } else {
@@ -213,29 +228,40 @@ fn hartley_rows<T: FastReal, S: FastStore>(
     finite
 }
 
-/// Rows and columns of the tiles [`transpose`] moves at a time.
-const BLOCK: usize = 16;
+/// Rows and columns of the blocks [`transpose`] moves at a time: a block's
+/// row of complex f32 values is one 64-byte cache line.
+const BLOCK: usize = 8;
 
-/// `dst[c·dst_stride + r] = src[r·src_stride + c]` for `r < rows`,
-/// `c < cols`, in `BLOCK × BLOCK` tiles so that both sides stay in cache.
-fn transpose<C: Copy>(
-    src: &[C],
-    src_stride: usize,
+/// `dst[c·dst_stride + r] = row(r)[c]` for `r < rows`, `c < cols`, a
+/// `BLOCK × BLOCK` block at a time held in registers, so that each side is
+/// read and written a line of `BLOCK` values at a time.
+fn transpose<'a, C: Copy + 'a>(
+    row: impl Fn(usize) -> &'a [C],
     rows: usize,
     cols: usize,
     dst: &mut [C],
     dst_stride: usize,
 ) {
-    for r0 in (0..rows).step_by(BLOCK) {
-        let r1 = (r0 + BLOCK).min(rows);
-        for c0 in (0..cols).step_by(BLOCK) {
-            let c1 = (c0 + BLOCK).min(cols);
-            for r in r0..r1 {
-                let line = &src[r * src_stride + c0..r * src_stride + c1];
-                for (c, &v) in (c0..c1).zip(line) {
-                    dst[c * dst_stride + r] = v;
-                }
+    let (rows_b, cols_b) = (rows - rows % BLOCK, cols - cols % BLOCK);
+    for r0 in (0..rows_b).step_by(BLOCK) {
+        let src: [&[C]; BLOCK] = std::array::from_fn(|k| &row(r0 + k)[..cols]);
+        for c0 in (0..cols_b).step_by(BLOCK) {
+            let block: [[C; BLOCK]; BLOCK] =
+                std::array::from_fn(|k| std::array::from_fn(|c| src[k][c0 + c]));
+            for c in 0..BLOCK {
+                let column: [C; BLOCK] = std::array::from_fn(|k| block[k][c]);
+                dst[(c0 + c) * dst_stride + r0..][..BLOCK].copy_from_slice(&column);
             }
+        }
+        for c in cols_b..cols {
+            for (k, line) in src.iter().enumerate() {
+                dst[c * dst_stride + r0 + k] = line[c];
+            }
+        }
+    }
+    for r in rows_b..rows {
+        for (c, &v) in row(r)[..cols].iter().enumerate() {
+            dst[c * dst_stride + r] = v;
         }
     }
 }
