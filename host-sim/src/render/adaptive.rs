@@ -2,7 +2,7 @@
 //! spectrum for a tolerance in dB, then views that read the cheaper filters
 //! wherever the marks allow, with statistics.
 
-use crate::render::adaptive_view::AdaptiveRenderer;
+use crate::render::adaptive_view::{AdaptiveRenderer, Walked};
 use crate::render::fast_dht::{dht_3d_real, half_spectrum_bytes, SparseCube};
 use crate::render::fast_marks;
 use crate::render::spectrum::OwnedSpectrum;
@@ -105,6 +105,15 @@ struct ErrorModel {
     /// exponents, a format f32 holds), so the marks may test it.
     exact: bool,
     work: Vec<f32>,
+    /// The inverse transform of every sample (the reference's field), kept
+    /// when memory allows: the weak samples' field is then this minus the
+    /// strong samples' ([`ErrorModel::probe`]).
+    full: Option<Vec<f32>>,
+    /// The largest `|F|` in each z-plane, and in each row `y` over all
+    /// planes: the strong samples of a threshold lie on the planes and rows
+    /// that reach it.
+    plane_max: Vec<f32>,
+    row_max: Vec<f32>,
 }
 
 impl ErrorModel {
@@ -140,6 +149,7 @@ impl ErrorModel {
                 }
             });
         let (bins, lowest) = magnitude_bins(&values);
+        let (plane_max, row_max) = extents(&values, n);
         let large_response = Self::responses(&large, n);
         let mut model = Self {
             n,
@@ -150,11 +160,65 @@ impl ErrorModel {
             lowest,
             exact: plain && (S::BITS <= 16 || S::NAME == "f32"),
             work: vec![0.0; n * n * n],
+            full: None,
+            plane_max,
+            row_max,
         };
-        let ones = model.large_response.clone();
-        model.reference =
-            model.field_energy(f64::INFINITY, |x| ones[x[0]] * ones[x[1]] * ones[x[2]])?;
+        let large = model.large_response.clone();
+        let weight = Weight {
+            gain: 0.0,
+            small: &large,
+            large: &large,
+        };
+        model.reference = model.field_energy(f64::INFINITY, &weight)?;
+        // A third cube for the full field, if the budget allows it.
+        let room = crate::budget::Budget::new()
+            .hold("adaptive samples and fields (f32)", 3 * cells, 4)
+            .hold(
+                "adaptive transform half spectrum",
+                half_spectrum_bytes::<f32>(n),
+                1,
+            )
+            .check(crate::budget::limit(), "")
+            .is_ok();
+        if room {
+            model.full = Some(std::mem::replace(&mut model.work, vec![0.0; n * n * n]));
+        }
         Ok(model)
+    }
+
+    /// The error energy of the samples below `tau` with `weight`:
+    /// [`ErrorModel::field_energy`], or, when the strong samples
+    /// (`|F| ≥ tau`) lie on at most ¾ of the rows `(y, z)` and the
+    /// budget is not below [`SUBTRACTION_BUDGET`], the full field minus the
+    /// strong samples' field. The transform then skips the rows and planes
+    /// without strong samples (its first two passes), and the weak field is
+    /// the same up to f32 rounding relative to the whole field's energy.
+    fn probe(&mut self, tau: f64, weight: &Weight<'_>, budget: f64) -> Result<f64, String> {
+        let n = self.n;
+        let t = tau as f32;
+        let planes: Vec<bool> = self.plane_max.iter().map(|&m| m >= t).collect();
+        let rows: Vec<bool> = self.row_max.iter().map(|&m| m >= t).collect();
+        let occupied = planes.iter().filter(|&&p| p).count() * rows.iter().filter(|&&r| r).count();
+        let full = match &self.full {
+            Some(full) if budget >= SUBTRACTION_BUDGET && 4 * occupied <= 3 * n * n => full,
+            _ => return self.field_energy(tau, weight),
+        };
+        let values = &self.values;
+        let fill = move |y: usize, z: usize, line: &mut [f32]| {
+            let row = &values[(z * n + y) * n..][..n];
+            for (w, &v) in line.iter_mut().zip(row) {
+                *w = if v.abs() < t { 0.0 } else { v };
+            }
+        };
+        let cube = SparseCube {
+            n,
+            rows_y: &rows,
+            planes_z: &planes,
+            fill: &fill,
+        };
+        dht_3d_real::<f32, f32>(&cube, &mut self.work).map_err(|e| e.to_string())?;
+        Ok(weight.energy(full, Some(&self.work), n))
     }
 
     /// `ĥ(x/n)` for each grid index `x` in natural order (signed position).
@@ -168,11 +232,7 @@ impl ErrorModel {
     /// samples below `tau` (unnormalized: the transform is its own inverse
     /// up to `n³`, and every energy here carries the same factor), through
     /// the host's FFT-based transform on all cores.
-    fn field_energy(
-        &mut self,
-        tau: f64,
-        weight: impl Fn([usize; 3]) -> f64 + Sync,
-    ) -> Result<f64, String> {
+    fn field_energy(&mut self, tau: f64, weight: &Weight<'_>) -> Result<f64, String> {
         let n = self.n;
         let tau = tau as f32;
         let (values, all) = (&self.values, vec![true; n]);
@@ -189,28 +249,7 @@ impl ErrorModel {
             fill: &fill,
         };
         dht_3d_real::<f32, f32>(&cube, &mut self.work).map_err(|e| e.to_string())?;
-        Ok(self.work_energy(weight))
-    }
-
-    /// `Σ_x (work(x)·weight(x))²`.
-    fn work_energy(&self, weight: impl Fn([usize; 3]) -> f64 + Sync) -> f64 {
-        let n = self.n;
-        self.work
-            .par_chunks(n * n)
-            .enumerate()
-            .map(|(z, plane)| {
-                let mut energy = 0.0f64;
-                for (y, row) in plane.chunks_exact(n).enumerate() {
-                    let mut line = 0.0f64;
-                    for (x, &f) in row.iter().enumerate() {
-                        let e = f as f64 * weight([x, y, z]);
-                        line += e * e;
-                    }
-                    energy += line;
-                }
-                energy
-            })
-            .sum()
+        Ok(weight.energy(&self.work, None, n))
     }
 
     /// The error energy of threshold bin `b` as if the weight were its mean
@@ -244,8 +283,11 @@ impl ErrorModel {
         let n = self.n;
         let hs = Self::responses(small, n);
         let hl = self.large_response.clone();
-        let weight =
-            |x: [usize; 3]| gain * hs[x[0]] * hs[x[1]] * hs[x[2]] - hl[x[0]] * hl[x[1]] * hl[x[2]];
+        let weight = Weight {
+            gain,
+            small: &hs,
+            large: &hl,
+        };
         if self.bins.is_empty() || self.reference <= 0.0 {
             return Ok((0.0, 0.0, 0));
         }
@@ -272,7 +314,7 @@ impl ErrorModel {
             } else {
                 good.0 + (bad - good.0) / 2
             };
-            let e = self.field_energy(tau_of(b), weight)?;
+            let e = self.probe(tau_of(b), &weight, budget)?;
             probes += 1;
             let estimate = self.estimate(b, mean_square);
             if estimate > 0.0 && e > 0.0 {
@@ -289,6 +331,75 @@ impl ErrorModel {
             None => (0.0, 0.0, probes),
         })
     }
+}
+
+/// The weight of eq. 15, `w(x) = g·ĥ₂(x)ĥ₂(y)ĥ₂(z) − ĥ₁(x)ĥ₁(y)ĥ₁(z)`,
+/// from the responses per grid index (`g = 0` gives `−ĥ₁`, the reference's
+/// weight up to sign).
+struct Weight<'a> {
+    gain: f64,
+    small: &'a [f64],
+    large: &'a [f64],
+}
+
+impl Weight<'_> {
+    /// `Σ_x ((field(x) − minus(x))·w(x))²` over the cube of side `n` (x
+    /// fastest; `minus` zero if `None`), on all cores: per row,
+    /// `w = a·ĥ₂(x) − b·ĥ₁(x)` with `a = g·ĥ₂(y)ĥ₂(z)` and `b = ĥ₁(y)ĥ₁(z)`,
+    /// summed in f64 in four interleaved lanes.
+    fn energy(&self, field: &[f32], minus: Option<&[f32]>, n: usize) -> f64 {
+        let plane = n * n;
+        field
+            .par_chunks(plane)
+            .enumerate()
+            .map(|(z, f)| match minus {
+                Some(m) => self.plane_energy(z, n, |i| f[i] - m[z * plane + i]),
+                None => self.plane_energy(z, n, |i| f[i]),
+            })
+            .sum()
+    }
+
+    /// The energy of plane `z`, its values `value(i)` (`i = x + n·y`).
+    #[inline(always)]
+    fn plane_energy(&self, z: usize, n: usize, value: impl Fn(usize) -> f32) -> f64 {
+        let (hs, hl) = (self.small, self.large);
+        let mut energy = 0.0f64;
+        for y in 0..n {
+            let (a, b) = (self.gain * hs[y] * hs[z], hl[y] * hl[z]);
+            let mut lanes = [0.0f64; 4];
+            for x in 0..n {
+                let e = value(x + n * y) as f64 * (a * hs[x] - b * hl[x]);
+                lanes[x % 4] += e * e;
+            }
+            energy += (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
+        }
+        energy
+    }
+}
+
+/// The smallest per-level budget (energy relative to the volume's) for which
+/// [`ErrorModel::probe`] subtracts fields: f32 rounding of the full field is
+/// about `10^-14` of its energy, far below.
+const SUBTRACTION_BUDGET: f64 = 1e-9;
+
+/// The largest `|v|` of each z-plane, and of each row `y` over all planes,
+/// of the cube of side `n`.
+fn extents(values: &[f32], n: usize) -> (Vec<f32>, Vec<f32>) {
+    let per_plane: Vec<(f32, Vec<f32>)> = values
+        .par_chunks(n * n)
+        .map(|plane| {
+            let rows: Vec<f32> = plane
+                .chunks_exact(n)
+                .map(|row| row.iter().fold(0.0f32, |m, v| m.max(v.abs())))
+                .collect();
+            (rows.iter().fold(0.0f32, |m, &v| m.max(v)), rows)
+        })
+        .collect();
+    let planes = per_plane.iter().map(|p| p.0).collect();
+    let rows = (0..n)
+        .map(|y| per_plane.iter().fold(0.0f32, |m, p| m.max(p.1[y])))
+        .collect();
+    (planes, rows)
 }
 
 /// `2^(j/8)` for `j = 1 … 7` in f32: a mantissa in `[1, 2)` is in eighth
@@ -370,6 +481,24 @@ pub struct AdaptiveSettings {
     pub h_d: Option<f64>,
     /// How the thresholds are derived.
     pub bound: Bound,
+    /// A view whose marks would move less than this share of its slice
+    /// samples (0 to 1) to the cheaper filters is rendered by the plain
+    /// walk with the full filter instead, which is then faster
+    /// ([`DEFAULT_PLAIN_BELOW`]; 0 always walks adaptively).
+    pub plain_below: f64,
+}
+
+/// The share of substituted samples below which the plain walk is faster
+/// than the adaptive one (`cargo bench -p fvr-host --bench adaptive --
+/// breakeven`; see docs/adaptive.md).
+pub const DEFAULT_PLAIN_BELOW: f64 = 0.5;
+
+/// Parse a share in percent (0 to 100) into a fraction.
+pub fn parse_percent(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if (0.0..=100.0).contains(&v) => Ok(v / 100.0),
+        _ => Err(format!("expected a percentage from 0 to 100, got `{s}`")),
+    }
 }
 
 impl AdaptiveSettings {
@@ -381,6 +510,7 @@ impl AdaptiveSettings {
             chain: vec![FilterKind::Nearest],
             h_d: None,
             bound: Bound::Exact,
+            plain_below: DEFAULT_PLAIN_BELOW,
         }
     }
 }
@@ -417,6 +547,10 @@ pub struct AdaptiveMarks {
     pub bound: Bound,
     /// The cheaper filters, cheapest first.
     pub levels: Vec<Level>,
+    /// [`AdaptiveSettings::plain_below`]: views whose marks would move a
+    /// smaller share of their samples to the cheaper filters are walked
+    /// plainly with the full filter.
+    pub plain_below: f64,
     n: usize,
 }
 
@@ -451,8 +585,14 @@ impl AdaptiveMarks {
             ref chain,
             h_d: h_d_override,
             bound,
+            plain_below,
         } = *settings;
         parse_tolerance(&tolerance_db.to_string())?;
+        if !(0.0..=1.0).contains(&plain_below) {
+            return Err(format!(
+                "the share below which views walk plainly is 0 to 1, got {plain_below}"
+            ));
+        }
         if bound == Bound::Exact && h_d_override.is_some() {
             return Err(
                 "--adaptive-hd sets the h_d of the paper's bound; the exact bound measures the \
@@ -526,6 +666,7 @@ impl AdaptiveMarks {
             tolerance_db,
             bound,
             levels,
+            plain_below,
             n,
         })
     }
@@ -556,6 +697,21 @@ impl AdaptiveMarks {
         let stats = AdaptiveRenderer::<T>::new(self, spec)?
             .render_into(spec, view, width, height, &mut out)?;
         Ok((out.into_iter().map(T::to_f64).collect(), stats))
+    }
+
+    /// A sentence on how a view was walked and whether adaptivity had any
+    /// effect in its `stats`.
+    pub fn note(&self, stats: &AdaptiveStats, walked: Walked) -> Option<String> {
+        match walked {
+            Walked::Plain { share } => Some(format!(
+                "the marks allow {:.1}% of this view's samples on the cheaper filters, below \
+                 the {:.1}% at which the adaptive walk pays: 0.0% of samples substituted, plain \
+                 walk used (the full filter's image)",
+                100.0 * share,
+                100.0 * self.plain_below
+            )),
+            Walked::Adaptive => self.effect(stats),
+        }
     }
 
     /// A sentence on whether adaptivity had any effect in `stats`.
