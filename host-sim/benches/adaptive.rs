@@ -9,11 +9,17 @@
 //!   direction (1, 0.3, 0.2);
 //!
 //! each also with the core's single-threaded adaptive extraction
-//! (`adaptive_40db_core`); and `marks_kb6_256`: the exact bound's marks at
+//! (`adaptive_40db_core`); `marks_kb6_256`: the exact bound's marks at
 //! 40 dB (`marks_exact_40db`) against the preprocessing they follow
-//! (`prepare`), on the same volume. Compare as ratios within one run.
+//! (`prepare`), on the same volume; and `breakeven_kb4_256`,
+//! `breakeven_kb6_256`: the plain view (`plain`) against the adaptive walk
+//! (never the plain fallback) at tolerances that substitute from none to
+//! nearly all of the view's samples (`adaptive_<dB>db_<share>pct`, the
+//! share in the name), where the adaptive walk breaks even with the plain
+//! one. Compare as ratios within one run.
 //!
-//! Run: `cargo bench -p fvr-host --bench adaptive`.
+//! Run: `cargo bench -p fvr-host --bench adaptive` (the break-even groups
+//! alone with `FVR_BENCH_BREAKEVEN=1`).
 
 use std::hint::black_box;
 
@@ -32,7 +38,12 @@ fn group(c: &mut Criterion, name: &str, volume: &Volume, filter: Filter) {
     let spec = OwnedSpectrum::<f16>::prepare::<f32>(volume, filter).unwrap();
     let n = spec.n();
     let side = volume.dims[0];
-    let marks = AdaptiveMarks::build(&spec, &AdaptiveSettings::new(40.0)).unwrap();
+    // The adaptive walk always (the plain fallback is `breakeven`'s peer).
+    let settings = AdaptiveSettings {
+        plain_below: 0.0,
+        ..AdaptiveSettings::new(40.0)
+    };
+    let marks = AdaptiveMarks::build(&spec, &settings).unwrap();
     let view = View::along([1.0, 0.3, 0.2]);
     let mut renderer = ViewRenderer::<f32>::new(n, filter);
     let mut adaptive = AdaptiveRenderer::<f32>::new(&marks, &spec).unwrap();
@@ -79,7 +90,58 @@ fn marking(c: &mut Criterion, name: &str, volume: &Volume, filter: Filter) {
     group.finish();
 }
 
+/// The plain view against the adaptive walk at several tolerances, each
+/// named with the share of the view's samples it substitutes.
+fn breakeven(c: &mut Criterion, name: &str, volume: &Volume, filter: Filter) {
+    let spec = OwnedSpectrum::<f16>::prepare::<f32>(volume, filter).unwrap();
+    let n = spec.n();
+    let side = volume.dims[0];
+    let view = View::along([1.0, 0.3, 0.2]);
+    let mut renderer = ViewRenderer::<f32>::new(n, filter);
+    let mut out = vec![0.0f32; side * side];
+    let mut group = c.benchmark_group(name);
+    group.sample_size(20);
+    group.bench_function("plain", |b| {
+        b.iter(|| {
+            renderer
+                .render_into(&spec, black_box(&view), side, side, &mut out)
+                .unwrap()
+        })
+    });
+    for db in [400.0, 120.0, 90.0, 70.0, 55.0, 40.0] {
+        let settings = AdaptiveSettings {
+            plain_below: 0.0,
+            ..AdaptiveSettings::new(db)
+        };
+        let marks = AdaptiveMarks::build(&spec, &settings).unwrap();
+        let mut adaptive = AdaptiveRenderer::<f32>::new(&marks, &spec).unwrap();
+        let stats = adaptive
+            .render_into(&spec, &view, side, side, &mut out)
+            .unwrap();
+        let share = 100.0 * (stats.samples - stats.per_filter[0]) as f64 / stats.samples as f64;
+        group.bench_function(format!("adaptive_{db}db_{share:.1}pct"), |b| {
+            b.iter(|| {
+                adaptive
+                    .render_into(&spec, black_box(&view), side, side, &mut out)
+                    .unwrap()
+            })
+        });
+    }
+    group.finish();
+}
+
 fn benches(c: &mut Criterion) {
+    if std::env::var_os("FVR_BENCH_BREAKEVEN").is_some() {
+        let n = 256;
+        let volume = sample(&GaussianMixture::random(1, n, 8), [n; 3]);
+        for (name, kind) in [
+            ("breakeven_kb4_256", FilterKind::Kb4),
+            ("breakeven_kb6_256", FilterKind::Kb6),
+        ] {
+            breakeven(c, name, &volume, Filter::new(kind, 1).unwrap());
+        }
+        return;
+    }
     let n = 128;
     let volume = sample(&GaussianMixture::random(1, n, 8), [n; 3]);
     group(

@@ -196,7 +196,12 @@ fn renderer_image_equals_core_extraction() {
     let volume = smooth([n, n, 20], 4);
     let filter = Filter::new(FilterKind::Kb6, 1).unwrap();
     let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
-    let marks = AdaptiveMarks::build(&spec, &AdaptiveSettings::new(40.0)).unwrap();
+    // Always the adaptive walk: this compares it with the core's.
+    let settings = AdaptiveSettings {
+        plain_below: 0.0,
+        ..AdaptiveSettings::new(40.0)
+    };
+    let marks = AdaptiveMarks::build(&spec, &settings).unwrap();
     let view_spec = spec.view();
     let kernel = KernelTable::<f32>::new(filter);
     let tables: Vec<KernelTable<f32>> = marks

@@ -13,10 +13,13 @@ use fvr_host::sources::phantom::{sample, GaussianMixture, SheppLogan};
 use fvr_tests::mixture_spectrum;
 use half::f16;
 
-/// Adaptive settings with the 1³ filter and the given bound.
+/// Adaptive settings with the 1³ filter and the given bound, every view
+/// walked adaptively (never the plain walk's fallback, whose image is the
+/// full filter's).
 fn nearest(tolerance_db: f64, bound: Bound) -> AdaptiveSettings {
     AdaptiveSettings {
         bound,
+        plain_below: 0.0,
         ..AdaptiveSettings::new(tolerance_db)
     }
 }
@@ -254,7 +257,7 @@ fn statistics_add_up_and_report_no_effect() {
     let view = View::along([1.0, 0.4, 0.1]);
     let settings = AdaptiveSettings {
         chain: parse_chain("nearest").unwrap(),
-        ..AdaptiveSettings::new(40.0)
+        ..nearest(40.0, Bound::Exact)
     };
     let marks = AdaptiveMarks::build(&spec, &settings).unwrap();
     let (_, stats) = marks.render::<f16, f32>(&spec, &view, n, n).unwrap();

@@ -2,11 +2,12 @@
 //! spectrum for a tolerance in dB, then views that read the cheaper filters
 //! wherever the marks allow, with statistics.
 
-use crate::render::adaptive_view::AdaptiveRenderer;
-use crate::render::fast_dht::{dht_3d_real, half_spectrum_bytes, SparseCube};
+mod bound;
+
+use crate::render::adaptive_view::{AdaptiveRenderer, Walked};
 use crate::render::fast_marks;
 use crate::render::spectrum::OwnedSpectrum;
-use fvr_core::dht::signed_index;
+use bound::ErrorModel;
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
 use fvr_core::num::{Real, Sample};
@@ -14,7 +15,6 @@ use fvr_core::slice::adaptive::{
     marks_words, response_difference, threshold_for, AdaptiveStats, MAX_LEVELS,
 };
 use fvr_core::spectrum::Spectrum;
-use rayon::prelude::*;
 
 /// The cheaper filters tried, cheapest first, as the user names them.
 pub fn parse_chain(s: &str) -> Result<Vec<FilterKind>, String> {
@@ -87,275 +87,6 @@ impl Bound {
     }
 }
 
-/// The spectrum and grid the exact bound works on: the stored samples in
-/// f32 and the large filter's response per signed grid index.
-struct ErrorModel {
-    n: usize,
-    values: Vec<f32>,
-    large_response: Vec<f64>,
-    /// `Σ (f·h₁)²` over the grid: the energy the tolerance is relative to,
-    /// in the same (unnormalized) units as the error energies.
-    reference: f64,
-    /// `Σ F²` of the samples in each ⅛-octave magnitude bin `b`
-    /// (`2^((b−1)/8) ≤ |F| < 2^(b/8)`), from bin `lowest` up.
-    bins: Vec<f64>,
-    /// The bin of `bins[0]`.
-    lowest: i64,
-    /// `values[i]` is the spectrum's `value(i)` exactly (no block
-    /// exponents, a format f32 holds), so the marks may test it.
-    exact: bool,
-    work: Vec<f32>,
-}
-
-impl ErrorModel {
-    fn new<S: Sample>(view: &Spectrum<'_, S>) -> Result<Self, String> {
-        let n = view.n();
-        let cells = (n as u64).pow(3);
-        crate::budget::Budget::new()
-            .hold("adaptive samples and error field (f32)", 2 * cells, 4)
-            .hold(
-                "adaptive transform half spectrum",
-                half_spectrum_bytes::<f32>(n),
-                1,
-            )
-            .check(crate::budget::limit(), "use --adaptive-bound paper")
-            .map_err(|e| e.to_string())?;
-        let large = *view.filter();
-        let mut values = vec![0f32; n * n * n];
-        let (data, plain) = (view.data(), view.blocks().is_none());
-        values
-            .par_chunks_mut(n * n)
-            .enumerate()
-            .for_each(|(z, plane)| match plain {
-                // Without block exponents a value is its stored sample.
-                true => {
-                    for (v, d) in plane.iter_mut().zip(&data[z * n * n..]) {
-                        *v = d.to_f32();
-                    }
-                }
-                false => {
-                    for (i, v) in plane.iter_mut().enumerate() {
-                        *v = view.value(z * n * n + i) as f32;
-                    }
-                }
-            });
-        let (bins, lowest) = magnitude_bins(&values);
-        let large_response = Self::responses(&large, n);
-        let mut model = Self {
-            n,
-            values,
-            large_response,
-            reference: 0.0,
-            bins,
-            lowest,
-            exact: plain && (S::BITS <= 16 || S::NAME == "f32"),
-            work: vec![0.0; n * n * n],
-        };
-        let ones = model.large_response.clone();
-        model.reference =
-            model.field_energy(f64::INFINITY, |x| ones[x[0]] * ones[x[1]] * ones[x[2]])?;
-        Ok(model)
-    }
-
-    /// `ĥ(x/n)` for each grid index `x` in natural order (signed position).
-    fn responses(filter: &Filter, n: usize) -> Vec<f64> {
-        (0..n)
-            .map(|k| filter.response(signed_index(k, n) as f64 / n as f64))
-            .collect()
-    }
-
-    /// `Σ_x (f_τ(x)·weight(x))²`, `f_τ` the inverse transform of the
-    /// samples below `tau` (unnormalized: the transform is its own inverse
-    /// up to `n³`, and every energy here carries the same factor), through
-    /// the host's FFT-based transform on all cores.
-    fn field_energy(
-        &mut self,
-        tau: f64,
-        weight: impl Fn([usize; 3]) -> f64 + Sync,
-    ) -> Result<f64, String> {
-        let n = self.n;
-        let tau = tau as f32;
-        let (values, all) = (&self.values, vec![true; n]);
-        let fill = move |y: usize, z: usize, line: &mut [f32]| {
-            let row = &values[(z * n + y) * n..][..n];
-            for (w, &v) in line.iter_mut().zip(row) {
-                *w = if v.abs() < tau { v } else { 0.0 };
-            }
-        };
-        let cube = SparseCube {
-            n,
-            rows_y: &all,
-            planes_z: &all,
-            fill: &fill,
-        };
-        dht_3d_real::<f32, f32>(&cube, &mut self.work).map_err(|e| e.to_string())?;
-        Ok(self.work_energy(weight))
-    }
-
-    /// `Σ_x (work(x)·weight(x))²`.
-    fn work_energy(&self, weight: impl Fn([usize; 3]) -> f64 + Sync) -> f64 {
-        let n = self.n;
-        self.work
-            .par_chunks(n * n)
-            .enumerate()
-            .map(|(z, plane)| {
-                let mut energy = 0.0f64;
-                for (y, row) in plane.chunks_exact(n).enumerate() {
-                    let mut line = 0.0f64;
-                    for (x, &f) in row.iter().enumerate() {
-                        let e = f as f64 * weight([x, y, z]);
-                        line += e * e;
-                    }
-                    energy += line;
-                }
-                energy
-            })
-            .sum()
-    }
-
-    /// The error energy of threshold bin `b` as if the weight were its mean
-    /// square everywhere (Parseval: `n³·mean(w²)·Σ_{|F|<τ} F²`): exact for
-    /// a constant weight, and a guide for where to start the exact search.
-    fn estimate(&self, b: i64, mean_square_weight: f64) -> f64 {
-        // Bins `k ≤ b` hold the samples below `2^(b/8)`.
-        let below = (b - self.lowest + 1).clamp(0, self.bins.len() as i64) as usize;
-        let sum: f64 = self.bins[..below].iter().sum();
-        (self.n as f64).powi(3) * mean_square_weight * sum
-    }
-
-    /// The largest candidate threshold whose error energy for the pair
-    /// (large, `small` with gain `gain`) stays within `budget` of the
-    /// reference, and the relative energy it was verified at. Candidates are
-    /// ⅛-octave steps `2^(b/8)`, and the answer is bracketed between an
-    /// accepted step and a refused one (at first the empty weak set, which
-    /// has no error, and "no limit"). Each probe is one exact evaluation of
-    /// the error field. The first three probes go where the Parseval
-    /// estimate ([`ErrorModel::estimate`]) puts the answer, rescaled by the
-    /// ratio of exact to estimated energy at the last probe (the weight is
-    /// far from constant, so the raw estimate is off by octaves, but the
-    /// ratio varies slowly with `τ`); the rest bisect. It returns only
-    /// thresholds it evaluated.
-    fn threshold(
-        &mut self,
-        small: &Filter,
-        gain: f64,
-        budget: f64,
-    ) -> Result<(f64, f64, usize), String> {
-        let n = self.n;
-        let hs = Self::responses(small, n);
-        let hl = self.large_response.clone();
-        let weight =
-            |x: [usize; 3]| gain * hs[x[0]] * hs[x[1]] * hs[x[2]] - hl[x[0]] * hl[x[1]] * hl[x[2]];
-        if self.bins.is_empty() || self.reference <= 0.0 {
-            return Ok((0.0, 0.0, 0));
-        }
-        // mean(w²) of the separable weight, from per-axis sums of products.
-        let axis_mean = |f: &dyn Fn(usize) -> f64| (0..n).map(f).sum::<f64>() / n as f64;
-        let mean_square = gain * gain * axis_mean(&|i| hs[i] * hs[i]).powi(3)
-            - 2.0 * gain * axis_mean(&|i| hs[i] * hl[i]).powi(3)
-            + axis_mean(&|i| hl[i] * hl[i]).powi(3);
-        let tau_of = |b: i64| 2f64.powf(b as f64 / 8.0);
-        let allowed = budget * self.reference;
-        // Below step `lowest` no sample is weak: the empty set, accepted.
-        let mut good: (i64, Option<f64>) = (self.lowest - 1, None);
-        // From `top` on every sample is weak: no larger threshold changes the set.
-        let top = self.lowest + self.bins.len() as i64 - 1;
-        let mut bad = top + 1;
-        let mut scale = 1.0;
-        let mut probes = 0;
-        while bad - good.0 > 1 {
-            let b = if probes < 3 {
-                (good.0 + 1..bad)
-                    .rev()
-                    .find(|&b| scale * self.estimate(b, mean_square) <= allowed)
-                    .unwrap_or(good.0 + 1)
-            } else {
-                good.0 + (bad - good.0) / 2
-            };
-            let e = self.field_energy(tau_of(b), weight)?;
-            probes += 1;
-            let estimate = self.estimate(b, mean_square);
-            if estimate > 0.0 && e > 0.0 {
-                scale = e / estimate;
-            }
-            if e <= allowed {
-                good = (b, Some(e / self.reference));
-            } else {
-                bad = b;
-            }
-        }
-        Ok(match good.1 {
-            Some(r) => (tau_of(good.0), r, probes),
-            None => (0.0, 0.0, probes),
-        })
-    }
-}
-
-/// `2^(j/8)` for `j = 1 … 7` in f32: a mantissa in `[1, 2)` is in eighth
-/// `j` when it reaches the `j`-th entry (the estimate only guides the
-/// search, so the last bit of these does not matter).
-const EIGHTH_OCTAVES: [f32; 7] = [
-    1.090_507_8,
-    1.189_207_1,
-    1.296_839_6,
-    core::f32::consts::SQRT_2,
-    1.542_210_8,
-    1.681_792_9,
-    1.834_008_1,
-];
-
-/// `Σ F²` per ⅛-octave magnitude bin (`2^((b−1)/8) ≤ |F| < 2^(b/8)` in bin
-/// `b`), from the lowest occupied bin, and that bin; zeros are left out
-/// (they add nothing to any energy).
-fn magnitude_bins(values: &[f32]) -> (Vec<f64>, i64) {
-    let bin = |v: f32| {
-        // ⌊8·log₂|v|⌋ + 1 from the exponent and mantissa bits (normal
-        // numbers; subnormals through log₂).
-        let bits = v.abs().to_bits();
-        let exponent = (bits >> 23) as i64;
-        if exponent == 0 {
-            return ((v.abs() as f64).log2() * 8.0).floor() as i64 + 1;
-        }
-        let mantissa = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
-        let eighths = EIGHTH_OCTAVES.iter().filter(|t| mantissa >= **t).count() as i64;
-        8 * (exponent - 127) + eighths + 1
-    };
-    // Every bin an f32 can fall in (subnormals down to 2^−149), in one pass.
-    const FIRST: i64 = -8 * 150;
-    const BINS: usize = 8 * 280;
-    let all = values
-        .par_chunks(1 << 16)
-        .fold(
-            || vec![0f64; BINS],
-            |mut acc, chunk| {
-                for &v in chunk.iter().filter(|v| **v != 0.0) {
-                    acc[(bin(v) - FIRST) as usize] += v as f64 * v as f64;
-                }
-                acc
-            },
-        )
-        .reduce(
-            || vec![0f64; BINS],
-            |mut a, b| {
-                for (x, y) in a.iter_mut().zip(b) {
-                    *x += y;
-                }
-                a
-            },
-        );
-    // A nonzero f32 squared is a positive f64: occupied bins are positive.
-    let (lo, hi) = match (
-        all.iter().position(|&e| e > 0.0),
-        all.iter().rposition(|&e| e > 0.0),
-    ) {
-        (Some(lo), Some(hi)) => (lo, hi),
-        _ => return (Vec::new(), 0),
-    };
-    let bins = all[lo..=hi].to_vec();
-    let lo = lo as i64 + FIRST;
-    (bins, lo)
-}
-
 /// What the user asked of adaptive filtering.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AdaptiveSettings {
@@ -370,6 +101,24 @@ pub struct AdaptiveSettings {
     pub h_d: Option<f64>,
     /// How the thresholds are derived.
     pub bound: Bound,
+    /// A view whose marks would move less than this share of its slice
+    /// samples (0 to 1) to the cheaper filters is rendered by the plain
+    /// walk with the full filter instead, which is then faster
+    /// ([`DEFAULT_PLAIN_BELOW`]; 0 always walks adaptively).
+    pub plain_below: f64,
+}
+
+/// The share of substituted samples below which the plain walk is faster
+/// than the adaptive one (`cargo bench -p fvr-host --bench adaptive --
+/// breakeven`; see docs/adaptive.md).
+pub const DEFAULT_PLAIN_BELOW: f64 = 0.4;
+
+/// Parse a share in percent (0 to 100) into a fraction.
+pub fn parse_percent(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if (0.0..=100.0).contains(&v) => Ok(v / 100.0),
+        _ => Err(format!("expected a percentage from 0 to 100, got `{s}`")),
+    }
 }
 
 impl AdaptiveSettings {
@@ -381,6 +130,7 @@ impl AdaptiveSettings {
             chain: vec![FilterKind::Nearest],
             h_d: None,
             bound: Bound::Exact,
+            plain_below: DEFAULT_PLAIN_BELOW,
         }
     }
 }
@@ -417,6 +167,10 @@ pub struct AdaptiveMarks {
     pub bound: Bound,
     /// The cheaper filters, cheapest first.
     pub levels: Vec<Level>,
+    /// [`AdaptiveSettings::plain_below`]: views whose marks would move a
+    /// smaller share of their samples to the cheaper filters are walked
+    /// plainly with the full filter.
+    pub plain_below: f64,
     n: usize,
 }
 
@@ -451,8 +205,14 @@ impl AdaptiveMarks {
             ref chain,
             h_d: h_d_override,
             bound,
+            plain_below,
         } = *settings;
         parse_tolerance(&tolerance_db.to_string())?;
+        if !(0.0..=1.0).contains(&plain_below) {
+            return Err(format!(
+                "the share below which views walk plainly is 0 to 1, got {plain_below}"
+            ));
+        }
         if bound == Bound::Exact && h_d_override.is_some() {
             return Err(
                 "--adaptive-hd sets the h_d of the paper's bound; the exact bound measures the \
@@ -526,6 +286,7 @@ impl AdaptiveMarks {
             tolerance_db,
             bound,
             levels,
+            plain_below,
             n,
         })
     }
@@ -556,6 +317,21 @@ impl AdaptiveMarks {
         let stats = AdaptiveRenderer::<T>::new(self, spec)?
             .render_into(spec, view, width, height, &mut out)?;
         Ok((out.into_iter().map(T::to_f64).collect(), stats))
+    }
+
+    /// A sentence on how a view was walked and whether adaptivity had any
+    /// effect in its `stats`.
+    pub fn note(&self, stats: &AdaptiveStats, walked: Walked) -> Option<String> {
+        match walked {
+            Walked::Plain { share } => Some(format!(
+                "the marks allow {:.1}% of this view's samples on the cheaper filters, below \
+                 the {:.1}% at which the adaptive walk pays: 0.0% of samples substituted, plain \
+                 walk used (the full filter's image)",
+                100.0 * share,
+                100.0 * self.plain_below
+            )),
+            Walked::Adaptive => self.effect(stats),
+        }
     }
 
     /// A sentence on whether adaptivity had any effect in `stats`.

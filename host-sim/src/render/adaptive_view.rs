@@ -2,18 +2,29 @@
 //! the twiddles and the slice built once, then one adaptive extraction
 //! ([`super::fast_adaptive`], the core's for spectra it does not serve) and
 //! one 2D inverse transform per view.
+//!
+//! The adaptive walk computes every point's position in floating point and
+//! its weights from the kernel tables (the core's adaptive arithmetic), so
+//! a point on the large filter costs more than in the plain walk
+//! ([`super::fast_slice`]). When the marks move too small a share of a
+//! view's samples to the cheaper filters ([`AdaptiveMarks::plain_below`],
+//! counted first by [`fast_adaptive::tally`]), the view is rendered by the
+//! plain walk instead: the full filter's image bit for bit, which meets any
+//! tolerance.
 
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::KernelTable;
-use fvr_core::geometry::View;
-use fvr_core::image::{aux_len, check_image, finish, grid_len, placement, Crop, Inverse};
+use fvr_core::geometry::{Sampling, View};
+use fvr_core::image::{
+    aux_len, check_image, finish, grid_len, placement, placement_on_axes, Crop, Inverse,
+};
 use fvr_core::num::{Real, Sample};
 use fvr_core::slice::adaptive::{extract_slice_adaptive, AdaptiveLevel, AdaptiveStats, Marks};
 
 use super::adaptive::AdaptiveMarks;
 use super::fast_adaptive;
 use super::fast_inverse::finish_threaded;
-use super::fast_slice::Tiling;
+use super::fast_slice::{self, Tiling};
 use super::spectrum::OwnedSpectrum;
 
 /// Reusable per-view buffers and tables for adaptive views of one
@@ -31,6 +42,22 @@ pub struct AdaptiveRenderer<'m, T> {
     parallel: bool,
     core: bool,
     tiling: Tiling,
+    last: Walked,
+}
+
+/// How a view was extracted.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Walked {
+    /// By the adaptive walk (the host's or the core's).
+    Adaptive,
+    /// By the plain walk with the full filter, because the marks would have
+    /// moved only `share` of the view's samples to the cheaper filters,
+    /// below [`AdaptiveMarks::plain_below`].
+    Plain {
+        /// Share of the slice samples the marks allowed on the cheaper
+        /// filters.
+        share: f64,
+    },
 }
 
 impl<'m, T: Real> AdaptiveRenderer<'m, T> {
@@ -60,6 +87,7 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
             parallel: true,
             core: false,
             tiling: Tiling::default(),
+            last: Walked::Adaptive,
         })
     }
 
@@ -80,8 +108,15 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
         self
     }
 
+    /// How the last view [`AdaptiveRenderer::render_into`] rendered was
+    /// extracted.
+    pub fn walked(&self) -> Walked {
+        self.last
+    }
+
     /// Render one view into `out` (`width × height`, row 0 at the top); the
-    /// extraction's statistics.
+    /// extraction's statistics. With the plain walk ([`Walked::Plain`]),
+    /// every sample is counted on the full filter.
     ///
     /// # Errors
     /// As [`fvr_core::render::render`]; a spectrum of another side than the
@@ -113,6 +148,29 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
             })
             .collect::<Result<_, fvr_core::Error>>()?;
         let core_spec = spec.view();
+        self.last = Walked::Adaptive;
+        if let Some(stats) = self.plain_instead(&core_spec, &levels, &frame) {
+            let axes = Sampling::UNIT.slice_axes(&frame);
+            let (kernel, grid) = (&self.kernel, &mut self.grid);
+            if fast_slice::extract(&core_spec, kernel, &axes, self.tiling, self.parallel, grid) {
+                let share = 1.0 - stats.per_filter[0] as f64 / stats.samples.max(1) as f64;
+                self.last = Walked::Plain { share };
+                let place = placement_on_axes(core_spec.dims(), &axes, width, height, 1.0);
+                let crop = Crop::new(
+                    place,
+                    Sampling::UNIT.gain() / core_spec.scale(),
+                    width,
+                    height,
+                );
+                self.finish(n, &crop, out)?;
+                return Ok(AdaptiveStats {
+                    samples: stats.samples,
+                    per_filter: core::array::from_fn(|i| if i == 0 { stats.samples } else { 0 }),
+                    taps: stats.full_taps,
+                    full_taps: stats.full_taps,
+                });
+            }
+        }
         let host = match self.core {
             true => None,
             false => fast_adaptive::extract(
@@ -131,18 +189,43 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
                 extract_slice_adaptive(&core_spec, &self.kernel, &levels, &frame, &mut self.grid)?
             }
         };
-        let tw = Twiddles::from_table(&self.tw, n)?;
         let place = placement(core_spec.dims(), &frame, width, height);
         let crop = Crop::new(place, 1.0 / core_spec.scale(), width, height);
+        self.finish(n, &crop, out)?;
+        Ok(stats)
+    }
+
+    /// The statistics of the adaptive walk when it would move less than
+    /// [`AdaptiveMarks::plain_below`] of the samples to the cheaper
+    /// filters (the plain walk is then faster); `None` when the adaptive
+    /// walk is to be used (the core's walk asked for, no threshold, or a
+    /// spectrum the host's walks do not serve).
+    fn plain_instead<S: Sample>(
+        &self,
+        spec: &fvr_core::spectrum::Spectrum<'_, S>,
+        levels: &[AdaptiveLevel<'_, '_, T>],
+        frame: &fvr_core::geometry::Frame,
+    ) -> Option<AdaptiveStats> {
+        let below = self.marks.plain_below;
+        if self.core || below <= 0.0 || self.grid.len() != spec.n() * spec.n() {
+            return None;
+        }
+        let stats = fast_adaptive::tally(spec, &self.kernel, levels, frame, self.parallel)?;
+        let cheap = stats.samples - stats.per_filter[0];
+        ((cheap as f64) < below * stats.samples as f64).then_some(stats)
+    }
+
+    /// Shift, inverse-transform and crop the slice into `out`.
+    fn finish(&mut self, n: usize, crop: &Crop, out: &mut [T]) -> Result<(), fvr_core::Error> {
+        let tw = Twiddles::from_table(&self.tw, n)?;
         // At a few % of the taps the view is bound by its finish as much
         // as by the walk: the 2D inverse on the threads too when the walk
         // is (`fast_inverse`, the core's image bit for bit).
         if self.parallel && !self.core {
             let inverse = Inverse::Radix2(&tw);
-            finish_threaded(&mut self.grid, n, &crop, inverse, &mut self.trans, out)?;
+            finish_threaded(&mut self.grid, n, crop, inverse, &mut self.trans, out)
         } else {
-            finish(&mut self.grid, n, &crop, &tw, &mut self.aux, out)?;
+            finish(&mut self.grid, n, crop, &tw, &mut self.aux, out)
         }
-        Ok(stats)
     }
 }

@@ -98,35 +98,12 @@ pub fn extract<S: Sample, T: Real>(
     grid: &mut [T],
 ) -> Option<AdaptiveStats> {
     let n = spec.n();
-    // Its walk wraps by masks: power-of-two sides only.
-    if !supports(spec)
-        || !n.is_power_of_two()
-        || grid.len() != n * n
-        || kernel.filter() != spec.filter()
-        || levels.len() > MAX_LEVELS
-        || levels.iter().any(|l| l.marks.n() != n)
-    {
+    if grid.len() != n * n {
         return None;
     }
-    let mut filters = [None; 1 + MAX_LEVELS];
-    let mut marks = [None; MAX_LEVELS];
-    filters[0] = Some(applied(kernel, T::ONE)?);
-    for (i, level) in levels.iter().enumerate() {
-        filters[i + 1] = Some(applied(level.kernel, level.gain)?);
-        marks[i] = Some(level.marks);
-    }
-    let right = frame.right.map(T::from_f64);
+    let walk = Walk::new(spec, kernel, levels, frame, tiling)?;
     let up = frame.up.map(T::from_f64);
-    let walk = Walk {
-        data: spec.data(),
-        n,
-        right,
-        filters,
-        marks,
-        raw_gain: T::exp2i(T::raw_exponent::<S>()),
-        chunk: tiling.chunk.clamp(1, n) as i32,
-    };
-    let bands = bands(grid, n, &right, up, tiling.band.max(1));
+    let bands = bands(grid, n, &walk.right, up, tiling.band.max(1));
     let fill = |band: Vec<Row<'_, T>>| walk.fill_band(band);
     let stats = if parallel {
         bands
@@ -142,6 +119,67 @@ pub fn extract<S: Sample, T: Real>(
     Some(stats)
 }
 
+/// The statistics [`extract`] would return for the same arguments, without
+/// interpolating: each point's position, its test against the cube and its
+/// nearest sample's marks, as the walk computes them, so the counts are
+/// the walk's exactly. `None` where [`extract`] would return `None`.
+pub fn tally<S: Sample, T: Real>(
+    spec: &Spectrum<'_, S>,
+    kernel: &KernelTable<T>,
+    levels: &[AdaptiveLevel<'_, '_, T>],
+    frame: &Frame,
+    parallel: bool,
+) -> Option<AdaptiveStats> {
+    let n = spec.n();
+    let walk = Walk::new(spec, kernel, levels, frame, Tiling::default())?;
+    let up = frame.up.map(T::from_f64);
+    let count = |p: usize| {
+        let mut stats = AdaptiveStats::default();
+        let ky = signed(p, n);
+        let (kyu, low, high) = walked(n, &walk.right, up, ky);
+        let mut row = Row {
+            cells: &mut [],
+            kyu,
+            low,
+            high,
+        };
+        walk.fill_row(&mut row, low, high, &mut stats);
+        stats
+    };
+    Some(match parallel {
+        true => (0..n)
+            .into_par_iter()
+            .map(count)
+            .reduce(AdaptiveStats::default, merged),
+        false => (0..n).map(count).fold(AdaptiveStats::default(), merged),
+    })
+}
+
+/// The signed frequency of grid row `p` as the walk numbers it: `p` for
+/// `p ≤ (n − 1)/2`, else `p − n`.
+fn signed(p: usize, n: usize) -> i32 {
+    match p as i32 <= ((n - 1) / 2) as i32 {
+        true => p as i32,
+        false => p as i32 - n as i32,
+    }
+}
+
+/// `ky·u` for the row of signed frequency `ky` and its interval of `kx`
+/// walked: one column beyond the plain path's interval on each side, so
+/// the points within rounding of the faces are tested point by point, as
+/// the core tests them.
+fn walked<T: Real>(n: usize, right: &[T; 3], up: [T; 3], ky: i32) -> ([T; 3], i32, i32) {
+    let (half, k_max) = ((n / 2) as i32, ((n - 1) / 2) as i32);
+    let k = T::from_i32(ky);
+    let kyu = up.map(|c| k * c);
+    let (low, high) = row_interval(n, right, kyu);
+    (
+        kyu,
+        low.saturating_sub(1).max(-half),
+        high.saturating_add(1).min(k_max),
+    )
+}
+
 /// The rows of `grid` in bands of `band` mirror pairs (`p` and `−p`,
 /// `p = 0 … n/2`), each row with its walked interval of `kx`.
 fn bands<'g, T: Real>(
@@ -152,21 +190,16 @@ fn bands<'g, T: Real>(
     band: usize,
 ) -> Vec<Vec<Row<'g, T>>> {
     let mask = n - 1;
-    let (half, k_max) = ((n / 2) as i32, ((n - 1) / 2) as i32);
+    let k_max = ((n - 1) / 2) as i32;
     let mut rows: Vec<Option<&'g mut [T]>> = grid.chunks_exact_mut(n).map(Some).collect();
     let mut row = |index: usize, ky: i32| -> Option<Row<'g, T>> {
         let cells = rows[index].take()?;
-        let k = T::from_i32(ky);
-        let kyu = up.map(|c| k * c);
-        // One column beyond the plain path's interval on each side: the
-        // points within rounding of the faces are then tested point by
-        // point, as the core tests them.
-        let (low, high) = row_interval(n, right, kyu);
+        let (kyu, low, high) = walked(n, right, up, ky);
         Some(Row {
             cells,
             kyu,
-            low: low.saturating_sub(1).max(-half),
-            high: high.saturating_add(1).min(k_max),
+            low,
+            high,
         })
     };
     let mut bands = Vec::new();
@@ -195,7 +228,44 @@ fn merged(a: AdaptiveStats, b: AdaptiveStats) -> AdaptiveStats {
     }
 }
 
-impl<S: Sample, T: Real> Walk<'_, S, T> {
+impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
+    /// The walk of `levels` over `spec` on `frame`, or `None` where
+    /// [`extract`] declines.
+    fn new(
+        spec: &Spectrum<'a, S>,
+        kernel: &'a KernelTable<T>,
+        levels: &[AdaptiveLevel<'a, 'a, T>],
+        frame: &Frame,
+        tiling: Tiling,
+    ) -> Option<Self> {
+        let n = spec.n();
+        // Its walk wraps by masks: power-of-two sides only.
+        if !supports(spec)
+            || !n.is_power_of_two()
+            || kernel.filter() != spec.filter()
+            || levels.len() > MAX_LEVELS
+            || levels.iter().any(|l| l.marks.n() != n)
+        {
+            return None;
+        }
+        let mut filters = [None; 1 + MAX_LEVELS];
+        let mut marks = [None; MAX_LEVELS];
+        filters[0] = Some(applied(kernel, T::ONE)?);
+        for (i, level) in levels.iter().enumerate() {
+            filters[i + 1] = Some(applied(level.kernel, level.gain)?);
+            marks[i] = Some(level.marks);
+        }
+        Some(Self {
+            data: spec.data(),
+            n,
+            right: frame.right.map(T::from_f64),
+            filters,
+            marks,
+            raw_gain: T::exp2i(T::raw_exponent::<S>()),
+            chunk: tiling.chunk.clamp(1, n) as i32,
+        })
+    }
+
     /// Zero one band's rows, then fill their points inside the cube tile by
     /// tile; its statistics.
     fn fill_band(&self, mut band: Vec<Row<'_, T>>) -> AdaptiveStats {

@@ -7,6 +7,7 @@ use std::time::Instant;
 use fvr_core::geometry::View;
 use fvr_host::reference::snr_db;
 use fvr_host::render::adaptive::AdaptiveSettings;
+use fvr_host::render::adaptive_view::{AdaptiveRenderer, Walked};
 use fvr_host::render::spectrum::AnySpectrum;
 
 /// An adaptive render with what it did.
@@ -14,6 +15,7 @@ pub(crate) struct AdaptiveReport {
     pub(crate) image: Vec<f64>,
     pub(crate) marks: fvr_host::render::adaptive::AdaptiveMarks,
     pub(crate) stats: fvr_core::slice::adaptive::AdaptiveStats,
+    pub(crate) walked: Walked,
     pub(crate) mark_time: std::time::Duration,
     pub(crate) view_time: std::time::Duration,
     pub(crate) full_view_time: std::time::Duration,
@@ -39,6 +41,14 @@ impl AdaptiveReport {
             "  samples       {:.1}% on the full filter",
             pct(s.per_filter[0], s.samples)
         );
+        if let Walked::Plain { share } = self.walked {
+            println!(
+                "  adaptive      0.0% of samples substituted, plain walk used (the marks allow \
+                 {:.1}%, below --adaptive-plain-below {:.1}%)",
+                100.0 * share,
+                100.0 * self.marks.plain_below
+            );
+        }
         for (i, l) in self.marks.levels.iter().enumerate() {
             println!(
                 "  samples       {:.1}% on {} (h_d {:.3}, threshold {:.3e}, {} of {} spectrum samples marked)",
@@ -51,8 +61,10 @@ impl AdaptiveReport {
             );
             if let Some(r) = l.error_ratio {
                 println!(
-                    "  error field   {:.1} dB below the volume (exact bound, eq. 15)",
-                    -10.0 * r.log10()
+                    "  error field   {:.1} dB below the volume (exact bound, eq. 15; {} probe \
+                     transforms)",
+                    -10.0 * r.log10(),
+                    l.probes.unwrap_or(0)
                 );
             }
         }
@@ -61,7 +73,7 @@ impl AdaptiveReport {
             self.marks.bytes(),
             self.mark_time.as_secs_f64() * 1e3
         );
-        if let Some(note) = self.marks.effect(s) {
+        if let Some(note) = self.marks.note(s, self.walked) {
             println!("  note          {note}");
         }
     }
@@ -80,6 +92,7 @@ impl AdaptiveReport {
                 marked: l.marked,
                 samples: s.per_filter[i + 1],
                 error_field_db: l.error_ratio.map(|r| -10.0 * r.log10()),
+                probes: l.probes,
             })
             .collect();
         AdaptiveJson {
@@ -96,7 +109,13 @@ impl AdaptiveReport {
             view_ms: self.view_time.as_secs_f64() * 1e3,
             full_view_ms: self.full_view_time.as_secs_f64() * 1e3,
             snr_vs_full_db: self.snr_vs_full,
-            note: self.marks.effect(s),
+            plain_walk: matches!(self.walked, Walked::Plain { .. }),
+            allowed_share: match self.walked {
+                Walked::Plain { share } => share,
+                Walked::Adaptive => 1.0 - s.per_filter[0] as f64 / s.samples.max(1) as f64,
+            },
+            plain_below: self.marks.plain_below,
+            note: self.marks.note(s, self.walked),
         }
     }
 }
@@ -122,8 +141,23 @@ pub(crate) fn adaptive_render(
         let marks = fvr_host::render::adaptive::AdaptiveMarks::build(spec, settings)?;
         let mark_time = t0.elapsed();
         let t1 = Instant::now();
-        let (image, stats) = marks.render::<S, T>(spec, view, w, h)?;
+        let (image, stats, walked) = {
+            let mut renderer = AdaptiveRenderer::<T>::new(&marks, spec)?;
+            let mut out = vec![T::ZERO; w * h];
+            let stats = renderer.render_into(spec, view, w, h, &mut out)?;
+            let image: Vec<f64> = out.into_iter().map(T::to_f64).collect();
+            (image, stats, renderer.walked())
+        };
         let view_time = t1.elapsed();
+        if let (Walked::Plain { share }, false) = (walked, fvr_host::progress::quiet()) {
+            eprintln!(
+                "fvr: note: adaptive: the marks allow {:.1}% of the samples on the cheaper \
+                 filters, below {:.1}% (--adaptive-plain-below): 0.0% of samples substituted, \
+                 plain walk used",
+                100.0 * share,
+                100.0 * marks.plain_below
+            );
+        }
         let t2 = Instant::now();
         let full = any.render(view, w, h)?;
         let full_view_time = t2.elapsed();
@@ -132,6 +166,7 @@ pub(crate) fn adaptive_render(
             image,
             marks,
             stats,
+            walked,
             mark_time,
             view_time,
             full_view_time,
@@ -160,6 +195,12 @@ pub(crate) struct AdaptiveJson {
     view_ms: f64,
     full_view_ms: f64,
     snr_vs_full_db: f64,
+    /// The view was walked plainly with the full filter: the marks allowed
+    /// fewer than `plain_below` of its samples on the cheaper filters.
+    plain_walk: bool,
+    /// Share of the view's samples the marks allow on the cheaper filters.
+    allowed_share: f64,
+    plain_below: f64,
     note: Option<String>,
 }
 
@@ -172,4 +213,5 @@ struct LevelJson {
     marked: usize,
     samples: u64,
     error_field_db: Option<f64>,
+    probes: Option<usize>,
 }

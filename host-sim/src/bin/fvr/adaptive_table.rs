@@ -50,8 +50,11 @@ pub(crate) fn adaptive_table(args: &AdaptiveTableArgs) -> Result<(), Error> {
             volume.subtract_background(-1024.0)?;
             volume = volume.resample_isotropic(128)?;
         }
+        // The paper's table counts the taps the marks allow: always the
+        // adaptive walk, never the plain walk's fallback.
         let settings = AdaptiveSettings {
             bound,
+            plain_below: 0.0,
             ..AdaptiveSettings::new(tolerance)
         };
         rows.push(fvr_host::studies::adaptive_table::table1_row(

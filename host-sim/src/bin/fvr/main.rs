@@ -83,7 +83,8 @@ Progress bars go to stderr only when it is a terminal; --quiet turns them off.";
 #[derive(Parser)]
 #[command(name = "fvr", version, after_help = GEOMETRY)]
 pub(crate) struct Cli {
-    /// No progress bars (they are shown only when stderr is a terminal anyway).
+    /// No progress bars (they are shown only when stderr is a terminal
+    /// anyway) and no notes on stderr.
     #[arg(long, global = true)]
     quiet: bool,
     /// The most memory a job may plan to hold (bytes, or with K, M or G).
@@ -227,6 +228,7 @@ fn default_scene() -> Result<(), Error> {
         adaptive_chain: "nearest".into(),
         adaptive_hd: None,
         adaptive_bound: None,
+        adaptive_plain_below: fvr_host::render::adaptive::DEFAULT_PLAIN_BELOW,
         preview_level: 0,
         exact: false,
         input: InputArgs::default(),

@@ -25,7 +25,9 @@ use fvr_core::shading::{Light, Scene, MAX_LIGHTS};
 use fvr_host::image::output::write_png;
 use fvr_host::reference::shaded::exact_scene_projection_sampled;
 use fvr_host::reference::{exact_projection_sampled, snr_db};
-use fvr_host::render::adaptive::{parse_chain, parse_tolerance, AdaptiveSettings, Bound};
+use fvr_host::render::adaptive::{
+    parse_chain, parse_percent, parse_tolerance, AdaptiveSettings, Bound, DEFAULT_PLAIN_BELOW,
+};
 use fvr_host::render::shaded::{
     light_ring, negative_cue_share, parse_depth_cue, parse_light, parse_light_ring, parse_rgb,
     SceneRenderer, DEFAULT_PROFILE_HARMONICS, DEPTH_CUE_HELP,
@@ -126,6 +128,14 @@ pub(crate) struct RenderArgs {
     /// Default: `exact`, or `paper` when --adaptive-hd is given.
     #[arg(long, value_name = "BOUND", value_parser = Bound::from_name)]
     pub(crate) adaptive_bound: Option<Bound>,
+    /// Render a view with the plain walk and the full filter (its image
+    /// exactly) when the marks of --adaptive would move fewer than PCT
+    /// percent of its samples to the cheaper filters: below that share the
+    /// adaptive walk is slower than the plain one. 0 always walks
+    /// adaptively.
+    #[arg(long, value_name = "PCT", value_parser = parse_percent,
+          default_value_t = 100.0 * DEFAULT_PLAIN_BELOW)]
+    pub(crate) adaptive_plain_below: f64,
     /// Progressive preview level: 0 full resolution; L renders the image at
     /// 1/2^L of the size from the central 1/4^L of the slice (4^L times fewer
     /// interpolations). Plain X-ray views only. (`--level` is the PNG
@@ -306,6 +316,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
                 Some(_) => Bound::Paper,
                 None => Bound::Exact,
             }),
+            plain_below: args.adaptive_plain_below,
         };
         let report = adaptive_render(&spectra.density, &view, w, h, &settings)?;
         let gain = sampling.gain() * scene.ambient[0];

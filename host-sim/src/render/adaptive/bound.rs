@@ -1,0 +1,410 @@
+//! The exact bound of adaptive filtering ([`super::Bound::Exact`]): the
+//! error field of eq. 15 evaluated by 3D inverse transforms, and the search
+//! for the largest threshold it accepts.
+
+use crate::render::fast_dht::{dht_3d_real, half_spectrum_bytes, SparseCube};
+use fvr_core::dht::signed_index;
+use fvr_core::filter::Filter;
+use fvr_core::num::Sample;
+use fvr_core::spectrum::Spectrum;
+use rayon::prelude::*;
+
+/// The spectrum and grid the exact bound works on: the stored samples in
+/// f32 and the large filter's response per signed grid index.
+pub(super) struct ErrorModel {
+    n: usize,
+    pub(super) values: Vec<f32>,
+    large_response: Vec<f64>,
+    /// `Σ (f·h₁)²` over the grid: the energy the tolerance is relative to,
+    /// in the same (unnormalized) units as the error energies.
+    reference: f64,
+    /// `Σ F²` of the samples in each ⅛-octave magnitude bin `b`
+    /// (`2^((b−1)/8) ≤ |F| < 2^(b/8)`), from bin `lowest` up.
+    bins: Vec<f64>,
+    /// The bin of `bins[0]`.
+    lowest: i64,
+    /// `values[i]` is the spectrum's `value(i)` exactly (no block
+    /// exponents, a format f32 holds), so the marks may test it.
+    pub(super) exact: bool,
+    work: Vec<f32>,
+    /// The inverse transform of every sample (the reference's field), kept
+    /// when memory allows: the weak samples' field is then this minus the
+    /// strong samples' ([`ErrorModel::probe`]).
+    full: Option<Vec<f32>>,
+    /// The largest `|F|` in each z-plane, and in each row `y` over all
+    /// planes: the strong samples of a threshold lie on the planes and rows
+    /// that reach it.
+    plane_max: Vec<f32>,
+    row_max: Vec<f32>,
+}
+
+impl ErrorModel {
+    pub(super) fn new<S: Sample>(view: &Spectrum<'_, S>) -> Result<Self, String> {
+        let n = view.n();
+        let cells = (n as u64).pow(3);
+        crate::budget::Budget::new()
+            .hold("adaptive samples and error field (f32)", 2 * cells, 4)
+            .hold(
+                "adaptive transform half spectrum",
+                half_spectrum_bytes::<f32>(n),
+                1,
+            )
+            .check(crate::budget::limit(), "use --adaptive-bound paper")
+            .map_err(|e| e.to_string())?;
+        let large = *view.filter();
+        let mut values = vec![0f32; n * n * n];
+        let Scan {
+            bins,
+            lowest,
+            plane_max,
+            row_max,
+        } = scan(view, &mut values);
+        let plain = view.blocks().is_none();
+        let large_response = Self::responses(&large, n);
+        let mut model = Self {
+            n,
+            values,
+            large_response,
+            reference: 0.0,
+            bins,
+            lowest,
+            exact: plain && (S::BITS <= 16 || S::NAME == "f32"),
+            work: vec![0.0; n * n * n],
+            full: None,
+            plane_max,
+            row_max,
+        };
+        let large = model.large_response.clone();
+        let weight = Weight {
+            gain: 0.0,
+            small: &large,
+            large: &large,
+        };
+        model.reference = model.field_energy(f64::INFINITY, &weight)?;
+        // A third cube for the full field, if the budget allows it.
+        let room = crate::budget::Budget::new()
+            .hold("adaptive samples and fields (f32)", 3 * cells, 4)
+            .hold(
+                "adaptive transform half spectrum",
+                half_spectrum_bytes::<f32>(n),
+                1,
+            )
+            .check(crate::budget::limit(), "")
+            .is_ok();
+        if room {
+            model.full = Some(std::mem::replace(&mut model.work, vec![0.0; n * n * n]));
+        }
+        Ok(model)
+    }
+
+    /// The error energy of the samples below `tau` with `weight`:
+    /// [`ErrorModel::field_energy`], or, when the strong samples
+    /// (`|F| ≥ tau`) lie on at most ¾ of the rows `(y, z)` and the
+    /// budget is not below [`SUBTRACTION_BUDGET`], the full field minus the
+    /// strong samples' field. The transform then skips the rows and planes
+    /// without strong samples (its first two passes), and the weak field is
+    /// the same up to f32 rounding relative to the whole field's energy.
+    fn probe(&mut self, tau: f64, weight: &Weight<'_>, budget: f64) -> Result<f64, String> {
+        let n = self.n;
+        let t = tau as f32;
+        let planes: Vec<bool> = self.plane_max.iter().map(|&m| m >= t).collect();
+        let rows: Vec<bool> = self.row_max.iter().map(|&m| m >= t).collect();
+        let occupied = planes.iter().filter(|&&p| p).count() * rows.iter().filter(|&&r| r).count();
+        let full = match &self.full {
+            Some(full) if budget >= SUBTRACTION_BUDGET && 4 * occupied <= 3 * n * n => full,
+            _ => return self.field_energy(tau, weight),
+        };
+        let values = &self.values;
+        let fill = move |y: usize, z: usize, line: &mut [f32]| {
+            let row = &values[(z * n + y) * n..][..n];
+            for (w, &v) in line.iter_mut().zip(row) {
+                *w = if v.abs() < t { 0.0 } else { v };
+            }
+        };
+        let cube = SparseCube {
+            n,
+            rows_y: &rows,
+            planes_z: &planes,
+            fill: &fill,
+        };
+        dht_3d_real::<f32, f32>(&cube, &mut self.work).map_err(|e| e.to_string())?;
+        Ok(weight.energy(full, Some(&self.work), n))
+    }
+
+    /// `ĥ(x/n)` for each grid index `x` in natural order (signed position).
+    fn responses(filter: &Filter, n: usize) -> Vec<f64> {
+        (0..n)
+            .map(|k| filter.response(signed_index(k, n) as f64 / n as f64))
+            .collect()
+    }
+
+    /// `Σ_x (f_τ(x)·weight(x))²`, `f_τ` the inverse transform of the
+    /// samples below `tau` (unnormalized: the transform is its own inverse
+    /// up to `n³`, and every energy here carries the same factor), through
+    /// the host's FFT-based transform on all cores.
+    fn field_energy(&mut self, tau: f64, weight: &Weight<'_>) -> Result<f64, String> {
+        let n = self.n;
+        let tau = tau as f32;
+        let (values, all) = (&self.values, vec![true; n]);
+        let fill = move |y: usize, z: usize, line: &mut [f32]| {
+            let row = &values[(z * n + y) * n..][..n];
+            for (w, &v) in line.iter_mut().zip(row) {
+                *w = if v.abs() < tau { v } else { 0.0 };
+            }
+        };
+        let cube = SparseCube {
+            n,
+            rows_y: &all,
+            planes_z: &all,
+            fill: &fill,
+        };
+        dht_3d_real::<f32, f32>(&cube, &mut self.work).map_err(|e| e.to_string())?;
+        Ok(weight.energy(&self.work, None, n))
+    }
+
+    /// The error energy of threshold bin `b` as if the weight were its mean
+    /// square everywhere (Parseval: `n³·mean(w²)·Σ_{|F|<τ} F²`): exact for
+    /// a constant weight, and a guide for where to start the exact search.
+    fn estimate(&self, b: i64, mean_square_weight: f64) -> f64 {
+        // Bins `k ≤ b` hold the samples below `2^(b/8)`.
+        let below = (b - self.lowest + 1).clamp(0, self.bins.len() as i64) as usize;
+        let sum: f64 = self.bins[..below].iter().sum();
+        (self.n as f64).powi(3) * mean_square_weight * sum
+    }
+
+    /// The largest candidate threshold whose error energy for the pair
+    /// (large, `small` with gain `gain`) stays within `budget` of the
+    /// reference, and the relative energy it was verified at. Candidates are
+    /// ⅛-octave steps `2^(b/8)`, and the answer is bracketed between an
+    /// accepted step and a refused one (at first the empty weak set, which
+    /// has no error, and "no limit"). Each probe is one exact evaluation of
+    /// the error field. The first three probes go where the Parseval
+    /// estimate ([`ErrorModel::estimate`]) puts the answer, rescaled by the
+    /// ratio of exact to estimated energy at the last probe (the weight is
+    /// far from constant, so the raw estimate is off by octaves, but the
+    /// ratio varies slowly with `τ`); the rest bisect. It returns only
+    /// thresholds it evaluated.
+    pub(super) fn threshold(
+        &mut self,
+        small: &Filter,
+        gain: f64,
+        budget: f64,
+    ) -> Result<(f64, f64, usize), String> {
+        let n = self.n;
+        let hs = Self::responses(small, n);
+        let hl = self.large_response.clone();
+        let weight = Weight {
+            gain,
+            small: &hs,
+            large: &hl,
+        };
+        if self.bins.is_empty() || self.reference <= 0.0 {
+            return Ok((0.0, 0.0, 0));
+        }
+        // mean(w²) of the separable weight, from per-axis sums of products.
+        let axis_mean = |f: &dyn Fn(usize) -> f64| (0..n).map(f).sum::<f64>() / n as f64;
+        let mean_square = gain * gain * axis_mean(&|i| hs[i] * hs[i]).powi(3)
+            - 2.0 * gain * axis_mean(&|i| hs[i] * hl[i]).powi(3)
+            + axis_mean(&|i| hl[i] * hl[i]).powi(3);
+        let tau_of = |b: i64| 2f64.powf(b as f64 / 8.0);
+        let allowed = budget * self.reference;
+        // Below step `lowest` no sample is weak: the empty set, accepted.
+        let mut good: (i64, Option<f64>) = (self.lowest - 1, None);
+        // From `top` on every sample is weak: no larger threshold changes the set.
+        let top = self.lowest + self.bins.len() as i64 - 1;
+        let mut bad = top + 1;
+        let mut scale = 1.0;
+        let mut probes = 0;
+        while bad - good.0 > 1 {
+            let b = if probes < 3 {
+                (good.0 + 1..bad)
+                    .rev()
+                    .find(|&b| scale * self.estimate(b, mean_square) <= allowed)
+                    .unwrap_or(good.0 + 1)
+            } else {
+                good.0 + (bad - good.0) / 2
+            };
+            let e = self.probe(tau_of(b), &weight, budget)?;
+            probes += 1;
+            let estimate = self.estimate(b, mean_square);
+            if estimate > 0.0 && e > 0.0 {
+                scale = e / estimate;
+            }
+            if e <= allowed {
+                good = (b, Some(e / self.reference));
+            } else {
+                bad = b;
+            }
+        }
+        Ok(match good.1 {
+            Some(r) => (tau_of(good.0), r, probes),
+            None => (0.0, 0.0, probes),
+        })
+    }
+}
+
+/// The weight of eq. 15, `w(x) = g·ĥ₂(x)ĥ₂(y)ĥ₂(z) − ĥ₁(x)ĥ₁(y)ĥ₁(z)`,
+/// from the responses per grid index (`g = 0` gives `−ĥ₁`, the reference's
+/// weight up to sign).
+struct Weight<'a> {
+    gain: f64,
+    small: &'a [f64],
+    large: &'a [f64],
+}
+
+impl Weight<'_> {
+    /// `Σ_x ((field(x) − minus(x))·w(x))²` over the cube of side `n` (x
+    /// fastest; `minus` zero if `None`), on all cores: per row,
+    /// `w = a·ĥ₂(x) − b·ĥ₁(x)` with `a = g·ĥ₂(y)ĥ₂(z)` and `b = ĥ₁(y)ĥ₁(z)`,
+    /// summed in f64 in four interleaved lanes.
+    fn energy(&self, field: &[f32], minus: Option<&[f32]>, n: usize) -> f64 {
+        let plane = n * n;
+        field
+            .par_chunks(plane)
+            .enumerate()
+            .map(|(z, f)| match minus {
+                Some(m) => self.plane_energy(z, n, |i| f[i] - m[z * plane + i]),
+                None => self.plane_energy(z, n, |i| f[i]),
+            })
+            .sum()
+    }
+
+    /// The energy of plane `z`, its values `value(i)` (`i = x + n·y`).
+    #[inline(always)]
+    fn plane_energy(&self, z: usize, n: usize, value: impl Fn(usize) -> f32) -> f64 {
+        let (hs, hl) = (self.small, self.large);
+        let mut energy = 0.0f64;
+        for y in 0..n {
+            let (a, b) = (self.gain * hs[y] * hs[z], hl[y] * hl[z]);
+            let mut lanes = [0.0f64; 4];
+            for x in 0..n {
+                let e = value(x + n * y) as f64 * (a * hs[x] - b * hl[x]);
+                lanes[x % 4] += e * e;
+            }
+            energy += (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
+        }
+        energy
+    }
+}
+
+/// The smallest per-level budget (energy relative to the volume's) for which
+/// [`ErrorModel::probe`] subtracts fields: f32 rounding of the full field is
+/// about `10^-14` of its energy, far below.
+const SUBTRACTION_BUDGET: f64 = 1e-9;
+
+/// `2^(j/8)` for `j = 1 … 7` in f32: a mantissa in `[1, 2)` is in eighth
+/// `j` when it reaches the `j`-th entry (the estimate only guides the
+/// search, so the last bit of these does not matter).
+const EIGHTH_OCTAVES: [f32; 7] = [
+    1.090_507_8,
+    1.189_207_1,
+    1.296_839_6,
+    core::f32::consts::SQRT_2,
+    1.542_210_8,
+    1.681_792_9,
+    1.834_008_1,
+];
+
+/// What one pass over the samples gathers ([`scan`]).
+struct Scan {
+    /// `Σ F²` per ⅛-octave magnitude bin (`2^((b−1)/8) ≤ |F| < 2^(b/8)` in
+    /// bin `b`), from the lowest occupied bin; zeros are left out (they
+    /// add nothing to any energy).
+    bins: Vec<f64>,
+    /// The bin of `bins[0]`.
+    lowest: i64,
+    /// The largest `|F|` of each z-plane.
+    plane_max: Vec<f32>,
+    /// The largest `|F|` of each row `y`, over all planes.
+    row_max: Vec<f32>,
+}
+
+/// Every bin an f32 can fall in (subnormals down to 2^−149): bin `FIRST`
+/// first.
+const FIRST: i64 = -8 * 150;
+const BINS: usize = 8 * 280;
+
+/// The ⅛-octave bin of a nonzero `v`: `⌊8·log₂|v|⌋ + 1`, from the exponent
+/// and mantissa bits for normal numbers (the mantissa compared with
+/// [`EIGHTH_OCTAVES`] as integers: the same order as the floats), through
+/// `log₂` for subnormals.
+#[inline(always)]
+fn bin(v: f32) -> i64 {
+    let bits = v.abs().to_bits();
+    let exponent = (bits >> 23) as i64;
+    if exponent == 0 {
+        return ((v.abs() as f64).log2() * 8.0).floor() as i64 + 1;
+    }
+    let mantissa = bits & 0x007f_ffff;
+    let eighths: u32 = EIGHTH_OCTAVES
+        .iter()
+        .map(|t| u32::from(mantissa >= (t.to_bits() & 0x007f_ffff)))
+        .sum();
+    8 * (exponent - 127) + eighths as i64 + 1
+}
+
+/// Fill `values` with the spectrum's samples in f32, plane by plane on
+/// all cores, and gather their magnitude bins and extents in the same pass.
+fn scan<S: Sample>(view: &Spectrum<'_, S>, values: &mut [f32]) -> Scan {
+    let n = view.n();
+    let (data, plain) = (view.data(), view.blocks().is_none());
+    let planes: Vec<(Vec<f64>, f32, Vec<f32>)> = values
+        .par_chunks_mut(n * n)
+        .enumerate()
+        .map(|(z, plane)| {
+            match plain {
+                // Without block exponents a value is its stored sample.
+                true => {
+                    for (v, d) in plane.iter_mut().zip(&data[z * n * n..]) {
+                        *v = d.to_f32();
+                    }
+                }
+                false => {
+                    for (i, v) in plane.iter_mut().enumerate() {
+                        *v = view.value(z * n * n + i) as f32;
+                    }
+                }
+            }
+            let mut bins = vec![0f64; BINS];
+            let rows: Vec<f32> = plane
+                .chunks_exact(n)
+                .map(|row| {
+                    let mut largest = 0f32;
+                    for &v in row {
+                        largest = largest.max(v.abs());
+                        if v != 0.0 {
+                            bins[(bin(v) - FIRST) as usize] += v as f64 * v as f64;
+                        }
+                    }
+                    largest
+                })
+                .collect();
+            (bins, rows.iter().fold(0f32, |m, &r| m.max(r)), rows)
+        })
+        .collect();
+    let mut all = vec![0f64; BINS];
+    let mut row_max = vec![0f32; n];
+    for (bins, _, rows) in &planes {
+        for (a, b) in all.iter_mut().zip(bins) {
+            *a += b;
+        }
+        for (m, &r) in row_max.iter_mut().zip(rows) {
+            *m = m.max(r);
+        }
+    }
+    let plane_max = planes.iter().map(|p| p.1).collect();
+    // A nonzero f32 squared is a positive f64: occupied bins are positive.
+    let (bins, lowest) = match (
+        all.iter().position(|&e| e > 0.0),
+        all.iter().rposition(|&e| e > 0.0),
+    ) {
+        (Some(lo), Some(hi)) => (all[lo..=hi].to_vec(), lo as i64 + FIRST),
+        _ => (Vec::new(), 0),
+    };
+    Scan {
+        bins,
+        lowest,
+        plane_max,
+        row_max,
+    }
+}
