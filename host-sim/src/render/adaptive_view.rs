@@ -25,6 +25,7 @@ use super::adaptive::AdaptiveMarks;
 use super::fast_adaptive;
 use super::fast_inverse::finish_threaded;
 use super::fast_slice::{self, Tiling};
+use super::fast_strip;
 use super::spectrum::OwnedSpectrum;
 
 /// Reusable per-view buffers and tables for adaptive views of one
@@ -152,7 +153,11 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
         if let Some(stats) = self.plain_instead(&core_spec, &levels, &frame) {
             let axes = Sampling::UNIT.slice_axes(&frame);
             let (kernel, grid) = (&self.kernel, &mut self.grid);
-            if fast_slice::extract(&core_spec, kernel, &axes, self.tiling, self.parallel, grid) {
+            // The plain renderer's walk ([`super::view::Walk::Strip`]).
+            let (tiling, parallel) = (self.tiling, self.parallel);
+            if fast_strip::extract(&core_spec, kernel, &axes, tiling, parallel, grid)
+                || fast_slice::extract(&core_spec, kernel, &axes, tiling, parallel, grid)
+            {
                 let share = 1.0 - stats.per_filter[0] as f64 / stats.samples.max(1) as f64;
                 self.last = Walked::Plain { share };
                 let place = placement_on_axes(core_spec.dims(), &axes, width, height, 1.0);
