@@ -13,6 +13,7 @@ use fvr_core::Error;
 use fvr_host::reference::{exact_projection, snr_db};
 use fvr_host::render::plan::grid_filter;
 use fvr_host::render::spectrum::{AnySpectrum, KbDesign, OwnedSpectrum, Precision, ViewRenderer};
+use fvr_host::render::view::Walk;
 use fvr_host::sources::phantom_by_name;
 
 #[test]
@@ -123,21 +124,36 @@ fn threads_levels_and_one_shot_agree_on_mixed_sides() {
     assert_eq!(n, 60);
     let spec = OwnedSpectrum::<f32>::prepare_on::<f32>(&volume, filter, n).unwrap();
     let view = View::along([0.3, -1.0, 0.45]);
-    let render = |threads: usize| {
+    let render = |threads: usize, walk: Walk| {
         let mut out = vec![0.0f32; 48 * 48];
         ViewRenderer::<f32>::new(n, filter)
             .with_threads(threads)
+            .with_walk(walk)
             .render_into(&spec, &view, 48, 48, &mut out)
             .unwrap();
-        out
+        out.iter().map(|v| v.to_f64()).collect::<Vec<f64>>()
     };
-    let one = render(1);
-    assert_eq!(one, render(4), "threads change the image");
     let once =
         fvr_host::render::view::render_once::<_, f32>(&spec.view(), &Request::new(view, 48, 48))
             .unwrap();
-    let one64: Vec<f64> = one.iter().map(|v| v.to_f64()).collect();
-    assert_eq!(once, one64, "one-shot render differs from the renderer");
+    // The exact walk keeps the core's bits on any thread count.
+    let exact = render(1, Walk::Exact);
+    assert_eq!(exact, render(4, Walk::Exact), "threads change the image");
+    assert_eq!(once, exact, "one-shot render differs from the exact walk");
+    // This view's right axis has a zero (up hint on y), so the default walk
+    // sums by strips: the same products in another order, the same image
+    // on any thread count, and within f32 rounding of the core's
+    // (`tests/fast_strip.rs` bounds it point by point; 100 dB is far below
+    // f32's floor of about 140 dB and far above any wrong tap).
+    let strip = render(1, Walk::Strip);
+    assert_eq!(
+        strip,
+        render(4, Walk::Strip),
+        "threads change the strip image"
+    );
+    assert_ne!(strip, exact, "the strip walk was not taken");
+    let near = snr_db(&once, &strip);
+    assert!(near >= 100.0, "strip walk against the core: {near:.1} dB");
     // Level 1 (m = 30): pixels two voxels apart; compare with every other
     // pixel of the full image, which carries the band above m/2 too: a
     // smooth volume keeps that small.

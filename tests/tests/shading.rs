@@ -352,6 +352,25 @@ fn plain_scene_builds_nothing_extra_and_matches_plain_render() {
         .render(&view, 32, 32)
         .unwrap();
     assert_eq!(spectra.render(&xray, &view, 32, 32).unwrap().data, plain);
+    // A cue with equal ends weighs every depth alike: half the plain image
+    // for a weight of 0.5 (a power of two, so exact).
+    for cue in [
+        DepthCue::Linear {
+            front: 0.5,
+            back: 0.5,
+        },
+        DepthCue::Sine {
+            front: 0.5,
+            back: 0.5,
+        },
+    ] {
+        let flat = Scene {
+            cue,
+            ..Scene::xray()
+        };
+        let half: Vec<f64> = plain.iter().map(|v| 0.5 * v).collect();
+        assert_eq!(spectra.render(&flat, &view, 32, 32).unwrap().data, half);
+    }
 
     let shaded = lit(DepthCue::None);
     let lit_spectra = SceneSpectra::prepare(&volume, filter, Precision::F16, &shaded).unwrap();

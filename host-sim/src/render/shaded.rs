@@ -139,7 +139,12 @@ impl SceneSpectra {
                 .map_err(|e| e.to_string());
         }
         if scene.channels() == 1 && !scene.has_partner_terms() {
-            let grey = scene.ambient[0];
+            // A cue with equal ends weighs every depth alike.
+            let cue = match scene.cue {
+                DepthCue::Linear { front, .. } | DepthCue::Sine { front, .. } => front,
+                DepthCue::None | DepthCue::Profile { .. } => 1.0,
+            };
+            let grey = scene.ambient[0] * cue;
             let data = self
                 .density
                 .render_sampled(view, sampling, width, height)
@@ -172,13 +177,16 @@ impl SceneSpectra {
         width: usize,
         height: usize,
     ) -> Result<Image, fvr_core::Error> {
-        // A plain X-ray scene on a mixed-radix side goes through the view
-        // renderer, which has the mixed-radix inverse.
-        if !self.density.n().is_power_of_two()
-            && scene.channels() == 1
-            && !scene.has_partner_terms()
-        {
-            let grey = scene.ambient[0];
+        // A plain X-ray scene goes through the view renderer: its walk
+        // (strips where the rows hold a coordinate) and, on a mixed-radix
+        // side, its inverse. The image is the plain projection's.
+        if scene.channels() == 1 && !scene.has_partner_terms() {
+            // A cue with equal ends weighs every depth alike.
+            let cue = match scene.cue {
+                DepthCue::Linear { front, .. } | DepthCue::Sine { front, .. } => front,
+                DepthCue::None | DepthCue::Profile { .. } => 1.0,
+            };
+            let grey = scene.ambient[0] * cue;
             let data = self.density.render(view, width, height)?;
             return Ok(Image {
                 channels: 1,
