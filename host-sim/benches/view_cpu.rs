@@ -12,6 +12,7 @@
 //! per figure (default 40), `FVR_BENCH_N` the volume's side (default 256),
 //! `FVR_BENCH_SIDE` the spectrum's (default `FVR_BENCH_N`; up to twice it,
 //! e.g. 320 for a mixed-radix side, with the filter of σ = 1.25).
+//! `FVR_BENCH_DIRS="x,y,z;x,y,z"` replaces the three directions.
 //! `FVR_BENCH_BRICKS=4x4x4,8x4x4` times the slice alone instead, from the
 //! linear spectrum and from bricked copies of it
 //! (`fvr_host::render::fast_bricks`), alternating, one thread.
@@ -108,11 +109,7 @@ fn main() {
             .with_threads(1)
             .with_tiling(tiling)
             .with_walk(Walk::Exact);
-        for (name, dir) in [
-            ("axis", [0.0, -1.0, 0.0]),
-            ("oblique", [1.0, 0.3, 0.2]),
-            ("orbit45", [1.0, -1.0, 0.0]),
-        ] {
+        for (name, dir) in directions(env("FVR_BENCH_DIRS")) {
             let view = View::along(dir);
             let host = per_view(views, || {
                 renderer
@@ -193,4 +190,27 @@ fn slices(spec: &OwnedSpectrum<f16>, bricks: &str, tiling: Tiling, views: usize)
         }
         println!("{line}");
     }
+}
+
+/// The named directions timed: `dirs` (`x,y,z;x,y,z`, each named by
+/// itself) or the axis, an oblique direction and the orbit at 45°.
+fn directions(dirs: Option<String>) -> Vec<(String, [f64; 3])> {
+    let given: Vec<(String, [f64; 3])> = dirs
+        .iter()
+        .flat_map(|d| d.split(';'))
+        .filter_map(|d| {
+            let v: Vec<f64> = d.split(',').filter_map(|x| x.trim().parse().ok()).collect();
+            Some((d.trim().to_string(), [*v.first()?, *v.get(1)?, *v.get(2)?]))
+        })
+        .collect();
+    if !given.is_empty() {
+        return given;
+    }
+    [
+        ("axis", [0.0, -1.0, 0.0]),
+        ("oblique", [1.0, 0.3, 0.2]),
+        ("orbit45", [1.0, -1.0, 0.0]),
+    ]
+    .map(|(name, d)| (name.to_string(), d))
+    .to_vec()
 }

@@ -87,10 +87,10 @@ fn fast_f16_widening_is_bit_identical_to_half_for_every_pattern() {
 
 #[test]
 fn raw_f16_widening_times_two_pow_112_is_the_value_for_every_finite_pattern() {
-    // The hot loops fold 2^112 into a weight; (w·2^112)·raw must equal
-    // w·value bit for bit, which holds when raw·2^112 is the value exactly.
+    // The device's hot loops fold 2^112 into a weight; (w·2^112)·raw must
+    // equal w·value bit for bit, which holds when raw·2^112 is the value
+    // exactly.
     let two_pow_112 = f32::exp2i(112);
-    assert_eq!(<f32 as Real>::raw_exponent::<f16>(), 112);
     for bits in (0..0x7C00u16).chain(0x8000..0xFC00u16) {
         let raw = fvr_core::num::f16_bits_to_f32_raw(bits);
         let value = f16::from_bits(bits).to_f32();
@@ -99,13 +99,45 @@ fn raw_f16_widening_times_two_pow_112_is_the_value_for_every_finite_pattern() {
             value.to_bits(),
             "{bits:#06x}"
         );
-        assert_eq!(
-            <f32 as Real>::load_raw(f16::from_bits(bits)).to_bits(),
-            raw.to_bits()
-        );
         for w in [0.3f32, -1.7e-3, 0.999_999_9] {
             assert_eq!(
                 ((w * two_pow_112) * raw).to_bits(),
+                (w * value).to_bits(),
+                "{bits:#06x} {w}"
+            );
+        }
+    }
+}
+
+#[test]
+fn load_raw_times_its_gain_is_the_value_and_off_arm_never_subnormal() {
+    // Whatever this target's raw exponent e, load_raw·2^e is the value
+    // and (w·2^e)·load_raw is w·value bit for bit, so the walks' products
+    // are the device's. Off Arm the widening is never a binary32
+    // subnormal: x86 cores take a microcode assist per subnormal operand.
+    let e = <f32 as Real>::raw_exponent::<f16>();
+    assert_eq!(e, if cfg!(target_arch = "arm") { 112 } else { 0 });
+    let gain = f32::exp2i(e);
+    for bits in (0..0x7C00u16).chain(0x8000..0xFC00u16) {
+        let raw = <f32 as Real>::load_raw(f16::from_bits(bits));
+        let value = f16::from_bits(bits).to_f32();
+        assert_eq!((raw * gain).to_bits(), value.to_bits(), "{bits:#06x}");
+        assert_eq!(
+            fvr_core::num::f16_bits_to_f32_finite(bits).to_bits(),
+            value.to_bits(),
+            "{bits:#06x}"
+        );
+        assert_eq!(
+            fvr_core::num::f16_bits_to_f32(bits).to_bits(),
+            value.to_bits(),
+            "{bits:#06x}"
+        );
+        if !cfg!(target_arch = "arm") {
+            assert!(raw == 0.0 || raw.is_normal(), "{bits:#06x}: {raw:e}");
+        }
+        for w in [0.3f32, -1.7e-3, 0.999_999_9] {
+            assert_eq!(
+                ((w * gain) * raw).to_bits(),
                 (w * value).to_bits(),
                 "{bits:#06x} {w}"
             );

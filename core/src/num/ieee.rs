@@ -21,6 +21,9 @@ use super::Sample;
 /// (Cortex-M4F, x86-64 without `target-feature=+f16c`) through a branchy
 /// path of about 25 instructions; this is about 8, and slice extraction does
 /// one per filter tap.
+///
+/// Off Arm the finite patterns take [`f16_bits_to_f32_finite`] instead,
+/// which never forms a binary32 subnormal.
 #[inline(always)]
 pub fn f16_bits_to_f32(bits: u16) -> f32 {
     const TWO_POW_112: f32 = f32::from_bits((127 + 112) << 23);
@@ -28,7 +31,38 @@ pub fn f16_bits_to_f32(bits: u16) -> f32 {
     if magnitude >= 0x7C00 {
         return f16::from_bits(bits).to_f32();
     }
+    if cfg!(not(target_arch = "arm")) {
+        return f16_bits_to_f32_finite(bits);
+    }
     let value = f32::from_bits(magnitude << 13) * TWO_POW_112;
+    f32::from_bits(value.to_bits() | ((bits as u32 & 0x8000) << 16))
+}
+
+/// The finite binary16 `bits` as the binary32 of the same value, exactly,
+/// without branches and without forming a binary32 subnormal: normals by
+/// rebiasing the exponent in the integer field (`+112`), subnormals (and
+/// zero) as their 10-bit mantissa times `2^−24`, an exact integer-to-float
+/// conversion and product; a select picks one. Exponent-all-ones patterns
+/// come out finite and wrong, which is why it is only for data known to
+/// be finite.
+///
+/// Why: x86-64 cores (Intel's in particular) take a microcode assist of
+/// the order of a hundred cycles for each floating-point operation with a
+/// subnormal operand, so [`f16_bits_to_f32_raw`], whose binary16
+/// subnormals become binary32 subnormals, slows the slice walk several
+/// times on smooth volumes whose spectra are mostly small values. The
+/// Cortex-M4F's FPU takes subnormals at full speed and keeps the raw path.
+#[inline(always)]
+pub fn f16_bits_to_f32_finite(bits: u16) -> f32 {
+    const TWO_POW_MINUS_24: f32 = f32::from_bits((127 - 24) << 23);
+    let magnitude = (bits & 0x7FFF) as u32;
+    let normal = f32::from_bits((magnitude << 13) + (112 << 23));
+    let subnormal = magnitude as f32 * TWO_POW_MINUS_24;
+    let value = if magnitude < 0x0400 {
+        subnormal
+    } else {
+        normal
+    };
     f32::from_bits(value.to_bits() | ((bits as u32 & 0x8000) << 16))
 }
 
@@ -49,10 +83,18 @@ impl Sample for f16 {
     const BITS: u32 = 16;
     const SCALE_LOG2: i32 = 14;
     const MAX_FINITE: f64 = 65504.0;
-    const RAW_EXPONENT_F32: i32 = 112;
+    /// The raw rebias ([`f16_bits_to_f32_raw`]) on Arm; elsewhere the value
+    /// itself ([`f16_bits_to_f32_finite`]), whose operands are never
+    /// subnormal. Either way the products of the hot loops are the same
+    /// bits: a power of two moved between the factors of an exact product.
+    const RAW_EXPONENT_F32: i32 = if cfg!(target_arch = "arm") { 112 } else { 0 };
     #[inline(always)]
     fn to_f32_raw(self) -> f32 {
-        f16_bits_to_f32_raw(self.to_bits())
+        if cfg!(target_arch = "arm") {
+            f16_bits_to_f32_raw(self.to_bits())
+        } else {
+            f16_bits_to_f32_finite(self.to_bits())
+        }
     }
     #[inline(always)]
     fn from_f32(v: f32) -> Self {

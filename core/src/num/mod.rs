@@ -47,7 +47,7 @@ pub use block::{encode_blocks, BlockExponents, BlockLayout};
 pub use fixed::{Q15, Q7};
 pub use format::{encode_elements, Arithmetic, Blocking, Format, FormatName};
 pub use half::{bf16, f16};
-pub use ieee::{f16_bits_to_f32, f16_bits_to_f32_raw};
+pub use ieee::{f16_bits_to_f32, f16_bits_to_f32_finite, f16_bits_to_f32_raw};
 pub use minifloat::{FloatLayout, Minifloat16, Minifloat8};
 pub use real::Real;
 pub use sample::Sample;

@@ -58,8 +58,9 @@ pub trait Real:
     fn exp2i(e: i32) -> Self;
     /// A stored *finite* sample as its value times `2^−e`, `e` being
     /// [`Real::raw_exponent`]`::<S>()`: the cheapest exact widening (for f16
-    /// into f32, the bits moved into place without the rebias
-    /// multiplication of [`super::f16_bits_to_f32`]). Hot loops fold `2^e` into a
+    /// into f32 on Arm, the bits moved into place without the rebias
+    /// multiplication of [`super::f16_bits_to_f32`]; elsewhere a widening
+    /// without subnormal results, [`super::f16_bits_to_f32_finite`]). Hot loops fold `2^e` into a
     /// weight once instead of paying for it per sample. Not meaningful for
     /// infinities and NaNs (spectra hold neither: [`crate::spectrum`]).
     fn load_raw<S: Sample>(s: S) -> Self;
