@@ -283,6 +283,10 @@ trap 'rm -rf "$budget_ws"' EXIT
 git ls-files -z --cached --others --exclude-standard | xargs -0 cp --parents -t "$budget_ws"
 sed -i 's/^version = "\([0-9.]*\)"$/version = "\1-budget"/' "$budget_ws/Cargo.toml"
 grep -q '^version = "[0-9.]*-budget"$' "$budget_ws/Cargo.toml" || fail "could not set the copy's workspace version"
+# Resolving the copy's lock offline needs every locked crate in the local
+# registry, other platforms' too (cargo metadata reads them all), which a
+# fresh machine's builds never download.
+cargo fetch --locked --quiet || fail "cargo fetch failed: the copy's lock cannot be resolved offline"
 (cd "$budget_ws" && cargo metadata --offline --format-version 1 >/dev/null) \
     || fail "could not update the copy's Cargo.lock offline"
 expect_build_failure() { # flash-length pattern what
