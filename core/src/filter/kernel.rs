@@ -460,12 +460,21 @@ impl EnergyProfile {
                 let mut start = 0;
                 for &(b, end) in &runs[..count] {
                     // Four partial sums: the adds are not one dependent chain.
-                    let mut lanes = [0.0f64; 4];
-                    for (t, i) in (start..end).enumerate() {
-                        let v = volume.finite_voxel(i, j, k)?;
-                        lanes[t % 4] += v * v;
+                    let (mut a, mut b4, mut c, mut d) = (0.0f64, 0.0, 0.0, 0.0);
+                    let mut i = start;
+                    while i + 4 <= end {
+                        let e = |x| volume.finite_voxel(x, j, k).map(|v| v * v);
+                        a += e(i)?;
+                        b4 += e(i + 1)?;
+                        c += e(i + 2)?;
+                        d += e(i + 3)?;
+                        i += 4;
                     }
-                    let run = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
+                    for x in i..end {
+                        let v = volume.finite_voxel(x, j, k)?;
+                        a += v * v;
+                    }
+                    let run = (a + b4) + (c + d);
                     energy[b] += run;
                     row += run;
                     start = end;
@@ -515,7 +524,8 @@ mod tests {
             for k in 0..dims[2] {
                 for j in 0..dims[1] {
                     for i in 0..dims[0] {
-                        let e = field.voxel(i, j, k).powi(2);
+                        let v = field.voxel(i, j, k);
+                        let e = v * v;
                         want[bin(i, 0)] += e;
                         want[bin(j, 1)] += e;
                         want[bin(k, 2)] += e;
