@@ -324,32 +324,21 @@ impl<const W: usize, S: Sample, T: Real> Strip<'_, W, S, T> {
         let u0 = self.wrap(lo as i64);
         if su == 1 && u0 + len <= n {
             let start = line + u0;
-            if len >= 16 {
-                // Long runs (rows along x): plane by plane, which vectorizes.
-                for (c, &weight) in wh.iter().enumerate() {
-                    let Some(src) = self.data.get(planes[c] + start..planes[c] + start + len)
-                    else {
-                        return;
-                    };
-                    if c == 0 {
-                        for (o, &v) in cells.iter_mut().zip(src) {
-                            *o = weight * T::load_raw(v);
-                        }
-                    } else {
-                        for (o, &v) in cells.iter_mut().zip(src) {
-                            *o += weight * T::load_raw(v);
-                        }
+            // Plane by plane, short runs too: on rows along y (runs of about
+            // W + 1 cells) 15–25% less CPU than summing each cell's planes in
+            // turn (`view_cpu`, side 320, kb5).
+            for (c, &weight) in wh.iter().enumerate() {
+                let Some(src) = self.data.get(planes[c] + start..planes[c] + start + len) else {
+                    return;
+                };
+                if c == 0 {
+                    for (o, &v) in cells.iter_mut().zip(src) {
+                        *o = weight * T::load_raw(v);
                     }
-                }
-            } else {
-                // Short runs: each cell's planes in registers.
-                for (i, o) in cells.iter_mut().enumerate() {
-                    let mut acc = T::ZERO;
-                    for c in 0..W {
-                        let v = self.data.get(planes[c] + start + i).copied();
-                        acc += wh[c] * T::load_raw(v.unwrap_or_default());
+                } else {
+                    for (o, &v) in cells.iter_mut().zip(src) {
+                        *o += weight * T::load_raw(v);
                     }
-                    *o = acc;
                 }
             }
             return;
