@@ -138,23 +138,8 @@ impl SceneSpectra {
                 .render(&scaled, view, width, height)
                 .map_err(|e| e.to_string());
         }
-        if scene.channels() == 1 && !scene.has_partner_terms() {
-            // A cue with equal ends weighs every depth alike.
-            let cue = match scene.cue {
-                DepthCue::Linear { front, .. } | DepthCue::Sine { front, .. } => front,
-                DepthCue::None | DepthCue::Profile { .. } => 1.0,
-            };
-            let grey = scene.ambient[0] * cue;
-            let data = self
-                .density
-                .render_sampled(view, sampling, width, height)
-                .map_err(|e| e.to_string())?;
-            return Ok(Image {
-                channels: 1,
-                width,
-                height,
-                data: data.into_iter().map(|v| v * grey).collect(),
-            });
+        if let Some(image) = self.plain_xray(scene, view, sampling, width, height) {
+            return image.map_err(|e| e.to_string());
         }
         let [x, y, z] = sampling.spacing();
         Err(format!(
@@ -163,6 +148,40 @@ impl SceneSpectra {
              --ignore-spacing (voxel units), or render an X-ray view",
             sampling.pixel_size()
         ))
+    }
+
+    /// A plain X-ray scene (grey, no lights, no depth-varying cue) through
+    /// the view renderer: its walk (strips where the rows hold a
+    /// coordinate) and, on a mixed-radix side, its inverse, so the image is
+    /// the plain projection's times the ambient grey and the cue's constant
+    /// weight. `None` for any other scene.
+    fn plain_xray(
+        &self,
+        scene: &Scene,
+        view: &View,
+        sampling: &Sampling,
+        width: usize,
+        height: usize,
+    ) -> Option<Result<Image, fvr_core::Error>> {
+        if scene.channels() != 1 || scene.has_partner_terms() {
+            return None;
+        }
+        // A cue with equal ends weighs every depth alike.
+        let cue = match scene.cue {
+            DepthCue::Linear { front, .. } | DepthCue::Sine { front, .. } => front,
+            DepthCue::None | DepthCue::Profile { .. } => 1.0,
+        };
+        let grey = scene.ambient[0] * cue;
+        Some(
+            self.density
+                .render_sampled(view, sampling, width, height)
+                .map(|data| Image {
+                    channels: 1,
+                    width,
+                    height,
+                    data: data.into_iter().map(|v| v * grey).collect(),
+                }),
+        )
     }
 
     /// Render one view of `scene`; the image comes back in f64.
@@ -177,23 +196,8 @@ impl SceneSpectra {
         width: usize,
         height: usize,
     ) -> Result<Image, fvr_core::Error> {
-        // A plain X-ray scene goes through the view renderer: its walk
-        // (strips where the rows hold a coordinate) and, on a mixed-radix
-        // side, its inverse. The image is the plain projection's.
-        if scene.channels() == 1 && !scene.has_partner_terms() {
-            // A cue with equal ends weighs every depth alike.
-            let cue = match scene.cue {
-                DepthCue::Linear { front, .. } | DepthCue::Sine { front, .. } => front,
-                DepthCue::None | DepthCue::Profile { .. } => 1.0,
-            };
-            let grey = scene.ambient[0] * cue;
-            let data = self.density.render(view, width, height)?;
-            return Ok(Image {
-                channels: 1,
-                width,
-                height,
-                data: data.into_iter().map(|v| v * grey).collect(),
-            });
+        if let Some(image) = self.plain_xray(scene, view, &Sampling::UNIT, width, height) {
+            return image;
         }
         fn go<S: Sample, T: Real>(
             d: &OwnedSpectrum<S>,
