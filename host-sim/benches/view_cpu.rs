@@ -1,8 +1,10 @@
 //! CPU time per view on one thread (the thread's own user + system time
 //! from `/proc/thread-self/stat`, so time the thread spends waiting for a
 //! core shared with other processes is not counted): the host extraction
-//! (`fvr_host::render::fast_strip` where the rows hold a coordinate, the
-//! exact walk `fvr_host::render::fast_slice` beside it) against the core's render, at 256³
+//! (`fvr_host::render::fast_column` where the slice contains an axis,
+//! `fvr_host::render::fast_strip` where its rows hold a coordinate, the
+//! exact walk `fvr_host::render::fast_slice` beside it; and each walk's
+//! slice alone) against the core's render, at 256³
 //! f16, kb4 and kb6, along an axis, an oblique direction and the orbit
 //! direction at 45°. A companion of the `view` criterion bench for a
 //! loaded machine, where wall-clock times of threaded views mean little.
@@ -27,6 +29,7 @@ use fvr_host::render::fast_bricks::Bricked;
 use fvr_host::render::fast_slice::{extract, extract_bricked, Tiling};
 use fvr_host::render::spectrum::{OwnedSpectrum, ViewRenderer};
 use fvr_host::render::view::{render_once, Walk};
+use fvr_host::render::{fast_column, fast_strip};
 use fvr_host::sources::phantom::{sample, GaussianMixture};
 use half::f16;
 
@@ -127,12 +130,34 @@ fn main() {
             });
             println!(
                 "{kind:?} {name:8} host {host:6.2}  exact walk {exact:6.2}  core {core:6.2}  \
-                 exact/host {:.2}  core/host {:.2}",
+                 exact/host {:.2}  core/host {:.2}  slice alone: {}",
                 exact / host,
-                core / host
+                core / host,
+                slice_walks(&spec, &view, tiling, views)
             );
         }
     }
+}
+
+/// Slice-only CPU ms per view of the column, strip and exact walks on
+/// `view`, each where it applies.
+fn slice_walks(spec: &OwnedSpectrum<f16>, view: &View, tiling: Tiling, views: usize) -> String {
+    let n = spec.n();
+    let kernel = KernelTable::<f32>::new(spec.filter());
+    let axes = Sampling::UNIT.slice_axes(&view.frame().unwrap());
+    let mut grid = vec![0.0f32; n * n];
+    let spec = spec.view();
+    let mut time = |walk: &dyn Fn(&mut [f32]) -> bool| {
+        if walk(&mut grid) {
+            format!("{:6.2}", per_view(views, || assert!(walk(&mut grid))))
+        } else {
+            "     —".into()
+        }
+    };
+    let column = time(&|g| fast_column::extract(&spec, &kernel, &axes, tiling, false, g));
+    let strip = time(&|g| fast_strip::extract(&spec, &kernel, &axes, tiling, false, g));
+    let exact = time(&|g| extract(&spec, &kernel, &axes, tiling, false, g));
+    format!("column {column}  strip {strip}  exact {exact}")
 }
 
 /// Slice-only CPU ms per view from the linear spectrum and from each

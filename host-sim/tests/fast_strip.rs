@@ -1,13 +1,16 @@
-//! The strip walk (`fvr_host::render::fast_strip`) against the core's
-//! extraction (`fvr_core::slice::extract_slice_rows`): the same slice to
-//! within the rounding of two sums of the same `W³` products,
-//! `|strip − core| ≤ 2·(3W + 2)·ε·Σ|w·c|` at every point, `Σ|w·c|` being
-//! the core's walk over `|c|` with `|k|`. Every filter width; f16 and f32 storage
-//! with f32 arithmetic, f64 with f64; rows holding z, y and x (each with
-//! its own strides); oblique and near-axis slices whose strips wrap
-//! around the cube; physical-unit axes; power-of-two and mixed-radix
-//! sides; one thread and several. Views whose rows hold no coordinate are
-//! refused, and the renderer's image follows the walk it is given.
+//! The strip walk (`fvr_host::render::fast_strip`) and the column walk
+//! (`fvr_host::render::fast_column`) against the core's extraction
+//! (`fvr_core::slice::extract_slice_rows`): the same slice to within the
+//! rounding of two sums of the same `W³` products,
+//! `|walk − core| ≤ 2·γ·Σ|w·c|` at every point, `Σ|w·c|` being the
+//! core's walk over `|c|` with `|k|`, `γ = (3W + 2)·ε` for the strip and
+//! `(3W + 8)·ε` for the column walk (its reflected weights' rounding).
+//! Every filter width; f16 and f32 storage with f32 arithmetic, f64 with
+//! f64; rows holding z, y and x and slices containing z, y and x (each
+//! with its own strides); oblique, near-axis and axis-aligned slices whose
+//! taps wrap around the cube; physical-unit axes; power-of-two and
+//! mixed-radix sides; one thread and several. Views the walks do not serve
+//! are refused, and the renderer's image follows the walk it is given.
 
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::{Sampling, SliceAxes, View};
@@ -16,9 +19,11 @@ use fvr_core::render::Request;
 use fvr_core::slice::extract_slice_rows;
 use fvr_core::spectrum::Spectrum;
 use fvr_core::volume::GridOversampling;
+use fvr_host::render::fast_column::{self, column_axis};
 use fvr_host::render::fast_slice::Tiling;
-use fvr_host::render::fast_strip::{extract, held_axis};
+use fvr_host::render::fast_strip::{self, held_axis};
 use fvr_host::render::spectrum::{OwnedSpectrum, ViewRenderer};
+use fvr_host::render::turntable::orbit;
 use fvr_host::render::view::{render_once, Walk};
 use fvr_host::sources::phantom::{sample, GaussianMixture};
 use fvr_host::volume::Volume;
@@ -79,9 +84,78 @@ fn axes_list() -> Vec<(SliceAxes, usize)> {
     list
 }
 
-/// The core's slice and the strip's, on one thread and several (garbage
+/// Slice axes containing z (turntables about z: oblique, along an axis
+/// and diagonal), y and x.
+fn column_axes_list() -> Vec<(SliceAxes, usize)> {
+    let mut list = Vec::new();
+    for (up, dirs) in [
+        (
+            [0.0, 0.0, 1.0],
+            vec![
+                [0.0, -1.0, 0.0],
+                [1.0, -0.3, 0.0],
+                [-0.6, -0.8, 0.0],
+                [1.0, 1.0, 0.0],
+            ],
+        ),
+        (
+            [0.0, 1.0, 0.0],
+            vec![[0.3, 0.0, 1.0], [-1.0, 0.0, 0.05], [0.0, 0.0, 1.0]],
+        ),
+        (
+            [1.0, 0.0, 0.0],
+            vec![[0.0, 0.4, -0.9], [0.0, 1.0, 0.0], [0.0, -0.7, 0.7]],
+        ),
+    ] {
+        let axis = up.iter().position(|&c| c == 1.0).unwrap();
+        for dir in dirs {
+            let axes = Sampling::UNIT.slice_axes(&View { dir, up }.frame().unwrap());
+            list.push((axes, axis));
+        }
+    }
+    list
+}
+
+/// The walk under test.
+#[derive(Clone, Copy, Debug)]
+enum Fast {
+    Strip,
+    Column,
+}
+
+impl Fast {
+    fn extract<S: Sample, T: Real + Send + Sync>(
+        self,
+        spec: &Spectrum<'_, S>,
+        kernel: &KernelTable<T>,
+        axes: &SliceAxes,
+        parallel: bool,
+        grid: &mut [T],
+    ) -> bool {
+        let tiling = Tiling::default();
+        match self {
+            Self::Strip => fast_strip::extract(spec, kernel, axes, tiling, parallel, grid),
+            Self::Column => fast_column::extract(spec, kernel, axes, tiling, parallel, grid),
+        }
+    }
+
+    /// `γ / ε` for width `w`.
+    fn sums(self, w: usize) -> f64 {
+        match self {
+            Self::Strip => 3.0 * w as f64 + 2.0,
+            Self::Column => 3.0 * w as f64 + 8.0,
+        }
+    }
+}
+
+/// The core's slice and the walk's, on one thread and several (garbage
 /// first: every point must be written), within the bound.
-fn check<S: Sample, T: Real + Send + Sync>(spec: &OwnedSpectrum<S>, axes: &SliceAxes, what: &str) {
+fn check<S: Sample, T: Real + Send + Sync>(
+    fast: Fast,
+    spec: &OwnedSpectrum<S>,
+    axes: &SliceAxes,
+    what: &str,
+) {
     let view = spec.view();
     let n = view.n();
     let filter = *view.filter();
@@ -92,25 +166,30 @@ fn check<S: Sample, T: Real + Send + Sync>(spec: &OwnedSpectrum<S>, axes: &Slice
         core.iter().filter(|v| v.to_f64() != 0.0).count() > n * n / 4,
         "{what}: the slice is mostly zero"
     );
-    // Each point's Σ|w·c|: the core's walk in f64 over |c| with |k|.
+    // Each point's Σ|w·c|: the core's walk over |c| with |k|, in `T` so
+    // that it keeps the rows the core keeps (in f64 an up axis a rounding
+    // longer than 1 drops row n/2 at the cube's face). Its own rounding,
+    // at most 3W·ε of it, is inside the bound's 1.001 margin.
     let abs_data: Vec<S> = view
         .data()
         .iter()
         .map(|&c| S::from_f64(c.to_f64().abs()))
         .collect();
     let abs_spec = Spectrum::from_parts(&abs_data, n, view.scale(), filter, view.dims()).unwrap();
-    let exact = KernelTable::<f64>::new(filter);
-    let abs_values: Vec<f64> = exact.values().iter().map(|v| v.abs()).collect();
-    let abs_kernel = KernelTable::<f64>::from_values(filter, &abs_values).unwrap();
-    let mut mass = vec![0.0f64; n * n];
-    extract_slice_rows(&abs_spec, &abs_kernel, axes, 0, &mut mass).unwrap();
-    // The two sums' rounding, with the f64 mass's own as margin.
-    let gamma = 2.0 * (3.0 * filter.width() as f64 + 2.0) * 2.0 * T::EPSILON_HALF * 1.001;
+    let abs_values: Vec<T> = kernel
+        .values()
+        .iter()
+        .map(|&v| T::from_f64(v.to_f64().abs()))
+        .collect();
+    let abs_kernel = KernelTable::<T>::from_values(filter, &abs_values).unwrap();
+    let mut mass_t = vec![T::ZERO; n * n];
+    extract_slice_rows(&abs_spec, &abs_kernel, axes, 0, &mut mass_t).unwrap();
+    let mass: Vec<f64> = mass_t.iter().map(|m| m.to_f64()).collect();
+    let gamma = 2.0 * fast.sums(filter.width()) * 2.0 * T::EPSILON_HALF * 1.001;
     for parallel in [false, true] {
         let mut host = vec![T::from_f64(7.0); n * n];
-        let tiling = Tiling::default();
         assert!(
-            extract(&view, &kernel, axes, tiling, parallel, &mut host),
+            fast.extract(&view, &kernel, axes, parallel, &mut host),
             "{what}"
         );
         let over = core
@@ -135,7 +214,28 @@ fn every_filter_and_held_axis_within_rounding_f16() {
         let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
         for (axes, held) in axes_list() {
             assert_eq!(held_axis(&axes), Some(held), "{axes:?}");
-            check::<f16, f32>(&spec, &axes, &format!("{kind:?} f16 {axes:?}"));
+            check::<f16, f32>(Fast::Strip, &spec, &axes, &format!("{kind:?} f16 {axes:?}"));
+        }
+        for (axes, axis) in column_axes_list() {
+            assert_eq!(column_axis(&axes), Some(axis), "{axes:?}");
+            let what = format!("{kind:?} column f16 {axes:?}");
+            check::<f16, f32>(Fast::Column, &spec, &axes, &what);
+        }
+    }
+}
+
+/// Every frame of a turntable about an axis, from a start square to it,
+/// contains that axis exactly: the column walk serves the whole orbit.
+#[test]
+fn turntables_about_an_axis_contain_it_in_every_frame() {
+    for (start, axis, a) in [
+        ([0.0, -1.0, 0.0], [0.0, 0.0, 1.0], 2),
+        ([1.0, 0.0, 0.3], [0.0, 1.0, 0.0], 1),
+        ([0.0, 0.6, -0.8], [1.0, 0.0, 0.0], 0),
+    ] {
+        for view in orbit(start, axis, 37).unwrap() {
+            let axes = Sampling::UNIT.slice_axes(&view.frame().unwrap());
+            assert_eq!(column_axis(&axes), Some(a), "{view:?}");
         }
     }
 }
@@ -149,8 +249,23 @@ fn f32_storage_and_f64_arithmetic_within_rounding() {
         let spec32 = OwnedSpectrum::<f32>::prepare::<f32>(&volume, filter).unwrap();
         let spec64 = OwnedSpectrum::<f64>::prepare::<f64>(&volume, filter).unwrap();
         for (axes, _) in axes_list() {
-            check::<f32, f32>(&spec32, &axes, &format!("{kind:?} f32 {axes:?}"));
-            check::<f64, f64>(&spec64, &axes, &format!("{kind:?} f64 {axes:?}"));
+            check::<f32, f32>(
+                Fast::Strip,
+                &spec32,
+                &axes,
+                &format!("{kind:?} f32 {axes:?}"),
+            );
+            check::<f64, f64>(
+                Fast::Strip,
+                &spec64,
+                &axes,
+                &format!("{kind:?} f64 {axes:?}"),
+            );
+        }
+        for (axes, _) in column_axes_list() {
+            let what = format!("{kind:?} column {axes:?}");
+            check::<f32, f32>(Fast::Column, &spec32, &axes, &what);
+            check::<f64, f64>(Fast::Column, &spec64, &axes, &what);
         }
     }
 }
@@ -165,7 +280,18 @@ fn physical_units_and_mixed_radix_sides_within_rounding() {
             let spec = OwnedSpectrum::<f16>::prepare_on::<f32>(&volume, filter, n).unwrap();
             for dir in [[1.0, 0.3, 0.2], [0.0, -1.0, 0.0], [0.3, -0.9, 0.5]] {
                 let axes = sampling.slice_axes(&View::along(dir).frame().unwrap());
-                check::<f16, f32>(&spec, &axes, &format!("{kind:?} n {n} {dir:?}"));
+                check::<f16, f32>(
+                    Fast::Strip,
+                    &spec,
+                    &axes,
+                    &format!("{kind:?} n {n} {dir:?}"),
+                );
+            }
+            for dir in [[0.0, -1.0, 0.0], [1.0, 0.3, 0.0], [0.3, -0.9, 0.0]] {
+                let axes = sampling.slice_axes(&View::along(dir).frame().unwrap());
+                assert_eq!(column_axis(&axes), Some(2), "{axes:?}");
+                let what = format!("{kind:?} column n {n} {dir:?}");
+                check::<f16, f32>(Fast::Column, &spec, &axes, &what);
             }
         }
     }
@@ -185,51 +311,65 @@ fn rows_holding_no_coordinate_are_refused() {
     };
     assert_eq!(held_axis(&axes), None);
     let mut grid = vec![7.0f32; n * n];
-    assert!(!extract(
-        &view,
-        &kernel,
-        &axes,
-        Tiling::default(),
-        true,
-        &mut grid
-    ));
+    assert_eq!(column_axis(&axes), None);
+    for fast in [Fast::Strip, Fast::Column] {
+        assert!(!fast.extract(&view, &kernel, &axes, true, &mut grid));
+        assert!(
+            grid.iter().all(|&v| v == 7.0),
+            "{fast:?}: a refused grid was written"
+        );
+    }
+    // Rows holding z but the slice containing no axis: the strip walk's.
+    let (axes, _) = axes_list().remove(0);
+    assert_eq!(column_axis(&axes), None);
+    assert!(!Fast::Column.extract(&view, &kernel, &axes, true, &mut grid));
     assert!(grid.iter().all(|&v| v == 7.0), "a refused grid was written");
 }
 
 /// The renderer sums by the walk it is given: `Walk::Exact` is the
-/// core's image bit for bit, `Walk::Strip` (the default) another rounding
-/// of it, at least 100 dB from it on a phantom: 34 dB below f16 storage's
+/// core's image bit for bit, `Walk::Strip` (the default: the column walk
+/// on a slice containing an axis, else the strip walk) the same or another
+/// rounding of it, at least 100 dB from it on a phantom: 34 dB below f16 storage's
 /// own floor (`2^−11`, 66 dB), so the walk never shows in a measured SNR.
 #[test]
 fn renderer_follows_its_walk() {
     let n = 64;
     let volume = sample(&GaussianMixture::random(5, n, 8), [n; 3]);
-    let view = View::along([1.0, 0.3, 0.2]);
-    for kind in [FilterKind::Kb4, FilterKind::Kb6] {
-        let filter = Filter::new(kind, 1).unwrap();
-        let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
-        let render = |walk: Walk| {
-            let mut out = vec![0.0f32; n * n];
-            ViewRenderer::<f32>::new(n, filter)
-                .with_walk(walk)
-                .render_into(&spec, &view, n, n, &mut out)
-                .unwrap();
-            out
-        };
-        let core = render_once::<f16, f32>(&spec.view(), &Request::new(view, n, n)).unwrap();
-        let exact = render(Walk::Exact);
-        assert!(core
-            .iter()
-            .zip(&exact)
-            .all(|(a, b)| a.to_bits() == (*b as f64).to_bits()));
-        let strip = render(Walk::default());
-        let (mut signal, mut noise) = (0.0f64, 0.0f64);
-        for (a, b) in core.iter().zip(&strip) {
-            signal += a * a;
-            noise += (a - *b as f64).powi(2);
+    for dir in [[1.0, 0.3, 0.2], [1.0, 0.3, 0.0]] {
+        let view = View::along(dir);
+        for kind in [FilterKind::Kb4, FilterKind::Kb6] {
+            let filter = Filter::new(kind, 1).unwrap();
+            let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+            let render = |walk: Walk| {
+                let mut out = vec![0.0f32; n * n];
+                ViewRenderer::<f32>::new(n, filter)
+                    .with_walk(walk)
+                    .render_into(&spec, &view, n, n, &mut out)
+                    .unwrap();
+                out
+            };
+            let core = render_once::<f16, f32>(&spec.view(), &Request::new(view, n, n)).unwrap();
+            let exact = render(Walk::Exact);
+            assert!(core
+                .iter()
+                .zip(&exact)
+                .all(|(a, b)| a.to_bits() == (*b as f64).to_bits()));
+            let fast = render(Walk::default());
+            let (mut signal, mut noise) = (0.0f64, 0.0f64);
+            for (a, b) in core.iter().zip(&fast) {
+                signal += a * a;
+                noise += (a - *b as f64).powi(2);
+            }
+            // The column walk nests its sums as the core does (x, then y,
+            // then z) and may match it bit for bit; the strip walk cannot.
+            if dir[2] != 0.0 {
+                assert!(noise > 0.0, "{kind:?} {dir:?}: the strip walk was not used");
+            }
+            let snr = 10.0 * (signal / noise).log10();
+            assert!(
+                snr >= 100.0,
+                "{kind:?} {dir:?}: fast walk against core {snr:.1} dB"
+            );
         }
-        assert!(noise > 0.0, "{kind:?}: the strip walk was not used");
-        let snr = 10.0 * (signal / noise).log10();
-        assert!(snr >= 100.0, "{kind:?}: strip against core {snr:.1} dB");
     }
 }

@@ -25,8 +25,8 @@ use super::adaptive::AdaptiveMarks;
 use super::fast_adaptive;
 use super::fast_inverse::finish_threaded;
 use super::fast_slice::{self, Tiling};
-use super::fast_strip;
 use super::spectrum::OwnedSpectrum;
+use super::{fast_column, fast_strip};
 
 /// Reusable per-view buffers and tables for adaptive views of one
 /// spectrum's marks, in arithmetic `T`.
@@ -155,7 +155,8 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
             let (kernel, grid) = (&self.kernel, &mut self.grid);
             // The plain renderer's walk ([`super::view::Walk::Strip`]).
             let (tiling, parallel) = (self.tiling, self.parallel);
-            if fast_strip::extract(&core_spec, kernel, &axes, tiling, parallel, grid)
+            if fast_column::extract(&core_spec, kernel, &axes, tiling, parallel, grid)
+                || fast_strip::extract(&core_spec, kernel, &axes, tiling, parallel, grid)
                 || fast_slice::extract(&core_spec, kernel, &axes, tiling, parallel, grid)
             {
                 let share = 1.0 - stats.per_filter[0] as f64 / stats.samples.max(1) as f64;

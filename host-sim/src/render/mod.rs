@@ -5,6 +5,7 @@ pub mod adaptive;
 pub mod adaptive_view;
 pub mod fast_adaptive;
 pub mod fast_bricks;
+pub mod fast_column;
 pub mod fast_dht;
 pub mod fast_inverse;
 pub mod fast_marks;

@@ -13,8 +13,8 @@ use fvr_core::spectrum::Spectrum;
 
 use super::fast_inverse::MixedFinish;
 use super::fast_slice::{self, Tiling};
-use super::fast_strip;
 use super::spectrum::OwnedSpectrum;
+use super::{fast_column, fast_strip};
 
 /// Reusable per-view buffers and tables for arithmetic `T`.
 #[derive(Debug)]
@@ -35,9 +35,11 @@ pub struct ViewRenderer<T> {
 /// How a plain view's slice is summed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Walk {
-    /// Reduced along the axis the slice's rows hold, where there is one
-    /// ([`fast_strip`]): the core's values to within rounding, with a
-    /// third to a sixth of the products. Elsewhere as [`Walk::Exact`].
+    /// Factored along the axis the slice contains, where there is one
+    /// ([`fast_column`]), else reduced along the axis the slice's rows
+    /// hold, where there is one ([`fast_strip`]): the core's values to
+    /// within rounding, with a third to a sixth of the products. Elsewhere
+    /// as [`Walk::Exact`].
     #[default]
     Strip,
     /// Tap by tap in the core's order ([`fast_slice`]): the core's
@@ -155,7 +157,8 @@ impl<T: Real> ViewRenderer<T> {
             let walk = self.walk;
             let extract = |parallel: bool, grid: &mut [T]| {
                 (walk == Walk::Strip
-                    && fast_strip::extract(&spec, kernel, &axes, tiling, parallel, grid))
+                    && (fast_column::extract(&spec, kernel, &axes, tiling, parallel, grid)
+                        || fast_strip::extract(&spec, kernel, &axes, tiling, parallel, grid)))
                     || fast_slice::extract(&spec, kernel, &axes, tiling, parallel, grid)
             };
             let filled = match (&self.pool, self.threads) {
