@@ -154,7 +154,18 @@ fn slice_walks(spec: &OwnedSpectrum<f16>, view: &View, tiling: Tiling, views: us
             "     —".into()
         }
     };
-    let column = time(&|g| fast_column::extract(&spec, &kernel, &axes, tiling, false, g));
+    let along = std::cell::RefCell::new(Vec::new());
+    let column = time(&|g| {
+        fast_column::extract(
+            &spec,
+            &kernel,
+            &axes,
+            tiling,
+            false,
+            g,
+            &mut along.borrow_mut(),
+        )
+    });
     let strip = time(&|g| fast_strip::extract(&spec, &kernel, &axes, tiling, false, g));
     let exact = time(&|g| extract(&spec, &kernel, &axes, tiling, false, g));
     format!("column {column}  strip {strip}  exact {exact}")

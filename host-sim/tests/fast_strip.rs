@@ -135,7 +135,9 @@ impl Fast {
         let tiling = Tiling::default();
         match self {
             Self::Strip => fast_strip::extract(spec, kernel, axes, tiling, parallel, grid),
-            Self::Column => fast_column::extract(spec, kernel, axes, tiling, parallel, grid),
+            Self::Column => {
+                fast_column::extract(spec, kernel, axes, tiling, parallel, grid, &mut Vec::new())
+            }
         }
     }
 

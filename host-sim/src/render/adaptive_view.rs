@@ -40,6 +40,8 @@ pub struct AdaptiveRenderer<'m, T> {
     aux: Vec<T>,
     /// The transposed grid of the threaded finish.
     trans: Vec<T>,
+    /// The column walk's sums between its passes.
+    along: Vec<T>,
     parallel: bool,
     core: bool,
     tiling: Tiling,
@@ -85,6 +87,7 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
             grid: vec![T::ZERO; n * n],
             aux: vec![T::ZERO; aux_len(n)],
             trans: vec![T::ZERO; grid_len(n)],
+            along: Vec::new(),
             parallel: true,
             core: false,
             tiling: Tiling::default(),
@@ -152,10 +155,10 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
         self.last = Walked::Adaptive;
         if let Some(stats) = self.plain_instead(&core_spec, &levels, &frame) {
             let axes = Sampling::UNIT.slice_axes(&frame);
-            let (kernel, grid) = (&self.kernel, &mut self.grid);
+            let (kernel, grid, along) = (&self.kernel, &mut self.grid, &mut self.along);
             // The plain renderer's walk ([`super::view::Walk::Strip`]).
             let (tiling, parallel) = (self.tiling, self.parallel);
-            if fast_column::extract(&core_spec, kernel, &axes, tiling, parallel, grid)
+            if fast_column::extract(&core_spec, kernel, &axes, tiling, parallel, grid, along)
                 || fast_strip::extract(&core_spec, kernel, &axes, tiling, parallel, grid)
                 || fast_slice::extract(&core_spec, kernel, &axes, tiling, parallel, grid)
             {

@@ -54,6 +54,8 @@ pub fn column_axis(axes: &SliceAxes) -> Option<usize> {
 /// `axes` as [`super::fast_slice::extract`] does, to within rounding (see
 /// the module's bound), `tiling.chunk` columns per unit of work: on the
 /// current rayon pool's threads when `parallel`, else on this thread.
+/// `along` holds the planes' sums between the passes (`2n²` values; kept
+/// by the caller, so that views after the first allocate nothing).
 /// `false` (grid untouched) when the slice contains no axis
 /// ([`column_axis`]), [`supports`] does not hold, the grid is not `n²` or
 /// `kernel` is not the spectrum's filter.
@@ -64,6 +66,7 @@ pub fn extract<S: Sample, T: Real + Send + Sync>(
     tiling: Tiling,
     parallel: bool,
     grid: &mut [T],
+    along: &mut Vec<T>,
 ) -> bool {
     let n = spec.n();
     if !supports(spec) || grid.len() != n * n || kernel.filter() != spec.filter() {
@@ -75,12 +78,12 @@ pub fn extract<S: Sample, T: Real + Send + Sync>(
     let g = Geometry::new(axes, n, tiling, parallel);
     let data = spec.data();
     match kernel.filter().width() {
-        1 => walk::<1, S, T>(data, kernel, &g, axis, grid),
-        2 => walk::<2, S, T>(data, kernel, &g, axis, grid),
-        3 => walk::<3, S, T>(data, kernel, &g, axis, grid),
-        4 => walk::<4, S, T>(data, kernel, &g, axis, grid),
-        5 => walk::<5, S, T>(data, kernel, &g, axis, grid),
-        _ => walk::<MAX_WIDTH, S, T>(data, kernel, &g, axis, grid),
+        1 => walk::<1, S, T>(data, kernel, &g, axis, grid, along),
+        2 => walk::<2, S, T>(data, kernel, &g, axis, grid, along),
+        3 => walk::<3, S, T>(data, kernel, &g, axis, grid, along),
+        4 => walk::<4, S, T>(data, kernel, &g, axis, grid, along),
+        5 => walk::<5, S, T>(data, kernel, &g, axis, grid, along),
+        _ => walk::<MAX_WIDTH, S, T>(data, kernel, &g, axis, grid, along),
     }
 }
 
@@ -223,6 +226,7 @@ fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
     g: &Geometry<T>,
     axis: usize,
     grid: &mut [T],
+    along: &mut Vec<T>,
 ) -> bool {
     let mut phases = Box::new(PhaseTable::<T, W>::zeroed());
     if phases.fill(kernel).is_err() {
@@ -251,7 +255,8 @@ fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
     // Pass 1: `L(k, z)` for every column (and its mirrored taps where
     // they differ), z fastest, by blocks of columns.
     let block = g.tiling.chunk.clamp(1, n);
-    let mut along = vec![T::ZERO; 2 * n * n];
+    // Every value is written before it is read: no clearing.
+    along.resize(2 * n * n, T::ZERO);
     let fill = |scratch: &mut Scratch<W, T>, (b, chunk): (usize, &mut [T])| {
         let first = b * block;
         let last = (first + block).min(n);
@@ -281,7 +286,7 @@ fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
     for r in &rows {
         by_row[r.row].push(r);
     }
-    let along = &along;
+    let along = &*along;
     let finish = |(row, out): (usize, &mut [T])| {
         out.fill(T::ZERO);
         for r in &by_row[row] {

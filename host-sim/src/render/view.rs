@@ -23,6 +23,8 @@ pub struct ViewRenderer<T> {
     tw: Vec<T>,
     grid: Vec<T>,
     aux: Vec<T>,
+    /// The column walk's sums between its passes.
+    along: Vec<T>,
     /// The threaded finish of a mixed-radix side.
     mixed: Option<MixedFinish<T>>,
     n: usize,
@@ -57,6 +59,7 @@ impl<T: Real> ViewRenderer<T> {
             tw,
             grid: vec![T::ZERO; grid_len(n)],
             aux: vec![T::ZERO; aux_len(n)],
+            along: Vec::new(),
             mixed: (!n.is_power_of_two())
                 .then(|| MixedFinish::new(n).ok())
                 .flatten(),
@@ -154,10 +157,10 @@ impl<T: Real> ViewRenderer<T> {
             let axes = sampling.slice_axes(&view.frame()?);
             check_image(width, height, n)?;
             let (kernel, tiling, grid) = (&self.kernel, self.tiling, &mut self.grid);
-            let walk = self.walk;
-            let extract = |parallel: bool, grid: &mut [T]| {
+            let (walk, along) = (self.walk, &mut self.along);
+            let mut extract = |parallel: bool, grid: &mut [T]| {
                 (walk == Walk::Strip
-                    && (fast_column::extract(&spec, kernel, &axes, tiling, parallel, grid)
+                    && (fast_column::extract(&spec, kernel, &axes, tiling, parallel, grid, along)
                         || fast_strip::extract(&spec, kernel, &axes, tiling, parallel, grid)))
                     || fast_slice::extract(&spec, kernel, &axes, tiling, parallel, grid)
             };
