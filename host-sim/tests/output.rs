@@ -251,3 +251,30 @@ fn turntable_frames_equal_single_renders_of_the_same_views() {
         assert_ne!(frames[0], frames[1]);
     }
 }
+
+/// The selected ranks are the sorted values' at the same nearest ranks, on
+/// shuffled values with repeats, for every pair of percentiles on a grid.
+#[test]
+fn percentiles_are_the_sorted_values_ranks() {
+    let mut state = 12345u64;
+    for len in [1usize, 2, 7, 100, 1001] {
+        let pixels: Vec<f64> = (0..len)
+            .map(|_| {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                ((state >> 40) % 50) as f64 - 20.0
+            })
+            .collect();
+        let mut sorted = pixels.clone();
+        sorted.sort_by(f64::total_cmp);
+        let at = |p: f64| sorted[((p / 100.0) * (len - 1) as f64).round() as usize];
+        for lo in [0.0, 0.5, 10.0, 50.0] {
+            for hi in [50.5, 90.0, 99.5, 100.0] {
+                let (a, b) = (at(lo), at(hi));
+                let expected = if b > a { (a, b) } else { (a, a + 1.0) };
+                assert_eq!(percentile_range(&pixels, lo, hi), expected, "{len} {lo} {hi}");
+            }
+        }
+    }
+}

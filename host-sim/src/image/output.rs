@@ -104,15 +104,19 @@ impl Window {
 }
 
 /// The `p_lo`-th and `p_hi`-th percentiles of the finite values (nearest
-/// rank on the sorted values), widened to a non-empty interval.
+/// rank on the sorted values), widened to a non-empty interval. Each rank
+/// is selected in linear time, not sorted for (a turntable's frames hold
+/// millions of pixels).
 pub fn percentile_range(pixels: &[f64], p_lo: f64, p_hi: f64) -> (f64, f64) {
     let mut v: Vec<f64> = pixels.iter().copied().filter(|x| x.is_finite()).collect();
     if v.is_empty() {
         return (0.0, 1.0);
     }
-    v.sort_by(f64::total_cmp);
-    let at = |p: f64| v[((p / 100.0) * (v.len() - 1) as f64).round() as usize];
-    let (lo, hi) = (at(p_lo), at(p_hi));
+    let rank = |p: f64| (((p / 100.0) * (v.len() - 1) as f64).round() as usize).min(v.len() - 1);
+    let (r_lo, r_hi) = (rank(p_lo), rank(p_hi));
+    let hi = *v.select_nth_unstable_by(r_hi, f64::total_cmp).1;
+    // Ranks below `r_hi` now sit before it.
+    let lo = *v[..=r_hi].select_nth_unstable_by(r_lo.min(r_hi), f64::total_cmp).1;
     if hi > lo {
         (lo, hi)
     } else {
