@@ -273,7 +273,11 @@ fn percentiles_are_the_sorted_values_ranks() {
             for hi in [50.5, 90.0, 99.5, 100.0] {
                 let (a, b) = (at(lo), at(hi));
                 let expected = if b > a { (a, b) } else { (a, a + 1.0) };
-                assert_eq!(percentile_range(&pixels, lo, hi), expected, "{len} {lo} {hi}");
+                assert_eq!(
+                    percentile_range(&pixels, lo, hi),
+                    expected,
+                    "{len} {lo} {hi}"
+                );
             }
         }
     }

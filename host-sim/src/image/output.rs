@@ -116,7 +116,9 @@ pub fn percentile_range(pixels: &[f64], p_lo: f64, p_hi: f64) -> (f64, f64) {
     let (r_lo, r_hi) = (rank(p_lo), rank(p_hi));
     let hi = *v.select_nth_unstable_by(r_hi, f64::total_cmp).1;
     // Ranks below `r_hi` now sit before it.
-    let lo = *v[..=r_hi].select_nth_unstable_by(r_lo.min(r_hi), f64::total_cmp).1;
+    let lo = *v[..=r_hi]
+        .select_nth_unstable_by(r_lo.min(r_hi), f64::total_cmp)
+        .1;
     if hi > lo {
         (lo, hi)
     } else {

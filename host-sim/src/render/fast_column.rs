@@ -39,6 +39,7 @@ use fvr_core::num::{Real, Sample};
 use fvr_core::spectrum::Spectrum;
 use rayon::prelude::*;
 
+use super::fast_runs::{axes_and_strides, wrap, Runs};
 use super::fast_slice::{row_interval, supports, Geometry, Tiling};
 
 /// Planes interpolated side by side (the multiply-adds' lanes).
@@ -112,9 +113,7 @@ struct Column<const W: usize, T> {
 struct Scratch<const W: usize, T> {
     /// The block's tap sets and where their runs go.
     columns: Vec<(Column<W, T>, usize)>,
-    lo: Vec<i32>,
-    hi: Vec<i32>,
-    off: Vec<usize>,
+    runs: Runs,
     cells: Vec<[T; LANES]>,
 }
 
@@ -129,16 +128,6 @@ struct Line<'a, const W: usize, S, T> {
     /// Fixed-point position of column 0 and step per column on `u`, `w`.
     origin: [i64; 2],
     step: [i64; 2],
-}
-
-/// `j mod n`.
-#[inline(always)]
-fn wrap(n: usize, j: i64) -> usize {
-    if n.is_power_of_two() {
-        j as usize & (n - 1)
-    } else {
-        j.rem_euclid(n as i64) as usize
-    }
 }
 
 /// The signed frequency of grid column `c` (`c` for `c ≤ (n − 1)/2`, else
@@ -233,20 +222,15 @@ fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
         return false;
     }
     let n = g.n;
-    let (u, w) = match axis {
-        0 => (1, 2),
-        1 => (0, 2),
-        _ => (0, 1),
-    };
-    let stride = |b: usize| n.pow(b as u32);
+    let (axes @ [_, u, w], strides) = axes_and_strides(axis, n);
     let gain = T::exp2i(T::raw_exponent::<S>());
-    let Some((rows, origin)) = rows(g, &phases, [axis, u, w], gain) else {
+    let Some((rows, origin)) = rows(g, &phases, axes, gain) else {
         return false;
     };
     let line = Line::<W, S, T> {
         data,
         n,
-        strides: [stride(axis), stride(u), stride(w)],
+        strides,
         phases: &phases,
         origin,
         step: [u, w].map(|b| PhaseTable::<T, W>::fixed_step(g.right[b])),
@@ -264,9 +248,7 @@ fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
     };
     let new_scratch = || Scratch::<W, T> {
         columns: Vec::new(),
-        lo: Vec::new(),
-        hi: Vec::new(),
-        off: Vec::new(),
+        runs: Runs::default(),
         cells: Vec::new(),
     };
     if g.parallel {
@@ -371,49 +353,24 @@ impl<const W: usize, S: Sample, T: Real> Line<'_, W, S, T> {
                 s.columns.push((*r, 2 * i * n + n));
             }
         }
-        let (Some(w_min), Some(w_max)) = (
-            s.columns.iter().map(|(q, _)| q.jw).min(),
-            s.columns.iter().map(|(q, _)| q.jw).max(),
-        ) else {
-            return;
-        };
         // The cells the block reaches: one run of `u` per line `w`.
-        let lines = (w_max - w_min) as usize + W;
-        s.lo.clear();
-        s.lo.resize(lines, i32::MAX);
-        s.hi.clear();
-        s.hi.resize(lines, i32::MIN);
-        for (q, _) in &s.columns {
-            let at = (q.jw - w_min) as usize;
-            for l in at..at + W {
-                s.lo[l] = s.lo[l].min(q.ju);
-                s.hi[l] = s.hi[l].max(q.ju + W as i32 - 1);
-            }
+        let runs = &mut s.runs;
+        if !runs.cover::<W>(s.columns.iter().map(|(q, _)| (q.ju, q.jw))) {
+            return;
         }
-        s.off.clear();
-        let mut total = 0usize;
-        for l in 0..lines {
-            s.off.push(total);
-            // A line no column reaches (none on a line: neighbouring
-            // columns' windows overlap) holds no run.
-            total += (s.hi[l] as i64 - s.lo[l] as i64 + 1).max(0) as usize;
-        }
-        s.off.push(total);
         s.cells.clear();
-        s.cells.resize(total, [T::ZERO; LANES]);
+        s.cells.resize(runs.total(), [T::ZERO; LANES]);
         for z0 in (0..n).step_by(LANES) {
             let m = LANES.min(n - z0);
-            for l in 0..lines {
-                let w = wrap(n, w_min as i64 + l as i64);
-                let cells = &mut s.cells[s.off[l]..s.off[l + 1]];
-                self.widen(z0, m, w, s.lo[l], cells);
+            for l in 0..runs.lines() {
+                let w = wrap(n, runs.w_min as i64 + l as i64);
+                let cells = &mut s.cells[runs.off[l]..runs.off[l + 1]];
+                self.widen(z0, m, w, runs.lo[l], cells);
             }
             for (q, dst) in &s.columns {
-                let at = (q.jw - w_min) as usize;
                 let mut acc = [T::ZERO; LANES];
                 for b in 0..W {
-                    let l = at + b;
-                    let start = s.off[l] + (q.ju - s.lo[l]) as usize;
+                    let start = runs.start(q.ju, q.jw, b);
                     let Some(run) = s.cells.get(start..start + W) else {
                         continue;
                     };

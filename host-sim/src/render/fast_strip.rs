@@ -36,6 +36,7 @@ use fvr_core::num::{Real, Sample};
 use fvr_core::spectrum::Spectrum;
 use rayon::prelude::*;
 
+use super::fast_runs::{axes_and_strides, wrap, Runs};
 use super::fast_slice::{bands_of_pairs, set_up_pair, supports, Geometry, Pair, Tiling};
 
 /// The axis whose coordinate the rows of a slice on `axes` hold (a zero
@@ -93,9 +94,7 @@ struct Point<const W: usize, T> {
 struct Scratch<const W: usize, T> {
     plus: Vec<Point<W, T>>,
     minus: Vec<Point<W, T>>,
-    lo: Vec<i32>,
-    hi: Vec<i32>,
-    off: Vec<usize>,
+    runs: Runs,
     cells: Vec<T>,
     values: Vec<T>,
 }
@@ -105,9 +104,7 @@ impl<const W: usize, T> Scratch<W, T> {
         Self {
             plus: Vec::new(),
             minus: Vec::new(),
-            lo: Vec::new(),
-            hi: Vec::new(),
-            off: Vec::new(),
+            runs: Runs::default(),
             cells: Vec::new(),
             values: Vec::new(),
         }
@@ -140,17 +137,12 @@ fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
         return false;
     }
     let n = g.n;
-    let (u, w) = match held {
-        0 => (1, 2),
-        1 => (0, 2),
-        _ => (0, 1),
-    };
-    let stride = |a: usize| n.pow(a as u32);
+    let (axes, strides) = axes_and_strides(held, n);
     let strip = Strip::<W, S, T> {
         data,
         n,
-        axes: [held, u, w],
-        strides: [stride(held), stride(u), stride(w)],
+        axes,
+        strides,
         phases: &phases,
         raw_gain: T::exp2i(T::raw_exponent::<S>()),
         step: g.right.map(PhaseTable::<T, W>::fixed_step),
@@ -173,16 +165,6 @@ fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
 }
 
 impl<const W: usize, S: Sample, T: Real> Strip<'_, W, S, T> {
-    /// `j mod n`.
-    #[inline(always)]
-    fn wrap(&self, j: i64) -> usize {
-        if self.n.is_power_of_two() {
-            j as usize & (self.n - 1)
-        } else {
-            j.rem_euclid(self.n as i64) as usize
-        }
-    }
-
     /// Row `p` and row `−p` of `pair`, each through its own strip.
     fn fill_pair(&self, pair: &mut Pair<'_, T>, s: &mut Scratch<W, T>) {
         let n = self.n;
@@ -194,7 +176,7 @@ impl<const W: usize, S: Sample, T: Real> Strip<'_, W, S, T> {
         let [h, au, aw] = self.axes;
         let mirror = |j: i32| -j - (W as i32 - 1);
         let reversed = |w: &[T; W]| -> [T; W] { core::array::from_fn(|t| w[W - 1 - t]) };
-        let col = |k: i32| self.wrap(k as i64);
+        let col = |k: i32| wrap(self.n, k as i64);
         // The held coordinate does not move along the row (`step[h] = 0`).
         let (jh, wh) = self.phases.taps_fixed_point(pair.base[h]);
         let wh = wh.map(|w| w * self.raw_gain);
@@ -261,46 +243,23 @@ impl<const W: usize, S: Sample, T: Real> Strip<'_, W, S, T> {
     /// each point interpolated on it.
     fn row_values(&self, jh: i32, wh: &[T; W], points: &[Point<W, T>], s: &mut Scratch<W, T>) {
         s.values.clear();
-        let (Some(w_min), Some(w_max)) = (
-            points.iter().map(|q| q.jw).min(),
-            points.iter().map(|q| q.jw).max(),
-        ) else {
+        let runs = &mut s.runs;
+        if !runs.cover::<W>(points.iter().map(|q| (q.ju, q.jw))) {
             return;
-        };
-        let lines = (w_max - w_min) as usize + W;
-        s.lo.clear();
-        s.lo.resize(lines, i32::MAX);
-        s.hi.clear();
-        s.hi.resize(lines, i32::MIN);
-        for q in points {
-            let first = (q.jw - w_min) as usize;
-            for l in first..first + W {
-                s.lo[l] = s.lo[l].min(q.ju);
-                s.hi[l] = s.hi[l].max(q.ju + W as i32 - 1);
-            }
         }
-        s.off.clear();
-        let mut total = 0usize;
-        for l in 0..lines {
-            s.off.push(total);
-            total += (s.hi[l] - s.lo[l] + 1) as usize;
-        }
-        s.off.push(total);
         s.cells.clear();
-        s.cells.resize(total, T::ZERO);
+        s.cells.resize(runs.total(), T::ZERO);
         let planes: [usize; W] =
-            core::array::from_fn(|c| self.wrap(jh as i64 + c as i64) * self.strides[0]);
-        for l in 0..lines {
-            let w = self.wrap((w_min as i64) + l as i64);
-            let cells = &mut s.cells[s.off[l]..s.off[l + 1]];
-            self.reduce(&planes, wh, w, s.lo[l], cells);
+            core::array::from_fn(|c| wrap(self.n, jh as i64 + c as i64) * self.strides[0]);
+        for l in 0..runs.lines() {
+            let w = wrap(self.n, runs.w_min as i64 + l as i64);
+            let cells = &mut s.cells[runs.off[l]..runs.off[l + 1]];
+            self.reduce(&planes, wh, w, runs.lo[l], cells);
         }
         for q in points {
-            let first = (q.jw - w_min) as usize;
             let mut acc = T::ZERO;
             for b in 0..W {
-                let l = first + b;
-                let start = s.off[l] + (q.ju - s.lo[l]) as usize;
+                let start = runs.start(q.ju, q.jw, b);
                 let mut acc_u = T::ZERO;
                 if let Some(run) = s.cells.get(start..start + W) {
                     for t in 0..W {
@@ -321,7 +280,7 @@ impl<const W: usize, S: Sample, T: Real> Strip<'_, W, S, T> {
         let [_, su, sw] = self.strides;
         let len = cells.len();
         let line = w * sw;
-        let u0 = self.wrap(lo as i64);
+        let u0 = wrap(self.n, lo as i64);
         if su == 1 && u0 + len <= n {
             let start = line + u0;
             // Plane by plane, short runs too: on rows along y (runs of about
@@ -344,7 +303,7 @@ impl<const W: usize, S: Sample, T: Real> Strip<'_, W, S, T> {
             return;
         }
         for (i, o) in cells.iter_mut().enumerate() {
-            let u = self.wrap(lo as i64 + i as i64);
+            let u = wrap(self.n, lo as i64 + i as i64);
             let mut acc = T::ZERO;
             for c in 0..W {
                 let v = self.data.get(planes[c] + line + u * su).copied();

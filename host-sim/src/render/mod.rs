@@ -11,6 +11,7 @@ pub mod fast_inverse;
 pub mod fast_marks;
 pub mod fast_mixed;
 pub mod fast_prepare;
+mod fast_runs;
 pub mod fast_slice;
 pub mod fast_store;
 pub mod fast_strip;

@@ -1,0 +1,91 @@
+//! The cells of two cube axes `(u, w)` that a set of points' `W × W` tap
+//! windows reach, kept as one run of `u` per line `w`: the buffer layout of
+//! the strip and column walks ([`super::fast_strip`], [`super::fast_column`]).
+
+/// `j mod n`: a mask on a power-of-two side, else a remainder.
+#[inline(always)]
+pub(super) fn wrap(n: usize, j: i64) -> usize {
+    if n.is_power_of_two() {
+        j as usize & (n - 1)
+    } else {
+        j.rem_euclid(n as i64) as usize
+    }
+}
+
+/// The axis `held` and the other two, `u` before `w` in memory order, and
+/// their element strides on a cube of side `n` (x fastest).
+pub(super) fn axes_and_strides(held: usize, n: usize) -> ([usize; 3], [usize; 3]) {
+    let (u, w) = match held {
+        0 => (1, 2),
+        1 => (0, 2),
+        _ => (0, 1),
+    };
+    let axes = [held, u, w];
+    (axes, axes.map(|a| n.pow(a as u32)))
+}
+
+/// The runs: line `l` (that is `w = w_min + l`, unwrapped) holds the cells
+/// `u = lo[l] ..` at `off[l] .. off[l + 1]` of a buffer of [`Runs::total`]
+/// cells.
+#[derive(Default)]
+pub(super) struct Runs {
+    pub(super) w_min: i32,
+    pub(super) lo: Vec<i32>,
+    hi: Vec<i32>,
+    pub(super) off: Vec<usize>,
+}
+
+impl Runs {
+    /// Cover the windows whose first taps are `(ju, jw)`; `false` when
+    /// there are none.
+    pub(super) fn cover<const W: usize>(
+        &mut self,
+        windows: impl Iterator<Item = (i32, i32)> + Clone,
+    ) -> bool {
+        let (Some(w_min), Some(w_max)) = (
+            windows.clone().map(|(_, jw)| jw).min(),
+            windows.clone().map(|(_, jw)| jw).max(),
+        ) else {
+            return false;
+        };
+        self.w_min = w_min;
+        let lines = (w_max - w_min) as usize + W;
+        self.lo.clear();
+        self.lo.resize(lines, i32::MAX);
+        self.hi.clear();
+        self.hi.resize(lines, i32::MIN);
+        for (ju, jw) in windows {
+            let first = (jw - w_min) as usize;
+            for l in first..first + W {
+                self.lo[l] = self.lo[l].min(ju);
+                self.hi[l] = self.hi[l].max(ju + W as i32 - 1);
+            }
+        }
+        self.off.clear();
+        let mut total = 0usize;
+        for l in 0..lines {
+            self.off.push(total);
+            // A line no window reaches holds no run.
+            total += (self.hi[l] as i64 - self.lo[l] as i64 + 1).max(0) as usize;
+        }
+        self.off.push(total);
+        true
+    }
+
+    /// Lines covered.
+    pub(super) fn lines(&self) -> usize {
+        self.lo.len()
+    }
+
+    /// Cells in all runs.
+    pub(super) fn total(&self) -> usize {
+        self.off.last().copied().unwrap_or(0)
+    }
+
+    /// Where row `b` of the window at `(ju, jw)` starts in the buffer.
+    #[inline(always)]
+    pub(super) fn start(&self, ju: i32, jw: i32, b: usize) -> usize {
+        let l = (jw - self.w_min) as usize + b;
+        self.off[l] + (ju - self.lo[l]) as usize
+    }
+}
