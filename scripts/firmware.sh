@@ -151,11 +151,14 @@ for program in "${CALIBRATED[@]}"; do
 done
 
 echo "== firmware: QEMU outputs against the host (bit for bit, dB)"
-FVR_QEMU_OUT="$run_dir" cargo test --locked -p fvr-firmware \
+# `--workspace`, not `-p`: the features then unify as in the workspace's
+# own test build, which `scripts/test-all.sh` has just made, so these test
+# binaries are reused instead of rebuilt with `fvr-host` under them.
+FVR_QEMU_OUT="$run_dir" cargo test --locked --workspace \
     --test qemu_agreement --test qemu_fixed --test qemu_prepare --test qemu_prepare_q15 \
     -- --ignored --nocapture
 echo "== firmware: what libm and micromath cost the image (host)"
-cargo test --locked -p fvr-firmware-trig --test trig -- --nocapture
+cargo test --locked --workspace --test trig -- --nocapture
 
 echo "== firmware: instruction counts (64x64 view, Cortex-M4F, exact to +-40)"
 # Plain frames are split by a staged render; cued and shaded frames by
