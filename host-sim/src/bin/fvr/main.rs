@@ -8,6 +8,7 @@ mod accuracy;
 mod adaptive_report;
 mod adaptive_table;
 mod args;
+mod checks;
 mod compare;
 mod convert;
 #[cfg(fuzzing)]

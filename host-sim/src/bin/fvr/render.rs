@@ -17,6 +17,7 @@ use serde::Serialize;
 use serde_json::value::RawValue;
 
 use crate::adaptive_report::{AdaptiveJson, AdaptiveReport};
+use crate::checks::{check_finite, check_output, check_resample};
 use crate::json::{debug_triple, one_line};
 
 use clap::Args;
@@ -669,42 +670,5 @@ impl Rendered<'_> {
             _ => println!("  SNR vs exact  n/a (not a built-in phantom)"),
         }
         Ok(())
-    }
-}
-
-/// Checks of the output path before any work: its directory exists, and it
-/// is not the input file (compared by file identity).
-pub(crate) fn check_output(
-    out: &Path,
-    allowed: &'static [&'static str],
-    volume_spec: &str,
-) -> Result<(), Error> {
-    fvr_host::io::paths::check_output(out, allowed, &[Path::new(volume_spec)])?;
-    Ok(())
-}
-
-/// Refuse a resampled volume beyond the memory limit before allocating it.
-pub(crate) fn check_resample(volume: &Volume, largest: usize) -> Result<(), Error> {
-    let dims = volume.resampled_dims(largest)?;
-    let mut budget = fvr_host::budget::Budget::new();
-    budget.hold(
-        "resampled volume",
-        dims.iter().map(|&d| d as u64).product(),
-        4,
-    );
-    budget.check(fvr_host::budget::limit(), "use a smaller --resample")?;
-    Ok(())
-}
-
-/// Refuse to write an image with a NaN or infinite pixel.
-pub(crate) fn check_finite(data: &[f64]) -> Result<(), Error> {
-    match data.iter().position(|v| !v.is_finite()) {
-        None => Ok(()),
-        Some(i) => Err(format!(
-            "the image has non-finite pixels (the first is pixel {i}, value {:e}): a setting overflowed; \
-             lower --ambient, the --light colours or the --depth-cue weights",
-            data[i]
-        )
-        .into()),
     }
 }

@@ -96,7 +96,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     let volume_spec = args.volume.as_deref().ok_or_else(|| {
         "no volume: give VOLUME, or `volume.path` or `volume.builtin` in the scene".to_string()
     })?;
-    crate::render::check_output(&args.out, &["apng", "png"], volume_spec)?;
+    crate::checks::check_output(&args.out, &["apng", "png"], volume_spec)?;
     declare_job(args, views.len());
     let volume = args.input.load(volume_spec)?;
     let _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
@@ -208,7 +208,7 @@ fn write_frames(
     let Some(range) = range else {
         let frames = turntable::render_views(spec, views, sampling, w, h, bar)?;
         for frame in &frames {
-            crate::render::check_finite(frame)?;
+            crate::checks::check_finite(frame)?;
         }
         let t = Instant::now();
         write_apng(&args.out, w, h, &frames, args.fps, style)?;
@@ -217,7 +217,7 @@ fn write_frames(
     let mut stream = ApngStream::create(&args.out, (w, h), views.len(), args.fps, style, range)?;
     let mut encode = Duration::ZERO;
     turntable::render_each(spec, views, sampling, (w, h), bar, |_, frame| {
-        crate::render::check_finite(frame)?;
+        crate::checks::check_finite(frame)?;
         let t = Instant::now();
         stream.push(frame)?;
         encode += t.elapsed();
