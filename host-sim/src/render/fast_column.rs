@@ -40,7 +40,7 @@ use fvr_core::spectrum::Spectrum;
 use rayon::prelude::*;
 
 use super::fast_runs::{axes_and_strides, wrap, Runs};
-use super::fast_slice::{row_interval, supports, Geometry, Tiling};
+use super::fast_slice::{row_setup, supports, Geometry, Tiling};
 
 /// Planes interpolated side by side (the multiply-adds' lanes).
 const LANES: usize = 8;
@@ -152,25 +152,15 @@ fn rows<const W: usize, T: Real>(
     gain: T,
 ) -> Option<(Vec<RowTaps<W, T>>, [i64; 2])> {
     let n = g.n;
-    let half = (n / 2) as i32;
     let k_max = ((n - 1) / 2) as i32;
     let step = g.right.map(PhaseTable::<T, W>::fixed_step);
     let mut origin = None;
     let mut list = Vec::with_capacity(n + 1);
     let planes = |j: i32| -> [usize; W] { core::array::from_fn(|c| wrap(n, j as i64 + c as i64)) };
     for p in 0..=n / 2 {
-        let ky = T::from_usize(p);
-        let kyu = g.up.map(|c| ky * c);
-        let (low, high) = row_interval(n, &g.right, kyu);
-        let k_low = if p == 0 { 0 } else { -half };
-        let (low, high) = (low.max(k_low), high.min(half));
-        if low > high {
+        let Some((low, high, anchor, base)) = row_setup::<W, T>(g, p) else {
             continue;
-        }
-        let anchor = 0.clamp(low, high);
-        let kx = T::from_i32(anchor);
-        let base: [i64; 3] =
-            core::array::from_fn(|b| PhaseTable::<T, W>::fixed_position(kx * g.right[b] + kyu[b]));
+        };
         let here = [u, w].map(|b| base[b] - anchor as i64 * step[b]);
         if *origin.get_or_insert(here) != here {
             return None;

@@ -317,30 +317,44 @@ pub(super) fn bands_of_pairs<T>(grid: &mut [T], n: usize, band: usize) -> Vec<Ve
     bands
 }
 
+/// Row `p`'s interval of `kx` inside the Nyquist cube (`kx ≥ 0` on row 0,
+/// whose mirrors hold the rest), its anchor and the anchor's fixed-point
+/// position, as the core sets its rows up; `None` when the interval is
+/// empty.
+pub(super) fn row_setup<const W: usize, T: Real>(
+    g: &Geometry<T>,
+    p: usize,
+) -> Option<(i32, i32, i32, [i64; 3])> {
+    let half = (g.n / 2) as i32;
+    let ky = T::from_usize(p);
+    let kyu = g.up.map(|c| ky * c);
+    let (low, high) = row_interval(g.n, &g.right, kyu);
+    let k_low = if p == 0 { 0 } else { -half };
+    let (low, high) = (low.max(k_low), high.min(half));
+    if low > high {
+        return None;
+    }
+    let anchor = 0.clamp(low, high);
+    let kx = T::from_i32(anchor);
+    let base =
+        core::array::from_fn(|a| PhaseTable::<T, W>::fixed_position(kx * g.right[a] + kyu[a]));
+    Some((low, high, anchor, base))
+}
+
 /// Zero the pair's rows and set its interval inside the Nyquist cube,
-/// anchor and anchor position; `false` when the interval is empty.
+/// anchor and anchor position ([`row_setup`]); `false` when the interval
+/// is empty.
 pub(super) fn set_up_pair<const W: usize, T: Real>(
     g: &Geometry<T>,
     pair: &mut Pair<'_, T>,
 ) -> bool {
-    let n = g.n;
-    let half = (n / 2) as i32;
     for row in [&mut pair.plus, &mut pair.minus].into_iter().flatten() {
         row.fill(T::ZERO);
     }
-    let ky = T::from_usize(pair.p);
-    let kyu = g.up.map(|c| ky * c);
-    let (low, high) = row_interval(n, &g.right, kyu);
-    let k_low = if pair.p == 0 { 0 } else { -half };
-    let (low, high) = (low.max(k_low), high.min(half));
-    if low > high {
+    let Some((low, high, anchor, base)) = row_setup::<W, T>(g, pair.p) else {
         return false;
-    }
-    let anchor = 0.clamp(low, high);
-    let kx = T::from_i32(anchor);
-    pair.base =
-        core::array::from_fn(|a| PhaseTable::<T, W>::fixed_position(kx * g.right[a] + kyu[a]));
-    (pair.low, pair.high, pair.anchor) = (low, high, anchor);
+    };
+    (pair.low, pair.high, pair.anchor, pair.base) = (low, high, anchor, base);
     true
 }
 
