@@ -51,6 +51,12 @@ pub fn column_axis(axes: &SliceAxes) -> Option<usize> {
     (0..3).find(|&a| axes.right[a] == 0.0 && (0..3).all(|b| b == a || axes.up[b] == 0.0))
 }
 
+/// Values the walk keeps between its passes for side `n`: two per cell of
+/// the slice, for the columns whose mirror rows reach other cells.
+pub const fn along_len(n: usize) -> usize {
+    2 * n * n
+}
+
 /// Fill the `n × n` slice `grid` (`kx` fastest, natural DHT order) on
 /// `axes` as [`super::fast_slice::extract`] does, to within rounding (see
 /// the module's bound), `tiling.chunk` columns per unit of work: on the
@@ -230,7 +236,7 @@ fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
     // they differ), z fastest, by blocks of columns.
     let block = g.tiling.chunk.clamp(1, n);
     // Every value is written before it is read: no clearing.
-    along.resize(2 * n * n, T::ZERO);
+    along.resize(along_len(n), T::ZERO);
     let fill = |scratch: &mut Scratch<W, T>, (b, chunk): (usize, &mut [T])| {
         let first = b * block;
         let last = (first + block).min(n);

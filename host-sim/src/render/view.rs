@@ -71,14 +71,21 @@ impl<T: Real> ViewRenderer<T> {
         }
     }
 
-    /// Bytes of per-view working memory (slice grid, auxiliary, tables).
+    /// Bytes of per-view working memory (slice grid, auxiliary, tables),
+    /// at its largest: with the column walk's buffer, which is allocated
+    /// at the first view that takes that walk.
     pub fn bytes(&self) -> usize {
         // A mixed side's threaded finish: a table and a transposed grid.
         let mixed = match self.n.is_power_of_two() {
             true => 0,
             false => self.tw.len() + grid_len(self.n),
         };
-        (self.tw.len() + self.grid.len() + self.aux.len() + mixed) * std::mem::size_of::<T>()
+        let along = match self.walk {
+            Walk::Strip => fast_column::along_len(self.n),
+            Walk::Exact => 0,
+        };
+        (self.tw.len() + self.grid.len() + self.aux.len() + mixed + along)
+            * std::mem::size_of::<T>()
             + std::mem::size_of::<KernelTable<T>>()
     }
 
@@ -300,6 +307,36 @@ fn inverse_table<T: Real>(n: usize) -> Vec<T> {
         match MixedPlan::new(&mut table, n) {
             Ok(_) => table,
             Err(_) => Vec::new(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sources::phantom::{sample, GaussianMixture};
+    use fvr_core::filter::FilterKind;
+
+    /// The count a memory budget is planned with holds every buffer a
+    /// view leaves allocated, the column walk's among them.
+    #[test]
+    fn bytes_hold_what_views_allocate() {
+        let volume = sample(&GaussianMixture::random(3, 32, 2), [32; 3]);
+        for n in [32, 40] {
+            let filter = Filter::new(FilterKind::Kb4, 1).unwrap();
+            let spec = OwnedSpectrum::<half::f16>::prepare_on::<f32>(&volume, filter, n).unwrap();
+            let mut r = ViewRenderer::<f32>::new(n, filter).with_threads(1);
+            let mut out = vec![0.0f32; n * n];
+            // About z (the column walk), then tilted (strip walk).
+            for dir in [[1.0, 0.3, 0.0], [1.0, 0.3, 0.2]] {
+                r.render_into(&spec, &View::along(dir), n, n, &mut out)
+                    .unwrap();
+            }
+            assert_eq!(r.along.len(), fast_column::along_len(n));
+            let held = (r.tw.capacity() + r.grid.capacity() + r.aux.capacity())
+                + r.along.capacity()
+                + r.mixed.as_ref().map_or(0, |m| m.bytes() / 4);
+            assert!(held * 4 <= r.bytes(), "{n}: {} > {}", held * 4, r.bytes());
         }
     }
 }

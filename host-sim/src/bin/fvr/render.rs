@@ -188,8 +188,10 @@ fn declare_job(args: &RenderArgs, scene: &Scene) {
             let (w, h) = size.map_or((side, side), |(w, h)| {
                 ((w as u64).min(n), (h as u64).min(n))
             });
+            // Per cell at f64: slice, column walk's sums (2), a mixed
+            // side's transposed grid and the output.
             n.saturating_mul(n)
-                .saturating_mul(24)
+                .saturating_mul(40)
                 .saturating_add(w.saturating_mul(h).saturating_mul(32))
         }),
         "use a smaller --resample or --size, --precision f16 or --oversample 1",

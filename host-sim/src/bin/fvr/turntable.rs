@@ -77,8 +77,9 @@ fn declare_job(args: &TurntableArgs, frames: usize) {
             });
             let frame = w.saturating_mul(h).saturating_mul(8);
             let all = frame.saturating_mul(frames as u64);
-            // Per-view grids (slice, scratch, output) and the frames kept.
-            let grids = n.saturating_mul(n).saturating_mul(24);
+            // Per-view grids at f64 (slice, the column walk's sums (2), a
+            // mixed side's transposed grid, output) and the frames kept.
+            let grids = n.saturating_mul(n).saturating_mul(40);
             grids.saturating_add(if all <= HOLD_FRAMES_BYTES {
                 all
             } else {
