@@ -1,16 +1,18 @@
 //! Criterion benchmarks: one view with the full filter against the adaptive
 //! one (paper §4), both with reusable buffers on all cores (the host's
-//! extractions, then the same 2D inverse transform):
+//! extractions, then the same 2D inverse transform), for three chains at
+//! 40 dB: the 1³ filter (`adaptive_40db_nearest`), the zero filter
+//! (`adaptive_40db_zero`) and both (`adaptive_40db_zero_nearest`):
 //!
-//! - `adaptive_kb3_os2_128`: kb3 → 1³ at 40 dB, oversampling 2, on a 128³
-//!   Gaussian mixture (f16);
-//! - `adaptive_kb6_256`: kb6 → 1³ at 40 dB, oversampling 1, on the 256³
-//!   Gaussian mixture of `fvr render gaussians@256` (f16), along the oblique
-//!   direction (1, 0.3, 0.2);
+//! - `adaptive_kb3_os2_128`: kb3, oversampling 2, on a 128³ Gaussian
+//!   mixture (f16);
+//! - `adaptive_kb6_256`: kb6, oversampling 1, on the 256³ Gaussian mixture
+//!   of `fvr render gaussians@256` (f16), along the oblique direction
+//!   (1, 0.3, 0.2);
 //!
-//! each also with the core's single-threaded adaptive extraction
-//! (`adaptive_40db_core`); `marks_kb6_256`: the exact bound's marks at
-//! 40 dB (`marks_exact_40db`) against the preprocessing they follow
+//! each also with the core's single-threaded adaptive extraction of the
+//! default chain (`adaptive_40db_core`); `marks_kb6_256`: the exact bound's
+//! marks at 40 dB for each chain (`marks_exact_40db_<chain>`) against the preprocessing they follow
 //! (`prepare`), on the same volume; and `breakeven_kb4_256`,
 //! `breakeven_kb6_256`: the plain view (`plain`) against the adaptive walk
 //! (never the plain fallback) at tolerances that substitute from none to
@@ -26,12 +28,22 @@ use std::hint::black_box;
 use criterion::{criterion_group, criterion_main, Criterion};
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
-use fvr_host::render::adaptive::{AdaptiveMarks, AdaptiveSettings};
+use fvr_host::render::adaptive::{AdaptiveMarks, AdaptiveSettings, Cheaper};
 use fvr_host::render::adaptive_view::AdaptiveRenderer;
 use fvr_host::render::spectrum::{OwnedSpectrum, ViewRenderer};
 use fvr_host::sources::phantom::{sample, GaussianMixture};
 use fvr_host::volume::Volume;
 use half::f16;
+
+/// The chains compared: the 1³ filter, the zero filter, and both.
+const CHAINS: [(&str, &[Cheaper]); 3] = [
+    ("nearest", &[Cheaper::Filter(FilterKind::Nearest)]),
+    ("zero", &[Cheaper::Zero]),
+    (
+        "zero_nearest",
+        &[Cheaper::Zero, Cheaper::Filter(FilterKind::Nearest)],
+    ),
+];
 
 /// The full and adaptive views of `volume` with `filter`, in group `name`.
 fn group(c: &mut Criterion, name: &str, volume: &Volume, filter: Filter) {
@@ -46,7 +58,6 @@ fn group(c: &mut Criterion, name: &str, volume: &Volume, filter: Filter) {
     let marks = AdaptiveMarks::build(&spec, &settings).unwrap();
     let view = View::along([1.0, 0.3, 0.2]);
     let mut renderer = ViewRenderer::<f32>::new(n, filter);
-    let mut adaptive = AdaptiveRenderer::<f32>::new(&marks, &spec).unwrap();
     let mut out = vec![0.0f32; side * side];
     let mut group = c.benchmark_group(name);
     group.sample_size(20);
@@ -57,13 +68,24 @@ fn group(c: &mut Criterion, name: &str, volume: &Volume, filter: Filter) {
                 .unwrap()
         })
     });
-    group.bench_function("adaptive_40db", |b| {
-        b.iter(|| {
-            adaptive
-                .render_into(&spec, black_box(&view), side, side, &mut out)
-                .unwrap()
-        })
-    });
+    for (label, chain) in CHAINS {
+        let marks = AdaptiveMarks::build(
+            &spec,
+            &AdaptiveSettings {
+                chain: chain.to_vec(),
+                ..settings.clone()
+            },
+        )
+        .unwrap();
+        let mut adaptive = AdaptiveRenderer::<f32>::new(&marks, &spec).unwrap();
+        group.bench_function(format!("adaptive_40db_{label}"), |b| {
+            b.iter(|| {
+                adaptive
+                    .render_into(&spec, black_box(&view), side, side, &mut out)
+                    .unwrap()
+            })
+        });
+    }
     let mut core = AdaptiveRenderer::<f32>::new(&marks, &spec)
         .unwrap()
         .with_core(true);
@@ -84,9 +106,15 @@ fn marking(c: &mut Criterion, name: &str, volume: &Volume, filter: Filter) {
     group.bench_function("prepare", |b| {
         b.iter(|| OwnedSpectrum::<f16>::prepare::<f32>(black_box(volume), filter).unwrap())
     });
-    group.bench_function("marks_exact_40db", |b| {
-        b.iter(|| AdaptiveMarks::build(black_box(&spec), &AdaptiveSettings::new(40.0)).unwrap())
-    });
+    for (label, chain) in CHAINS {
+        let settings = AdaptiveSettings {
+            chain: chain.to_vec(),
+            ..AdaptiveSettings::new(40.0)
+        };
+        group.bench_function(format!("marks_exact_40db_{label}"), |b| {
+            b.iter(|| AdaptiveMarks::build(black_box(&spec), &settings).unwrap())
+        });
+    }
     group.finish();
 }
 

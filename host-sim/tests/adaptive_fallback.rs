@@ -9,7 +9,6 @@ use common::{assert_ok, fvr, temp_dir};
 
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::View;
-use fvr_core::slice::adaptive::{AdaptiveLevel, Marks};
 use fvr_host::render::adaptive::{AdaptiveMarks, AdaptiveSettings};
 use fvr_host::render::adaptive_view::{AdaptiveRenderer, Walked};
 use fvr_host::render::fast_adaptive::{extract, tally};
@@ -133,21 +132,8 @@ fn tally_counts_as_the_walk_does() {
     let view_spec = spec.view();
     let marks = AdaptiveMarks::build(&spec, &AdaptiveSettings::new(40.0)).unwrap();
     let kernel = KernelTable::<f32>::new(spec.filter());
-    let tables: Vec<KernelTable<f32>> = marks
-        .levels
-        .iter()
-        .map(|l| KernelTable::new(l.filter))
-        .collect();
-    let levels: Vec<AdaptiveLevel<'_, '_, f32>> = marks
-        .levels
-        .iter()
-        .zip(&tables)
-        .map(|(l, t)| AdaptiveLevel {
-            kernel: t,
-            marks: Marks::new(&l.words, n).unwrap(),
-            gain: l.gain as f32,
-        })
-        .collect();
+    let tables = marks.tables::<f32>();
+    let levels = marks.core_levels(&tables).unwrap();
     for dir in DIRECTIONS.into_iter().chain([[0.02, -1.0, 0.01]]) {
         let frame = View::along(dir).frame().unwrap();
         let mut grid = vec![0.0f32; n * n];
@@ -155,6 +141,7 @@ fn tally_counts_as_the_walk_does() {
             &view_spec,
             &kernel,
             &levels,
+            marks.summary(),
             &frame,
             Tiling::default(),
             true,
@@ -162,8 +149,11 @@ fn tally_counts_as_the_walk_does() {
         )
         .unwrap();
         for parallel in [false, true] {
-            let counted = tally(&view_spec, &kernel, &levels, &frame, parallel).unwrap();
-            assert_eq!(counted, walked, "{dir:?}, parallel {parallel}");
+            // With the summary of the first level's marks or without.
+            for whole in [marks.summary(), None] {
+                let counted = tally(&view_spec, &kernel, &levels, whole, &frame, parallel).unwrap();
+                assert_eq!(counted, walked, "{dir:?}, parallel {parallel}");
+            }
         }
     }
 }

@@ -12,8 +12,8 @@ use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::View;
 use fvr_core::image::{aux_len, finish, placement, Crop};
 use fvr_core::num::{Real, Sample};
-use fvr_core::slice::adaptive::{extract_slice_adaptive, AdaptiveLevel, AdaptiveStats, Marks};
-use fvr_host::render::adaptive::{AdaptiveMarks, AdaptiveSettings, Bound};
+use fvr_core::slice::adaptive::{extract_slice_adaptive, AdaptiveStats};
+use fvr_host::render::adaptive::{AdaptiveMarks, AdaptiveSettings, Bound, Cheaper};
 use fvr_host::render::adaptive_view::AdaptiveRenderer;
 use fvr_host::render::fast_adaptive::extract;
 use fvr_host::render::fast_slice::Tiling;
@@ -47,23 +47,6 @@ fn smooth(dims: [usize; 3], seed: u64) -> Volume {
     sample(&GaussianMixture::random(seed, side, 6), dims)
 }
 
-/// The levels of `marks` over `tables`.
-fn levels<'a, T: Real>(
-    marks: &'a AdaptiveMarks,
-    tables: &'a [KernelTable<T>],
-) -> Vec<AdaptiveLevel<'a, 'a, T>> {
-    marks
-        .levels
-        .iter()
-        .zip(tables)
-        .map(|(l, t)| AdaptiveLevel {
-            kernel: t,
-            marks: Marks::new(&l.words, marks.n()).unwrap(),
-            gain: T::from_f64(l.gain),
-        })
-        .collect()
-}
-
 /// The core's slice and statistics, then the host's for every tiling and
 /// thread split, compared bit for bit (as f64 bit patterns: exact for f32
 /// and f64 alike). Returns the core's statistics.
@@ -77,24 +60,24 @@ fn check<S: Sample, T: Real>(
     let n = view.n();
     let frame = View::along(dir).frame().unwrap();
     let kernel = KernelTable::<T>::new(*view.filter());
-    let tables: Vec<KernelTable<T>> = marks
-        .levels
-        .iter()
-        .map(|l| KernelTable::new(l.filter))
-        .collect();
-    let levels = levels(marks, &tables);
+    let tables = marks.tables::<T>();
+    let levels = marks.core_levels(&tables).unwrap();
     let mut core = vec![T::ZERO; n * n];
     let core_stats = extract_slice_adaptive(&view, &kernel, &levels, &frame, &mut core).unwrap();
     assert!(
         core.iter().filter(|v| v.to_f64() != 0.0).count() > n * n / 4,
         "{what}: the slice is mostly zero"
     );
-    for tiling in TILINGS {
+    // With the summary of the first level's marks, and without.
+    let wholes = [marks.summary(), None];
+    for (tiling, whole) in TILINGS.into_iter().zip(wholes.into_iter().cycle()) {
         for parallel in [false, true] {
             // Garbage first: every point must be written.
             let mut host = vec![T::from_f64(7.0); n * n];
-            let stats = extract(&view, &kernel, &levels, &frame, tiling, parallel, &mut host)
-                .unwrap_or_else(|| panic!("{what}: not served"));
+            let stats = extract(
+                &view, &kernel, &levels, whole, &frame, tiling, parallel, &mut host,
+            )
+            .unwrap_or_else(|| panic!("{what}: not served"));
             assert_eq!(stats, core_stats, "{what}, {tiling:?}, parallel {parallel}");
             let differ = core
                 .iter()
@@ -135,7 +118,10 @@ fn two_level_chain_f32_and_f64_bit_identical() {
     let volume = sample(&GaussianMixture::random(1, n, 8), [n; 3]);
     let filter = Filter::new(FilterKind::Kb6, 1).unwrap();
     let settings = AdaptiveSettings {
-        chain: vec![FilterKind::Nearest, FilterKind::Kb3],
+        chain: vec![
+            Cheaper::Filter(FilterKind::Nearest),
+            Cheaper::Filter(FilterKind::Kb3),
+        ],
         ..AdaptiveSettings::new(30.0)
     };
     let spec32 = OwnedSpectrum::<f32>::prepare::<f32>(&volume, filter).unwrap();
@@ -153,6 +139,41 @@ fn two_level_chain_f32_and_f64_bit_identical() {
     assert!(
         used.iter().all(|&c| c > 0),
         "a filter of the chain unused: {used:?}"
+    );
+}
+
+#[test]
+fn zero_level_reads_nothing_and_matches_the_core() {
+    // The zero filter first, then 1³: points on all three, the zero ones 0
+    // and without taps, the slice and statistics the core's bit for bit.
+    let n = 32;
+    let volume = sample(&GaussianMixture::random(4, n, 8), [n; 3]);
+    let filter = Filter::new(FilterKind::Kb6, 1).unwrap();
+    let settings = AdaptiveSettings {
+        chain: vec![Cheaper::Zero, Cheaper::Filter(FilterKind::Nearest)],
+        ..AdaptiveSettings::new(40.0)
+    };
+    let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+    let marks = AdaptiveMarks::build(&spec, &settings).unwrap();
+    assert_eq!(marks.levels[0].gain, 0.0);
+    // The walks settle some points from the summary of the zero level.
+    let summary = marks.summary().unwrap();
+    let corners = (0..n).step_by(8);
+    let corner = |x, y, z| summary.holds([x, y, z]);
+    assert!(corners.clone().any(|z| corners
+        .clone()
+        .any(|y| corners.clone().any(|x| corner(x, y, z)))));
+    let mut used = [0u64; 3];
+    for dir in DIRECTIONS {
+        let s = check::<f16, f32>(&spec, &marks, dir, &format!("kb6 zero {dir:?}"));
+        assert_eq!(s.taps, s.per_filter[0] * 216 + s.per_filter[2], "{dir:?}");
+        for (u, c) in used.iter_mut().zip(s.per_filter) {
+            *u += c;
+        }
+    }
+    assert!(
+        used.iter().all(|&c| c > 0),
+        "a link of the chain unused: {used:?}"
     );
 }
 
@@ -204,12 +225,8 @@ fn renderer_image_equals_core_extraction() {
     let marks = AdaptiveMarks::build(&spec, &settings).unwrap();
     let view_spec = spec.view();
     let kernel = KernelTable::<f32>::new(filter);
-    let tables: Vec<KernelTable<f32>> = marks
-        .levels
-        .iter()
-        .map(|l| KernelTable::new(l.filter))
-        .collect();
-    let levels = levels(&marks, &tables);
+    let tables = marks.tables::<f32>();
+    let levels = marks.core_levels(&tables).unwrap();
     let mut tw_buf = vec![0f32; Twiddles::<f32>::buffer_len(n)];
     let tw = Twiddles::new(&mut tw_buf, n).unwrap();
     for parallel in [false, true] {
@@ -242,5 +259,6 @@ fn renderer_image_equals_core_extraction() {
     let frame = View::along([1.0, 0.3, 0.2]).frame().unwrap();
     let mut grid = vec![0f32; n * n];
     let tiling = Tiling::default();
-    assert!(extract(&view_spec, &other, &levels, &frame, tiling, true, &mut grid).is_none());
+    let whole = marks.summary();
+    assert!(extract(&view_spec, &other, &levels, whole, &frame, tiling, true, &mut grid).is_none());
 }

@@ -6,7 +6,7 @@ use fvr_core::geometry::View;
 use fvr_core::slice::adaptive::{mark, marks_words, threshold_for, Marks};
 use fvr_host::reference::snr_db;
 use fvr_host::render::adaptive::{
-    parse_chain, parse_tolerance, AdaptiveMarks, AdaptiveSettings, Bound,
+    parse_chain, parse_tolerance, AdaptiveMarks, AdaptiveSettings, Bound, Cheaper,
 };
 use fvr_host::render::spectrum::{AnySpectrum, OwnedSpectrum};
 use fvr_host::sources::phantom::{sample, GaussianMixture, SheppLogan};
@@ -77,6 +77,77 @@ fn adaptive_images_stay_within_the_requested_tolerance() {
     // and the exact bound must substitute more than the paper's.
     assert!(substituted[0] > 100_000, "{substituted:?}");
     assert!(substituted[1] > substituted[0], "{substituted:?}");
+}
+
+/// The guarantee with the zero filter, alone and before the 1³ filter:
+/// the images stay within the tolerance, the zero level takes points, and
+/// its error energy is eq. 15 with `ĥ₂ = 0` evaluated the slow way.
+#[test]
+fn zero_filter_chains_stay_within_the_tolerance() {
+    let n = 64;
+    let volumes = [
+        (
+            "gaussians:1",
+            sample(&GaussianMixture::random(1, n, 8), [n; 3]),
+        ),
+        ("shepp-logan", sample(&SheppLogan::new([n; 3]), [n; 3])),
+    ];
+    let views = [View::along([1.0, 0.3, 0.2]), View::along([0.0, 1.0, 0.0])];
+    let mut zeroed = 0u64;
+    for (name, volume) in &volumes {
+        let filter = Filter::new(FilterKind::Kb6, 1).unwrap();
+        let spec = OwnedSpectrum::<f16>::prepare::<f32>(volume, filter).unwrap();
+        let any = AnySpectrum::F16(spec.clone());
+        let fulls: Vec<Vec<f64>> = views.iter().map(|v| any.render(v, n, n).unwrap()).collect();
+        for chain in ["zero", "zero,nearest"] {
+            for bound in [Bound::Paper, Bound::Exact] {
+                for tol in [30.0, 40.0, 50.0] {
+                    let settings = AdaptiveSettings {
+                        chain: parse_chain(chain).unwrap(),
+                        ..nearest(tol, bound)
+                    };
+                    let marks = AdaptiveMarks::build(&spec, &settings).unwrap();
+                    assert_eq!(marks.levels[0].gain, 0.0);
+                    for (view, full) in views.iter().zip(&fulls) {
+                        let (image, stats) = marks.render::<f16, f32>(&spec, view, n, n).unwrap();
+                        zeroed += stats.per_filter[1];
+                        let snr = snr_db(full, &image);
+                        assert!(
+                            snr >= tol,
+                            "{name} {chain} {bound:?} {view:?} tolerance {tol}: {snr:.1} dB"
+                        );
+                    }
+                }
+            }
+        }
+    }
+    assert!(zeroed > 10_000, "{zeroed}");
+    // The zero level's energy, against a direct evaluation at 8³.
+    let n = 8;
+    let volume = sample(&GaussianMixture::random(6, n, 4), [n; 3]);
+    let spec =
+        OwnedSpectrum::<f16>::prepare::<f32>(&volume, Filter::new(FilterKind::Kb4, 2).unwrap())
+            .unwrap();
+    let mut checked = 0;
+    for tol in [20.0, 30.0, 40.0] {
+        let settings = AdaptiveSettings {
+            chain: vec![Cheaper::Zero],
+            ..nearest(tol, Bound::Exact)
+        };
+        let level = &AdaptiveMarks::build(&spec, &settings).unwrap().levels[0];
+        if level.threshold == 0.0 {
+            continue;
+        }
+        let ratio = level.error_ratio.unwrap();
+        let direct = direct_error_ratio(&spec, level.threshold, 0.0);
+        assert!(ratio <= 10f64.powf(-tol / 10.0), "{tol}: {ratio}");
+        assert!(
+            (direct - ratio).abs() <= 1e-4 * ratio,
+            "{tol}: direct {direct} against {ratio}"
+        );
+        checked += 1;
+    }
+    assert!(checked >= 2, "{checked}");
 }
 
 /// The exact bound accepts the largest threshold the 3D criterion allows:
@@ -265,7 +336,8 @@ fn statistics_add_up_and_report_no_effect() {
     assert_eq!(stats.full_taps, stats.samples * 64);
     assert_eq!(stats.taps, stats.per_filter[0] * 64 + stats.per_filter[1]);
     assert!(stats.taps < stats.full_taps);
-    assert_eq!(marks.bytes(), 64 * 64 * 64 / 8);
+    // The marks, and the summary's bit per brick of 8³.
+    assert_eq!(marks.bytes(), 64 * 64 * 64 / 8 + 8 * 8 * 8 / 8);
 
     let tight = AdaptiveMarks::build(&spec, &nearest(400.0, Bound::Exact)).unwrap();
     let (_, s) = tight.render::<f16, f32>(&spec, &view, n, n).unwrap();
@@ -296,7 +368,7 @@ fn bad_tolerances_and_chains_are_refused() {
         OwnedSpectrum::<f16>::prepare::<f32>(&volume, Filter::new(FilterKind::Kb3, 2).unwrap())
             .unwrap();
     let kb4 = AdaptiveSettings {
-        chain: vec![FilterKind::Kb4],
+        chain: vec![Cheaper::Filter(FilterKind::Kb4)],
         ..AdaptiveSettings::new(40.0)
     };
     let err = AdaptiveMarks::build(&spec, &kb4).unwrap_err();

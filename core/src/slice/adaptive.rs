@@ -225,7 +225,8 @@ pub struct AdaptiveLevel<'k, 'm, T> {
     pub kernel: &'k KernelTable<T>,
     /// Samples where it may be used.
     pub marks: Marks<'m>,
-    /// Gain applied to its output.
+    /// Gain applied to its output. Gain 0 makes the level the zero
+    /// filter: its points are 0 and read no taps (the kernel is unused).
     pub gain: T,
 }
 
@@ -305,6 +306,11 @@ pub fn extract_slice_adaptive<S: Sample, Z: CubeSide, T: Real>(
                 .find(|(_, l)| l.marks.get(index))
                 .map_or((kernel, T::ONE, 0), |(i, l)| (l.kernel, l.gain, i + 1));
             stats.per_filter[slot] += 1;
+            // A level of gain 0 is the zero filter: it reads nothing.
+            if gain == T::ZERO {
+                *g = T::ZERO;
+                continue;
+            }
             let w = table.filter().width();
             stats.taps += (w * w * w) as u64;
             *g = gain * interpolate(spec, table, q, mask);

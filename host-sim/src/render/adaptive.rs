@@ -6,23 +6,57 @@ mod bound;
 
 use crate::render::adaptive_view::{AdaptiveRenderer, Walked};
 use crate::render::fast_marks;
+use crate::render::marks_summary::MarksSummary;
 use crate::render::spectrum::OwnedSpectrum;
 use bound::ErrorModel;
-use fvr_core::filter::{Filter, FilterKind};
+use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::View;
 use fvr_core::num::{Real, Sample};
 use fvr_core::slice::adaptive::{
-    marks_words, response_difference, threshold_for, AdaptiveStats, MAX_LEVELS,
+    marks_words, response_difference, threshold_for, AdaptiveLevel, AdaptiveStats, Marks,
+    MAX_LEVELS,
 };
 use fvr_core::spectrum::Spectrum;
 
-/// The cheaper filters tried, cheapest first, as the user names them.
-pub fn parse_chain(s: &str) -> Result<Vec<FilterKind>, String> {
-    let kinds: Vec<FilterKind> = s
+/// One link of an adaptive chain: what stands in for the large filter
+/// where the spectrum is weak.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Cheaper {
+    /// The zero filter (`ĥ₂ = 0` in eq. 15): the point is left out, and
+    /// reads nothing. Its error is the weak samples' own contribution.
+    Zero,
+    /// A narrower filter, its DC gain matched to the large one's.
+    Filter(FilterKind),
+}
+
+impl Cheaper {
+    /// Taps per axis: 0 for the zero filter.
+    pub fn width(self) -> usize {
+        match self {
+            Self::Zero => 0,
+            Self::Filter(kind) => kind.width(),
+        }
+    }
+
+    /// The name [`parse_chain`] accepts.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Zero => "zero",
+            Self::Filter(kind) => kind.name(),
+        }
+    }
+}
+
+/// The cheaper filters tried, cheapest first, as the user names them
+/// (`zero` or a filter's name).
+pub fn parse_chain(s: &str) -> Result<Vec<Cheaper>, String> {
+    let kinds: Vec<Cheaper> = s
         .split(',')
-        .map(|name| {
-            FilterKind::from_name(name.trim())
-                .ok_or_else(|| format!("unknown filter `{name}` in the adaptive chain"))
+        .map(|name| match name.trim() {
+            "zero" => Ok(Cheaper::Zero),
+            other => FilterKind::from_name(other)
+                .map(Cheaper::Filter)
+                .ok_or_else(|| format!("unknown filter `{name}` in the adaptive chain")),
         })
         .collect::<Result<_, _>>()?;
     if kinds.is_empty() || kinds.len() > MAX_LEVELS {
@@ -94,7 +128,7 @@ pub struct AdaptiveSettings {
     /// `10^(−dB/10)` below the volume's.
     pub tolerance_db: f64,
     /// The cheaper filters, cheapest first ([`parse_chain`]).
-    pub chain: Vec<FilterKind>,
+    pub chain: Vec<Cheaper>,
     /// With [`Bound::Paper`], an `h_d` to use instead of the filter pair's
     /// own (the paper used 0.3; a smaller value than the pair's voids the
     /// bound).
@@ -127,7 +161,7 @@ impl AdaptiveSettings {
     pub fn new(tolerance_db: f64) -> Self {
         Self {
             tolerance_db,
-            chain: vec![FilterKind::Nearest],
+            chain: vec![Cheaper::Filter(FilterKind::Nearest)],
             h_d: None,
             bound: Bound::Exact,
             plain_below: DEFAULT_PLAIN_BELOW,
@@ -138,7 +172,9 @@ impl AdaptiveSettings {
 /// One cheaper filter with its marks.
 #[derive(Clone, Debug)]
 pub struct Level {
-    /// The filter.
+    /// What stands in for the large filter.
+    pub cheaper: Cheaper,
+    /// Its filter (for [`Cheaper::Zero`], the 1³ filter, never read).
     pub filter: Filter,
     /// `h_d = max|g·ĥ_small/ĥ_large − 1|` over the volume.
     pub h_d: f64,
@@ -146,6 +182,8 @@ pub struct Level {
     pub threshold: f64,
     /// The marks' words.
     pub words: Vec<u32>,
+    /// The bricks the marks hold whole.
+    pub summary: MarksSummary,
     /// Samples marked.
     pub marked: usize,
     /// DC gain correction `ĥ_large(0)/ĥ_small(0)`.
@@ -235,22 +273,33 @@ impl AdaptiveMarks {
             Bound::Exact => Some(ErrorModel::new(view)?),
             Bound::Paper => None,
         };
-        for &kind in chain.iter() {
-            let small = Filter::new(kind, large.oversample()).map_err(|e| e.to_string())?;
-            if small.width() >= large.width() {
-                return Err(format!(
-                    "adaptive filter {} is not cheaper than the spectrum's {}",
-                    kind.name(),
-                    large.kind().name()
-                ));
-            }
-            let h_d = match h_d_override {
-                Some(h) if h.is_finite() && h > 0.0 => h,
-                Some(h) => return Err(format!("h_d must be a positive number, got {h}")),
-                None => response_difference(&large, &small, view.dims(), n)
-                    .map_err(|e| e.to_string())?,
+        for &cheaper in chain.iter() {
+            let (small, h_d, gain) = match cheaper {
+                // `|0·ĥ₂/ĥ₁ − 1| = 1` everywhere: no override applies.
+                Cheaper::Zero => (
+                    Filter::new(FilterKind::Nearest, large.oversample())
+                        .map_err(|e| e.to_string())?,
+                    1.0,
+                    0.0,
+                ),
+                Cheaper::Filter(kind) => {
+                    let small = Filter::new(kind, large.oversample()).map_err(|e| e.to_string())?;
+                    if small.width() >= large.width() {
+                        return Err(format!(
+                            "adaptive filter {} is not cheaper than the spectrum's {}",
+                            kind.name(),
+                            large.kind().name()
+                        ));
+                    }
+                    let h_d = match h_d_override {
+                        Some(h) if h.is_finite() && h > 0.0 => h,
+                        Some(h) => return Err(format!("h_d must be a positive number, got {h}")),
+                        None => response_difference(&large, &small, view.dims(), n)
+                            .map_err(|e| e.to_string())?,
+                    };
+                    (small, h_d, large.response(0.0) / small.response(0.0))
+                }
             };
-            let gain = large.response(0.0) / small.response(0.0);
             let (threshold, error_ratio, probes) = match model.as_mut() {
                 Some(model) => {
                     let (tau, ratio, probes) = model.threshold(&small, gain, budget)?;
@@ -272,7 +321,9 @@ impl AdaptiveMarks {
             }
             .map_err(|e| e.to_string())?;
             levels.push(Level {
+                cheaper,
                 filter: small,
+                summary: MarksSummary::new(&words, n),
                 h_d,
                 threshold,
                 words,
@@ -296,9 +347,49 @@ impl AdaptiveMarks {
         self.n
     }
 
-    /// Bytes of marks held (1 bit per voxel per level).
+    /// The levels as the core's extraction takes them, over `tables` (one
+    /// kernel table per level, in order).
+    ///
+    /// # Errors
+    /// Marks of the wrong length for their side.
+    pub fn core_levels<'a, T: Real>(
+        &'a self,
+        tables: &'a [KernelTable<T>],
+    ) -> Result<Vec<AdaptiveLevel<'a, 'a, T>>, fvr_core::Error> {
+        self.levels
+            .iter()
+            .zip(tables)
+            .map(|(l, t)| {
+                Ok(AdaptiveLevel {
+                    kernel: t,
+                    marks: Marks::new(&l.words, self.n)?,
+                    gain: T::from_f64(l.gain),
+                })
+            })
+            .collect()
+    }
+
+    /// The kernel tables of the levels, in order.
+    pub fn tables<T: Real>(&self) -> Vec<KernelTable<T>> {
+        self.levels
+            .iter()
+            .map(|l| KernelTable::new(l.filter))
+            .collect()
+    }
+
+    /// The summary of the first level's marks, which the host's walk reads
+    /// before the marks themselves.
+    pub fn summary(&self) -> Option<&MarksSummary> {
+        self.levels.first().map(|l| &l.summary)
+    }
+
+    /// Bytes of marks held (1 bit per voxel per level, and 1 per brick of
+    /// 512 voxels in the summaries).
     pub fn bytes(&self) -> usize {
-        self.levels.iter().map(|l| l.words.len() * 4).sum()
+        self.levels
+            .iter()
+            .map(|l| l.words.len() * 4 + l.summary.bytes())
+            .sum()
     }
 
     /// Render one view adaptively; returns the image (f64) and statistics.

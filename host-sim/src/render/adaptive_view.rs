@@ -19,7 +19,7 @@ use fvr_core::image::{
     aux_len, check_image, finish, grid_len, placement, placement_on_axes, Crop, Inverse,
 };
 use fvr_core::num::{Real, Sample};
-use fvr_core::slice::adaptive::{extract_slice_adaptive, AdaptiveLevel, AdaptiveStats, Marks};
+use fvr_core::slice::adaptive::{extract_slice_adaptive, AdaptiveLevel, AdaptiveStats};
 
 use super::adaptive::AdaptiveMarks;
 use super::fast_adaptive;
@@ -78,11 +78,7 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
         Ok(Self {
             marks,
             kernel: KernelTable::new(spec.filter()),
-            tables: marks
-                .levels
-                .iter()
-                .map(|l| KernelTable::new(l.filter))
-                .collect(),
+            tables: marks.tables(),
             tw,
             grid: vec![T::ZERO; n * n],
             aux: vec![T::ZERO; aux_len(n)],
@@ -138,19 +134,7 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
         let n = spec.n();
         let frame = view.frame()?;
         check_image(width, height, n)?;
-        let levels: Vec<AdaptiveLevel<'_, '_, T>> = self
-            .marks
-            .levels
-            .iter()
-            .zip(&self.tables)
-            .map(|(l, t)| {
-                Ok(AdaptiveLevel {
-                    kernel: t,
-                    marks: Marks::new(&l.words, self.marks.n())?,
-                    gain: T::from_f64(l.gain),
-                })
-            })
-            .collect::<Result<_, fvr_core::Error>>()?;
+        let levels = self.marks.core_levels(&self.tables)?;
         let core_spec = spec.view();
         self.last = Walked::Adaptive;
         if let Some(stats) = self.plain_instead(&core_spec, &levels, &frame) {
@@ -186,6 +170,7 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
                 &core_spec,
                 &self.kernel,
                 &levels,
+                self.marks.summary(),
                 &frame,
                 self.tiling,
                 self.parallel,
@@ -219,7 +204,8 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
         if self.core || below <= 0.0 || self.grid.len() != spec.n() * spec.n() {
             return None;
         }
-        let stats = fast_adaptive::tally(spec, &self.kernel, levels, frame, self.parallel)?;
+        let whole = self.marks.summary();
+        let stats = fast_adaptive::tally(spec, &self.kernel, levels, whole, frame, self.parallel)?;
         let cheap = stats.samples - stats.per_filter[0];
         ((cheap as f64) < below * stats.samples as f64).then_some(stats)
     }

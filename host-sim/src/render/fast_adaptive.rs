@@ -35,6 +35,7 @@ use fvr_core::spectrum::Spectrum;
 use rayon::prelude::*;
 
 use super::fast_slice::{row_interval, supports, tap_sum, Tiling};
+use super::marks_summary::MarksSummary;
 
 /// One filter of the chain as the walk applies it.
 #[derive(Clone, Copy)]
@@ -47,13 +48,18 @@ struct Applied<'k, T> {
     gain: T,
 }
 
-/// `table` with `gain`, if its width is one the walk unrolls.
+/// `table` with `gain`, if its width is one the walk unrolls. Gain 0 is
+/// the zero filter, which reads no taps.
 fn applied<T: Real>(table: &KernelTable<T>, gain: T) -> Option<Applied<'_, T>> {
     let width = table.filter().width();
+    let taps = match gain == T::ZERO {
+        true => 0,
+        false => (width * width * width) as u64,
+    };
     (width <= MAX_WIDTH).then_some(Applied {
         table,
         width,
-        taps: (width * width * width) as u64,
+        taps,
         gain,
     })
 }
@@ -66,6 +72,8 @@ struct Walk<'a, S, T> {
     /// `filters[0]` the large filter, then the levels in order.
     filters: [Option<Applied<'a, T>>; 1 + MAX_LEVELS],
     marks: [Option<Marks<'a>>; MAX_LEVELS],
+    /// The bricks the first level's marks hold whole.
+    whole: Option<&'a MarksSummary>,
     raw_gain: T,
     chunk: i32,
 }
@@ -82,16 +90,20 @@ struct Row<'g, T> {
 /// Fill the `n × n` slice `grid` (`kx` fastest, natural DHT order) as
 /// `extract_slice_adaptive(spec, kernel, levels, frame, grid)` would, bit
 /// for bit, with the same statistics: on the current rayon pool's threads
-/// when `parallel`, else on this thread. `None` (grid untouched) when
+/// when `parallel`, else on this thread. `whole`, the summary of the first
+/// level's marks, settles the points in its whole bricks without reading
+/// the marks. `None` (grid untouched) when
 /// [`supports`] does not hold for `spec` or its side is not a power of
 /// two, the grid is not `n²`, `kernel`
 /// is not the spectrum's filter, or the levels are more than
 /// [`MAX_LEVELS`] or have marks of another side: the core's function
 /// reports those.
+#[allow(clippy::too_many_arguments)]
 pub fn extract<S: Sample, T: Real>(
     spec: &Spectrum<'_, S>,
     kernel: &KernelTable<T>,
     levels: &[AdaptiveLevel<'_, '_, T>],
+    whole: Option<&MarksSummary>,
     frame: &Frame,
     tiling: Tiling,
     parallel: bool,
@@ -101,7 +113,7 @@ pub fn extract<S: Sample, T: Real>(
     if grid.len() != n * n {
         return None;
     }
-    let walk = Walk::new(spec, kernel, levels, frame, tiling)?;
+    let walk = Walk::new(spec, kernel, levels, whole, frame, tiling)?;
     let up = frame.up.map(T::from_f64);
     let bands = bands(grid, n, &walk.right, up, tiling.band.max(1));
     let fill = |band: Vec<Row<'_, T>>| walk.fill_band(band);
@@ -127,11 +139,12 @@ pub fn tally<S: Sample, T: Real>(
     spec: &Spectrum<'_, S>,
     kernel: &KernelTable<T>,
     levels: &[AdaptiveLevel<'_, '_, T>],
+    whole: Option<&MarksSummary>,
     frame: &Frame,
     parallel: bool,
 ) -> Option<AdaptiveStats> {
     let n = spec.n();
-    let walk = Walk::new(spec, kernel, levels, frame, Tiling::default())?;
+    let walk = Walk::new(spec, kernel, levels, whole, frame, Tiling::default())?;
     let up = frame.up.map(T::from_f64);
     let count = |p: usize| {
         let mut stats = AdaptiveStats::default();
@@ -235,6 +248,7 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
         spec: &Spectrum<'a, S>,
         kernel: &'a KernelTable<T>,
         levels: &[AdaptiveLevel<'a, 'a, T>],
+        whole: Option<&'a MarksSummary>,
         frame: &Frame,
         tiling: Tiling,
     ) -> Option<Self> {
@@ -261,6 +275,7 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
             right: frame.right.map(T::from_f64),
             filters,
             marks,
+            whole: whole.filter(|_| !levels.is_empty()),
             raw_gain: T::exp2i(T::raw_exponent::<S>()),
             chunk: tiling.chunk.clamp(1, n) as i32,
         })
@@ -310,16 +325,22 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
             let nearest: [usize; 3] =
                 core::array::from_fn(|a| (q[a] + T::HALF).floor_i64() as usize & mask);
             let index = nearest[0] + n * (nearest[1] + n * nearest[2]);
-            let slot = self
-                .marks
-                .iter()
-                .position(|m| m.is_some_and(|m| m.get(index)))
-                .map_or(0, |i| i + 1);
+            let slot = match self.whole.is_some_and(|w| w.holds(nearest)) {
+                true => 1,
+                false => self
+                    .marks
+                    .iter()
+                    .position(|m| m.is_some_and(|m| m.get(index)))
+                    .map_or(0, |i| i + 1),
+            };
             let filter = self.filters[slot].unwrap_or(large);
             stats.per_filter[slot] += 1;
             stats.taps += filter.taps;
             if let Some(cell) = row.cells.get_mut(k as usize & mask) {
-                *cell = filter.gain * self.value(&filter, q);
+                *cell = match filter.taps {
+                    0 => T::ZERO,
+                    _ => filter.gain * self.value(&filter, q),
+                };
             }
         }
     }

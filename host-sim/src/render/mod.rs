@@ -18,6 +18,7 @@ pub mod fast_strip;
 #[cfg(test)]
 mod fast_tests;
 pub mod filter;
+pub mod marks_summary;
 pub mod plan;
 pub mod scene_file;
 pub mod shaded;

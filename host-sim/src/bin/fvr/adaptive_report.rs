@@ -53,7 +53,7 @@ impl AdaptiveReport {
             println!(
                 "  samples       {:.1}% on {} (h_d {:.3}, threshold {:.3e}, {} of {} spectrum samples marked)",
                 pct(s.per_filter[i + 1], s.samples),
-                l.filter.kind().name(),
+                l.cheaper.name(),
                 l.h_d,
                 l.threshold,
                 l.marked,
@@ -86,7 +86,7 @@ impl AdaptiveReport {
             .iter()
             .enumerate()
             .map(|(i, l)| LevelJson {
-                filter: l.filter.kind().name(),
+                filter: l.cheaper.name(),
                 h_d: l.h_d,
                 threshold: l.threshold,
                 marked: l.marked,

@@ -182,8 +182,9 @@ impl ErrorModel {
     /// estimate ([`ErrorModel::estimate`]) puts the answer, rescaled by the
     /// ratio of exact to estimated energy at the last probe (the weight is
     /// far from constant, so the raw estimate is off by octaves, but the
-    /// ratio varies slowly with `τ`); the rest bisect. It returns only
-    /// thresholds it evaluated.
+    /// ratio varies slowly with `τ`); the rest bisect. The search starts
+    /// from the largest step that Parseval's bound with the weight's peak
+    /// accepts without a probe; the energy it returns is always evaluated.
     pub(super) fn threshold(
         &mut self,
         small: &Filter,
@@ -213,6 +214,18 @@ impl ErrorModel {
         // From `top` on every sample is weak: no larger threshold changes the set.
         let top = self.lowest + self.bins.len() as i64 - 1;
         let mut bad = top + 1;
+        // Accepted without a probe: Parseval with the weight's largest
+        // square, `(|g|·max|ĥ₂|³ + max|ĥ₁|³)²` (exact for the zero filter),
+        // bounds the error energy. The bin above is summed, as a sample on a
+        // bin's edge may be binned one up ([`bin`]).
+        let peak = |h: &[f64]| h.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let max_square = (gain.abs() * peak(&hs).powi(3) + peak(&hl).powi(3)).powi(2);
+        let seed = (good.0 + 1..bad)
+            .rev()
+            .find(|&b| self.estimate(b + 1, max_square) <= allowed);
+        if let Some(b) = seed {
+            good = (b, None);
+        }
         let mut scale = 1.0;
         let mut probes = 0;
         while bad - good.0 > 1 {
@@ -238,6 +251,11 @@ impl ErrorModel {
         }
         Ok(match good.1 {
             Some(r) => (tau_of(good.0), r, probes),
+            // The seed, never beaten: its energy, evaluated once.
+            None if seed.is_some() => {
+                let e = self.probe(tau_of(good.0), &weight, budget)?;
+                (tau_of(good.0), e / self.reference, probes + 1)
+            }
             None => (0.0, 0.0, probes),
         })
     }

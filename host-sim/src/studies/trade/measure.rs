@@ -10,7 +10,7 @@ use fvr_core::image::{aux_len, finish, placement, Crop};
 use fvr_core::num::Sample;
 use fvr_core::num::{bf16, BlockLayout, Blocking, Format, FormatName, Minifloat16, Q15};
 use fvr_core::render::{render, Buffers, Request, Source};
-use fvr_core::slice::adaptive::{extract_slice_adaptive, AdaptiveLevel, Marks};
+use fvr_core::slice::adaptive::extract_slice_adaptive;
 use fvr_core::spectrum::Spectrum;
 use half::f16;
 
@@ -154,12 +154,7 @@ impl<'s, 'm, S: Sample> Renderer<'s, 'm, S> {
         Self {
             spec,
             kernel: KernelTable::new(*spec.filter()),
-            small: marks.map_or(Vec::new(), |mk| {
-                mk.levels
-                    .iter()
-                    .map(|l| KernelTable::new(l.filter))
-                    .collect()
-            }),
+            small: marks.map_or(Vec::new(), |mk| mk.tables()),
             marks,
             tw,
             grid: vec![0.0; m * m],
@@ -177,25 +172,21 @@ impl<'s, 'm, S: Sample> Renderer<'s, 'm, S> {
         let tw = Twiddles::from_table(&self.tw, n)?;
         let side = self.side;
         if let Some(mk) = self.marks {
-            let levels: Vec<AdaptiveLevel<'_, '_, f32>> = mk
-                .levels
-                .iter()
-                .zip(&self.small)
-                .map(|(l, t)| {
-                    Ok(AdaptiveLevel {
-                        kernel: t,
-                        marks: Marks::new(&l.words, n)?,
-                        gain: l.gain as f32,
-                    })
-                })
-                .collect::<Result<_, fvr_core::Error>>()?;
+            let levels = mk.core_levels(&self.small)?;
             let frame = view.frame()?;
             // On this thread, as the plain points' core render: the host's
             // walk where it serves the spectrum, else the core's.
             let (kernel, grid) = (&self.kernel, &mut self.grid);
             let tiling = Tiling::default();
             let stats = match fast_adaptive::extract(
-                self.spec, kernel, &levels, &frame, tiling, false, grid,
+                self.spec,
+                kernel,
+                &levels,
+                mk.summary(),
+                &frame,
+                tiling,
+                false,
+                grid,
             ) {
                 Some(stats) => stats,
                 None => extract_slice_adaptive(self.spec, kernel, &levels, &frame, grid)?,

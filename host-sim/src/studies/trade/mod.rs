@@ -35,7 +35,7 @@ use fvr_core::num::{BlockLayout, Blocking, Format, FormatName};
 use fvr_core::slice::adaptive::marks_words;
 use fvr_core::spectrum::prepare_scratch_len;
 
-use crate::render::adaptive::parse_tolerance;
+use crate::render::adaptive::{parse_tolerance, Cheaper};
 use crate::sources::phantom::GaussianMixture;
 use crate::sources::{BLOB_COUNT, BLOB_SIGMA_FRACTION, DEFAULT_SEED, GAUSSIAN_COUNT};
 use crate::studies::precision::parse_format;
@@ -51,7 +51,7 @@ pub const MAX_LEVEL: u32 = 3;
 /// Smallest preview side a level may produce.
 pub const MIN_PREVIEW_SIDE: usize = 8;
 /// The cheaper filter of adaptive points (the project's default chain).
-pub const ADAPTIVE_CHAIN: [FilterKind; 1] = [FilterKind::Nearest];
+pub const ADAPTIVE_CHAIN: [Cheaper; 1] = [Cheaper::Filter(FilterKind::Nearest)];
 
 /// The axes of a sweep as given (comma-separated lists), before
 /// validation by [`Sweep::from_axes`].
