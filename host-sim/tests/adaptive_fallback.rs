@@ -92,18 +92,26 @@ fn a_smooth_phantom_still_renders_adaptively() {
     let n = spec.n();
     let marks = AdaptiveMarks::build(&spec, &AdaptiveSettings::new(40.0)).unwrap();
     let mut renderer = AdaptiveRenderer::<f32>::new(&marks, &spec).unwrap();
+    let mut adaptive = 0;
     for dir in DIRECTIONS {
         let view = View::along(dir);
         let mut out = vec![0.0f32; n * n];
         let stats = renderer.render_into(&spec, &view, n, n, &mut out).unwrap();
-        assert_eq!(renderer.walked(), Walked::Adaptive, "{dir:?} {stats:?}");
-        let cheap = (stats.samples - stats.per_filter[0]) as f64;
-        assert!(
-            cheap >= marks.plain_below * stats.samples as f64,
-            "{stats:?}"
-        );
-        assert!(stats.taps < stats.full_taps / 2, "{stats:?}");
+        // Each view on the walk its share calls for.
+        match renderer.walked() {
+            Walked::Adaptive => {
+                let cheap = (stats.samples - stats.per_filter[0]) as f64;
+                assert!(
+                    cheap >= marks.plain_below * stats.samples as f64,
+                    "{stats:?}"
+                );
+                assert!(stats.taps < stats.full_taps / 2, "{stats:?}");
+                adaptive += 1;
+            }
+            Walked::Plain { share } => assert!(share < marks.plain_below, "{dir:?} {share}"),
+        }
     }
+    assert!(adaptive >= DIRECTIONS.len() / 2, "{adaptive}");
     // Asked to walk plainly below a share the view does not reach, it does.
     let strict = AdaptiveMarks::build(
         &spec,

@@ -112,8 +112,10 @@ pub(crate) struct RenderArgs {
     /// full-filter image (eq. 16). Plain X-ray views only.
     #[arg(long, value_name = "DB", value_parser = parse_tolerance, allow_hyphen_values = true)]
     pub(crate) adaptive: Option<f64>,
-    /// The cheaper filters of --adaptive, cheapest first (1 or 2 of nearest,
-    /// linear, cubic, kb3, ...; each narrower than --filter).
+    /// The cheaper filters of --adaptive, cheapest first (1 or 2 of zero,
+    /// nearest, linear, cubic, kb3, ...; each narrower than --filter).
+    /// `zero` leaves a point out and reads nothing: on smooth volumes the
+    /// fastest, e.g. `zero` or `zero,nearest`.
     #[arg(long, default_value = "nearest")]
     pub(crate) adaptive_chain: String,
     /// Use this response difference h_d in eq. 16 instead of the one computed
