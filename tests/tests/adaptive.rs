@@ -100,7 +100,7 @@ fn zero_filter_chains_stay_within_the_tolerance() {
         let any = AnySpectrum::F16(spec.clone());
         let fulls: Vec<Vec<f64>> = views.iter().map(|v| any.render(v, n, n).unwrap()).collect();
         for chain in ["zero", "zero,nearest"] {
-            for bound in [Bound::Paper, Bound::Exact] {
+            for bound in [Bound::Paper, Bound::Exact, Bound::Parseval] {
                 for tol in [30.0, 40.0, 50.0] {
                     let settings = AdaptiveSettings {
                         chain: parse_chain(chain).unwrap(),
@@ -148,6 +148,52 @@ fn zero_filter_chains_stay_within_the_tolerance() {
         checked += 1;
     }
     assert!(checked >= 2, "{checked}");
+}
+
+/// Parseval's bound holds: for the zero filter and for 1³, its threshold is
+/// not above the exact bound's, and the energy it reports is within the
+/// budget and not below eq. 15 evaluated the slow way.
+#[test]
+fn parseval_bound_bounds_the_error_energy() {
+    let n = 8;
+    let volume = sample(&GaussianMixture::random(6, n, 4), [n; 3]);
+    let spec =
+        OwnedSpectrum::<f16>::prepare::<f32>(&volume, Filter::new(FilterKind::Kb4, 2).unwrap())
+            .unwrap();
+    let mut checked = 0;
+    for (cheaper, gain) in [
+        (Cheaper::Zero, 0.0),
+        (Cheaper::Filter(FilterKind::Nearest), f64::NAN),
+    ] {
+        for tol in [20.0, 30.0, 40.0] {
+            let build = |bound| {
+                let settings = AdaptiveSettings {
+                    chain: vec![cheaper],
+                    ..nearest(tol, bound)
+                };
+                AdaptiveMarks::build(&spec, &settings).unwrap().levels[0].clone()
+            };
+            let (bounded, exact) = (build(Bound::Parseval), build(Bound::Exact));
+            assert_eq!(bounded.probes, Some(0));
+            assert!(bounded.threshold <= exact.threshold, "{cheaper:?} {tol}");
+            if bounded.threshold == 0.0 {
+                continue;
+            }
+            let gain = if gain.is_nan() { bounded.gain } else { gain };
+            let ratio = bounded.error_ratio.unwrap();
+            let direct = direct_error_ratio(&spec, bounded.threshold, gain);
+            assert!(
+                ratio <= 10f64.powf(-tol / 10.0),
+                "{cheaper:?} {tol}: {ratio}"
+            );
+            assert!(
+                direct <= ratio * (1.0 + 1e-4),
+                "{cheaper:?} {tol}: direct {direct} above the bound {ratio}"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked >= 3, "{checked}");
 }
 
 /// The exact bound accepts the largest threshold the 3D criterion allows:

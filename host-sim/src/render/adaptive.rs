@@ -97,17 +97,25 @@ pub enum Bound {
     /// volume (one for the reference, then the search of
     /// `ErrorModel::threshold`).
     Exact,
+    /// The error energy bounded by Parseval's theorem with the weight's
+    /// largest square, against the same reference as [`Bound::Exact`]: a
+    /// guarantee from one 3D transform (the reference's), with no probes,
+    /// and a smaller threshold than the exact one's. Tight for the zero
+    /// filter, whose weight `−ĥ₁` peaks at 1.
+    Parseval,
 }
 
 impl Bound {
-    /// Parse `paper` or `exact`.
+    /// Parse `paper`, `exact` or `parseval`.
     pub fn from_name(s: &str) -> Result<Self, String> {
         match s.trim() {
             "paper" => Ok(Self::Paper),
             "exact" => Ok(Self::Exact),
+            "parseval" => Ok(Self::Parseval),
             other => Err(format!(
-                "unknown adaptive bound `{other}`: use `exact` (the error field of eq. 15) or \
-                 `paper` (eq. 16 with the worst-case response difference)"
+                "unknown adaptive bound `{other}`: use `exact` (the error field of eq. 15), \
+                 `parseval` (its energy bounded, one transform) or `paper` (eq. 16 with the \
+                 worst-case response difference)"
             )),
         }
     }
@@ -117,6 +125,7 @@ impl Bound {
         match self {
             Self::Paper => "paper",
             Self::Exact => "exact",
+            Self::Parseval => "parseval",
         }
     }
 }
@@ -191,7 +200,8 @@ pub struct Level {
     /// DC gain correction `ĥ_large(0)/ĥ_small(0)`.
     pub gain: f64,
     /// With [`Bound::Exact`]: the 3D error energy of this level's
-    /// substitution relative to the volume's, as verified for `threshold`.
+    /// substitution relative to the volume's, as verified for `threshold`;
+    /// with [`Bound::Parseval`], the bound on it.
     pub error_ratio: Option<f64>,
     /// With [`Bound::Exact`]: the 3D inverse transforms the threshold
     /// search ran for this level (the reference's not counted).
@@ -253,7 +263,7 @@ impl AdaptiveMarks {
                 "the share below which views walk plainly is 0 to 1, got {plain_below}"
             ));
         }
-        if bound == Bound::Exact && h_d_override.is_some() {
+        if bound != Bound::Paper && h_d_override.is_some() {
             return Err(
                 "--adaptive-hd sets the h_d of the paper's bound; the exact bound measures the \
                  error field instead: use --adaptive-bound paper with it"
@@ -272,7 +282,7 @@ impl AdaptiveMarks {
         let radius = large.width().div_ceil(2);
         let mut levels = Vec::with_capacity(chain.len());
         let mut model = match bound {
-            Bound::Exact => Some(ErrorModel::new(view)?),
+            Bound::Exact | Bound::Parseval => Some(ErrorModel::new(view)?),
             Bound::Paper => None,
         };
         for &cheaper in chain.iter() {
@@ -303,6 +313,10 @@ impl AdaptiveMarks {
                 }
             };
             let (threshold, error_ratio, probes) = match model.as_mut() {
+                Some(model) if bound == Bound::Parseval => {
+                    let (tau, ratio) = model.peak_threshold(&small, gain, budget);
+                    (tau, Some(ratio), Some(0))
+                }
                 Some(model) => {
                     let (tau, ratio, probes) = model.threshold(&small, gain, budget)?;
                     (tau, Some(ratio), Some(probes))

@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use fvr_core::geometry::View;
 use fvr_host::reference::snr_db;
-use fvr_host::render::adaptive::AdaptiveSettings;
+use fvr_host::render::adaptive::{AdaptiveSettings, Bound};
 use fvr_host::render::adaptive_view::{AdaptiveRenderer, Walked};
 use fvr_host::render::spectrum::AnySpectrum;
 
@@ -59,13 +59,19 @@ impl AdaptiveReport {
                 l.marked,
                 l.words.len() * 32
             );
-            if let Some(r) = l.error_ratio {
-                println!(
+            match (l.error_ratio, self.marks.bound) {
+                (Some(r), Bound::Parseval) => println!(
+                    "  error field   at least {:.1} dB below the volume (Parseval's bound on \
+                     eq. 15, no probe transforms)",
+                    -10.0 * r.log10()
+                ),
+                (Some(r), _) => println!(
                     "  error field   {:.1} dB below the volume (exact bound, eq. 15; {} probe \
                      transforms)",
                     -10.0 * r.log10(),
                     l.probes.unwrap_or(0)
-                );
+                ),
+                (None, _) => {}
             }
         }
         println!(

@@ -126,7 +126,9 @@ pub(crate) struct RenderArgs {
     pub(crate) adaptive_hd: Option<f64>,
     /// How --adaptive turns decibels into a magnitude threshold: `exact`
     /// measures the error field of eq. 15 (one 3D inverse transform per
-    /// candidate threshold, about 8, once per volume); `paper` uses eq. 16
+    /// candidate threshold, about 8, once per volume); `parseval` bounds
+    /// that field's energy by Parseval's theorem (one transform, a smaller
+    /// threshold; close to `exact` for the zero filter); `paper` uses eq. 16
     /// with the worst-case response difference h_d (instant, but loose).
     /// Default: `exact`, or `paper` when --adaptive-hd is given.
     #[arg(long, value_name = "BOUND", value_parser = Bound::from_name)]

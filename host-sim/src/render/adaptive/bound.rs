@@ -172,6 +172,43 @@ impl ErrorModel {
         (self.n as f64).powi(3) * mean_square_weight * sum
     }
 
+    /// The largest ⅛-octave step whose error energy for `weight` Parseval's
+    /// theorem with the weight's largest square, `(|g|·max|ĥ₂|³ +
+    /// max|ĥ₁|³)²` (exact for the zero filter), bounds within `allowed`
+    /// (unnormalized); the bin above is summed, as a sample on a bin's edge
+    /// may be binned one up ([`bin`]).
+    fn peak_bin(&self, weight: &Weight<'_>, allowed: f64) -> Option<i64> {
+        let max_square = weight.peak_square();
+        let top = self.lowest + self.bins.len() as i64 - 1;
+        (self.lowest..=top)
+            .rev()
+            .find(|&b| self.estimate(b + 1, max_square) <= allowed)
+    }
+
+    /// [`super::Bound::Parseval`]: the threshold [`ErrorModel::peak_bin`]
+    /// accepts for the pair (large, `small` with gain `gain`) within
+    /// `budget`, and the bound on its relative error energy; `(0, 0)` when
+    /// no step is accepted.
+    pub(super) fn peak_threshold(&self, small: &Filter, gain: f64, budget: f64) -> (f64, f64) {
+        let hs = Self::responses(small, self.n);
+        let weight = Weight {
+            gain,
+            small: &hs,
+            large: &self.large_response,
+        };
+        if self.bins.is_empty() || self.reference <= 0.0 {
+            return (0.0, 0.0);
+        }
+        let max_square = weight.peak_square();
+        match self.peak_bin(&weight, budget * self.reference) {
+            Some(b) => (
+                2f64.powf(b as f64 / 8.0),
+                self.estimate(b + 1, max_square) / self.reference,
+            ),
+            None => (0.0, 0.0),
+        }
+    }
+
     /// The largest candidate threshold whose error energy for the pair
     /// (large, `small` with gain `gain`) stays within `budget` of the
     /// reference, and the relative energy it was verified at. Candidates are
@@ -214,15 +251,8 @@ impl ErrorModel {
         // From `top` on every sample is weak: no larger threshold changes the set.
         let top = self.lowest + self.bins.len() as i64 - 1;
         let mut bad = top + 1;
-        // Accepted without a probe: Parseval with the weight's largest
-        // square, `(|g|·max|ĥ₂|³ + max|ĥ₁|³)²` (exact for the zero filter),
-        // bounds the error energy. The bin above is summed, as a sample on a
-        // bin's edge may be binned one up ([`bin`]).
-        let peak = |h: &[f64]| h.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let max_square = (gain.abs() * peak(&hs).powi(3) + peak(&hl).powi(3)).powi(2);
-        let seed = (good.0 + 1..bad)
-            .rev()
-            .find(|&b| self.estimate(b + 1, max_square) <= allowed);
+        // Accepted without a probe.
+        let seed = self.peak_bin(&weight, allowed);
         if let Some(b) = seed {
             good = (b, None);
         }
@@ -271,6 +301,12 @@ struct Weight<'a> {
 }
 
 impl Weight<'_> {
+    /// `(|g|·max|ĥ₂|³ + max|ĥ₁|³)²`: at least `w(x)²` everywhere.
+    fn peak_square(&self) -> f64 {
+        let peak = |h: &[f64]| h.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        (self.gain.abs() * peak(self.small).powi(3) + peak(self.large).powi(3)).powi(2)
+    }
+
     /// `Σ_x ((field(x) − minus(x))·w(x))²` over the cube of side `n` (x
     /// fastest; `minus` zero if `None`), on all cores: per row,
     /// `w = a·ĥ₂(x) − b·ĥ₁(x)` with `a = g·ĥ₂(y)ĥ₂(z)` and `b = ĥ₁(y)ĥ₁(z)`,
