@@ -1,8 +1,10 @@
 //! Criterion benchmarks: one view with the full filter against the adaptive
 //! one (paper §4), both with reusable buffers on all cores (the host's
-//! extractions, then the same 2D inverse transform), for three chains at
-//! 40 dB: the 1³ filter (`adaptive_40db_nearest`), the zero filter
-//! (`adaptive_40db_zero`) and both (`adaptive_40db_zero_nearest`):
+//! extractions, then the same 2D inverse transform), for four chains at
+//! 40 dB: with the exact bound the 1³ filter (`adaptive_40db_nearest`), the
+//! zero filter (`adaptive_40db_zero`) and both (`adaptive_40db_zero_nearest`);
+//! the zero filter with Parseval's bound (`adaptive_40db_zero_parseval`,
+//! `fvr render --adaptive`'s default):
 //!
 //! - `adaptive_kb3_os2_128`: kb3, oversampling 2, on a 128³ Gaussian
 //!   mixture (f16);
@@ -11,8 +13,8 @@
 //!   (1, 0.3, 0.2);
 //!
 //! each also with the core's single-threaded adaptive extraction of the
-//! default chain (`adaptive_40db_core`); `marks_kb6_256`: the exact bound's
-//! marks at 40 dB for each chain (`marks_exact_40db_<chain>`) against the preprocessing they follow
+//! 1³ filter (`adaptive_40db_core`); `marks_kb6_256`: the marks at 40 dB
+//! for each chain (`marks_40db_<chain>`) against the preprocessing they follow
 //! (`prepare`), on the same volume; and `breakeven_kb4_256`,
 //! `breakeven_kb6_256`: the plain view (`plain`) against the adaptive walk
 //! (never the plain fallback) at tolerances that substitute from none to
@@ -28,21 +30,25 @@ use std::hint::black_box;
 use criterion::{criterion_group, criterion_main, Criterion};
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
-use fvr_host::render::adaptive::{AdaptiveMarks, AdaptiveSettings, Cheaper};
+use fvr_host::render::adaptive::{AdaptiveMarks, AdaptiveSettings, Bound, Cheaper};
 use fvr_host::render::adaptive_view::AdaptiveRenderer;
 use fvr_host::render::spectrum::{OwnedSpectrum, ViewRenderer};
 use fvr_host::sources::phantom::{sample, GaussianMixture};
 use fvr_host::volume::Volume;
 use half::f16;
 
-/// The chains compared: the 1³ filter, the zero filter, and both.
-const CHAINS: [(&str, &[Cheaper]); 3] = [
-    ("nearest", &[Cheaper::Filter(FilterKind::Nearest)]),
-    ("zero", &[Cheaper::Zero]),
+/// The chains compared, each with its bound: the 1³ filter, the zero
+/// filter, and both, with the exact bound (`fvr adaptive-table`'s default);
+/// the zero filter with Parseval's (`fvr render --adaptive`'s).
+const CHAINS: [(&str, &[Cheaper], Bound); 4] = [
+    ("nearest", &[Cheaper::Filter(FilterKind::Nearest)], Bound::Exact),
+    ("zero", &[Cheaper::Zero], Bound::Exact),
     (
         "zero_nearest",
         &[Cheaper::Zero, Cheaper::Filter(FilterKind::Nearest)],
+        Bound::Exact,
     ),
+    ("zero_parseval", &[Cheaper::Zero], Bound::Parseval),
 ];
 
 /// The full and adaptive views of `volume` with `filter`, in group `name`.
@@ -68,11 +74,12 @@ fn group(c: &mut Criterion, name: &str, volume: &Volume, filter: Filter) {
                 .unwrap()
         })
     });
-    for (label, chain) in CHAINS {
+    for (label, chain, bound) in CHAINS {
         let marks = AdaptiveMarks::build(
             &spec,
             &AdaptiveSettings {
                 chain: chain.to_vec(),
+                bound,
                 ..settings.clone()
             },
         )
@@ -106,12 +113,13 @@ fn marking(c: &mut Criterion, name: &str, volume: &Volume, filter: Filter) {
     group.bench_function("prepare", |b| {
         b.iter(|| OwnedSpectrum::<f16>::prepare::<f32>(black_box(volume), filter).unwrap())
     });
-    for (label, chain) in CHAINS {
+    for (label, chain, bound) in CHAINS {
         let settings = AdaptiveSettings {
             chain: chain.to_vec(),
+            bound,
             ..AdaptiveSettings::new(40.0)
         };
-        group.bench_function(format!("marks_exact_40db_{label}"), |b| {
+        group.bench_function(format!("marks_40db_{label}"), |b| {
             b.iter(|| AdaptiveMarks::build(black_box(&spec), &settings).unwrap())
         });
     }

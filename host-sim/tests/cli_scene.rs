@@ -145,7 +145,12 @@ fn adaptive_and_preview_options_report_and_refuse_conflicts() {
         "2",
     ];
     let mut args = base.to_vec();
-    args.extend(["--adaptive", "40", "--stats-json", "--out", "a.nrrd"]);
+    // The paper's 1³ filter with the exact bound (the search's regression
+    // case, docs/adaptive.md), on the adaptive walk always (the plain
+    // walk's image is the full one's).
+    args.extend(["--adaptive", "40", "--adaptive-plain-below", "0"]);
+    args.extend(["--adaptive-chain", "nearest", "--adaptive-bound", "exact"]);
+    args.extend(["--stats-json", "--out", "a.nrrd"]);
     let out = fvr(&args, &dir);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert_ok(&out);
@@ -170,6 +175,20 @@ fn adaptive_and_preview_options_report_and_refuse_conflicts() {
         .and_then(|v| v.trim().parse().ok())
         .expect("an SNR");
     assert!(snr >= 40.0, "{json}");
+
+    // The defaults: the zero filter and Parseval's bound.
+    let mut defaults = base.to_vec();
+    defaults.extend(["--adaptive", "40", "--stats-json", "--out", "d.nrrd"]);
+    let out = fvr(&defaults, &dir);
+    assert_ok(&out);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    for key in [
+        "\"bound\": \"parseval\"",
+        "\"filter\": \"zero\"",
+        "\"probes\": 0",
+    ] {
+        assert!(stdout.contains(key), "{key} not in {stdout}");
+    }
 
     let mut preview = base.to_vec();
     preview.extend(["--preview-level", "1", "--out", "p.nrrd"]);

@@ -167,8 +167,9 @@ pub fn parse_percent(s: &str) -> Result<f64, String> {
 }
 
 impl AdaptiveSettings {
-    /// `tolerance_db` with the 1³ filter and the exact bound: the defaults
-    /// of `fvr render --adaptive`.
+    /// `tolerance_db` with the paper's 1³ filter and the exact bound (the
+    /// defaults of `fvr adaptive-table`; `fvr render --adaptive` takes the
+    /// zero filter and Parseval's bound).
     pub fn new(tolerance_db: f64) -> Self {
         Self {
             tolerance_db,

@@ -226,7 +226,7 @@ fn default_scene() -> Result<(), Error> {
         resample: None,
         stats_json: false,
         adaptive: None,
-        adaptive_chain: "nearest".into(),
+        adaptive_chain: render::DEFAULT_CHAIN.into(),
         adaptive_hd: None,
         adaptive_bound: None,
         adaptive_plain_below: fvr_host::render::adaptive::DEFAULT_PLAIN_BELOW,

@@ -50,7 +50,7 @@ pub const MIN_SIZE: usize = 16;
 pub const MAX_LEVEL: u32 = 3;
 /// Smallest preview side a level may produce.
 pub const MIN_PREVIEW_SIDE: usize = 8;
-/// The cheaper filter of adaptive points (the project's default chain).
+/// The cheaper filter of adaptive points: the paper's 1³ filter.
 pub const ADAPTIVE_CHAIN: [Cheaper; 1] = [Cheaper::Filter(FilterKind::Nearest)];
 
 /// The axes of a sweep as given (comma-separated lists), before
