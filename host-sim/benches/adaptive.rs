@@ -41,7 +41,11 @@ use half::f16;
 /// filter, and both, with the exact bound (`fvr adaptive-table`'s default);
 /// the zero filter with Parseval's (`fvr render --adaptive`'s).
 const CHAINS: [(&str, &[Cheaper], Bound); 4] = [
-    ("nearest", &[Cheaper::Filter(FilterKind::Nearest)], Bound::Exact),
+    (
+        "nearest",
+        &[Cheaper::Filter(FilterKind::Nearest)],
+        Bound::Exact,
+    ),
     ("zero", &[Cheaper::Zero], Bound::Exact),
     (
         "zero_nearest",

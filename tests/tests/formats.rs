@@ -352,3 +352,20 @@ fn q15_line_blocks_prepared_in_place_match_the_f64_spectrum_within_five_rounding
         );
     }
 }
+
+/// Every 16-bit pattern of f16 and bf16 round-trips through
+/// `Sample::from_pattern16` and `Sample::pattern16` to the same value;
+/// wider formats have none.
+#[test]
+fn sixteen_bit_patterns_round_trip_exhaustively() {
+    for p in 0..=u16::MAX {
+        let h = <half::f16 as Sample>::from_pattern16(p).unwrap();
+        assert_eq!(h.to_bits(), p);
+        assert_eq!(h.pattern16(), Some(p));
+        let b = <half::bf16 as Sample>::from_pattern16(p).unwrap();
+        assert_eq!(b.to_bits(), p);
+        assert_eq!(b.pattern16(), Some(p));
+    }
+    assert_eq!(1.5f32.pattern16(), None);
+    assert_eq!(<f64 as Sample>::from_pattern16(7), None);
+}

@@ -97,6 +97,14 @@ impl Sample for f16 {
         }
     }
     #[inline(always)]
+    fn pattern16(self) -> Option<u16> {
+        Some(self.to_bits())
+    }
+    #[inline(always)]
+    fn from_pattern16(p: u16) -> Option<Self> {
+        Some(f16::from_bits(p))
+    }
+    #[inline(always)]
     fn from_f32(v: f32) -> Self {
         f16::from_f32(v)
     }
@@ -177,6 +185,14 @@ impl Sample for bf16 {
     const MAX_FINITE: f64 = 3.389_531_389_251_535_5e38;
     const BITS: u32 = 16;
     const SCALE_LOG2: i32 = 14;
+    #[inline(always)]
+    fn pattern16(self) -> Option<u16> {
+        Some(self.to_bits())
+    }
+    #[inline(always)]
+    fn from_pattern16(p: u16) -> Option<Self> {
+        Some(bf16::from_bits(p))
+    }
     #[inline(always)]
     fn from_f32(v: f32) -> Self {
         bf16::from_f32(v)

@@ -33,6 +33,18 @@ pub trait Sample: Copy + Default + Debug + PartialEq + Send + Sync {
     fn to_f32_raw(self) -> f32 {
         self.to_f32()
     }
+    /// The stored bits of a 16-bit IEEE-style format, for tables indexed by
+    /// them (a histogram of a spectrum's values); `None` for the others.
+    #[inline(always)]
+    fn pattern16(self) -> Option<u16> {
+        None
+    }
+    /// The value whose stored bits are `p` ([`Sample::pattern16`]'s
+    /// inverse); `None` for formats without 16-bit patterns.
+    #[inline(always)]
+    fn from_pattern16(_p: u16) -> Option<Self> {
+        None
+    }
     /// Round an f32 to this format, to nearest even.
     fn from_f32(v: f32) -> Self;
     /// Round an f64 to this format, to nearest even (one rounding).

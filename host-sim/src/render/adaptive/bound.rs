@@ -397,11 +397,47 @@ fn bin(v: f32) -> i64 {
     8 * (exponent - 127) + eighths as i64 + 1
 }
 
+/// `Σ F²` per bin ([`bin`]) of samples with 16-bit patterns
+/// ([`Sample::pattern16`]), from a count of each pattern on all cores: each
+/// value squared once, times its count (exact in f64), then summed.
+fn pattern_bins<S: Sample>(data: &[S]) -> Vec<f64> {
+    const PATTERNS: usize = 1 << 16;
+    let counts = data
+        .par_chunks(1 << 16)
+        .fold(
+            || vec![0u64; PATTERNS],
+            |mut counts, chunk| {
+                for d in chunk {
+                    counts[usize::from(d.pattern16().unwrap_or(0))] += 1;
+                }
+                counts
+            },
+        )
+        .reduce(
+            || vec![0u64; PATTERNS],
+            |mut a, b| {
+                a.iter_mut().zip(&b).for_each(|(x, y)| *x += y);
+                a
+            },
+        );
+    let mut bins = vec![0f64; BINS];
+    for (p, &count) in counts.iter().enumerate() {
+        let v = S::from_pattern16(p as u16).map_or(0.0, |s| s.to_f32());
+        if count > 0 && v != 0.0 {
+            bins[(bin(v) - FIRST) as usize] += count as f64 * (v as f64 * v as f64);
+        }
+    }
+    bins
+}
+
 /// Fill `values` with the spectrum's samples in f32, plane by plane on
 /// all cores, and gather their magnitude bins and extents in the same pass.
 fn scan<S: Sample>(view: &Spectrum<'_, S>, values: &mut [f32]) -> Scan {
     let n = view.n();
     let (data, plain) = (view.data(), view.blocks().is_none());
+    // A 16-bit format's samples take at most 65,536 values: count them,
+    // then bin each value once.
+    let patterns = plain && data.first().is_some_and(|d| d.pattern16().is_some());
     let planes: Vec<(Vec<f64>, f32, Vec<f32>)> = values
         .par_chunks_mut(n * n)
         .enumerate()
@@ -426,7 +462,7 @@ fn scan<S: Sample>(view: &Spectrum<'_, S>, values: &mut [f32]) -> Scan {
                     let mut largest = 0f32;
                     for &v in row {
                         largest = largest.max(v.abs());
-                        if v != 0.0 {
+                        if v != 0.0 && !patterns {
                             bins[(bin(v) - FIRST) as usize] += v as f64 * v as f64;
                         }
                     }
@@ -436,7 +472,10 @@ fn scan<S: Sample>(view: &Spectrum<'_, S>, values: &mut [f32]) -> Scan {
             (bins, rows.iter().fold(0f32, |m, &r| m.max(r)), rows)
         })
         .collect();
-    let mut all = vec![0f64; BINS];
+    let mut all = match patterns {
+        true => pattern_bins(data),
+        false => vec![0f64; BINS],
+    };
     let mut row_max = vec![0f32; n];
     for (bins, _, rows) in &planes {
         for (a, b) in all.iter_mut().zip(bins) {
@@ -460,5 +499,59 @@ fn scan<S: Sample>(view: &Spectrum<'_, S>, values: &mut [f32]) -> Scan {
         lowest,
         plane_max,
         row_max,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use half::{bf16, f16};
+
+    /// The bins from pattern counts are the bins summed sample by sample,
+    /// to f64 rounding, for f16 and bf16 over their whole range.
+    #[test]
+    fn pattern_bins_are_the_per_sample_bins() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let bits: Vec<u16> = (0..200_000)
+            .map(|_| {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                state as u16
+            })
+            .collect();
+        fn check<S: Sample>(data: &[S]) {
+            let mut direct = vec![0f64; BINS];
+            for d in data {
+                let v = d.to_f32();
+                if v != 0.0 {
+                    direct[(bin(v) - FIRST) as usize] += v as f64 * v as f64;
+                }
+            }
+            let counted = pattern_bins(data);
+            let mut occupied = 0;
+            for (b, (a, c)) in direct.iter().zip(&counted).enumerate() {
+                assert!(
+                    (a - c).abs() <= 1e-12 * a.abs(),
+                    "{} bin {b}: {a} {c}",
+                    S::NAME
+                );
+                occupied += usize::from(*a > 0.0);
+            }
+            assert!(occupied > 100, "{}: {occupied}", S::NAME);
+        }
+        let finite = |v: f32| v.is_finite();
+        let halves: Vec<f16> = bits
+            .iter()
+            .map(|&b| f16::from_bits(b))
+            .filter(|h| finite(h.to_f32()))
+            .collect();
+        let brains: Vec<bf16> = bits
+            .iter()
+            .map(|&b| bf16::from_bits(b))
+            .filter(|h| finite(h.to_f32()))
+            .collect();
+        check(&halves);
+        check(&brains);
     }
 }
