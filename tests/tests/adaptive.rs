@@ -24,6 +24,14 @@ fn nearest(tolerance_db: f64, bound: Bound) -> AdaptiveSettings {
     }
 }
 
+/// An 8³ Gaussian mixture's kb4 spectrum at oversampling 2 (16³): small
+/// enough for the naive transforms of [`direct_error_ratio`].
+fn eighth_spectrum() -> OwnedSpectrum<f16> {
+    let n = 8;
+    let volume = sample(&GaussianMixture::random(6, n, 4), [n; 3]);
+    OwnedSpectrum::<f16>::prepare::<f32>(&volume, Filter::new(FilterKind::Kb4, 2).unwrap()).unwrap()
+}
+
 /// The guarantee: the adaptive image is never further from the full-filter
 /// image than the tolerance, over volumes, views, filters, tolerances and
 /// both bounds.
@@ -123,11 +131,7 @@ fn zero_filter_chains_stay_within_the_tolerance() {
     }
     assert!(zeroed > 10_000, "{zeroed}");
     // The zero level's energy, against a direct evaluation at 8³.
-    let n = 8;
-    let volume = sample(&GaussianMixture::random(6, n, 4), [n; 3]);
-    let spec =
-        OwnedSpectrum::<f16>::prepare::<f32>(&volume, Filter::new(FilterKind::Kb4, 2).unwrap())
-            .unwrap();
+    let spec = eighth_spectrum();
     let mut checked = 0;
     for tol in [20.0, 30.0, 40.0] {
         let settings = AdaptiveSettings {
@@ -155,11 +159,7 @@ fn zero_filter_chains_stay_within_the_tolerance() {
 /// budget and not below eq. 15 evaluated the slow way.
 #[test]
 fn parseval_bound_bounds_the_error_energy() {
-    let n = 8;
-    let volume = sample(&GaussianMixture::random(6, n, 4), [n; 3]);
-    let spec =
-        OwnedSpectrum::<f16>::prepare::<f32>(&volume, Filter::new(FilterKind::Kb4, 2).unwrap())
-            .unwrap();
+    let spec = eighth_spectrum();
     let mut checked = 0;
     for (cheaper, gain) in [
         (Cheaper::Zero, 0.0),
@@ -225,11 +225,7 @@ fn exact_bound_is_within_budget_and_no_tighter_than_the_papers() {
 /// way. A 16³ spectrum keeps the naive transform (O(N²), N = 4096) cheap.
 #[test]
 fn exact_bound_energy_matches_a_direct_evaluation() {
-    let n = 8;
-    let volume = sample(&GaussianMixture::random(6, n, 4), [n; 3]);
-    let spec =
-        OwnedSpectrum::<f16>::prepare::<f32>(&volume, Filter::new(FilterKind::Kb4, 2).unwrap())
-            .unwrap();
+    let spec = eighth_spectrum();
     let mut checked = 0;
     for tol in [20.0, 30.0, 40.0] {
         let exact = AdaptiveMarks::build(&spec, &nearest(tol, Bound::Exact)).unwrap();
@@ -249,7 +245,8 @@ fn exact_bound_energy_matches_a_direct_evaluation() {
         // (unless every sample is already below the threshold).
         let next = level.threshold * 2f64.powf(0.125);
         let budget = 10f64.powf(-tol / 10.0);
-        let largest = (0..n * n * n).fold(0.0f64, |m, i| m.max(spec.view().value(i).abs()));
+        let all = spec.n().pow(3);
+        let largest = (0..all).fold(0.0f64, |m, i| m.max(spec.view().value(i).abs()));
         if next <= largest {
             let beyond = direct_error_ratio(&spec, next, level.gain);
             assert!(beyond > budget, "{tol}: {next} is within the budget too");
