@@ -175,14 +175,15 @@ impl ErrorModel {
     /// The largest ⅛-octave step whose error energy for `weight` Parseval's
     /// theorem with the weight's largest square, `(|g|·max|ĥ₂|³ +
     /// max|ĥ₁|³)²` (exact for the zero filter), bounds within `allowed`
-    /// (unnormalized); the bin above is summed, as a sample on a bin's edge
-    /// may be binned one up ([`bin`]).
-    fn peak_bin(&self, weight: &Weight<'_>, allowed: f64) -> Option<i64> {
+    /// (unnormalized), with that bound; the bin above is summed, as a
+    /// sample on a bin's edge may be binned one up ([`bin`]).
+    fn peak_bin(&self, weight: &Weight<'_>, allowed: f64) -> Option<(i64, f64)> {
         let max_square = weight.peak_square();
         let top = self.lowest + self.bins.len() as i64 - 1;
         (self.lowest..=top)
             .rev()
-            .find(|&b| self.estimate(b + 1, max_square) <= allowed)
+            .map(|b| (b, self.estimate(b + 1, max_square)))
+            .find(|&(_, e)| e <= allowed)
     }
 
     /// [`super::Bound::Parseval`]: the threshold [`ErrorModel::peak_bin`]
@@ -199,12 +200,8 @@ impl ErrorModel {
         if self.bins.is_empty() || self.reference <= 0.0 {
             return (0.0, 0.0);
         }
-        let max_square = weight.peak_square();
         match self.peak_bin(&weight, budget * self.reference) {
-            Some(b) => (
-                2f64.powf(b as f64 / 8.0),
-                self.estimate(b + 1, max_square) / self.reference,
-            ),
+            Some((b, e)) => (2f64.powf(b as f64 / 8.0), e / self.reference),
             None => (0.0, 0.0),
         }
     }
@@ -253,7 +250,7 @@ impl ErrorModel {
         let mut bad = top + 1;
         // Accepted without a probe.
         let seed = self.peak_bin(&weight, allowed);
-        if let Some(b) = seed {
+        if let Some((b, _)) = seed {
             good = (b, None);
         }
         let mut scale = 1.0;
