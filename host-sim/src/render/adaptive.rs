@@ -56,7 +56,12 @@ pub fn parse_chain(s: &str) -> Result<Vec<Cheaper>, String> {
             "zero" => Ok(Cheaper::Zero),
             other => FilterKind::from_name(other)
                 .map(Cheaper::Filter)
-                .ok_or_else(|| format!("unknown filter `{name}` in the adaptive chain")),
+                .ok_or_else(|| {
+                    format!(
+                        "unknown filter `{name}` in the adaptive chain: expected zero, nearest, \
+                         linear, cubic, kb3, kb4 or kb5"
+                    )
+                }),
         })
         .collect::<Result<_, _>>()?;
     if kinds.is_empty() || kinds.len() > MAX_LEVELS {
@@ -266,8 +271,8 @@ impl AdaptiveMarks {
         }
         if bound != Bound::Paper && h_d_override.is_some() {
             return Err(
-                "--adaptive-hd sets the h_d of the paper's bound; the exact bound measures the \
-                 error field instead: use --adaptive-bound paper with it"
+                "--adaptive-hd sets the h_d of the paper's bound; the exact and parseval bounds \
+                 use the error field of eq. 15 instead: use --adaptive-bound paper with it"
                     .into(),
             );
         }
