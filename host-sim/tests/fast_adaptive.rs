@@ -17,6 +17,7 @@ use fvr_host::render::adaptive::{AdaptiveMarks, AdaptiveSettings, Bound, Cheaper
 use fvr_host::render::adaptive_view::AdaptiveRenderer;
 use fvr_host::render::fast_adaptive::extract;
 use fvr_host::render::fast_slice::Tiling;
+use fvr_host::render::marks_summary::MarksSummary;
 use fvr_host::render::spectrum::OwnedSpectrum;
 use fvr_host::sources::phantom::{sample, GaussianMixture};
 use fvr_host::volume::Volume;
@@ -56,6 +57,18 @@ fn check<S: Sample, T: Real>(
     dir: [f64; 3],
     what: &str,
 ) -> AdaptiveStats {
+    let n = spec.n();
+    check_busy::<S, T>(spec, marks, dir, n * n / 4, what)
+}
+
+/// [`check`], the core's slice with more than `busy` nonzero points.
+fn check_busy<S: Sample, T: Real>(
+    spec: &OwnedSpectrum<S>,
+    marks: &AdaptiveMarks,
+    dir: [f64; 3],
+    busy: usize,
+    what: &str,
+) -> AdaptiveStats {
     let view = spec.view();
     let n = view.n();
     let frame = View::along(dir).frame().unwrap();
@@ -65,7 +78,7 @@ fn check<S: Sample, T: Real>(
     let mut core = vec![T::ZERO; n * n];
     let core_stats = extract_slice_adaptive(&view, &kernel, &levels, &frame, &mut core).unwrap();
     assert!(
-        core.iter().filter(|v| v.to_f64() != 0.0).count() > n * n / 4,
+        core.iter().filter(|v| v.to_f64() != 0.0).count() > busy,
         "{what}: the slice is mostly zero"
     );
     // With the summary of the first level's marks, and without.
@@ -175,6 +188,81 @@ fn zero_level_reads_nothing_and_matches_the_core() {
         used.iter().all(|&c| c > 0),
         "a link of the chain unused: {used:?}"
     );
+}
+
+#[test]
+fn runs_among_whole_zero_bricks_are_counted_as_the_core_walks_them() {
+    // A zero level on a smooth volume at 64, most of its bricks whole and
+    // some far from any that is not: the walk only counts the runs of
+    // points among them, which end at every angle to the bricks' faces.
+    let n = 64;
+    let volume = sample(&GaussianMixture::random(4, n, 8), [n; 3]);
+    let filter = Filter::new(FilterKind::Kb6, 1).unwrap();
+    let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+    for chain in [
+        vec![Cheaper::Zero],
+        vec![Cheaper::Zero, Cheaper::Filter(FilterKind::Nearest)],
+    ] {
+        let levels = chain.len();
+        let settings = AdaptiveSettings {
+            chain,
+            ..AdaptiveSettings::new(40.0)
+        };
+        let marks = AdaptiveMarks::build(&spec, &settings).unwrap();
+        let summary = marks.summary().unwrap();
+        let m = n / 8;
+        let mut at = [0usize; 4];
+        for b in 0..m * m * m {
+            let d = summary.distance([b % m, b / m % m, b / (m * m)].map(|c| 8 * c));
+            at[usize::from(d).min(3)] += 1;
+        }
+        assert!(at.iter().all(|&c| c > 0), "bricks at 0, 1, 2, 3+: {at:?}");
+        for dir in DIRECTIONS {
+            let what = format!("{levels} levels, {dir:?}");
+            let s = check_busy::<f16, f32>(&spec, &marks, dir, n, &what);
+            assert!(s.per_filter[0] > 0 && s.per_filter[1] > 0, "{what}: {s:?}");
+        }
+    }
+}
+
+#[test]
+fn runs_end_before_scattered_unmarked_bricks() {
+    // Marks of the zero level replaced by whole bricks marked or not (one
+    // in eight not, at random): a point a run carried into a brick not
+    // marked would be counted as zero where the core filters it.
+    let n = 64;
+    let volume = sample(&GaussianMixture::random(4, n, 8), [n; 3]);
+    let filter = Filter::new(FilterKind::Kb6, 1).unwrap();
+    let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+    let settings = AdaptiveSettings {
+        chain: vec![Cheaper::Zero],
+        ..AdaptiveSettings::new(40.0)
+    };
+    let mut marks = AdaptiveMarks::build(&spec, &settings).unwrap();
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let m = n / 8;
+    let unmarked: Vec<bool> = (0..m * m * m)
+        .map(|_| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state % 8 == 0
+        })
+        .collect();
+    let level = &mut marks.levels[0];
+    level.words.fill(0);
+    for i in 0..n * n * n {
+        let (x, y, z) = (i % n / 8, i / n % n / 8, i / (n * n) / 8);
+        if !unmarked[x + m * (y + m * z)] {
+            level.words[i / 32] |= 1 << (i % 32);
+        }
+    }
+    level.summary = MarksSummary::new(&level.words, n);
+    for dir in DIRECTIONS {
+        let what = format!("scattered bricks, {dir:?}");
+        let s = check_busy::<f16, f32>(&spec, &marks, dir, n, &what);
+        assert!(s.per_filter[0] > n as u64, "{what}: {s:?}");
+    }
 }
 
 /// Volumes that are not cubes inside their grid, and oversampling 2 (the

@@ -35,7 +35,7 @@ use fvr_core::spectrum::Spectrum;
 use rayon::prelude::*;
 
 use super::fast_slice::{row_interval, supports, tap_sum, Tiling};
-use super::marks_summary::MarksSummary;
+use super::marks_summary::{MarksSummary, BRICK};
 
 /// One filter of the chain as the walk applies it.
 #[derive(Clone, Copy)]
@@ -74,6 +74,11 @@ struct Walk<'a, S, T> {
     marks: [Option<Marks<'a>>; MAX_LEVELS],
     /// The bricks the first level's marks hold whole.
     whole: Option<&'a MarksSummary>,
+    /// When the first level is the zero filter, its summary, whose
+    /// distances let runs of points be counted without their marks.
+    zero_runs: Option<&'a MarksSummary>,
+    /// `1/|right_a|` (infinite for 0).
+    inverse_step: [T; 3],
     raw_gain: T,
     chunk: i32,
 }
@@ -115,7 +120,7 @@ pub fn extract<S: Sample, T: Real>(
     }
     let walk = Walk::new(spec, kernel, levels, whole, frame, tiling)?;
     let up = frame.up.map(T::from_f64);
-    let bands = bands(grid, n, &walk.right, up, tiling.band.max(1));
+    let bands = walk.bands(grid, up, tiling.band.max(1));
     let fill = |band: Vec<Row<'_, T>>| walk.fill_band(band);
     let stats = if parallel {
         bands
@@ -149,13 +154,8 @@ pub fn tally<S: Sample, T: Real>(
     let count = |p: usize| {
         let mut stats = AdaptiveStats::default();
         let ky = signed(p, n);
-        let (kyu, low, high) = walked(n, &walk.right, up, ky);
-        let mut row = Row {
-            cells: &mut [],
-            kyu,
-            low,
-            high,
-        };
+        let mut row = walk.row(&mut [], up, ky);
+        let (low, high) = (row.low, row.high);
         walk.fill_row(&mut row, low, high, &mut stats);
         stats
     };
@@ -191,44 +191,6 @@ fn walked<T: Real>(n: usize, right: &[T; 3], up: [T; 3], ky: i32) -> ([T; 3], i3
         low.saturating_sub(1).max(-half),
         high.saturating_add(1).min(k_max),
     )
-}
-
-/// The rows of `grid` in bands of `band` mirror pairs (`p` and `−p`,
-/// `p = 0 … n/2`), each row with its walked interval of `kx`.
-fn bands<'g, T: Real>(
-    grid: &'g mut [T],
-    n: usize,
-    right: &[T; 3],
-    up: [T; 3],
-    band: usize,
-) -> Vec<Vec<Row<'g, T>>> {
-    let mask = n - 1;
-    let k_max = ((n - 1) / 2) as i32;
-    let mut rows: Vec<Option<&'g mut [T]>> = grid.chunks_exact_mut(n).map(Some).collect();
-    let mut row = |index: usize, ky: i32| -> Option<Row<'g, T>> {
-        let cells = rows[index].take()?;
-        let (kyu, low, high) = walked(n, right, up, ky);
-        Some(Row {
-            cells,
-            kyu,
-            low,
-            high,
-        })
-    };
-    let mut bands = Vec::new();
-    for first in (0..=n / 2).step_by(band) {
-        let mut rows = Vec::with_capacity(2 * band);
-        for p in first..(first + band).min(n / 2 + 1) {
-            if p as i32 <= k_max {
-                rows.extend(row(p, p as i32));
-            }
-            if p > 0 {
-                rows.extend(row((n - p) & mask, -(p as i32)));
-            }
-        }
-        bands.push(rows);
-    }
-    bands
 }
 
 /// The sums of two statistics.
@@ -276,9 +238,46 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
             filters,
             marks,
             whole: whole.filter(|_| !levels.is_empty()),
+            zero_runs: whole.filter(|_| levels.first().is_some_and(|l| l.gain == T::ZERO)),
+            inverse_step: frame.right.map(|r| T::from_f64(1.0 / r.abs())),
             raw_gain: T::exp2i(T::raw_exponent::<S>()),
             chunk: tiling.chunk.clamp(1, n) as i32,
         })
+    }
+
+    /// The rows of `grid` in bands of `band` mirror pairs (`p` and `−p`,
+    /// `p = 0 … n/2`).
+    fn bands<'g>(&self, grid: &'g mut [T], up: [T; 3], band: usize) -> Vec<Vec<Row<'g, T>>> {
+        let n = self.n;
+        let mask = n - 1;
+        let k_max = ((n - 1) / 2) as i32;
+        let mut rows: Vec<Option<&'g mut [T]>> = grid.chunks_exact_mut(n).map(Some).collect();
+        let mut row = |index: usize, ky: i32| Some(self.row(rows[index].take()?, up, ky));
+        let mut bands = Vec::new();
+        for first in (0..=n / 2).step_by(band) {
+            let mut rows = Vec::with_capacity(2 * band);
+            for p in first..(first + band).min(n / 2 + 1) {
+                if p as i32 <= k_max {
+                    rows.extend(row(p, p as i32));
+                }
+                if p > 0 {
+                    rows.extend(row((n - p) & mask, -(p as i32)));
+                }
+            }
+            bands.push(rows);
+        }
+        bands
+    }
+
+    /// The row of signed frequency `ky` over `cells`.
+    fn row<'g>(&self, cells: &'g mut [T], up: [T; 3], ky: i32) -> Row<'g, T> {
+        let (kyu, low, high) = walked(self.n, &self.right, up, ky);
+        Row {
+            cells,
+            kyu,
+            low,
+            high,
+        }
     }
 
     /// Zero one band's rows, then fill their points inside the cube tile by
@@ -304,9 +303,88 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
         stats
     }
 
-    /// Points `kx = from … to` of `row`, each as the core computes it.
+    /// Points `kx = from … to` of `row`, each as the core computes it. With
+    /// a zero first level, a point whose brick is whole starts a run of
+    /// points that stay among whole bricks, which are only counted (cells
+    /// already zero, no taps).
     #[inline(always)]
     fn fill_row(&self, row: &mut Row<'_, T>, from: i32, to: i32, stats: &mut AdaptiveStats) {
+        let summary = match self.zero_runs {
+            Some(summary) => summary,
+            None => return self.fill_points(row, from, to, stats),
+        };
+        let mask = self.n - 1;
+        let mut k = from;
+        while k <= to {
+            let kx = T::from_i32(k);
+            let q: [T; 3] = core::array::from_fn(|a| kx * self.right[a] + row.kyu[a]);
+            let s = q.map(|c| (c + T::HALF).floor_i64());
+            let d = summary.distance(s.map(|c| c as usize & mask));
+            if d == 0 {
+                self.fill_points(row, k, k, stats);
+                k += 1;
+                continue;
+            }
+            let run = self.run(s, i32::from(d)).min(to - k);
+            self.count_zero(row.kyu, k, k + run, stats);
+            k += run + 1;
+        }
+    }
+
+    /// How many points past one whose nearest sample is `s`, in a brick at
+    /// distance `d ≥ 1`, certainly have their nearest samples in whole
+    /// bricks. On axis `a` the next points' nearest samples move one way
+    /// (rounding is monotonic), `j` points on by less than `j·|right_a| + 1`
+    /// (the positions' rounding is far below the `0.01` kept), and stay
+    /// among whole bricks up to `8(d − 1)` samples beyond the brick's face.
+    #[inline(always)]
+    fn run(&self, s: [i64; 3], d: i32) -> i32 {
+        let brick = BRICK as i32;
+        let beyond = brick * (d - 1);
+        let mut run = i32::MAX;
+        for a in 0..3 {
+            let offset = (s[a] & (BRICK as i64 - 1)) as i32;
+            let room = match self.right[a] > T::ZERO {
+                true => brick - 1 - offset + beyond,
+                false => offset + beyond,
+            };
+            if self.right[a] != T::ZERO {
+                let j =
+                    ((T::from_i32(room) - T::from_f64(0.01)) * self.inverse_step[a]).floor_i64();
+                run = run.min(j.clamp(0, i32::MAX as i64) as i32);
+            }
+        }
+        run
+    }
+
+    /// Count points `kx = from … to` of the row at `kyu` inside the cube
+    /// (the core's test) as the first level's, the zero filter. Each
+    /// coordinate is monotonic in `kx` (rounding is), so when both ends
+    /// are inside, every point between is.
+    #[inline(always)]
+    fn count_zero(&self, kyu: [T; 3], from: i32, to: i32, stats: &mut AdaptiveStats) {
+        let large = match self.filters[0] {
+            Some(f) if from <= to => f,
+            _ => return,
+        };
+        let nyquist = T::from_usize(self.n) * T::HALF;
+        let inside = |k: i32| {
+            let kx = T::from_i32(k);
+            let q: [T; 3] = core::array::from_fn(|a| kx * self.right[a] + kyu[a]);
+            !q.iter().any(|&c| c > nyquist || -c > nyquist)
+        };
+        let count = match inside(from) && inside(to) {
+            true => (to - from) as u64 + 1,
+            false => (from..=to).map(|k| u64::from(inside(k))).sum(),
+        };
+        stats.samples += count;
+        stats.full_taps += large.taps * count;
+        stats.per_filter[1] += count;
+    }
+
+    /// [`Walk::fill_row`] point by point.
+    #[inline(always)]
+    fn fill_points(&self, row: &mut Row<'_, T>, from: i32, to: i32, stats: &mut AdaptiveStats) {
         let n = self.n;
         let mask = n - 1;
         let nyquist = T::from_usize(n) * T::HALF;
