@@ -3,20 +3,26 @@
 //! and power-of-two sides, in f32 and f64, for shifted and unshifted
 //! placements, crops that wrap, interleaved channels and any thread count;
 //! odd sides, which the core's finish does not take, against the core's
-//! 2D transform.
+//! 2D transform; grids with rows of `+0` and of `−0`.
 
 use fvr_core::dht::{dht_2d_mixed, dht_2d_mixed_scratch_len, mixed_table_len, MixedPlan, Twiddles};
 use fvr_core::image::{aux_len, finish_with, Crop, Inverse, Placement};
 use fvr_core::num::Real;
 use fvr_host::render::fast_inverse::{finish_threaded, MixedFinish};
 
-/// A fixed-seed pseudo-random grid in [−0.5, 0.5).
+/// A fixed-seed pseudo-random grid in [−0.5, 0.5), with the rows of a
+/// weak slice: every fourth row from row 2 `+0` (its mirror too, where `m`
+/// is even), and row 3 `−0`, which is no `+0` row.
 fn grid<T: Real>(m: usize, seed: u32) -> Vec<T> {
     let mut state = seed;
     (0..m * m)
-        .map(|_| {
+        .map(|i| {
             state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            T::from_f64((state >> 8) as f64 / 16_777_216.0 - 0.5)
+            match i / m {
+                y if y % 4 == 2 => T::ZERO,
+                3 => T::from_f64(-0.0),
+                _ => T::from_f64((state >> 8) as f64 / 16_777_216.0 - 0.5),
+            }
         })
         .collect()
 }

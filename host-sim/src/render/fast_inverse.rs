@@ -131,7 +131,8 @@ const BLOCK: usize = 16;
 /// for bit, from the filled `m × m` slice `grid` (overwritten)
 /// through `trans` ([`grid_len`]`(m)` elements of scratch) into `out`
 /// (`width·height·channels`). Needs no `aux`; any side the transform
-/// serves, odd ones too.
+/// serves, odd ones too. Rows that are `+0` after the shift take the
+/// transform of such a row, computed once.
 ///
 /// # Errors
 /// As [`fvr_core::image::finish_with`].
@@ -148,13 +149,22 @@ pub fn finish_threaded<T: Real>(
     let grid = &mut grid[..m * m];
     let trans = &mut trans[..m * m];
     let tables = shift_tables(m, crop.place.shift);
+    // A row of +0 (rows of a weak slice outside its strong disc) transforms
+    // to the same bits every time: copied, not transformed.
+    let mut zero = vec![T::ZERO; m];
+    line(&mut zero, &mut vec![T::ZERO; mixed_scratch_len(m)], inverse);
+    let row_pass =
+        |row: &mut [T], scratch: &mut [T]| match row.iter().all(|v| v.to_f64().to_bits() == 0) {
+            true => row.copy_from_slice(&zero),
+            false => line(row, scratch, inverse),
+        };
     for_row_pairs(grid, m, |y, row, mut mirror, scratch| {
         if let Some(t) = &tables {
             t.shift_rows(y, row, mirror.as_deref_mut());
         }
-        line(row, scratch, inverse);
+        row_pass(row, scratch);
         if let Some(mirror) = mirror {
-            line(mirror, scratch, inverse);
+            row_pass(mirror, scratch);
         }
     });
     transpose(grid, trans, m);
