@@ -190,15 +190,20 @@ fn zero_level_reads_nothing_and_matches_the_core() {
     );
 }
 
+/// The f16 kb6 spectrum of a smooth volume at 64, whose strong samples lie
+/// near the origin.
+fn smooth_kb6_64() -> OwnedSpectrum<f16> {
+    let volume = sample(&GaussianMixture::random(4, 64, 8), [64; 3]);
+    let filter = Filter::new(FilterKind::Kb6, 1).unwrap();
+    OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap()
+}
+
 #[test]
 fn runs_among_whole_zero_bricks_are_counted_as_the_core_walks_them() {
     // A zero level on a smooth volume at 64, most of its bricks whole and
     // some far from any that is not: the walk only counts the runs of
     // points among them, which end at every angle to the bricks' faces.
-    let n = 64;
-    let volume = sample(&GaussianMixture::random(4, n, 8), [n; 3]);
-    let filter = Filter::new(FilterKind::Kb6, 1).unwrap();
-    let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+    let (n, spec) = (64, smooth_kb6_64());
     for chain in [
         vec![Cheaper::Zero],
         vec![Cheaper::Zero, Cheaper::Filter(FilterKind::Nearest)],
@@ -230,10 +235,7 @@ fn runs_end_before_scattered_unmarked_bricks() {
     // Marks of the zero level replaced by whole bricks marked or not (one
     // in eight not, at random): a point a run carried into a brick not
     // marked would be counted as zero where the core filters it.
-    let n = 64;
-    let volume = sample(&GaussianMixture::random(4, n, 8), [n; 3]);
-    let filter = Filter::new(FilterKind::Kb6, 1).unwrap();
-    let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+    let (n, spec) = (64, smooth_kb6_64());
     let settings = AdaptiveSettings {
         chain: vec![Cheaper::Zero],
         ..AdaptiveSettings::new(40.0)
