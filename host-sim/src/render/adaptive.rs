@@ -405,8 +405,8 @@ impl AdaptiveMarks {
         self.levels.first().map(|l| &l.summary)
     }
 
-    /// Bytes of marks held (1 bit per voxel per level, and 1 per brick of
-    /// 512 voxels in the summaries).
+    /// Bytes of marks held (1 bit per voxel per level, and 1 byte per brick
+    /// of 512 voxels in the summaries).
     pub fn bytes(&self) -> usize {
         self.levels
             .iter()

@@ -75,7 +75,7 @@ impl AdaptiveReport {
             }
         }
         println!(
-            "  marks         {} bytes (1 bit per voxel per level), built in {:.1} ms",
+            "  marks         {} bytes (1 bit per voxel and 1 byte per 8^3 brick per level), built in {:.1} ms",
             self.marks.bytes(),
             self.mark_time.as_secs_f64() * 1e3
         );
