@@ -316,8 +316,7 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
         let mask = self.n - 1;
         let mut k = from;
         while k <= to {
-            let kx = T::from_i32(k);
-            let q: [T; 3] = core::array::from_fn(|a| kx * self.right[a] + row.kyu[a]);
+            let q = self.position(k, row.kyu);
             let s = q.map(|c| (c + T::HALF).floor_i64());
             let d = summary.distance(s.map(|c| c as usize & mask));
             if d == 0 {
@@ -329,6 +328,14 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
             self.count_zero(row.kyu, k, k + run, stats);
             k += run + 1;
         }
+    }
+
+    /// The position `q = kx·right + kyu` of point `kx = k`, in `T` as the
+    /// core computes it.
+    #[inline(always)]
+    fn position(&self, k: i32, kyu: [T; 3]) -> [T; 3] {
+        let kx = T::from_i32(k);
+        core::array::from_fn(|a| kx * self.right[a] + kyu[a])
     }
 
     /// How many points past one whose nearest sample is `s`, in a brick at
@@ -369,8 +376,7 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
         };
         let nyquist = T::from_usize(self.n) * T::HALF;
         let inside = |k: i32| {
-            let kx = T::from_i32(k);
-            let q: [T; 3] = core::array::from_fn(|a| kx * self.right[a] + kyu[a]);
+            let q = self.position(k, kyu);
             !q.iter().any(|&c| c > nyquist || -c > nyquist)
         };
         let count = match inside(from) && inside(to) {
@@ -393,8 +399,7 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
             None => return,
         };
         for k in from..=to {
-            let kx = T::from_i32(k);
-            let q: [T; 3] = core::array::from_fn(|a| kx * self.right[a] + row.kyu[a]);
+            let q = self.position(k, row.kyu);
             if q.iter().any(|&c| c > nyquist || -c > nyquist) {
                 continue;
             }
