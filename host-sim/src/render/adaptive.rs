@@ -6,6 +6,7 @@ mod bound;
 
 use crate::render::adaptive_view::{AdaptiveRenderer, Walked};
 use crate::render::fast_marks;
+use crate::render::fast_prepare::PreparedEnergy;
 use crate::render::marks_summary::MarksSummary;
 use crate::render::spectrum::OwnedSpectrum;
 use bound::ErrorModel;
@@ -244,7 +245,7 @@ impl AdaptiveMarks {
         spec: &OwnedSpectrum<S>,
         settings: &AdaptiveSettings,
     ) -> Result<Self, String> {
-        Self::build_for(&spec.view(), settings)
+        Self::build_with(&spec.view(), settings, spec.prepared_energy())
     }
 
     /// [`AdaptiveMarks::build`] for any core spectrum (every storage
@@ -255,6 +256,17 @@ impl AdaptiveMarks {
     pub fn build_for<S: Sample>(
         view: &Spectrum<'_, S>,
         settings: &AdaptiveSettings,
+    ) -> Result<Self, String> {
+        Self::build_with(view, settings, None)
+    }
+
+    /// [`AdaptiveMarks::build_for`], with the energy the preparation of
+    /// `view`'s spectrum measured, if known: Parseval's bound then takes
+    /// its reference from it instead of an inverse transform.
+    fn build_with<S: Sample>(
+        view: &Spectrum<'_, S>,
+        settings: &AdaptiveSettings,
+        prepared: Option<&PreparedEnergy>,
     ) -> Result<Self, String> {
         let AdaptiveSettings {
             tolerance_db,
@@ -288,7 +300,9 @@ impl AdaptiveMarks {
         let radius = large.width().div_ceil(2);
         let mut levels = Vec::with_capacity(chain.len());
         let mut model = match bound {
-            Bound::Exact | Bound::Parseval => Some(ErrorModel::new(view)?),
+            Bound::Exact | Bound::Parseval => {
+                Some(ErrorModel::new(view, prepared, bound == Bound::Exact)?)
+            }
             Bound::Paper => None,
         };
         for &cheaper in chain.iter() {

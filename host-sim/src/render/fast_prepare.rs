@@ -26,6 +26,32 @@ pub struct FastSpectrum<S> {
     pub n: usize,
     /// Scale of the stored values.
     pub scale: f64,
+    /// The scaled volume's energy and the roundings since.
+    pub energy: PreparedEnergy,
+}
+
+/// What the preparation knows of the energy of its spectrum's inverse
+/// transform, for the reference of the adaptive marks' bounds
+/// (`render::adaptive`), which would otherwise take a 3D inverse transform.
+///
+/// With `g` the premultiplied, scaled cube, `F = DHT(g)` unnormalized and
+/// `ĥ` the filter's response per grid index, `DHT(F)·ĥ = n³·g·ĥ = n³·s·v`
+/// on the volume's voxels and 0 elsewhere. The stored spectrum differs
+/// from `F` by the transform's and the storage's roundings, bounded here
+/// relative to its norm.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PreparedEnergy {
+    /// `s²·Σ v²` over the voxels, `s` the spectrum's scale (summed in f64).
+    pub scaled: f64,
+    /// Relative bound on `|g·ĥ − s·v|` per voxel and on the sum's rounding.
+    pub input: f64,
+    /// Relative bound on the transform's error in norm: ten times the
+    /// classic `log₂(n³)·ε` of an FFT in the arithmetic `T`.
+    pub transform: f64,
+    /// Unit roundoff of the storage format.
+    pub storage: f64,
+    /// Half the spacing of the storage format's subnormals.
+    pub floor: f64,
 }
 
 /// What [`prepare_fast`] holds at its peak for side `n`: the stored spectrum
@@ -45,26 +71,33 @@ pub fn fast_budget<T, S>(n: usize) -> Budget {
     b
 }
 
-/// `Σ |v_i|·p_i` in f64 over [`LANES`] interleaved partial sums, so that
-/// the sum vectorizes instead of waiting on one addition after another.
-fn row_magnitude(line: &[f32], p: &[f64]) -> f64 {
+/// `(Σ |v_i|·p_i, Σ v_i²)` in f64, each over [`LANES`] interleaved
+/// partial sums, so that the sums vectorize instead of waiting on one
+/// addition after another.
+fn row_sums(line: &[f32], p: &[f64]) -> (f64, f64) {
     let mut acc = [0.0f64; LANES];
+    let mut sq = [0.0f64; LANES];
     let (lines, ps) = (line.chunks_exact(LANES), p.chunks_exact(LANES));
     let (rest, rest_p) = (lines.remainder(), ps.remainder());
     for (vs, ps) in lines.zip(ps) {
-        for ((a, &v), &p) in acc.iter_mut().zip(vs).zip(ps) {
+        for (((a, q), &v), &p) in acc.iter_mut().zip(&mut sq).zip(vs).zip(ps) {
             *a += (v as f64).abs() * p;
+            *q += v as f64 * v as f64;
         }
     }
-    let tail: f64 = rest
+    let (tail, tail_sq) = rest
         .iter()
         .zip(rest_p)
-        .map(|(&v, &p)| (v as f64).abs() * p)
-        .sum();
-    acc.iter().sum::<f64>() + tail
+        .fold((0.0, 0.0), |(a, q), (&v, &p)| {
+            (a + (v as f64).abs() * p, q + v as f64 * v as f64)
+        });
+    (
+        acc.iter().sum::<f64>() + tail,
+        sq.iter().sum::<f64>() + tail_sq,
+    )
 }
 
-/// Partial sums in [`row_magnitude`].
+/// Partial sums in [`row_sums`].
 const LANES: usize = 8;
 
 /// Premultiply `volume` for `filter`, zero-pad it into the cube of side
@@ -116,13 +149,13 @@ pub fn prepare_fast_on<T: FastReal, S: FastStore>(
     let pmx: Vec<f64> = (0..nx)
         .map(|i| premul[shifted(i, 0)].to_f64().abs())
         .collect();
-    let sums: Vec<Result<f64, Error>> = volume
+    let sums: Vec<Result<(f64, f64), Error>> = volume
         .data
         .par_chunks_exact(nx * ny)
         .enumerate()
         .map(|(k, plane)| {
             let pz = premul[shifted(k, 2)].to_f64();
-            let mut sum = 0.0f64;
+            let (mut sum, mut energy) = (0.0f64, 0.0f64);
             for (j, line) in plane.chunks_exact(nx).enumerate() {
                 if !line.iter().fold(true, |ok, v| ok & v.is_finite()) {
                     let i = line.iter().position(|v| !v.is_finite()).unwrap_or(0);
@@ -132,14 +165,18 @@ pub fn prepare_fast_on<T: FastReal, S: FastStore>(
                     });
                 }
                 let pyz = (premul[shifted(j, 1)].to_f64() * pz).abs();
-                sum += row_magnitude(line, &pmx) * pyz;
+                let (magnitude, squares) = row_sums(line, &pmx);
+                sum += magnitude * pyz;
+                energy += squares;
             }
-            Ok(sum)
+            Ok((sum, energy))
         })
         .collect();
-    let mut bound = 0.0f64;
+    let (mut bound, mut energy) = (0.0f64, 0.0f64);
     for s in sums {
-        bound += s?;
+        let (b, e) = s?;
+        bound += b;
+        energy += e;
     }
     if !bound.is_finite() {
         return Err(Error::Overflow {
@@ -189,5 +226,20 @@ pub fn prepare_fast_on<T: FastReal, S: FastStore>(
     // Zeroed on all cores: the first touch of the pages is a large part.
     data.par_extend(rayon::iter::repeat_n(S::default(), n * n * n));
     dht_3d_real(&cube, &mut data)?;
-    Ok(FastSpectrum { data, n, scale })
+    let cells = (n as f64).powi(3);
+    let energy = PreparedEnergy {
+        scaled: energy * scale * scale,
+        // Seven roundings of T in `g = v·p(x)·(p(y)·p(z)·s)` with each
+        // `p = 1/ĥ` rounded, and the f64 sum of squares.
+        input: 8.0 * T::EPSILON_HALF.to_f64() + (nx * ny * nz) as f64 * f64::EPSILON / 2.0,
+        transform: 10.0 * cells.log2() * T::EPSILON_HALF.to_f64(),
+        storage: S::UNIT_ROUNDOFF,
+        floor: S::SUBNORMAL_HALF_SPACING,
+    };
+    Ok(FastSpectrum {
+        data,
+        n,
+        scale,
+        energy,
+    })
 }

@@ -9,6 +9,12 @@ use super::fast_dht::FastReal;
 
 /// A storage format the fast preparation writes ([`super::fast_prepare`]).
 pub trait FastStore: Sample {
+    /// Unit roundoff: a value rounded to `Self` in its normal range is within
+    /// this share of it.
+    const UNIT_ROUNDOFF: f64;
+    /// Half the spacing of `Self`'s subnormals: the largest absolute error
+    /// of a value rounded below the normal range.
+    const SUBNORMAL_HALF_SPACING: f64;
     /// `dst[i] = src[i]` rounded to nearest even; `false` if a value is not
     /// finite in `Self`.
     fn store_row<T: FastReal>(src: &[T], dst: &mut [Self]) -> bool {
@@ -21,10 +27,22 @@ pub trait FastStore: Sample {
     }
 }
 
-impl FastStore for f32 {}
-impl FastStore for f64 {}
+impl FastStore for f32 {
+    const UNIT_ROUNDOFF: f64 = f32::EPSILON as f64 / 2.0;
+    // 2^−150.
+    const SUBNORMAL_HALF_SPACING: f64 = f32::MIN_POSITIVE as f64 * f32::EPSILON as f64 / 2.0;
+}
+
+impl FastStore for f64 {
+    const UNIT_ROUNDOFF: f64 = f64::EPSILON / 2.0;
+    // The spacing itself (2^−1074): half of it is not an f64.
+    const SUBNORMAL_HALF_SPACING: f64 = f64::MIN_POSITIVE * f64::EPSILON;
+}
 
 impl FastStore for f16 {
+    const UNIT_ROUNDOFF: f64 = 1.0 / 2048.0;
+    // 2^−25.
+    const SUBNORMAL_HALF_SPACING: f64 = 1.0 / 33_554_432.0;
     fn store_row<T: FastReal>(src: &[T], dst: &mut [Self]) -> bool {
         if T::EPSILON_HALF != f32::EPSILON_HALF {
             // f64 → f16 must round once, from f64.

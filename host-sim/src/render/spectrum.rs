@@ -20,7 +20,7 @@ use fvr_core::volume::{padded_size, DenseVolume, GridOversampling};
 use half::f16;
 
 use super::fast_dht::FastReal;
-use super::fast_prepare::prepare_fast_on;
+use super::fast_prepare::{prepare_fast_on, PreparedEnergy};
 use super::fast_store::FastStore;
 use crate::volume::Volume;
 
@@ -87,6 +87,9 @@ pub struct OwnedSpectrum<S> {
     scale: f64,
     filter: Filter,
     dims: [usize; 3],
+    /// The energy the FFT preparation measured; `None` from the core's
+    /// in-place transform, which rounds after each pass.
+    energy: Option<PreparedEnergy>,
 }
 
 impl<S: Sample> OwnedSpectrum<S> {
@@ -133,6 +136,7 @@ impl<S: Sample> OwnedSpectrum<S> {
             scale: spec.scale,
             filter,
             dims: volume.dims,
+            energy: Some(spec.energy),
         })
     }
 
@@ -162,6 +166,7 @@ impl<S: Sample> OwnedSpectrum<S> {
             scale,
             filter,
             dims,
+            energy: None,
         })
     }
 
@@ -169,6 +174,12 @@ impl<S: Sample> OwnedSpectrum<S> {
     pub fn view(&self) -> Spectrum<'_, S> {
         Spectrum::from_parts(&self.data, self.n, self.scale, self.filter, self.dims)
             .expect("parts come from a prepared spectrum")
+    }
+
+    /// The scaled volume's energy and the roundings since, when the FFT
+    /// preparation made this spectrum.
+    pub fn prepared_energy(&self) -> Option<&PreparedEnergy> {
+        self.energy.as_ref()
     }
 
     /// Side of the padded cube.
