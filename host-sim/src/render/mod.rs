@@ -17,6 +17,7 @@ pub mod fast_store;
 pub mod fast_strip;
 #[cfg(test)]
 mod fast_tests;
+pub mod fast_transpose;
 pub mod filter;
 pub mod marks_summary;
 pub mod plan;

@@ -9,6 +9,7 @@
 
 use std::fmt;
 use std::str::FromStr;
+use std::sync::OnceLock;
 
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::Filter;
@@ -22,6 +23,7 @@ use half::f16;
 use super::fast_dht::FastReal;
 use super::fast_prepare::{prepare_fast_on, PreparedEnergy};
 use super::fast_store::FastStore;
+use super::fast_transpose::exchange_xy;
 use crate::volume::Volume;
 
 pub use super::filter::{
@@ -90,6 +92,10 @@ pub struct OwnedSpectrum<S> {
     /// The energy the FFT preparation measured; `None` from the core's
     /// in-place transform, which rounds after each pass.
     energy: Option<PreparedEnergy>,
+    /// The samples with x and y exchanged, once a renderer asked for them
+    /// ([`OwnedSpectrum::exchanged_xy`]); `None` inside when the memory
+    /// budget did not hold them.
+    exchanged: OnceLock<Option<Vec<S>>>,
 }
 
 impl<S: Sample> OwnedSpectrum<S> {
@@ -137,6 +143,7 @@ impl<S: Sample> OwnedSpectrum<S> {
             filter,
             dims: volume.dims,
             energy: Some(spec.energy),
+            exchanged: OnceLock::new(),
         })
     }
 
@@ -167,6 +174,7 @@ impl<S: Sample> OwnedSpectrum<S> {
             filter,
             dims,
             energy: None,
+            exchanged: OnceLock::new(),
         })
     }
 
@@ -180,6 +188,38 @@ impl<S: Sample> OwnedSpectrum<S> {
     /// preparation made this spectrum.
     pub fn prepared_energy(&self) -> Option<&PreparedEnergy> {
         self.energy.as_ref()
+    }
+
+    /// The spectrum with its x and y axes exchanged (y fastest in memory,
+    /// [`super::fast_transpose`]), for views whose strip rows run mostly
+    /// along y. Built on the first call, on all cores, when the memory
+    /// limit holds a second copy of the samples beside the first; `None`
+    /// when it does not.
+    pub fn exchanged_xy(&self) -> Option<Spectrum<'_, S>> {
+        let data = self
+            .exchanged
+            .get_or_init(|| {
+                let cells = (self.n as u64).pow(3);
+                let size = std::mem::size_of::<S>() as u64;
+                crate::budget::Budget::new()
+                    .hold("spectrum", cells, size)
+                    .hold("spectrum with x and y exchanged", cells, size)
+                    .check(crate::budget::limit(), "")
+                    .ok()?;
+                exchange_xy(&self.data, self.n)
+            })
+            .as_ref()?;
+        let [a, b, c] = self.dims;
+        Spectrum::from_parts(data, self.n, self.scale, self.filter, [b, a, c]).ok()
+    }
+
+    /// Bytes of the exchanged copy held ([`OwnedSpectrum::exchanged_xy`]),
+    /// 0 before it is built or when it was not.
+    pub fn exchanged_bytes(&self) -> usize {
+        match self.exchanged.get() {
+            Some(Some(d)) => std::mem::size_of_val(d.as_slice()),
+            _ => 0,
+        }
     }
 
     /// Side of the padded cube.

@@ -3,7 +3,7 @@
 
 use fvr_core::dht::{mixed_table_len, MixedPlan, Twiddles};
 use fvr_core::filter::{Filter, KernelTable};
-use fvr_core::geometry::{Sampling, View};
+use fvr_core::geometry::{Sampling, SliceAxes, View};
 use fvr_core::image::{aux_len, check_image, finish_with, grid_len, placement_on_axes};
 use fvr_core::image::{Crop, Inverse};
 use fvr_core::num::{Real, Sample};
@@ -14,7 +14,7 @@ use fvr_core::spectrum::Spectrum;
 use super::fast_inverse::MixedFinish;
 use super::fast_slice::{self, Tiling};
 use super::spectrum::OwnedSpectrum;
-use super::{fast_column, fast_strip};
+use super::{fast_column, fast_strip, fast_transpose};
 
 /// Reusable per-view buffers and tables for arithmetic `T`.
 #[derive(Debug)]
@@ -32,6 +32,8 @@ pub struct ViewRenderer<T> {
     pool: Option<rayon::ThreadPool>,
     tiling: Tiling,
     walk: Walk,
+    /// Strip views with rows along y drawn so far ([`Self::exchanged`]).
+    y_rows_views: usize,
 }
 
 /// How a plain view's slice is summed.
@@ -68,7 +70,33 @@ impl<T: Real> ViewRenderer<T> {
             pool: None,
             tiling: Tiling::default(),
             walk: Walk::default(),
+            y_rows_views: 0,
         }
+    }
+
+    /// The spectrum with x and y exchanged and the axes to match
+    /// ([`OwnedSpectrum::exchanged_xy`]), for a strip view whose rows run
+    /// mostly along y ([`fast_transpose::rows_along_y`]) and contain no
+    /// axis: from the second such view this renderer draws (a single view
+    /// would pay for the copy without using it again), or at once if the
+    /// spectrum already holds the copy.
+    fn exchanged<'s, S: Sample>(
+        walk: Walk,
+        seen: &mut usize,
+        spec: &'s OwnedSpectrum<S>,
+        axes: &SliceAxes,
+    ) -> Option<(Spectrum<'s, S>, SliceAxes)> {
+        let wanted = walk == Walk::Strip
+            && fast_transpose::rows_along_y(axes)
+            && fast_column::column_axis(axes).is_none();
+        if !wanted {
+            return None;
+        }
+        *seen += 1;
+        if *seen < 2 && spec.exchanged_bytes() == 0 {
+            return None;
+        }
+        Some((spec.exchanged_xy()?, fast_transpose::exchanged(axes)))
     }
 
     /// Bytes of per-view working memory (slice grid, auxiliary, tables),
@@ -158,16 +186,21 @@ impl<T: Real> ViewRenderer<T> {
             mixed = MixedPlan::from_table(&self.tw, self.n)?;
             Inverse::Mixed(&mixed)
         };
+        let owned = spec;
         let spec = spec.view();
         let n = spec.n();
         if self.grid.len() == grid_len(n) && fast_slice::supports(&spec) {
             let axes = sampling.slice_axes(&view.frame()?);
             check_image(width, height, n)?;
+            let exchanged = Self::exchanged(self.walk, &mut self.y_rows_views, owned, &axes);
             let (kernel, tiling, grid) = (&self.kernel, self.tiling, &mut self.grid);
             let (walk, along) = (self.walk, &mut self.along);
             let mut extract = |parallel: bool, grid: &mut [T]| {
                 (walk == Walk::Strip
                     && (fast_column::extract(&spec, kernel, &axes, tiling, parallel, grid, along)
+                        || exchanged.as_ref().is_some_and(|(spec, axes)| {
+                            fast_strip::extract(spec, kernel, axes, tiling, parallel, grid)
+                        })
                         || fast_strip::extract(&spec, kernel, &axes, tiling, parallel, grid)))
                     || fast_slice::extract(&spec, kernel, &axes, tiling, parallel, grid)
             };
