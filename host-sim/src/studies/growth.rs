@@ -6,9 +6,12 @@
 //! voxels, rendered to an `n × n` image along (1, 0.3, 0.2): kb3 at
 //! oversampling 1 from an f16 spectrum, extraction on all cores, against the
 //! f32 trilinear ray caster on all cores. Times are medians of `runs` views
-//! after one warm-up view; preprocessing is not timed.
+//! after one warm-up view, the sizes timed in turn in each round, each
+//! timed view right after an untimed one of its size; preprocessing is
+//! not timed.
 
 use std::path::Path;
+use std::time::Instant;
 
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
@@ -18,7 +21,6 @@ use crate::image::plot::{Canvas, Rgb};
 use crate::reference::raycast::RayCaster;
 use crate::render::spectrum::{OwnedSpectrum, ViewRenderer};
 use crate::sources::phantom::{sample, GaussianMixture};
-use crate::studies::timing::median_ms;
 
 /// Time per view at one size.
 #[derive(Clone, Debug, PartialEq)]
@@ -56,7 +58,14 @@ pub fn check_sizes(sizes: &[usize], large: bool) -> Result<(), String> {
 }
 
 /// Measure every size in `sizes` (checked by [`check_sizes`]) with `runs`
-/// timed views each, calling `progress` after each size.
+/// timed views each, calling `progress` with each size's row at the end.
+///
+/// Every size is set up first (phantom, spectrum, renderer, ray caster,
+/// one warm-up view each) and held; then each of the `runs` rounds times
+/// one view of each size in turn, right after an untimed one of the same
+/// size. A change of load on the machine then reaches every size alike,
+/// and the ratios between sizes, which are what this study is about, hold
+/// under it.
 ///
 /// # Errors
 /// Bad sizes or runs, or a render that fails.
@@ -72,29 +81,66 @@ pub fn measure(
     }
     let view = View::along([1.0, 0.3, 0.2]);
     let filter = Filter::new(FilterKind::Kb3, 1).map_err(|e| e.to_string())?;
-    let mut rows = Vec::new();
+    struct Setup {
+        n: usize,
+        spec: OwnedSpectrum<f16>,
+        renderer: ViewRenderer<f32>,
+        caster: RayCaster,
+        out: Vec<f32>,
+    }
+    impl Setup {
+        fn frequency(&mut self, view: &View) -> Result<(), String> {
+            let n = self.n;
+            self.renderer
+                .render_into(&self.spec, view, n, n, &mut self.out)
+                .map_err(|e| e.to_string())
+        }
+        fn raycast(&self, view: &View) -> Result<(), String> {
+            self.caster.project(view, self.n, self.n, 1.0, 0).map(drop)
+        }
+    }
+    let mut setups = Vec::with_capacity(sizes.len());
     for &n in sizes {
         let volume = sample(&GaussianMixture::random(1, n, 8), [n; 3]);
         let spec =
             OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).map_err(|e| e.to_string())?;
-        let mut renderer = ViewRenderer::<f32>::new(spec.n(), filter);
-        let mut out = vec![0.0f32; n * n];
-        let mut frequency_view = || {
-            renderer
-                .render_into(&spec, &view, n, n, &mut out)
-                .map_err(|e| e.to_string())
-        };
-        frequency_view()?;
-        let frequency_ms = median_ms(runs, frequency_view)?;
-        drop(spec);
-        let caster = RayCaster::new(&volume);
-        let raycast_view = || caster.project(&view, n, n, 1.0, 0).map(drop);
-        raycast_view()?;
-        let raycast_ms = median_ms(runs, raycast_view)?;
-        let row = GrowthRow {
+        let mut setup = Setup {
             n,
-            frequency_ms,
-            raycast_ms,
+            renderer: ViewRenderer::<f32>::new(spec.n(), filter),
+            spec,
+            caster: RayCaster::new(&volume),
+            out: vec![0.0f32; n * n],
+        };
+        setup.frequency(&view)?;
+        setup.raycast(&view)?;
+        setups.push(setup);
+    }
+    let mut times = vec![(Vec::with_capacity(runs), Vec::with_capacity(runs)); setups.len()];
+    let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
+    for _ in 0..runs {
+        for (setup, (frequency, raycast)) in setups.iter_mut().zip(&mut times) {
+            // Untimed, so that the timed view finds the caches holding this
+            // size's data, as the next view of one volume would, rather
+            // than the previous size's.
+            setup.frequency(&view)?;
+            let t = Instant::now();
+            setup.frequency(&view)?;
+            frequency.push(ms(t));
+            let t = Instant::now();
+            setup.raycast(&view)?;
+            raycast.push(ms(t));
+        }
+    }
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let mut rows = Vec::with_capacity(setups.len());
+    for (setup, (frequency, raycast)) in setups.iter().zip(&mut times) {
+        let row = GrowthRow {
+            n: setup.n,
+            frequency_ms: median(frequency),
+            raycast_ms: median(raycast),
         };
         progress(&row);
         rows.push(row);

@@ -10,10 +10,12 @@ pub(crate) struct GrowthArgs {
     /// Volume sides: powers of two from 16 to 256 (512 with --large).
     #[arg(long, value_delimiter = ',', default_values_t = [64usize, 128, 256])]
     pub(crate) sizes: Vec<usize>,
-    /// Timed views per size and method (after one warm-up view).
+    /// Timed views per size and method (after one warm-up view), the
+    /// sizes in turn in each round.
     #[arg(long, default_value_t = 15)]
     pub(crate) runs: usize,
-    /// Allow 512 (a 256 MiB spectrum and a 512 MiB volume).
+    /// Allow 512 (a 256 MiB spectrum, its 256 MiB copy with x and y
+    /// exchanged and a 512 MiB volume, held beside the smaller sizes').
     #[arg(long)]
     pub(crate) large: bool,
     /// Where to write the files.

@@ -126,7 +126,8 @@ pub(crate) enum Command {
     Trade(crate::trade::TradeArgs),
     /// How the time per view grows with the volume's side: the kb3 f16
     /// frequency-domain view against the f32 ray caster (both on all cores),
-    /// medians of RUNS views per size; writes growth.csv, growth.md and a
+    /// medians of RUNS views per size, the sizes timed in turn so that a
+    /// change of load reaches them alike; writes growth.csv, growth.md and a
     /// log-log growth.png, and prints the Markdown (with the growth per
     /// doubling against the n² log n ratio).
     Growth(crate::growth::GrowthArgs),
