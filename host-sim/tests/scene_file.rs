@@ -224,6 +224,12 @@ fn teapot_names_are_checked() {
     assert!(assert_ok(&fvr(&args, &dir)).contains("wrote t.png (32x32 grey)"));
 }
 
+/// The number after `"key": ` in a one-line JSON object.
+fn json_number(json: &str, key: &str) -> f64 {
+    let rest = &json[json.find(&format!("\"{key}\": ")).expect(key) + key.len() + 4..];
+    rest[..rest.find([',', '}']).unwrap()].parse().expect(key)
+}
+
 #[test]
 fn turntable_stats_json_is_one_object_with_views_per_second() {
     let (_, out) = fvr_in(
@@ -239,10 +245,7 @@ fn turntable_stats_json_is_one_object_with_views_per_second() {
         json.ends_with('}') && !stdout.contains("views/s"),
         "{stdout}"
     );
-    let number = |key: &str| -> f64 {
-        let rest = &json[json.find(&format!("\"{key}\": ")).expect(key) + key.len() + 4..];
-        rest[..rest.find([',', '}']).unwrap()].parse().expect(key)
-    };
+    let number = |key: &str| json_number(json, key);
     assert_eq!(number("frames"), 4.0);
     assert_eq!(number("spectrum_side"), 16.0);
     let (views_ms, per_second) = (number("views_ms"), number("views_per_second"));
@@ -252,6 +255,22 @@ fn turntable_stats_json_is_one_object_with_views_per_second() {
         "{json}"
     );
     assert!(json.contains("\"volume\": \"sphere@16\""), "{json}");
+    // About z from −y every frame contains z: no exchanged copy.
+    assert_eq!(number("exchanged_bytes"), 0.0, "{json}");
+    // Looking down at the orbit, the frames whose rows run along y take
+    // the spectrum with x and y exchanged: a second copy of its samples.
+    let (_, out) = fvr_in(
+        "scenefile-turntable-exchanged",
+        "turntable sphere@16 --oversample 1 --frames 8 --dir 1,0.3,0.4 --stats-json --out s.apng",
+    );
+    let stdout = assert_ok(&out);
+    let json = stdout.lines().find(|l| l.starts_with('{')).expect("JSON");
+    let number = |key: &str| json_number(json, key);
+    let spectrum = number("spectrum_bytes");
+    assert!(
+        spectrum > 0.0 && number("exchanged_bytes") == spectrum,
+        "{json}"
+    );
 }
 
 /// Render [`SCENE`] with `from` replaced by `to`, as `bad.toml` in a fresh

@@ -444,6 +444,16 @@ impl AnySpectrum {
         }
     }
 
+    /// Bytes of the copy with x and y exchanged held
+    /// ([`OwnedSpectrum::exchanged_bytes`]).
+    pub fn exchanged_bytes(&self) -> usize {
+        match self {
+            AnySpectrum::F16(s) => s.exchanged_bytes(),
+            AnySpectrum::F32(s) => s.exchanged_bytes(),
+            AnySpectrum::F64(s) => s.exchanged_bytes(),
+        }
+    }
+
     /// The filter the spectrum was premultiplied for.
     pub fn filter(&self) -> Filter {
         match self {

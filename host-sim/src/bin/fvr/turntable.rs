@@ -155,6 +155,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
             spectrum_side: n,
             precision: args.frame.spectrum.precision.name(),
             spectrum_bytes: spec.bytes(),
+            exchanged_bytes: spec.exchanged_bytes(),
             filter: args.frame.spectrum.filter.name(),
             oversample: crate::plan::oversample_json(args.frame.spectrum.oversample),
             load_ms: t_load.as_secs_f64() * 1e3,
@@ -240,6 +241,9 @@ struct TurntableStats<'a> {
     spectrum_side: usize,
     precision: &'a str,
     spectrum_bytes: usize,
+    /// The spectrum's copy with x and y exchanged, for strip rows along y
+    /// (0 when no frame took it).
+    exchanged_bytes: usize,
     filter: &'a str,
     oversample: serde_json::Value,
     load_ms: f64,
