@@ -59,6 +59,36 @@ pub fn extract<S: Sample, T: Real + Send + Sync>(
     parallel: bool,
     grid: &mut [T],
 ) -> bool {
+    extract_nested(spec, kernel, axes, tiling, parallel, grid, false)
+}
+
+/// [`extract`] on the spectrum with x and y exchanged
+/// ([`super::fast_transpose`]) and `axes` exchanged to match, for rows
+/// that hold z: the interpolation's inner sum runs over the exchanged
+/// spectrum's y (the original x), so that every value is summed as
+/// [`extract`] sums it on the original spectrum, bit for bit.
+pub fn extract_exchanged<S: Sample, T: Real + Send + Sync>(
+    spec: &Spectrum<'_, S>,
+    kernel: &KernelTable<T>,
+    axes: &SliceAxes,
+    tiling: Tiling,
+    parallel: bool,
+    grid: &mut [T],
+) -> bool {
+    held_axis(axes) == Some(2) && extract_nested(spec, kernel, axes, tiling, parallel, grid, true)
+}
+
+/// [`extract`], the interpolation's inner sum over the strip's `w` axis
+/// when `inner_w`, else over its `u` axis.
+fn extract_nested<S: Sample, T: Real + Send + Sync>(
+    spec: &Spectrum<'_, S>,
+    kernel: &KernelTable<T>,
+    axes: &SliceAxes,
+    tiling: Tiling,
+    parallel: bool,
+    grid: &mut [T],
+    inner_w: bool,
+) -> bool {
     let n = spec.n();
     if !supports(spec) || grid.len() != n * n || kernel.filter() != spec.filter() {
         return false;
@@ -69,12 +99,12 @@ pub fn extract<S: Sample, T: Real + Send + Sync>(
     let g = Geometry::new(axes, n, tiling, parallel);
     let data = spec.data();
     match kernel.filter().width() {
-        1 => walk::<1, S, T>(data, kernel, &g, held, grid),
-        2 => walk::<2, S, T>(data, kernel, &g, held, grid),
-        3 => walk::<3, S, T>(data, kernel, &g, held, grid),
-        4 => walk::<4, S, T>(data, kernel, &g, held, grid),
-        5 => walk::<5, S, T>(data, kernel, &g, held, grid),
-        _ => walk::<MAX_WIDTH, S, T>(data, kernel, &g, held, grid),
+        1 => walk::<1, S, T>(data, kernel, &g, held, inner_w, grid),
+        2 => walk::<2, S, T>(data, kernel, &g, held, inner_w, grid),
+        3 => walk::<3, S, T>(data, kernel, &g, held, inner_w, grid),
+        4 => walk::<4, S, T>(data, kernel, &g, held, inner_w, grid),
+        5 => walk::<5, S, T>(data, kernel, &g, held, inner_w, grid),
+        _ => walk::<MAX_WIDTH, S, T>(data, kernel, &g, held, inner_w, grid),
     }
 }
 
@@ -122,6 +152,8 @@ struct Strip<'a, const W: usize, S, T> {
     phases: &'a PhaseTable<T, W>,
     raw_gain: T,
     step: [i64; 3],
+    /// The interpolation's inner sum over `w` instead of `u`.
+    inner_w: bool,
 }
 
 #[inline(never)]
@@ -130,6 +162,7 @@ fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
     kernel: &KernelTable<T>,
     g: &Geometry<T>,
     held: usize,
+    inner_w: bool,
     grid: &mut [T],
 ) -> bool {
     let mut phases = Box::new(PhaseTable::<T, W>::zeroed());
@@ -146,6 +179,7 @@ fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
         phases: &phases,
         raw_gain: T::exp2i(T::raw_exponent::<S>()),
         step: g.right.map(PhaseTable::<T, W>::fixed_step),
+        inner_w,
     };
     let mut bands = bands_of_pairs(grid, n, g.tiling.band);
     let fill = |band: &mut Vec<Pair<'_, T>>| {
@@ -255,6 +289,22 @@ impl<const W: usize, S: Sample, T: Real> Strip<'_, W, S, T> {
             let w = wrap(self.n, runs.w_min as i64 + l as i64);
             let cells = &mut s.cells[runs.off[l]..runs.off[l + 1]];
             self.reduce(&planes, wh, w, runs.lo[l], cells);
+        }
+        if self.inner_w {
+            for q in points {
+                let starts: [usize; W] = core::array::from_fn(|b| runs.start(q.ju, q.jw, b));
+                let mut acc = T::ZERO;
+                for t in 0..W {
+                    let mut acc_w = T::ZERO;
+                    for b in 0..W {
+                        let cell = s.cells.get(starts[b] + t).copied();
+                        acc_w += q.ww[b] * cell.unwrap_or(T::ZERO);
+                    }
+                    acc += q.wu[t] * acc_w;
+                }
+                s.values.push(acc);
+            }
+            return;
         }
         for q in points {
             let mut acc = T::ZERO;

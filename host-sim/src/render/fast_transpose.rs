@@ -7,9 +7,9 @@
 //! contiguous; on rows that run mostly along y each y-line contributes a
 //! run of about `W + 1` cells, so every cell read costs most of a cache
 //! line. The same slice from the exchanged copy, with the slice's axes
-//! exchanged too, reads long runs again. The values are the same numbers;
-//! the strip's sums nest the other way round, so the slice is the same to
-//! within the strip walk's rounding bound.
+//! exchanged too, reads long runs again. The values are the same numbers,
+//! and [`super::fast_strip::extract_exchanged`] nests its sums as on the
+//! original, so the slice is the same bit for bit.
 
 use fvr_core::geometry::SliceAxes;
 use fvr_core::num::Sample;

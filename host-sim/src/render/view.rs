@@ -199,7 +199,9 @@ impl<T: Real> ViewRenderer<T> {
                 (walk == Walk::Strip
                     && (fast_column::extract(&spec, kernel, &axes, tiling, parallel, grid, along)
                         || exchanged.as_ref().is_some_and(|(spec, axes)| {
-                            fast_strip::extract(spec, kernel, axes, tiling, parallel, grid)
+                            fast_strip::extract_exchanged(
+                                spec, kernel, axes, tiling, parallel, grid,
+                            )
                         })
                         || fast_strip::extract(&spec, kernel, &axes, tiling, parallel, grid)))
                     || fast_slice::extract(&spec, kernel, &axes, tiling, parallel, grid)
