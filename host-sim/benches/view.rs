@@ -6,8 +6,8 @@
 //! direction, for the growth per doubling of n.
 //!
 //! Run: `cargo bench -p fvr-host --bench view`. Compare as ratios within
-//! one run. `FVR_BENCH_TILING=B,C` sets the tiling (pairs per band,
-//! columns per tile).
+//! one run. `FVR_BENCH_TILING=B,C[,A]` sets the tiling (pairs per band,
+//! columns per tile, lines prefetched ahead).
 
 use std::hint::black_box;
 
@@ -24,12 +24,9 @@ use half::f16;
 fn tiling() -> Tiling {
     std::env::var("FVR_BENCH_TILING")
         .ok()
-        .and_then(|s| {
-            let (b, c) = s.split_once(',')?;
-            Some(Tiling {
-                band: b.trim().parse().ok()?,
-                chunk: c.trim().parse().ok()?,
-            })
+        .map(|s| {
+            s.parse::<Tiling>()
+                .unwrap_or_else(|e| panic!("FVR_BENCH_TILING: {e}"))
         })
         .unwrap_or_default()
 }

@@ -10,7 +10,7 @@
 //! loaded machine, where wall-clock times of threaded views mean little.
 //!
 //! Run: `cargo bench -p fvr-host --bench view_cpu` (Linux only).
-//! `FVR_BENCH_TILING=B,C` sets the tiling, `FVR_BENCH_VIEWS` the views
+//! `FVR_BENCH_TILING=B,C[,A]` sets the tiling, `FVR_BENCH_VIEWS` the views
 //! per figure (default 40), `FVR_BENCH_N` the volume's side (default 256),
 //! `FVR_BENCH_SIDE` the spectrum's (default `FVR_BENCH_N`; up to twice it,
 //! e.g. 320 for a mixed-radix side, with the filter of σ = 1.25).
@@ -18,6 +18,9 @@
 //! `FVR_BENCH_BRICKS=4x4x4,8x4x4` times the slice alone instead, from the
 //! linear spectrum and from bricked copies of it
 //! (`fvr_host::render::fast_bricks`), alternating, one thread.
+//! `FVR_BENCH_AHEAD=0,8` times whole views instead, on renderers that
+//! prefetch that many lines ahead (`Tiling::ahead`), alternating, one
+//! thread.
 
 use std::hint::black_box;
 
@@ -64,12 +67,9 @@ fn main() {
     }
     let env = |k: &str| std::env::var(k).ok();
     let tiling = env("FVR_BENCH_TILING")
-        .and_then(|s| {
-            let (b, c) = s.split_once(',')?;
-            Some(Tiling {
-                band: b.trim().parse().ok()?,
-                chunk: c.trim().parse().ok()?,
-            })
+        .map(|s| {
+            s.parse::<Tiling>()
+                .unwrap_or_else(|e| panic!("FVR_BENCH_TILING: {e}"))
         })
         .unwrap_or_default();
     let views = env("FVR_BENCH_VIEWS")
@@ -103,6 +103,13 @@ fn main() {
         let spec = OwnedSpectrum::<f16>::prepare_on::<f32>(&volume, filter, side).unwrap();
         if let Some(bricks) = env("FVR_BENCH_BRICKS") {
             slices(&spec, &bricks, tiling, views);
+            continue;
+        }
+        if let Some(aheads) = env("FVR_BENCH_AHEAD") {
+            for (name, dir) in directions(env("FVR_BENCH_DIRS")) {
+                let line = prefetching(&spec, &View::along(dir), &aheads, tiling, views);
+                println!("{kind:?} {name:8} {line}");
+            }
             continue;
         }
         let mut renderer = ViewRenderer::<f32>::new(side, filter)
@@ -169,6 +176,48 @@ fn slice_walks(spec: &OwnedSpectrum<f16>, view: &View, tiling: Tiling, views: us
     let strip = time(&|g| fast_strip::extract(&spec, &kernel, &axes, tiling, false, g));
     let exact = time(&|g| extract(&spec, &kernel, &axes, tiling, false, g));
     format!("column {column}  strip {strip}  exact {exact}")
+}
+
+/// CPU ms per whole view (one thread) on renderers prefetching each
+/// distance in `aheads` (comma-separated), two rounds alternating, the
+/// faster round kept.
+fn prefetching(
+    spec: &OwnedSpectrum<f16>,
+    view: &View,
+    aheads: &str,
+    tiling: Tiling,
+    views: usize,
+) -> String {
+    let n = spec.n();
+    let mut out = vec![0.0f32; n * n];
+    let mut renderers: Vec<(usize, ViewRenderer<f32>, f64)> = aheads
+        .split(',')
+        .map(|a| {
+            let ahead = a
+                .trim()
+                .parse()
+                .unwrap_or_else(|_| panic!("FVR_BENCH_AHEAD: {a:?} is not a whole number"));
+            let renderer = ViewRenderer::<f32>::new(n, spec.filter())
+                .with_threads(1)
+                .with_tiling(Tiling { ahead, ..tiling });
+            (ahead, renderer, f64::INFINITY)
+        })
+        .collect();
+    for _ in 0..2 {
+        for (_, renderer, best) in &mut renderers {
+            let t = per_view(views, || {
+                renderer
+                    .render_into(spec, black_box(view), n, n, &mut out)
+                    .unwrap()
+            });
+            *best = best.min(t);
+        }
+    }
+    renderers
+        .iter()
+        .map(|(ahead, _, t)| format!("ahead {ahead}: {t:6.2}"))
+        .collect::<Vec<_>>()
+        .join("  ")
 }
 
 /// Slice-only CPU ms per view from the linear spectrum and from each

@@ -33,12 +33,9 @@ const DIRECTIONS: [[f64; 3]; 5] = [
 ];
 
 const TILINGS: [Tiling; 3] = [
-    Tiling { band: 1, chunk: 1 },
-    Tiling { band: 3, chunk: 5 },
-    Tiling {
-        band: 1000,
-        chunk: 1000,
-    },
+    Tiling::new(1, 1, 0),
+    Tiling::new(3, 5, 1),
+    Tiling::new(1000, 1000, 1000),
 ];
 
 /// A smooth volume of `dims` (Gaussian blobs, fixed seed), whose spectrum

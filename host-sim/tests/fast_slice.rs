@@ -105,13 +105,10 @@ fn check<S: Sample, T: Real + Send + Sync>(
 }
 
 const TILINGS: [Tiling; 4] = [
-    Tiling { band: 1, chunk: 1 },
-    Tiling { band: 3, chunk: 5 },
-    Tiling { band: 8, chunk: 32 },
-    Tiling {
-        band: 1000,
-        chunk: 1000,
-    },
+    Tiling::new(1, 1, 0),
+    Tiling::new(3, 5, 1),
+    Tiling::new(8, 32, 8),
+    Tiling::new(1000, 1000, 1000),
 ];
 
 #[test]

@@ -471,3 +471,61 @@ fn the_renderer_exchanges_x_and_y_from_the_second_view_along_y() {
     }
     assert_eq!(spec.exchanged_bytes(), spec.bytes());
 }
+
+/// A walk with its tiling and threading chosen.
+type Walker<'a> = dyn Fn(Tiling, bool, &mut [f32]) -> bool + 'a;
+
+/// Prefetching is a hint: the strip, exchanged and column walks give the
+/// same bits however far ahead they prefetch, past the last line too, on
+/// one thread and several, on a power-of-two and a mixed-radix side.
+#[test]
+fn prefetching_leaves_every_value_unchanged() {
+    let volume = noise_volume([32, 32, 32], 13);
+    for (grid, n) in [(GridOversampling::X1, 32), (GridOversampling::X1_25, 40)] {
+        let filter = Filter::for_grid(FilterKind::Kb4, grid).unwrap();
+        let spec = OwnedSpectrum::<f16>::prepare_on::<f32>(&volume, filter, n).unwrap();
+        let view = spec.view();
+        let swapped_data = exchange_xy(view.data(), n).unwrap();
+        let [a, b, c] = view.dims();
+        let swapped =
+            Spectrum::from_parts(&swapped_data, n, view.scale(), filter, [b, a, c]).unwrap();
+        let kernel = KernelTable::<f32>::new(filter);
+        let strip = Sampling::UNIT.slice_axes(&View::along([1.0, 0.3, 0.2]).frame().unwrap());
+        let column = Sampling::UNIT.slice_axes(&View::along([1.0, -0.3, 0.0]).frame().unwrap());
+        let walks: [(&str, &Walker); 3] = [
+            ("strip", &|t, p, g| {
+                fast_strip::extract(&view, &kernel, &strip, t, p, g)
+            }),
+            ("exchanged", &|t, p, g| {
+                fast_strip::extract_exchanged(&swapped, &kernel, &exchanged(&strip), t, p, g)
+            }),
+            ("column", &|t, p, g| {
+                fast_column::extract(&view, &kernel, &column, t, p, g, &mut Vec::new())
+            }),
+        ];
+        for (what, walk) in walks {
+            let run = |ahead: usize, parallel: bool| {
+                let tiling = Tiling {
+                    ahead,
+                    ..Tiling::default()
+                };
+                let mut grid = vec![7.0f32; n * n];
+                assert!(walk(tiling, parallel, &mut grid), "{what} n {n}");
+                grid
+            };
+            let plain = run(0, false);
+            assert!(plain.iter().any(|&v| v != 0.0 && v != 7.0), "{what} n {n}");
+            for ahead in [1, 3, 8, 1000] {
+                for parallel in [false, true] {
+                    let got = run(ahead, parallel);
+                    assert!(
+                        got.iter()
+                            .zip(&plain)
+                            .all(|(a, b)| a.to_bits() == b.to_bits()),
+                        "{what} n {n}, ahead {ahead}, parallel {parallel}"
+                    );
+                }
+            }
+        }
+    }
+}

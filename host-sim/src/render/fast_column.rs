@@ -39,6 +39,7 @@ use fvr_core::num::{Real, Sample};
 use fvr_core::spectrum::Spectrum;
 use rayon::prelude::*;
 
+use super::fast_prefetch::prefetch;
 use super::fast_runs::{axes_and_strides, wrap, Runs};
 use super::fast_slice::{row_setup, supports, Geometry, Tiling};
 
@@ -134,6 +135,8 @@ struct Line<'a, const W: usize, S, T> {
     /// Fixed-point position of column 0 and step per column on `u`, `w`.
     origin: [i64; 2],
     step: [i64; 2],
+    /// Lines prefetched ahead ([`Tiling::ahead`]).
+    ahead: usize,
 }
 
 /// The signed frequency of grid column `c` (`c` for `c ≤ (n − 1)/2`, else
@@ -230,6 +233,7 @@ fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
         phases: &phases,
         origin,
         step: [u, w].map(|b| PhaseTable::<T, W>::fixed_step(g.right[b])),
+        ahead: g.tiling.ahead,
     };
     let columns = line.columns();
     // Pass 1: `L(k, z)` for every column (and its mirrored taps where
@@ -356,9 +360,25 @@ impl<const W: usize, S: Sample, T: Real> Line<'_, W, S, T> {
         }
         s.cells.clear();
         s.cells.resize(runs.total(), [T::ZERO; LANES]);
+        let [sa, su, sw] = self.strides;
+        let lines = runs.lines();
         for z0 in (0..n).step_by(LANES) {
             let m = LANES.min(n - z0);
-            for l in 0..runs.lines() {
+            for l in 0..lines {
+                // The line `ahead` further on, in this group of planes or
+                // the next.
+                let (la, za) = match l + self.ahead {
+                    la if la < lines => (la, z0),
+                    la => (la - lines, z0 + LANES),
+                };
+                if self.ahead > 0 && za < n {
+                    if let Some((first, last)) = runs.ends(n, su, sw, la) {
+                        for plane in (za..n.min(za + LANES)).map(|z| z * sa) {
+                            prefetch(self.data, plane + first);
+                            prefetch(self.data, plane + last);
+                        }
+                    }
+                }
                 let w = wrap(n, runs.w_min as i64 + l as i64);
                 let cells = &mut s.cells[runs.off[l]..runs.off[l + 1]];
                 self.widen(z0, m, w, runs.lo[l], cells);

@@ -82,6 +82,22 @@ impl Runs {
         self.off.last().copied().unwrap_or(0)
     }
 
+    /// The first and last cell of line `l`'s run in the plane at offset 0
+    /// of a cube of side `n` with `u` and `w` strides `su` and `sw`
+    /// (indices wrapped), or `None` past the last line or on a line no
+    /// window reaches.
+    pub(super) fn ends(&self, n: usize, su: usize, sw: usize, l: usize) -> Option<(usize, usize)> {
+        let (lo, hi) = (*self.lo.get(l)?, *self.hi.get(l)?);
+        if hi < lo {
+            return None;
+        }
+        let line = wrap(n, self.w_min as i64 + l as i64) * sw;
+        Some((
+            line + wrap(n, lo as i64) * su,
+            line + wrap(n, hi as i64) * su,
+        ))
+    }
+
     /// Where row `b` of the window at `(ju, jw)` starts in the buffer.
     #[inline(always)]
     pub(super) fn start(&self, ju: i32, jw: i32, b: usize) -> usize {

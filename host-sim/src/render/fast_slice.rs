@@ -37,19 +37,59 @@ use rayon::prelude::*;
 use super::fast_bricks::Bricked;
 
 /// How the host extraction walks the slice: `band` mirror pairs per unit
-/// of work, `chunk` columns per tile.
+/// of work, `chunk` columns per tile, and how far ahead the strip and
+/// column walks prefetch.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Tiling {
     /// Mirror pairs (rows `p` and `−p`) per unit of work (≥ 1).
     pub band: usize,
     /// Columns per tile inside a band (≥ 1).
     pub chunk: usize,
+    /// Lines of cells the strip and column walks prefetch ahead of the one
+    /// they reduce (0: none; [`super::fast_prefetch`]).
+    pub ahead: usize,
+}
+
+impl Tiling {
+    /// `band` pairs by `chunk` columns, prefetching `ahead` lines.
+    pub const fn new(band: usize, chunk: usize, ahead: usize) -> Self {
+        Self { band, chunk, ahead }
+    }
 }
 
 impl Default for Tiling {
-    /// 8 pairs by 32 columns (`cargo bench -p fvr-host --bench view`).
+    /// 8 pairs by 32 columns (`cargo bench -p fvr-host --bench view`),
+    /// prefetching 8 lines ahead (`cargo bench -p fvr-host --bench
+    /// view_cpu`, side 512).
     fn default() -> Self {
-        Self { band: 8, chunk: 32 }
+        Self::new(8, 32, 8)
+    }
+}
+
+impl core::str::FromStr for Tiling {
+    type Err = String;
+
+    /// `band,chunk` or `band,chunk,ahead` (the benches' `FVR_BENCH_TILING`);
+    /// `ahead` defaults to [`Tiling::default`]'s.
+    fn from_str(s: &str) -> Result<Self, String> {
+        let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+        let number = |i: usize| -> Result<usize, String> {
+            parts[i]
+                .parse()
+                .map_err(|_| format!("tiling {s:?}: {:?} is not a whole number", parts[i]))
+        };
+        match parts.len() {
+            2 | 3 => Ok(Self {
+                band: number(0)?,
+                chunk: number(1)?,
+                ahead: if parts.len() == 3 {
+                    number(2)?
+                } else {
+                    Self::default().ahead
+                },
+            }),
+            _ => Err(format!("tiling {s:?}: give band,chunk or band,chunk,ahead")),
+        }
     }
 }
 
@@ -229,6 +269,7 @@ impl<T: Real> Geometry<T> {
             tiling: Tiling {
                 band: tiling.band.max(1),
                 chunk: tiling.chunk.max(1),
+                ahead: tiling.ahead,
             },
             parallel,
         }

@@ -36,6 +36,7 @@ use fvr_core::num::{Real, Sample};
 use fvr_core::spectrum::Spectrum;
 use rayon::prelude::*;
 
+use super::fast_prefetch::prefetch;
 use super::fast_runs::{axes_and_strides, wrap, Runs};
 use super::fast_slice::{bands_of_pairs, set_up_pair, supports, Geometry, Pair, Tiling};
 
@@ -154,6 +155,8 @@ struct Strip<'a, const W: usize, S, T> {
     step: [i64; 3],
     /// The interpolation's inner sum over `w` instead of `u`.
     inner_w: bool,
+    /// Lines prefetched ahead ([`Tiling::ahead`]).
+    ahead: usize,
 }
 
 #[inline(never)]
@@ -180,6 +183,7 @@ fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
         raw_gain: T::exp2i(T::raw_exponent::<S>()),
         step: g.right.map(PhaseTable::<T, W>::fixed_step),
         inner_w,
+        ahead: g.tiling.ahead,
     };
     let mut bands = bands_of_pairs(grid, n, g.tiling.band);
     let fill = |band: &mut Vec<Pair<'_, T>>| {
@@ -285,7 +289,16 @@ impl<const W: usize, S: Sample, T: Real> Strip<'_, W, S, T> {
         s.cells.resize(runs.total(), T::ZERO);
         let planes: [usize; W] =
             core::array::from_fn(|c| wrap(self.n, jh as i64 + c as i64) * self.strides[0]);
+        let [_, su, sw] = self.strides;
         for l in 0..runs.lines() {
+            if self.ahead > 0 {
+                if let Some((first, last)) = runs.ends(self.n, su, sw, l + self.ahead) {
+                    for &plane in &planes {
+                        prefetch(self.data, plane + first);
+                        prefetch(self.data, plane + last);
+                    }
+                }
+            }
             let w = wrap(self.n, runs.w_min as i64 + l as i64);
             let cells = &mut s.cells[runs.off[l]..runs.off[l + 1]];
             self.reduce(&planes, wh, w, runs.lo[l], cells);

@@ -10,6 +10,7 @@ pub mod fast_dht;
 pub mod fast_inverse;
 pub mod fast_marks;
 pub mod fast_mixed;
+mod fast_prefetch;
 pub mod fast_prepare;
 mod fast_runs;
 pub mod fast_slice;
