@@ -4,7 +4,8 @@
 //! (`fvr_host::render::fast_column` where the slice contains an axis,
 //! `fvr_host::render::fast_strip` where its rows hold a coordinate, the
 //! exact walk `fvr_host::render::fast_slice` beside it; and each walk's
-//! slice alone) against the core's render, at 256³
+//! slice alone, the strip walk also on the exchanged copy for rows along y)
+//! against the core's render, at 256³
 //! f16, kb4 and kb6, along an axis, an oblique direction and the orbit
 //! direction at 45°. A companion of the `view` criterion bench for a
 //! loaded machine, where wall-clock times of threaded views mean little.
@@ -30,6 +31,7 @@ use fvr_core::render::Request;
 use fvr_core::volume::GridOversampling;
 use fvr_host::render::fast_bricks::Bricked;
 use fvr_host::render::fast_slice::{extract, extract_bricked, Tiling};
+use fvr_host::render::fast_transpose::{exchanged, rows_along_y};
 use fvr_host::render::spectrum::{OwnedSpectrum, ViewRenderer};
 use fvr_host::render::view::{render_once, Walk};
 use fvr_host::render::{fast_column, fast_strip};
@@ -153,6 +155,7 @@ fn slice_walks(spec: &OwnedSpectrum<f16>, view: &View, tiling: Tiling, views: us
     let kernel = KernelTable::<f32>::new(spec.filter());
     let axes = Sampling::UNIT.slice_axes(&view.frame().unwrap());
     let mut grid = vec![0.0f32; n * n];
+    let owned = spec;
     let spec = spec.view();
     let mut time = |walk: &dyn Fn(&mut [f32]) -> bool| {
         if walk(&mut grid) {
@@ -174,8 +177,16 @@ fn slice_walks(spec: &OwnedSpectrum<f16>, view: &View, tiling: Tiling, views: us
         )
     });
     let strip = time(&|g| fast_strip::extract(&spec, &kernel, &axes, tiling, false, g));
+    // Built before the timing, on all cores, where the memory limit holds it.
+    let swapped = owned.exchanged_xy().filter(|_| rows_along_y(&axes));
+    let swapped_axes = exchanged(&axes);
+    let exchanged = time(&|g| {
+        swapped.as_ref().is_some_and(|s| {
+            fast_strip::extract_exchanged(s, &kernel, &swapped_axes, tiling, false, g)
+        })
+    });
     let exact = time(&|g| extract(&spec, &kernel, &axes, tiling, false, g));
-    format!("column {column}  strip {strip}  exact {exact}")
+    format!("column {column}  strip {strip}  exchanged {exchanged}  exact {exact}")
 }
 
 /// CPU ms per whole view (one thread) on renderers prefetching each
