@@ -4,7 +4,10 @@
 //! 40 dB: with the exact bound the 1³ filter (`adaptive_40db_nearest`), the
 //! zero filter (`adaptive_40db_zero`) and both (`adaptive_40db_zero_nearest`);
 //! the zero filter with Parseval's bound (`adaptive_40db_zero_parseval`,
-//! `fvr render --adaptive`'s default):
+//! `fvr render --adaptive`'s default), also with the large filter's points
+//! summed point by point in the core's arithmetic
+//! (`adaptive_40db_zero_parseval_exact`, [`Walk::Exact`]) instead of by the
+//! strip walk:
 //!
 //! - `adaptive_kb3_os2_128`: kb3, oversampling 2, on a 128³ Gaussian
 //!   mixture (f16);
@@ -33,6 +36,7 @@ use fvr_core::geometry::View;
 use fvr_host::render::adaptive::{AdaptiveMarks, AdaptiveSettings, Bound, Cheaper};
 use fvr_host::render::adaptive_view::AdaptiveRenderer;
 use fvr_host::render::spectrum::{OwnedSpectrum, ViewRenderer};
+use fvr_host::render::view::Walk;
 use fvr_host::sources::phantom::{sample, GaussianMixture};
 use fvr_host::volume::Volume;
 use half::f16;
@@ -96,6 +100,18 @@ fn group(c: &mut Criterion, name: &str, volume: &Volume, filter: Filter) {
                     .unwrap()
             })
         });
+        if label == "zero_parseval" {
+            let mut exact = AdaptiveRenderer::<f32>::new(&marks, &spec)
+                .unwrap()
+                .with_walk(Walk::Exact);
+            group.bench_function(format!("adaptive_40db_{label}_exact"), |b| {
+                b.iter(|| {
+                    exact
+                        .render_into(&spec, black_box(&view), side, side, &mut out)
+                        .unwrap()
+                })
+            });
+        }
     }
     let mut core = AdaptiveRenderer::<f32>::new(&marks, &spec)
         .unwrap()

@@ -5,7 +5,10 @@
 //! axis-aligned, oblique and near-axis directions, volumes that are not
 //! cubes inside their power-of-two grid, oversampling 2, and every tiling
 //! and thread split; and the adaptive renderer's image against the core's
-//! extraction followed by the core's finish.
+//! extraction followed by the core's finish. With the large filter's
+//! points left to the strip walk (`extract_with_strip`, the renderer's
+//! default): those points the strip walk's bits, every other point and
+//! the statistics the core's.
 
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
@@ -15,10 +18,12 @@ use fvr_core::num::{Real, Sample};
 use fvr_core::slice::adaptive::{extract_slice_adaptive, AdaptiveStats};
 use fvr_host::render::adaptive::{AdaptiveMarks, AdaptiveSettings, Bound, Cheaper};
 use fvr_host::render::adaptive_view::AdaptiveRenderer;
-use fvr_host::render::fast_adaptive::extract;
+use fvr_host::render::fast_adaptive::{extract, extract_with_strip};
 use fvr_host::render::fast_slice::Tiling;
+use fvr_host::render::fast_strip;
 use fvr_host::render::marks_summary::MarksSummary;
 use fvr_host::render::spectrum::OwnedSpectrum;
+use fvr_host::render::view::Walk;
 use fvr_host::sources::phantom::{sample, GaussianMixture};
 use fvr_host::volume::Volume;
 use half::f16;
@@ -319,7 +324,8 @@ fn renderer_image_equals_core_extraction() {
     for parallel in [false, true] {
         let mut renderer = AdaptiveRenderer::<f32>::new(&marks, &spec)
             .unwrap()
-            .with_parallel(parallel);
+            .with_parallel(parallel)
+            .with_walk(Walk::Exact);
         for dir in DIRECTIONS {
             let view = View::along(dir);
             let frame = view.frame().unwrap();
@@ -348,4 +354,180 @@ fn renderer_image_equals_core_extraction() {
     let tiling = Tiling::default();
     let whole = marks.summary();
     assert!(extract(&view_spec, &other, &levels, whole, &frame, tiling, true, &mut grid).is_none());
+}
+
+/// The slice [`extract_with_strip`] should give: the core's adaptive
+/// slice where `strip_point` says the point is not on the large filter,
+/// else the plain strip walk's value.
+fn merged(core: &[f32], plain: &[f32], strip_point: impl Fn(usize) -> bool) -> Vec<f32> {
+    (0..core.len())
+        .map(|i| if strip_point(i) { plain[i] } else { core[i] })
+        .collect()
+}
+
+/// With a zero first level, the points on the large filter are exactly
+/// the core's nonzero ones: there [`extract_with_strip`] gives the plain
+/// strip walk's bits, elsewhere `+0`, with the core's statistics, for every
+/// tiling and thread split; with a nearest level after the zero one, each
+/// point is the core's or the strip walk's, the strip walk's on at most
+/// the large filter's share. The renderer's default image is that slice
+/// through the core's finish, bit for bit.
+#[test]
+fn strip_walk_sums_the_large_filters_points_and_nothing_else() {
+    let spec = smooth_kb6_64();
+    let view_spec = spec.view();
+    let n = spec.n();
+    let kernel = KernelTable::<f32>::new(*view_spec.filter());
+    let chains: [(&[Cheaper], Bound); 3] = [
+        (&[Cheaper::Zero], Bound::Parseval),
+        (&[Cheaper::Zero], Bound::Exact),
+        (
+            &[Cheaper::Zero, Cheaper::Filter(FilterKind::Nearest)],
+            Bound::Exact,
+        ),
+    ];
+    let mut tw_buf = vec![0f32; Twiddles::<f32>::buffer_len(n)];
+    let tw = Twiddles::new(&mut tw_buf, n).unwrap();
+    for (chain, bound) in chains {
+        let settings = AdaptiveSettings {
+            plain_below: 0.0,
+            chain: chain.to_vec(),
+            bound,
+            ..AdaptiveSettings::new(40.0)
+        };
+        let marks = AdaptiveMarks::build(&spec, &settings).unwrap();
+        let tables = marks.tables::<f32>();
+        let levels = marks.core_levels(&tables).unwrap();
+        let mut renderer = AdaptiveRenderer::<f32>::new(&marks, &spec).unwrap();
+        for dir in DIRECTIONS {
+            let what = format!("{chain:?} {bound:?} {dir:?}");
+            let view = View::along(dir);
+            let frame = view.frame().unwrap();
+            let axes = frame.slice_axes();
+            let mut core = vec![0f32; n * n];
+            let core_stats =
+                extract_slice_adaptive(&view_spec, &kernel, &levels, &frame, &mut core).unwrap();
+            let mut plain = vec![0f32; n * n];
+            let tiling = Tiling::default();
+            assert!(fast_strip::extract(
+                &view_spec, &kernel, &axes, tiling, true, &mut plain
+            ));
+            let large = core_stats.per_filter[0] as usize;
+            assert!(
+                large > 0 && large < core_stats.samples as usize / 4,
+                "{what}: {core_stats:?}"
+            );
+            let expected = match chain.len() {
+                1 => {
+                    let nonzero = core.iter().filter(|v| v.to_bits() != 0).count();
+                    assert_eq!(nonzero, large, "{what}: a large-filter point is +0");
+                    merged(&core, &plain, |i| core[i].to_bits() != 0)
+                }
+                _ => Vec::new(),
+            };
+            for tiling in TILINGS {
+                for parallel in [false, true] {
+                    // Garbage first: every point must be written.
+                    let mut host = vec![7f32; n * n];
+                    let mut strong = vec![-3f32; n * n];
+                    let whole = marks.summary();
+                    let stats = extract_with_strip(
+                        &view_spec,
+                        &kernel,
+                        &levels,
+                        whole,
+                        &frame,
+                        tiling,
+                        parallel,
+                        &mut host,
+                        &mut strong,
+                    )
+                    .unwrap();
+                    let at = format!("{what}, {tiling:?}, parallel {parallel}");
+                    assert_eq!(stats, core_stats, "{at}");
+                    if !expected.is_empty() {
+                        for (i, (a, b)) in expected.iter().zip(&host).enumerate() {
+                            assert_eq!(a.to_bits(), b.to_bits(), "{at}, point {i}");
+                        }
+                        continue;
+                    }
+                    let mut from_strip = 0;
+                    for i in 0..n * n {
+                        let h = host[i].to_bits();
+                        assert!(
+                            h == core[i].to_bits() || h == plain[i].to_bits(),
+                            "{at}, {i}"
+                        );
+                        from_strip += usize::from(h != core[i].to_bits());
+                    }
+                    assert!(from_strip > 0 && from_strip <= large, "{at}: {from_strip}");
+                }
+            }
+            if expected.is_empty() {
+                continue;
+            }
+            let (width, height) = (48, 40);
+            let mut image = vec![0f32; width * height];
+            let mut grid = expected.clone();
+            let mut aux = vec![0f32; aux_len(n)];
+            let place = placement(view_spec.dims(), &frame, width, height);
+            let crop = Crop::new(place, 1.0 / view_spec.scale(), width, height);
+            finish(&mut grid, n, &crop, &tw, &mut aux, &mut image).unwrap();
+            let mut out = vec![0f32; width * height];
+            let stats = renderer
+                .render_into(&spec, &view, width, height, &mut out)
+                .unwrap();
+            assert_eq!(stats, core_stats, "{what}");
+            for (a, b) in image.iter().zip(&out) {
+                assert_eq!(a.to_bits(), b.to_bits(), "{what}: renderer");
+            }
+        }
+    }
+}
+
+/// Where the slice's rows hold no coordinate (an up hint off the axes),
+/// the strip walk does not serve, and [`extract_with_strip`] is
+/// [`extract`]: the core's slice bit for bit.
+#[test]
+fn without_a_held_axis_the_strip_extraction_is_the_cores() {
+    let spec = smooth_kb6_64();
+    let view_spec = spec.view();
+    let n = spec.n();
+    let kernel = KernelTable::<f32>::new(*view_spec.filter());
+    let settings = AdaptiveSettings {
+        plain_below: 0.0,
+        ..AdaptiveSettings::new(40.0)
+    };
+    let marks = AdaptiveMarks::build(&spec, &settings).unwrap();
+    let tables = marks.tables::<f32>();
+    let levels = marks.core_levels(&tables).unwrap();
+    let view = View {
+        dir: [1.0, 0.3, 0.2],
+        up: [0.2, 0.5, 1.0],
+    };
+    let frame = view.frame().unwrap();
+    assert!(frame.right.iter().all(|&c| c != 0.0), "{frame:?}");
+    let mut core = vec![0f32; n * n];
+    let core_stats =
+        extract_slice_adaptive(&view_spec, &kernel, &levels, &frame, &mut core).unwrap();
+    assert!(core_stats.per_filter[0] > 0, "{core_stats:?}");
+    let mut host = vec![7f32; n * n];
+    let mut strong = vec![0f32; n * n];
+    let (whole, tiling) = (marks.summary(), Tiling::default());
+    let stats = extract_with_strip(
+        &view_spec,
+        &kernel,
+        &levels,
+        whole,
+        &frame,
+        tiling,
+        true,
+        &mut host,
+        &mut strong,
+    )
+    .unwrap();
+    assert_eq!(stats, core_stats);
+    for (a, b) in core.iter().zip(&host) {
+        assert_eq!(a.to_bits(), b.to_bits());
+    }
 }

@@ -15,17 +15,15 @@
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::KernelTable;
 use fvr_core::geometry::{Sampling, View};
-use fvr_core::image::{
-    aux_len, check_image, finish, grid_len, placement, placement_on_axes, Crop, Inverse,
-};
+use fvr_core::image::{aux_len, check_image, finish, placement, placement_on_axes, Crop};
 use fvr_core::num::{Real, Sample};
 use fvr_core::slice::adaptive::{extract_slice_adaptive, AdaptiveLevel, AdaptiveStats};
 
 use super::adaptive::AdaptiveMarks;
 use super::fast_adaptive;
-use super::fast_inverse::finish_threaded;
 use super::fast_slice::{self, Tiling};
 use super::spectrum::OwnedSpectrum;
+use super::view::Walk;
 use super::{fast_column, fast_strip};
 
 /// Reusable per-view buffers and tables for adaptive views of one
@@ -38,10 +36,13 @@ pub struct AdaptiveRenderer<'m, T> {
     tw: Vec<T>,
     grid: Vec<T>,
     aux: Vec<T>,
-    /// The transposed grid of the threaded finish.
-    trans: Vec<T>,
     /// The column walk's sums between its passes.
     along: Vec<T>,
+    /// The strip walk's values of the large filter's points
+    /// ([`fast_adaptive::extract_with_strip`]), allocated at the first
+    /// view that takes it.
+    strong: Vec<T>,
+    walk: Walk,
     parallel: bool,
     core: bool,
     tiling: Tiling,
@@ -82,8 +83,9 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
             tw,
             grid: vec![T::ZERO; n * n],
             aux: vec![T::ZERO; aux_len(n)],
-            trans: vec![T::ZERO; grid_len(n)],
             along: Vec::new(),
+            strong: Vec::new(),
+            walk: Walk::default(),
             parallel: true,
             core: false,
             tiling: Tiling::default(),
@@ -96,6 +98,17 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
     /// way.
     pub fn with_parallel(mut self, parallel: bool) -> Self {
         self.parallel = parallel;
+        self
+    }
+
+    /// Sum the points on the large filter by the plain strip walk
+    /// ([`Walk::Strip`], the default, where the slice's rows hold a
+    /// coordinate: its values, within rounding of the core's) or point by
+    /// point in the core's arithmetic ([`Walk::Exact`]: the core's image
+    /// bit for bit). The points on the cheaper filters are the core's bit
+    /// for bit either way.
+    pub fn with_walk(mut self, walk: Walk) -> Self {
+        self.walk = walk;
         self
     }
 
@@ -164,18 +177,34 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
                 });
             }
         }
-        let host = match self.core {
-            true => None,
-            false => fast_adaptive::extract(
+        let whole = self.marks.summary();
+        let (kernel, tiling, parallel) = (&self.kernel, self.tiling, self.parallel);
+        let host = match (self.core, self.walk) {
+            (true, _) => None,
+            (false, Walk::Exact) => fast_adaptive::extract(
                 &core_spec,
-                &self.kernel,
+                kernel,
                 &levels,
-                self.marks.summary(),
+                whole,
                 &frame,
-                self.tiling,
-                self.parallel,
+                tiling,
+                parallel,
                 &mut self.grid,
             ),
+            (false, Walk::Strip) => {
+                self.strong.resize(n * n, T::ZERO);
+                fast_adaptive::extract_with_strip(
+                    &core_spec,
+                    kernel,
+                    &levels,
+                    whole,
+                    &frame,
+                    tiling,
+                    parallel,
+                    &mut self.grid,
+                    &mut self.strong,
+                )
+            }
         };
         let stats = match host {
             Some(stats) => stats,
@@ -210,17 +239,12 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
         ((cheap as f64) < below * stats.samples as f64).then_some(stats)
     }
 
-    /// Shift, inverse-transform and crop the slice into `out`.
+    /// Shift, inverse-transform and crop the slice into `out`, on this
+    /// thread: at side 256 the core's finish took 0.25–0.45 ms and the
+    /// threaded one ([`super::fast_inverse::finish_threaded`]) 0.5–0.8 ms
+    /// on the two cores of the machine that measured it.
     fn finish(&mut self, n: usize, crop: &Crop, out: &mut [T]) -> Result<(), fvr_core::Error> {
         let tw = Twiddles::from_table(&self.tw, n)?;
-        // At a few % of the taps the view is bound by its finish as much
-        // as by the walk: the 2D inverse on the threads too when the walk
-        // is (`fast_inverse`, the core's image bit for bit).
-        if self.parallel && !self.core {
-            let inverse = Inverse::Radix2(&tw);
-            finish_threaded(&mut self.grid, n, crop, inverse, &mut self.trans, out)
-        } else {
-            finish(&mut self.grid, n, crop, &tw, &mut self.aux, out)
-        }
+        finish(&mut self.grid, n, crop, &tw, &mut self.aux, out)
     }
 }

@@ -35,6 +35,7 @@ use fvr_core::spectrum::Spectrum;
 use rayon::prelude::*;
 
 use super::fast_slice::{row_interval, supports, tap_sum, Tiling};
+use super::fast_strip;
 use super::marks_summary::{MarksSummary, BRICK};
 
 /// One filter of the chain as the walk applies it.
@@ -81,15 +82,23 @@ struct Walk<'a, S, T> {
     inverse_step: [T; 3],
     raw_gain: T,
     chunk: i32,
+    /// Points on the large filter are left at zero for the strip walk
+    /// ([`extract_with_strip`]), their columns noted in [`Row::strong`].
+    defer: bool,
 }
 
 /// One row of the slice: its points, `ky·u` for its signed frequency `ky`,
 /// and the interval of `kx` walked.
 struct Row<'g, T> {
     cells: &'g mut [T],
+    /// The row's index in the grid.
+    index: usize,
     kyu: [T; 3],
     low: i32,
     high: i32,
+    /// The least and greatest `kx` of the points left to the strip walk
+    /// ([`Walk::defer`]); empty (`low > high`) when there are none.
+    strong: (i32, i32),
 }
 
 /// Fill the `n × n` slice `grid` (`kx` fastest, natural DHT order) as
@@ -121,7 +130,7 @@ pub fn extract<S: Sample, T: Real>(
     let walk = Walk::new(spec, kernel, levels, whole, frame, tiling)?;
     let up = frame.up.map(T::from_f64);
     let bands = walk.bands(grid, up, tiling.band.max(1));
-    let fill = |band: Vec<Row<'_, T>>| walk.fill_band(band);
+    let fill = |mut band: Vec<Row<'_, T>>| walk.fill_band(&mut band);
     let stats = if parallel {
         bands
             .into_par_iter()
@@ -133,6 +142,86 @@ pub fn extract<S: Sample, T: Real>(
             .map(fill)
             .fold(AdaptiveStats::default(), merged)
     };
+    Some(stats)
+}
+
+/// [`extract`] with the points on the large filter summed by the plain
+/// strip walk ([`fast_strip::extract_within`], its row intervals, phase
+/// tables and fixed-point stepping) over the intervals of each row that
+/// hold them, into `strong` (`n²` values of scratch), where the slice's
+/// rows hold a coordinate ([`fast_strip::held_axis`]); elsewhere as
+/// [`extract`]. The statistics and every point on a cheaper filter are
+/// [`extract`]'s bit for bit; each point on the large filter is the plain
+/// strip walk's value there, bit for bit, which is the core's to within
+/// the strip's rounding bound (`host-sim/tests/fast_adaptive.rs`).
+#[allow(clippy::too_many_arguments)]
+pub fn extract_with_strip<S: Sample, T: Real + Send + Sync>(
+    spec: &Spectrum<'_, S>,
+    kernel: &KernelTable<T>,
+    levels: &[AdaptiveLevel<'_, '_, T>],
+    whole: Option<&MarksSummary>,
+    frame: &Frame,
+    tiling: Tiling,
+    parallel: bool,
+    grid: &mut [T],
+    strong: &mut [T],
+) -> Option<AdaptiveStats> {
+    let n = spec.n();
+    let axes = frame.slice_axes();
+    if grid.len() != n * n || strong.len() != n * n || fast_strip::held_axis(&axes).is_none() {
+        return extract(spec, kernel, levels, whole, frame, tiling, parallel, grid);
+    }
+    let mut walk = Walk::new(spec, kernel, levels, whole, frame, tiling)?;
+    walk.defer = true;
+    let up = frame.up.map(T::from_f64);
+    let mut bands = walk.bands(grid, up, tiling.band.max(1));
+    let fill = |band: &mut Vec<Row<'_, T>>| walk.fill_band(band);
+    let stats = match parallel {
+        true => bands
+            .par_iter_mut()
+            .map(fill)
+            .reduce(AdaptiveStats::default, merged),
+        false => bands
+            .iter_mut()
+            .map(fill)
+            .fold(AdaptiveStats::default(), merged),
+    };
+    // Pair `p` walks row `p` at `kx = k` and row `−p` at `kx = −k`.
+    let mut within = vec![(1, 0); n / 2 + 1];
+    for row in bands.iter().flatten() {
+        let (low, high) = row.strong;
+        if low > high {
+            continue;
+        }
+        let ky = signed(row.index, n);
+        let (p, from, to) = match ky >= 0 {
+            true => (ky as usize, low, high),
+            false => (ky.unsigned_abs() as usize, -high, -low),
+        };
+        let w = &mut within[p];
+        *w = match w.0 <= w.1 {
+            true => (w.0.min(from), w.1.max(to)),
+            false => (from, to),
+        };
+    }
+    // Row 0 holds its own mirrors: `kx < 0` are pair 0's `k > 0`.
+    if let Some(w) = within.first_mut().filter(|w| w.0 <= w.1) {
+        *w = (w.0.min(-w.1), w.1.max(-w.0));
+    }
+    if !fast_strip::extract_within(spec, kernel, &axes, tiling, parallel, strong, &within) {
+        return extract(spec, kernel, levels, whole, frame, tiling, parallel, grid);
+    }
+    let strong = &*strong;
+    let copy = |band: &mut Vec<Row<'_, T>>| {
+        for row in band.iter_mut() {
+            let at = row.index * n;
+            walk.copy_strong(row, &strong[at..at + n]);
+        }
+    };
+    match parallel {
+        true => bands.par_iter_mut().for_each(copy),
+        false => bands.iter_mut().for_each(copy),
+    }
     Some(stats)
 }
 
@@ -154,7 +243,7 @@ pub fn tally<S: Sample, T: Real>(
     let count = |p: usize| {
         let mut stats = AdaptiveStats::default();
         let ky = signed(p, n);
-        let mut row = walk.row(&mut [], up, ky);
+        let mut row = walk.row(&mut [], p, up, ky);
         let (low, high) = (row.low, row.high);
         walk.fill_row(&mut row, low, high, &mut stats);
         stats
@@ -242,6 +331,7 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
             inverse_step: frame.right.map(|r| T::from_f64(1.0 / r.abs())),
             raw_gain: T::exp2i(T::raw_exponent::<S>()),
             chunk: tiling.chunk.clamp(1, n) as i32,
+            defer: false,
         })
     }
 
@@ -252,7 +342,7 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
         let mask = n - 1;
         let k_max = ((n - 1) / 2) as i32;
         let mut rows: Vec<Option<&'g mut [T]>> = grid.chunks_exact_mut(n).map(Some).collect();
-        let mut row = |index: usize, ky: i32| Some(self.row(rows[index].take()?, up, ky));
+        let mut row = |index: usize, ky: i32| Some(self.row(rows[index].take()?, index, up, ky));
         let mut bands = Vec::new();
         for first in (0..=n / 2).step_by(band) {
             let mut rows = Vec::with_capacity(2 * band);
@@ -269,20 +359,23 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
         bands
     }
 
-    /// The row of signed frequency `ky` over `cells`.
-    fn row<'g>(&self, cells: &'g mut [T], up: [T; 3], ky: i32) -> Row<'g, T> {
+    /// The row of signed frequency `ky` over `cells`, row `index` of the
+    /// grid.
+    fn row<'g>(&self, cells: &'g mut [T], index: usize, up: [T; 3], ky: i32) -> Row<'g, T> {
         let (kyu, low, high) = walked(self.n, &self.right, up, ky);
         Row {
             cells,
+            index,
             kyu,
             low,
             high,
+            strong: (1, 0),
         }
     }
 
     /// Zero one band's rows, then fill their points inside the cube tile by
     /// tile; its statistics.
-    fn fill_band(&self, mut band: Vec<Row<'_, T>>) -> AdaptiveStats {
+    fn fill_band(&self, band: &mut [Row<'_, T>]) -> AdaptiveStats {
         let mut stats = AdaptiveStats::default();
         let (mut first, mut last) = (i32::MAX, i32::MIN);
         for row in band.iter_mut() {
@@ -388,6 +481,44 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
         stats.per_filter[1] += count;
     }
 
+    /// The chain's slot of the point at `q` (0 the large filter, `i + 1`
+    /// level `i`): the first level whose marks hold its nearest sample, as
+    /// the core finds it; `None` outside the cube of half-side `nyquist`.
+    #[inline(always)]
+    fn slot(&self, q: [T; 3], nyquist: T) -> Option<usize> {
+        if q.iter().any(|&c| c > nyquist || -c > nyquist) {
+            return None;
+        }
+        let (n, mask) = (self.n, self.n - 1);
+        let nearest: [usize; 3] =
+            core::array::from_fn(|a| (q[a] + T::HALF).floor_i64() as usize & mask);
+        let index = nearest[0] + n * (nearest[1] + n * nearest[2]);
+        Some(match self.whole.is_some_and(|w| w.holds(nearest)) {
+            true => 1,
+            false => self
+                .marks
+                .iter()
+                .position(|m| m.is_some_and(|m| m.get(index)))
+                .map_or(0, |i| i + 1),
+        })
+    }
+
+    /// The large filter's points of `row`, left by [`Walk::fill_points`]
+    /// when deferring, from `strong`, the strip walk's row of the grid.
+    fn copy_strong(&self, row: &mut Row<'_, T>, strong: &[T]) {
+        let nyquist = T::from_usize(self.n) * T::HALF;
+        let mask = self.n - 1;
+        for k in row.strong.0..=row.strong.1 {
+            let q = self.position(k, row.kyu);
+            if self.slot(q, nyquist) == Some(0) {
+                let col = k as usize & mask;
+                if let (Some(cell), Some(&v)) = (row.cells.get_mut(col), strong.get(col)) {
+                    *cell = v;
+                }
+            }
+        }
+    }
+
     /// [`Walk::fill_row`] point by point.
     #[inline(always)]
     fn fill_points(&self, row: &mut Row<'_, T>, from: i32, to: i32, stats: &mut AdaptiveStats) {
@@ -400,25 +531,21 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
         };
         for k in from..=to {
             let q = self.position(k, row.kyu);
-            if q.iter().any(|&c| c > nyquist || -c > nyquist) {
+            let Some(slot) = self.slot(q, nyquist) else {
                 continue;
-            }
+            };
             stats.samples += 1;
             stats.full_taps += large.taps;
-            let nearest: [usize; 3] =
-                core::array::from_fn(|a| (q[a] + T::HALF).floor_i64() as usize & mask);
-            let index = nearest[0] + n * (nearest[1] + n * nearest[2]);
-            let slot = match self.whole.is_some_and(|w| w.holds(nearest)) {
-                true => 1,
-                false => self
-                    .marks
-                    .iter()
-                    .position(|m| m.is_some_and(|m| m.get(index)))
-                    .map_or(0, |i| i + 1),
-            };
             let filter = self.filters[slot].unwrap_or(large);
             stats.per_filter[slot] += 1;
             stats.taps += filter.taps;
+            if slot == 0 && self.defer {
+                row.strong = match row.strong.0 <= row.strong.1 {
+                    true => (row.strong.0.min(k), row.strong.1.max(k)),
+                    false => (k, k),
+                };
+                continue;
+            }
             if let Some(cell) = row.cells.get_mut(k as usize & mask) {
                 *cell = match filter.taps {
                     0 => T::ZERO,

@@ -60,7 +60,35 @@ pub fn extract<S: Sample, T: Real + Send + Sync>(
     parallel: bool,
     grid: &mut [T],
 ) -> bool {
-    extract_nested(spec, kernel, axes, tiling, parallel, grid, false)
+    extract_nested(spec, kernel, axes, tiling, parallel, grid, false, None)
+}
+
+/// [`extract`] on the points `k = within[p].0 ..= within[p].1` of each
+/// mirror pair `p = 0 … n/2` (row `p` at `kx = k`, row `−p` at `kx = −k`;
+/// `within` shorter than `n/2 + 1` leaves the pairs beyond it out), each
+/// point's value the same bit for bit as [`extract`]'s: a strip's cells do
+/// not depend on which of the row's points are summed from them. The rows
+/// of the pairs walked are zeroed first; the others are left as they are.
+#[allow(clippy::too_many_arguments)]
+pub fn extract_within<S: Sample, T: Real + Send + Sync>(
+    spec: &Spectrum<'_, S>,
+    kernel: &KernelTable<T>,
+    axes: &SliceAxes,
+    tiling: Tiling,
+    parallel: bool,
+    grid: &mut [T],
+    within: &[(i32, i32)],
+) -> bool {
+    extract_nested(
+        spec,
+        kernel,
+        axes,
+        tiling,
+        parallel,
+        grid,
+        false,
+        Some(within),
+    )
 }
 
 /// [`extract`] on the spectrum with x and y exchanged
@@ -76,11 +104,13 @@ pub fn extract_exchanged<S: Sample, T: Real + Send + Sync>(
     parallel: bool,
     grid: &mut [T],
 ) -> bool {
-    held_axis(axes) == Some(2) && extract_nested(spec, kernel, axes, tiling, parallel, grid, true)
+    held_axis(axes) == Some(2)
+        && extract_nested(spec, kernel, axes, tiling, parallel, grid, true, None)
 }
 
 /// [`extract`], the interpolation's inner sum over the strip's `w` axis
 /// when `inner_w`, else over its `u` axis.
+#[allow(clippy::too_many_arguments)]
 fn extract_nested<S: Sample, T: Real + Send + Sync>(
     spec: &Spectrum<'_, S>,
     kernel: &KernelTable<T>,
@@ -89,6 +119,7 @@ fn extract_nested<S: Sample, T: Real + Send + Sync>(
     parallel: bool,
     grid: &mut [T],
     inner_w: bool,
+    within: Option<&[(i32, i32)]>,
 ) -> bool {
     let n = spec.n();
     if !supports(spec) || grid.len() != n * n || kernel.filter() != spec.filter() {
@@ -100,12 +131,12 @@ fn extract_nested<S: Sample, T: Real + Send + Sync>(
     let g = Geometry::new(axes, n, tiling, parallel);
     let data = spec.data();
     match kernel.filter().width() {
-        1 => walk::<1, S, T>(data, kernel, &g, held, inner_w, grid),
-        2 => walk::<2, S, T>(data, kernel, &g, held, inner_w, grid),
-        3 => walk::<3, S, T>(data, kernel, &g, held, inner_w, grid),
-        4 => walk::<4, S, T>(data, kernel, &g, held, inner_w, grid),
-        5 => walk::<5, S, T>(data, kernel, &g, held, inner_w, grid),
-        _ => walk::<MAX_WIDTH, S, T>(data, kernel, &g, held, inner_w, grid),
+        1 => walk::<1, S, T>(data, kernel, &g, held, inner_w, within, grid),
+        2 => walk::<2, S, T>(data, kernel, &g, held, inner_w, within, grid),
+        3 => walk::<3, S, T>(data, kernel, &g, held, inner_w, within, grid),
+        4 => walk::<4, S, T>(data, kernel, &g, held, inner_w, within, grid),
+        5 => walk::<5, S, T>(data, kernel, &g, held, inner_w, within, grid),
+        _ => walk::<MAX_WIDTH, S, T>(data, kernel, &g, held, inner_w, within, grid),
     }
 }
 
@@ -166,6 +197,7 @@ fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
     g: &Geometry<T>,
     held: usize,
     inner_w: bool,
+    within: Option<&[(i32, i32)]>,
     grid: &mut [T],
 ) -> bool {
     let mut phases = Box::new(PhaseTable::<T, W>::zeroed());
@@ -189,8 +221,18 @@ fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
     let fill = |band: &mut Vec<Pair<'_, T>>| {
         let mut scratch = Scratch::new();
         for pair in band.iter_mut() {
+            let (from, to) = match within {
+                None => (i32::MIN, i32::MAX),
+                Some(w) => match w.get(pair.p) {
+                    Some(&(from, to)) if from <= to => (from, to),
+                    _ => continue,
+                },
+            };
             if set_up_pair::<W, T>(g, pair) {
-                strip.fill_pair(pair, &mut scratch);
+                (pair.low, pair.high) = (pair.low.max(from), pair.high.min(to));
+                if pair.low <= pair.high {
+                    strip.fill_pair(pair, &mut scratch);
+                }
             }
         }
     };
