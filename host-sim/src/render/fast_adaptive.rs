@@ -129,20 +129,8 @@ pub fn extract<S: Sample, T: Real>(
     }
     let walk = Walk::new(spec, kernel, levels, whole, frame, tiling)?;
     let up = frame.up.map(T::from_f64);
-    let bands = walk.bands(grid, up, tiling.band.max(1));
-    let fill = |mut band: Vec<Row<'_, T>>| walk.fill_band(&mut band);
-    let stats = if parallel {
-        bands
-            .into_par_iter()
-            .map(fill)
-            .reduce(AdaptiveStats::default, merged)
-    } else {
-        bands
-            .into_iter()
-            .map(fill)
-            .fold(AdaptiveStats::default(), merged)
-    };
-    Some(stats)
+    let mut bands = walk.bands(grid, up, tiling.band.max(1));
+    Some(walk.fill_bands(&mut bands, parallel))
 }
 
 /// [`extract`] with the points on the large filter summed by the plain
@@ -175,17 +163,7 @@ pub fn extract_with_strip<S: Sample, T: Real + Send + Sync>(
     walk.defer = true;
     let up = frame.up.map(T::from_f64);
     let mut bands = walk.bands(grid, up, tiling.band.max(1));
-    let fill = |band: &mut Vec<Row<'_, T>>| walk.fill_band(band);
-    let stats = match parallel {
-        true => bands
-            .par_iter_mut()
-            .map(fill)
-            .reduce(AdaptiveStats::default, merged),
-        false => bands
-            .iter_mut()
-            .map(fill)
-            .fold(AdaptiveStats::default(), merged),
-    };
+    let stats = walk.fill_bands(&mut bands, parallel);
     // Pair `p` walks row `p` at `kx = k` and row `−p` at `kx = −k`.
     let mut within = vec![(1, 0); n / 2 + 1];
     for row in bands.iter().flatten() {
@@ -370,6 +348,22 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
             low,
             high,
             strong: (1, 0),
+        }
+    }
+
+    /// Every band filled ([`Walk::fill_band`]), on the current rayon pool's
+    /// threads when `parallel`; the sum of their statistics.
+    fn fill_bands(&self, bands: &mut [Vec<Row<'_, T>>], parallel: bool) -> AdaptiveStats {
+        let fill = |band: &mut Vec<Row<'_, T>>| self.fill_band(band);
+        match parallel {
+            true => bands
+                .par_iter_mut()
+                .map(fill)
+                .reduce(AdaptiveStats::default, merged),
+            false => bands
+                .iter_mut()
+                .map(fill)
+                .fold(AdaptiveStats::default(), merged),
         }
     }
 
