@@ -239,10 +239,10 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
         ((cheap as f64) < below * stats.samples as f64).then_some(stats)
     }
 
-    /// Shift, inverse-transform and crop the slice into `out`, on this
-    /// thread: at side 256 the core's finish took 0.25–0.45 ms and the
-    /// threaded one ([`super::fast_inverse::finish_threaded`]) 0.5–0.8 ms
-    /// on the two cores of the machine that measured it.
+    /// Shift, inverse-transform and crop the slice into `out` on this
+    /// thread: at side 256 the core's finish was faster than the threaded
+    /// one ([`super::fast_inverse::finish_threaded`]) on the two shared
+    /// cores it was measured on (docs/adaptive.md).
     fn finish(&mut self, n: usize, crop: &Crop, out: &mut [T]) -> Result<(), fvr_core::Error> {
         let tw = Twiddles::from_table(&self.tw, n)?;
         finish(&mut self.grid, n, crop, &tw, &mut self.aux, out)

@@ -97,7 +97,7 @@ struct Row<'g, T> {
     low: i32,
     high: i32,
     /// The least and greatest `kx` of the points left to the strip walk
-    /// ([`Walk::defer`]); empty (`low > high`) when there are none.
+    /// ([`Walk::defer`]); [`EMPTY`] when there are none.
     strong: (i32, i32),
 }
 
@@ -165,7 +165,7 @@ pub fn extract_with_strip<S: Sample, T: Real + Send + Sync>(
     let mut bands = walk.bands(grid, up, tiling.band.max(1));
     let stats = walk.fill_bands(&mut bands, parallel);
     // Pair `p` walks row `p` at `kx = k` and row `−p` at `kx = −k`.
-    let mut within = vec![(1, 0); n / 2 + 1];
+    let mut within = vec![EMPTY; n / 2 + 1];
     for row in bands.iter().flatten() {
         let (low, high) = row.strong;
         if low > high {
@@ -176,11 +176,7 @@ pub fn extract_with_strip<S: Sample, T: Real + Send + Sync>(
             true => (ky as usize, low, high),
             false => (ky.unsigned_abs() as usize, -high, -low),
         };
-        let w = &mut within[p];
-        *w = match w.0 <= w.1 {
-            true => (w.0.min(from), w.1.max(to)),
-            false => (from, to),
-        };
+        within[p] = widened(within[p], from, to);
     }
     // Row 0 holds its own mirrors: `kx < 0` are pair 0's `k > 0`.
     if let Some(w) = within.first_mut().filter(|w| w.0 <= w.1) {
@@ -258,6 +254,14 @@ fn walked<T: Real>(n: usize, right: &[T; 3], up: [T; 3], ky: i32) -> ([T; 3], i3
         low.saturating_sub(1).max(-half),
         high.saturating_add(1).min(k_max),
     )
+}
+
+/// An interval of `kx` holding nothing (`low > high`).
+const EMPTY: (i32, i32) = (i32::MAX, i32::MIN);
+
+/// The least interval holding `span` and `from … to`.
+fn widened(span: (i32, i32), from: i32, to: i32) -> (i32, i32) {
+    (span.0.min(from), span.1.max(to))
 }
 
 /// The sums of two statistics.
@@ -347,7 +351,7 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
             kyu,
             low,
             high,
-            strong: (1, 0),
+            strong: EMPTY,
         }
     }
 
@@ -534,10 +538,7 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
             stats.per_filter[slot] += 1;
             stats.taps += filter.taps;
             if slot == 0 && self.defer {
-                row.strong = match row.strong.0 <= row.strong.1 {
-                    true => (row.strong.0.min(k), row.strong.1.max(k)),
-                    false => (k, k),
-                };
+                row.strong = widened(row.strong, k, k);
                 continue;
             }
             if let Some(cell) = row.cells.get_mut(k as usize & mask) {
