@@ -18,7 +18,9 @@ use fvr_core::num::{Real, Sample};
 use fvr_core::slice::adaptive::{extract_slice_adaptive, AdaptiveStats};
 use fvr_host::render::adaptive::{AdaptiveMarks, AdaptiveSettings, Bound, Cheaper};
 use fvr_host::render::adaptive_view::AdaptiveRenderer;
-use fvr_host::render::fast_adaptive::{extract, extract_with_strip};
+use fvr_host::render::fast_adaptive::{
+    extract, extract_with_strip, extract_with_strip_if, Settled,
+};
 use fvr_host::render::fast_slice::Tiling;
 use fvr_host::render::fast_strip;
 use fvr_host::render::marks_summary::MarksSummary;
@@ -529,5 +531,79 @@ fn without_a_held_axis_the_strip_extraction_is_the_cores() {
     assert_eq!(stats, core_stats);
     for (a, b) in core.iter().zip(&host) {
         assert_eq!(a.to_bits(), b.to_bits());
+    }
+}
+
+/// [`extract_with_strip_if`] hands its condition the core's statistics
+/// before summing the large filter's points: declined, it returns them;
+/// accepted, it is [`extract_with_strip`] bit for bit. Both where the
+/// strip walk serves and where it does not (an up hint off the axes).
+#[test]
+fn the_strip_walk_decides_on_the_cores_statistics() {
+    let spec = smooth_kb6_64();
+    let view_spec = spec.view();
+    let n = spec.n();
+    let kernel = KernelTable::<f32>::new(*view_spec.filter());
+    let marks = AdaptiveMarks::build(&spec, &AdaptiveSettings::new(40.0)).unwrap();
+    let tables = marks.tables::<f32>();
+    let levels = marks.core_levels(&tables).unwrap();
+    let mut views: Vec<View> = DIRECTIONS.iter().map(|&dir| View::along(dir)).collect();
+    views.push(View {
+        dir: [1.0, 0.3, 0.2],
+        up: [0.2, 0.5, 1.0],
+    });
+    let (whole, tiling) = (marks.summary(), Tiling::default());
+    for view in views {
+        let frame = view.frame().unwrap();
+        let mut core = vec![0f32; n * n];
+        let core_stats =
+            extract_slice_adaptive(&view_spec, &kernel, &levels, &frame, &mut core).unwrap();
+        let mut expected = vec![7f32; n * n];
+        let mut strong = vec![0f32; n * n];
+        let args = (&view_spec, &kernel, &levels[..], whole, &frame);
+        extract_with_strip(
+            args.0,
+            args.1,
+            args.2,
+            args.3,
+            args.4,
+            tiling,
+            true,
+            &mut expected,
+            &mut strong,
+        )
+        .unwrap();
+        for parallel in [false, true] {
+            for accept in [false, true] {
+                let mut seen = None;
+                let mut host = vec![7f32; n * n];
+                let settled = extract_with_strip_if(
+                    args.0,
+                    args.1,
+                    args.2,
+                    args.3,
+                    args.4,
+                    (tiling, parallel),
+                    &mut host,
+                    &mut strong,
+                    |stats| {
+                        seen = Some(*stats);
+                        accept
+                    },
+                )
+                .unwrap();
+                let at = format!("{view:?} parallel {parallel} accept {accept}");
+                assert_eq!(seen, Some(core_stats), "{at}");
+                match accept {
+                    false => assert_eq!(settled, Settled::Declined(core_stats), "{at}"),
+                    true => {
+                        assert_eq!(settled, Settled::Extracted(core_stats), "{at}");
+                        for (a, b) in expected.iter().zip(&host) {
+                            assert_eq!(a.to_bits(), b.to_bits(), "{at}");
+                        }
+                    }
+                }
+            }
+        }
     }
 }

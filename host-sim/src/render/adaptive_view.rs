@@ -7,20 +7,23 @@
 //! its weights from the kernel tables (the core's adaptive arithmetic), so
 //! a point on the large filter costs more than in the plain walk
 //! ([`super::fast_slice`]). When the marks move too small a share of a
-//! view's samples to the cheaper filters ([`AdaptiveMarks::plain_below`],
-//! counted first by [`fast_adaptive::tally`]), the view is rendered by the
-//! plain walk instead: the full filter's image bit for bit, which meets any
-//! tolerance.
+//! view's samples to the cheaper filters ([`AdaptiveMarks::plain_below`]),
+//! the view is rendered by the plain walk instead: the full filter's image
+//! bit for bit, which meets any tolerance. The share is the adaptive walk's
+//! own count, taken once every point's filter is settled and before the
+//! large filter's points are summed
+//! ([`fast_adaptive::extract_with_strip_if`]; [`fast_adaptive::tally`]
+//! first for the exact walk).
 
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::KernelTable;
 use fvr_core::geometry::{Sampling, View};
 use fvr_core::image::{aux_len, check_image, finish, placement, placement_on_axes, Crop};
 use fvr_core::num::{Real, Sample};
-use fvr_core::slice::adaptive::{extract_slice_adaptive, AdaptiveLevel, AdaptiveStats};
+use fvr_core::slice::adaptive::{extract_slice_adaptive, AdaptiveStats};
 
 use super::adaptive::AdaptiveMarks;
-use super::fast_adaptive;
+use super::fast_adaptive::{self, Settled};
 use super::fast_slice::{self, Tiling};
 use super::spectrum::OwnedSpectrum;
 use super::view::Walk;
@@ -150,64 +153,86 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
         let levels = self.marks.core_levels(&self.tables)?;
         let core_spec = spec.view();
         self.last = Walked::Adaptive;
-        if let Some(stats) = self.plain_instead(&core_spec, &levels, &frame) {
-            let axes = Sampling::UNIT.slice_axes(&frame);
-            let (kernel, grid, along) = (&self.kernel, &mut self.grid, &mut self.along);
-            // The plain renderer's walk ([`super::view::Walk::Strip`]).
-            let (tiling, parallel) = (self.tiling, self.parallel);
-            if fast_column::extract(&core_spec, kernel, &axes, tiling, parallel, grid, along)
-                || fast_strip::extract(&core_spec, kernel, &axes, tiling, parallel, grid)
-                || fast_slice::extract(&core_spec, kernel, &axes, tiling, parallel, grid)
-            {
-                let share = 1.0 - stats.per_filter[0] as f64 / stats.samples.max(1) as f64;
-                self.last = Walked::Plain { share };
-                let place = placement_on_axes(core_spec.dims(), &axes, width, height, 1.0);
-                let crop = Crop::new(
-                    place,
-                    Sampling::UNIT.gain() / core_spec.scale(),
-                    width,
-                    height,
-                );
-                self.finish(n, &crop, out)?;
-                return Ok(AdaptiveStats {
-                    samples: stats.samples,
-                    per_filter: core::array::from_fn(|i| if i == 0 { stats.samples } else { 0 }),
-                    taps: stats.full_taps,
-                    full_taps: stats.full_taps,
-                });
-            }
-        }
+        let below = self.marks.plain_below;
+        // Whether the plain walk may take the view: not when the core's
+        // walk is asked for, nor with no threshold.
+        let decide = !self.core && below > 0.0 && self.grid.len() == n * n;
+        let adaptive = |stats: &AdaptiveStats| {
+            let cheap = stats.samples - stats.per_filter[0];
+            !decide || cheap as f64 >= below * stats.samples as f64
+        };
         let whole = self.marks.summary();
         let (kernel, tiling, parallel) = (&self.kernel, self.tiling, self.parallel);
         let host = match (self.core, self.walk) {
             (true, _) => None,
-            (false, Walk::Exact) => fast_adaptive::extract(
-                &core_spec,
-                kernel,
-                &levels,
-                whole,
-                &frame,
-                tiling,
-                parallel,
-                &mut self.grid,
-            ),
+            (false, Walk::Exact) => {
+                let counted = match decide {
+                    true => {
+                        fast_adaptive::tally(&core_spec, kernel, &levels, whole, &frame, parallel)
+                    }
+                    false => None,
+                };
+                match counted.filter(|stats| !adaptive(stats)) {
+                    Some(stats) => Some(Settled::Declined(stats)),
+                    None => fast_adaptive::extract(
+                        &core_spec,
+                        kernel,
+                        &levels,
+                        whole,
+                        &frame,
+                        tiling,
+                        parallel,
+                        &mut self.grid,
+                    )
+                    .map(Settled::Extracted),
+                }
+            }
             (false, Walk::Strip) => {
                 self.strong.resize(n * n, T::ZERO);
-                fast_adaptive::extract_with_strip(
+                fast_adaptive::extract_with_strip_if(
                     &core_spec,
                     kernel,
                     &levels,
                     whole,
                     &frame,
-                    tiling,
-                    parallel,
+                    (tiling, parallel),
                     &mut self.grid,
                     &mut self.strong,
+                    adaptive,
                 )
             }
         };
         let stats = match host {
-            Some(stats) => stats,
+            Some(Settled::Extracted(stats)) => stats,
+            Some(Settled::Declined(stats)) => {
+                let (kernel, grid, along) = (&self.kernel, &mut self.grid, &mut self.along);
+                if let Some(axes) =
+                    plain(&core_spec, &frame, kernel, (tiling, parallel), grid, along)
+                {
+                    let share = 1.0 - stats.per_filter[0] as f64 / stats.samples.max(1) as f64;
+                    self.last = Walked::Plain { share };
+                    let place = placement_on_axes(core_spec.dims(), &axes, width, height, 1.0);
+                    let gain = Sampling::UNIT.gain() / core_spec.scale();
+                    self.finish(n, &Crop::new(place, gain, width, height), out)?;
+                    return Ok(AdaptiveStats {
+                        samples: stats.samples,
+                        per_filter: core::array::from_fn(|i| match i {
+                            0 => stats.samples,
+                            _ => 0,
+                        }),
+                        taps: stats.full_taps,
+                        full_taps: stats.full_taps,
+                    });
+                }
+                // No plain walk serves the spectrum: the adaptive one does.
+                let grid = &mut self.grid;
+                match fast_adaptive::extract(
+                    &core_spec, kernel, &levels, whole, &frame, tiling, parallel, grid,
+                ) {
+                    Some(stats) => stats,
+                    None => extract_slice_adaptive(&core_spec, kernel, &levels, &frame, grid)?,
+                }
+            }
             None => {
                 extract_slice_adaptive(&core_spec, &self.kernel, &levels, &frame, &mut self.grid)?
             }
@@ -218,27 +243,6 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
         Ok(stats)
     }
 
-    /// The statistics of the adaptive walk when it would move less than
-    /// [`AdaptiveMarks::plain_below`] of the samples to the cheaper
-    /// filters (the plain walk is then faster); `None` when the adaptive
-    /// walk is to be used (the core's walk asked for, no threshold, or a
-    /// spectrum the host's walks do not serve).
-    fn plain_instead<S: Sample>(
-        &self,
-        spec: &fvr_core::spectrum::Spectrum<'_, S>,
-        levels: &[AdaptiveLevel<'_, '_, T>],
-        frame: &fvr_core::geometry::Frame,
-    ) -> Option<AdaptiveStats> {
-        let below = self.marks.plain_below;
-        if self.core || below <= 0.0 || self.grid.len() != spec.n() * spec.n() {
-            return None;
-        }
-        let whole = self.marks.summary();
-        let stats = fast_adaptive::tally(spec, &self.kernel, levels, whole, frame, self.parallel)?;
-        let cheap = stats.samples - stats.per_filter[0];
-        ((cheap as f64) < below * stats.samples as f64).then_some(stats)
-    }
-
     /// Shift, inverse-transform and crop the slice into `out` on this
     /// thread: at side 256 the core's finish was faster than the threaded
     /// one ([`super::fast_inverse::finish_threaded`]) on the two shared
@@ -247,4 +251,22 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
         let tw = Twiddles::from_table(&self.tw, n)?;
         finish(&mut self.grid, n, crop, &tw, &mut self.aux, out)
     }
+}
+
+/// The slice of `spec` along `frame` by the plain renderer's walk with the
+/// full filter ([`super::view::Walk::Strip`]) into `grid`, and its axes;
+/// `None` when no plain walk serves the spectrum.
+fn plain<S: Sample, T: Real>(
+    spec: &fvr_core::spectrum::Spectrum<'_, S>,
+    frame: &fvr_core::geometry::Frame,
+    kernel: &KernelTable<T>,
+    (tiling, parallel): (Tiling, bool),
+    grid: &mut [T],
+    along: &mut Vec<T>,
+) -> Option<fvr_core::geometry::SliceAxes> {
+    let axes = Sampling::UNIT.slice_axes(frame);
+    let walked = fast_column::extract(spec, kernel, &axes, tiling, parallel, grid, along)
+        || fast_strip::extract(spec, kernel, &axes, tiling, parallel, grid)
+        || fast_slice::extract(spec, kernel, &axes, tiling, parallel, grid);
+    walked.then_some(axes)
 }

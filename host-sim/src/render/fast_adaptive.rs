@@ -154,16 +154,68 @@ pub fn extract_with_strip<S: Sample, T: Real + Send + Sync>(
     grid: &mut [T],
     strong: &mut [T],
 ) -> Option<AdaptiveStats> {
+    let walked = extract_with_strip_if(
+        spec,
+        kernel,
+        levels,
+        whole,
+        frame,
+        (tiling, parallel),
+        grid,
+        strong,
+        |_| true,
+    );
+    walked.map(|walked| match walked {
+        Settled::Extracted(stats) | Settled::Declined(stats) => stats,
+    })
+}
+
+/// What [`extract_with_strip_if`] did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Settled {
+    /// The slice is extracted, with these statistics.
+    Extracted(AdaptiveStats),
+    /// The walk's statistics (exactly [`extract`]'s) did not satisfy the
+    /// condition, and the grid holds no finished slice.
+    Declined(AdaptiveStats),
+}
+
+/// [`extract_with_strip`] once `proceed` accepts the walk's statistics,
+/// which are known when every point's filter is settled and before the
+/// strip walk sums the large filter's points: a caller that would rather
+/// render the view another way decides without a separate count
+/// ([`tally`]). Where the strip walk does not serve, the statistics come
+/// from [`tally`] and the slice, if accepted, from [`extract`].
+#[allow(clippy::too_many_arguments)]
+pub fn extract_with_strip_if<S: Sample, T: Real + Send + Sync>(
+    spec: &Spectrum<'_, S>,
+    kernel: &KernelTable<T>,
+    levels: &[AdaptiveLevel<'_, '_, T>],
+    whole: Option<&MarksSummary>,
+    frame: &Frame,
+    (tiling, parallel): (Tiling, bool),
+    grid: &mut [T],
+    strong: &mut [T],
+    proceed: impl FnOnce(&AdaptiveStats) -> bool,
+) -> Option<Settled> {
     let n = spec.n();
     let axes = frame.slice_axes();
     if grid.len() != n * n || strong.len() != n * n || fast_strip::held_axis(&axes).is_none() {
-        return extract(spec, kernel, levels, whole, frame, tiling, parallel, grid);
+        let stats = tally(spec, kernel, levels, whole, frame, parallel)?;
+        if !proceed(&stats) {
+            return Some(Settled::Declined(stats));
+        }
+        return extract(spec, kernel, levels, whole, frame, tiling, parallel, grid)
+            .map(Settled::Extracted);
     }
     let mut walk = Walk::new(spec, kernel, levels, whole, frame, tiling)?;
     walk.defer = true;
     let up = frame.up.map(T::from_f64);
     let mut bands = walk.bands(grid, up, tiling.band.max(1));
     let stats = walk.fill_bands(&mut bands, parallel);
+    if !proceed(&stats) {
+        return Some(Settled::Declined(stats));
+    }
     // Pair `p` walks row `p` at `kx = k` and row `−p` at `kx = −k`.
     let mut within = vec![EMPTY; n / 2 + 1];
     for row in bands.iter().flatten() {
@@ -183,7 +235,9 @@ pub fn extract_with_strip<S: Sample, T: Real + Send + Sync>(
         *w = (w.0.min(-w.1), w.1.max(-w.0));
     }
     if !fast_strip::extract_within(spec, kernel, &axes, tiling, parallel, strong, &within) {
-        return extract(spec, kernel, levels, whole, frame, tiling, parallel, grid);
+        drop(bands);
+        return extract(spec, kernel, levels, whole, frame, tiling, parallel, grid)
+            .map(Settled::Extracted);
     }
     let strong = &*strong;
     let copy = |band: &mut Vec<Row<'_, T>>| {
@@ -196,7 +250,7 @@ pub fn extract_with_strip<S: Sample, T: Real + Send + Sync>(
         true => bands.par_iter_mut().for_each(copy),
         false => bands.iter_mut().for_each(copy),
     }
-    Some(stats)
+    Some(Settled::Extracted(stats))
 }
 
 /// The statistics [`extract`] would return for the same arguments, without
