@@ -172,6 +172,44 @@ fn batched_2d_dht_matches_naive_and_the_line_path_bit_for_bit() {
 }
 
 #[test]
+fn square_2d_dht_with_few_nonzero_rows_matches_the_line_path() {
+    // From side 128, at most n/4 rows holding a nonzero value take their
+    // row pass one row at a time and the zero rows are skipped; one more
+    // row takes the batched pass. Either way the values are the line
+    // path's bit for bit (a zero only up to its sign).
+    twiddles!(256; tw32: f32);
+    for n in [128, 256] {
+        for rows in [1, n / 8, n / 4, n / 4 + 1] {
+            let x = signal(n * n, (n * 7 + rows) as u64);
+            // Rows `0 … a` and `n − b … n − 1` (a slice's low
+            // frequencies on both sides of zero), the rest zero.
+            let (a, b) = (rows.div_ceil(2), rows / 2);
+            let held = |y: usize| y < a || y >= n - b;
+            let x32: Vec<f32> = x
+                .iter()
+                .enumerate()
+                .map(|(i, &v)| if held(i / n) { v as f32 } else { 0.0 })
+                .collect();
+            let mut batched = x32.clone();
+            let mut lines = x32;
+            let mut col = vec![0.0f32; n];
+            dht_2d(&mut batched, n, n, &mut col, &tw32).unwrap();
+            dht_2d_lines(&mut lines, n, n, &mut col, &tw32).unwrap();
+            let mut zeros = 0;
+            for (i, (a, b)) in batched.iter().zip(&lines).enumerate() {
+                match *a == 0.0 {
+                    true => zeros += 1,
+                    false => assert_eq!(a.to_bits(), b.to_bits(), "{n}² with {rows} rows at {i}"),
+                }
+                assert_eq!(a, b, "{n}² with {rows} rows at {i}");
+            }
+            // Values that are zero are rare in a transform of noise.
+            assert!(zeros < n, "{n}² with {rows} rows: {zeros} zeros");
+        }
+    }
+}
+
+#[test]
 fn true_3d_dht_matches_naive_in_f64_f32_and_f16_storage() {
     twiddles!(16; tw64: f64, tw32: f32);
     for dims in [
