@@ -133,6 +133,25 @@ fn bad_scene_values_exit_2_naming_the_problem() {
     }
 }
 
+/// The number at `key`, at any depth, in the first line of `out` that is
+/// a JSON object.
+fn json_number(out: &str, key: &str) -> f64 {
+    fn find(v: &serde_json::Value, key: &str) -> Option<f64> {
+        match v {
+            serde_json::Value::Object(map) => map
+                .get(key)
+                .and_then(|x| x.as_f64())
+                .or_else(|| map.values().find_map(|x| find(x, key))),
+            _ => None,
+        }
+    }
+    out.lines()
+        .filter(|l| l.starts_with('{'))
+        .find_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
+        .and_then(|v| find(&v, key))
+        .unwrap_or_else(|| panic!("no number for {key} in {out}"))
+}
+
 #[test]
 fn adaptive_and_preview_options_report_and_refuse_conflicts() {
     let dir = temp_dir("scene-adaptive");
@@ -168,12 +187,7 @@ fn adaptive_and_preview_options_report_and_refuse_conflicts() {
     ] {
         assert!(json.contains(key), "{key} not in {json}");
     }
-    let snr: f64 = json
-        .split("\"snr_vs_full_db\": ")
-        .nth(1)
-        .and_then(|r| r.split([',', '}']).next())
-        .and_then(|v| v.trim().parse().ok())
-        .expect("an SNR");
+    let snr = json_number(json, "snr_vs_full_db");
     assert!(snr >= 40.0, "{json}");
 
     // The defaults: the zero filter and Parseval's bound.
@@ -186,9 +200,30 @@ fn adaptive_and_preview_options_report_and_refuse_conflicts() {
         "\"bound\": \"parseval\"",
         "\"filter\": \"zero\"",
         "\"probes\": 0",
+        "\"error_field_evaluated\": false",
     ] {
         assert!(stdout.contains(key), "{key} not in {stdout}");
     }
+    // Probes above Parseval's threshold: one or two transforms run, and
+    // the image still meets the tolerance.
+    let mut probed = base.to_vec();
+    probed.extend(["--adaptive", "40", "--adaptive-probes", "2"]);
+    probed.extend([
+        "--adaptive-plain-below",
+        "0",
+        "--stats-json",
+        "--out",
+        "q.nrrd",
+    ]);
+    let out = fvr(&probed, &dir);
+    assert_ok(&out);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("\"probes\": 1") || stdout.contains("\"probes\": 2"),
+        "{stdout}"
+    );
+    let snr = json_number(&stdout, "snr_vs_full_db");
+    assert!(snr >= 40.0, "{stdout}");
 
     let mut preview = base.to_vec();
     preview.extend(["--preview-level", "1", "--out", "p.nrrd"]);

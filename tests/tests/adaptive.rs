@@ -154,9 +154,10 @@ fn zero_filter_chains_stay_within_the_tolerance() {
     assert!(checked >= 2, "{checked}");
 }
 
-/// Parseval's bound holds: for the zero filter and for 1³, its threshold is
-/// not above the exact bound's, and the energy it reports is within the
-/// budget and not below eq. 15 evaluated the slow way.
+/// Parseval's bound holds: for the zero filter and for 1³, its threshold
+/// (without probes) is not above the exact bound's, and the energy it
+/// reports is within the budget and not below eq. 15 evaluated the slow
+/// way.
 #[test]
 fn parseval_bound_bounds_the_error_energy() {
     let spec = eighth_spectrum();
@@ -169,6 +170,7 @@ fn parseval_bound_bounds_the_error_energy() {
             let build = |bound| {
                 let settings = AdaptiveSettings {
                     chain: vec![cheaper],
+                    probes: 0,
                     ..nearest(tol, bound)
                 };
                 AdaptiveMarks::build(&spec, &settings).unwrap().levels[0].clone()
@@ -194,6 +196,65 @@ fn parseval_bound_bounds_the_error_energy() {
         }
     }
     assert!(checked >= 3, "{checked}");
+}
+
+/// Probes raise Parseval's threshold and keep the guarantee: with 1 or 2
+/// probes the threshold is never below Parseval's alone, at most that many
+/// transforms run, and eq. 15 evaluated the slow way stays within the
+/// budget. An accepted probe's energy is the direct one, against the
+/// preparation's floor of the reference (at most 0.12 dB below it,
+/// docs/adaptive.md); a seed never beaten keeps Parseval's bound.
+#[test]
+fn probes_raise_parsevals_threshold_within_budget() {
+    let spec = eighth_spectrum();
+    let mut raised = 0;
+    for (cheaper, gain) in [
+        (Cheaper::Zero, 0.0),
+        (Cheaper::Filter(FilterKind::Nearest), f64::NAN),
+    ] {
+        for tol in [20.0, 30.0, 40.0] {
+            let build = |probes| {
+                let settings = AdaptiveSettings {
+                    chain: vec![cheaper],
+                    probes,
+                    ..nearest(tol, Bound::Parseval)
+                };
+                AdaptiveMarks::build(&spec, &settings).unwrap().levels[0].clone()
+            };
+            let alone = build(0);
+            assert!(!alone.evaluated, "{cheaper:?} {tol}");
+            for probes in [1, 2] {
+                let at = format!("{cheaper:?} {tol} dB, {probes} probes");
+                let level = build(probes);
+                assert!(level.threshold >= alone.threshold, "{at}");
+                assert!(level.probes.unwrap() <= probes, "{at}: {:?}", level.probes);
+                let budget = 10f64.powf(-tol / 10.0);
+                let ratio = level.error_ratio.unwrap();
+                assert!(ratio <= budget, "{at}: {ratio}");
+                if level.threshold == 0.0 {
+                    continue;
+                }
+                let gain = if gain.is_nan() { level.gain } else { gain };
+                let direct = direct_error_ratio(&spec, level.threshold, gain);
+                assert!(direct <= budget, "{at}: direct {direct}");
+                match level.evaluated {
+                    true => {
+                        assert!(direct <= ratio * (1.0 + 1e-4), "{at}: {direct} {ratio}");
+                        assert!(
+                            direct >= ratio * 10f64.powf(-0.12 / 10.0),
+                            "{at}: {direct} {ratio}"
+                        );
+                        raised += usize::from(level.threshold > alone.threshold);
+                    }
+                    false => {
+                        assert_eq!(level.threshold, alone.threshold, "{at}");
+                        assert_eq!(level.error_ratio, alone.error_ratio, "{at}");
+                    }
+                }
+            }
+        }
+    }
+    assert!(raised >= 2, "{raised}");
 }
 
 /// The exact bound accepts the largest threshold the 3D criterion allows:

@@ -9,7 +9,7 @@ use crate::render::fast_marks;
 use crate::render::fast_prepare::PreparedEnergy;
 use crate::render::marks_summary::MarksSummary;
 use crate::render::spectrum::OwnedSpectrum;
-use bound::ErrorModel;
+use bound::{ErrorModel, Probes};
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::View;
 use fvr_core::num::{Real, Sample};
@@ -104,10 +104,12 @@ pub enum Bound {
     /// `ErrorModel::threshold`).
     Exact,
     /// The error energy bounded by Parseval's theorem with the weight's
-    /// largest square, against the same reference as [`Bound::Exact`]: a
-    /// guarantee from one 3D transform (the reference's), with no probes,
-    /// and a smaller threshold than the exact one's. Tight for the zero
-    /// filter, whose weight `−ĥ₁` peaks at 1.
+    /// largest square, against the same reference as [`Bound::Exact`] (or
+    /// a floor of it the preparation measured): a guarantee without a
+    /// probe, and a smaller threshold than the exact one's. Tight for the
+    /// zero filter, whose weight `−ĥ₁` peaks at 1. Then at most
+    /// [`AdaptiveSettings::probes`] evaluations of the error field raise
+    /// the threshold where the field allows.
     Parseval,
 }
 
@@ -155,7 +157,19 @@ pub struct AdaptiveSettings {
     /// walk with the full filter instead, which is then faster
     /// ([`DEFAULT_PLAIN_BELOW`]; 0 always walks adaptively).
     pub plain_below: f64,
+    /// With [`Bound::Parseval`]: at most this many 3D transforms that
+    /// evaluate the error field above Parseval's threshold and raise it
+    /// where the field allows (0, [`DEFAULT_PROBES`], for Parseval's bound
+    /// alone).
+    pub probes: usize,
 }
+
+/// Probes that raise Parseval's threshold by default: none. Each is a 3D
+/// transform of the error field, about one preparation's time, and on the
+/// smooth benchmark volume one probe took the marks from about 1.2 to 2.2
+/// preparations for a view 4% faster (docs/adaptive.md); a user rendering
+/// many views asks for them.
+pub const DEFAULT_PROBES: usize = 0;
 
 /// The share of substituted samples below which the plain walk is faster
 /// than the adaptive one: about 80% for kb6 and 97% for kb4 with the 1³
@@ -183,6 +197,7 @@ impl AdaptiveSettings {
             h_d: None,
             bound: Bound::Exact,
             plain_below: DEFAULT_PLAIN_BELOW,
+            probes: DEFAULT_PROBES,
         }
     }
 }
@@ -208,10 +223,15 @@ pub struct Level {
     pub gain: f64,
     /// With [`Bound::Exact`]: the 3D error energy of this level's
     /// substitution relative to the volume's, as verified for `threshold`;
-    /// with [`Bound::Parseval`], the bound on it.
+    /// with [`Bound::Parseval`], as verified by a probe or else the bound
+    /// on it ([`Level::evaluated`]).
     pub error_ratio: Option<f64>,
-    /// With [`Bound::Exact`]: the 3D inverse transforms the threshold
-    /// search ran for this level (the reference's not counted).
+    /// Whether [`Level::error_ratio`] was evaluated (an inverse transform
+    /// of the error field) rather than bounded.
+    pub evaluated: bool,
+    /// With [`Bound::Exact`] or [`Bound::Parseval`]: the 3D inverse
+    /// transforms the threshold search ran for this level (the
+    /// reference's not counted).
     pub probes: Option<usize>,
 }
 
@@ -274,6 +294,7 @@ impl AdaptiveMarks {
             h_d: h_d_override,
             bound,
             plain_below,
+            probes: parseval_probes,
         } = *settings;
         parse_tolerance(&tolerance_db.to_string())?;
         if !(0.0..=1.0).contains(&plain_below) {
@@ -300,8 +321,13 @@ impl AdaptiveMarks {
         let radius = large.width().div_ceil(2);
         let mut levels = Vec::with_capacity(chain.len());
         let mut model = match bound {
-            Bound::Exact | Bound::Parseval => {
-                Some(ErrorModel::new(view, prepared, bound == Bound::Exact)?)
+            Bound::Exact => Some(ErrorModel::new(view, prepared, Probes::Search)?),
+            Bound::Parseval => {
+                let probes = match parseval_probes {
+                    0 => Probes::None,
+                    _ => Probes::Few,
+                };
+                Some(ErrorModel::new(view, prepared, probes)?)
             }
             Bound::Paper => None,
         };
@@ -332,21 +358,19 @@ impl AdaptiveMarks {
                     (small, h_d, large.response(0.0) / small.response(0.0))
                 }
             };
-            let (threshold, error_ratio, probes) = match model.as_mut() {
+            let found = match model.as_mut() {
                 Some(model) if bound == Bound::Parseval => {
-                    let (tau, ratio) = model.peak_threshold(&small, gain, budget);
-                    (tau, Some(ratio), Some(0))
+                    Some(model.raised(&small, gain, budget, parseval_probes)?)
                 }
-                Some(model) => {
-                    let (tau, ratio, probes) = model.threshold(&small, gain, budget)?;
-                    (tau, Some(ratio), Some(probes))
-                }
-                None => (
-                    threshold_for(total, |i| view.value(i), h_d, budget),
-                    None,
-                    None,
-                ),
+                Some(model) => Some(model.threshold(&small, gain, budget, None)?),
+                None => None,
             };
+            let threshold = match found {
+                Some(found) => found.tau,
+                None => threshold_for(total, |i| view.value(i), h_d, budget),
+            };
+            let (error_ratio, probes) = (found.map(|f| f.ratio), found.map(|f| f.probes));
+            let evaluated = found.is_some_and(|f| f.evaluated);
             let mut words = vec![0u32; marks_words(n)];
             let exact = model.as_ref().filter(|m| m.exact).map(|m| &m.values[..]);
             let marked = match exact {
@@ -366,6 +390,7 @@ impl AdaptiveMarks {
                 marked,
                 gain,
                 error_ratio,
+                evaluated,
                 probes,
             });
         }

@@ -60,10 +60,17 @@ impl AdaptiveReport {
                 l.words.len() * 32
             );
             match (l.error_ratio, self.marks.bound) {
-                (Some(r), Bound::Parseval) => println!(
+                (Some(r), Bound::Parseval) if !l.evaluated => println!(
                     "  error field   at least {:.1} dB below the volume (Parseval's bound on \
-                     eq. 15, no probe transforms)",
-                    -10.0 * r.log10()
+                     eq. 15; {}, none accepted)",
+                    -10.0 * r.log10(),
+                    transforms(l.probes)
+                ),
+                (Some(r), Bound::Parseval) => println!(
+                    "  error field   {:.1} dB below the volume (Parseval's bound on eq. 15, \
+                     raised by {})",
+                    -10.0 * r.log10(),
+                    transforms(l.probes)
                 ),
                 (Some(r), _) => println!(
                     "  error field   {:.1} dB below the volume (exact bound, eq. 15; {} probe \
@@ -98,6 +105,7 @@ impl AdaptiveReport {
                 marked: l.marked,
                 samples: s.per_filter[i + 1],
                 error_field_db: l.error_ratio.map(|r| -10.0 * r.log10()),
+                error_field_evaluated: l.evaluated,
                 probes: l.probes,
             })
             .collect();
@@ -210,6 +218,14 @@ pub(crate) struct AdaptiveJson {
     note: Option<String>,
 }
 
+/// "1 probe transform", "3 probe transforms".
+fn transforms(probes: Option<usize>) -> String {
+    match probes.unwrap_or(0) {
+        1 => "1 probe transform".into(),
+        k => format!("{k} probe transforms"),
+    }
+}
+
 /// One cheaper filter of [`AdaptiveJson`].
 #[derive(Serialize)]
 struct LevelJson {
@@ -219,5 +235,8 @@ struct LevelJson {
     marked: usize,
     samples: u64,
     error_field_db: Option<f64>,
+    /// Whether `error_field_db` was evaluated (else it is a bound: the
+    /// field is at least that far below the volume).
+    error_field_evaluated: bool,
     probes: Option<usize>,
 }

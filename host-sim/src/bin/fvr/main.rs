@@ -231,6 +231,7 @@ fn default_scene() -> Result<(), Error> {
         adaptive_hd: None,
         adaptive_bound: None,
         adaptive_plain_below: fvr_host::render::adaptive::DEFAULT_PLAIN_BELOW,
+        adaptive_probes: fvr_host::render::adaptive::DEFAULT_PROBES,
         preview_level: 0,
         exact: false,
         input: InputArgs::default(),

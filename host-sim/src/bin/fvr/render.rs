@@ -28,6 +28,7 @@ use fvr_host::reference::shaded::exact_scene_projection_sampled;
 use fvr_host::reference::{exact_projection_sampled, snr_db};
 use fvr_host::render::adaptive::{
     parse_chain, parse_percent, parse_tolerance, AdaptiveSettings, Bound, DEFAULT_PLAIN_BELOW,
+    DEFAULT_PROBES,
 };
 use fvr_host::render::shaded::{
     light_ring, negative_cue_share, parse_depth_cue, parse_light, parse_light_ring, parse_rgb,
@@ -127,9 +128,10 @@ pub(crate) struct RenderArgs {
     /// How --adaptive turns decibels into a magnitude threshold: `exact`
     /// measures the error field of eq. 15 (one 3D inverse transform per
     /// candidate threshold, about 8, once per volume); `parseval` bounds
-    /// that field's energy by Parseval's theorem (one transform, a smaller
-    /// threshold; close to `exact` for the zero filter); `paper` uses eq. 16
-    /// with the worst-case response difference h_d (instant, but loose).
+    /// that field's energy by Parseval's theorem (no transform, a smaller
+    /// threshold), then raises it by --adaptive-probes evaluations of the
+    /// field; `paper` uses eq. 16 with the worst-case response difference
+    /// h_d (instant, but loose).
     /// Default: `parseval`, or `paper` when --adaptive-hd is given.
     #[arg(long, value_name = "BOUND", value_parser = Bound::from_name)]
     pub(crate) adaptive_bound: Option<Bound>,
@@ -141,6 +143,12 @@ pub(crate) struct RenderArgs {
     #[arg(long, value_name = "PCT", value_parser = parse_percent,
           default_value_t = 100.0 * DEFAULT_PLAIN_BELOW)]
     pub(crate) adaptive_plain_below: f64,
+    /// With --adaptive-bound parseval: at most N 3D inverse transforms
+    /// (each about one preparation's time) that evaluate the error field
+    /// of eq. 15 above Parseval's threshold and raise the threshold where
+    /// the field allows, for faster views. 0 keeps Parseval's bound alone.
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_PROBES)]
+    pub(crate) adaptive_probes: usize,
     /// Progressive preview level: 0 full resolution; L renders the image at
     /// 1/2^L of the size from the central 1/4^L of the slice (4^L times fewer
     /// interpolations). Plain X-ray views only. (`--level` is the PNG
@@ -329,6 +337,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
                 None => Bound::Parseval,
             }),
             plain_below: args.adaptive_plain_below,
+            probes: args.adaptive_probes,
         };
         let report = adaptive_render(&spectra.density, &view, w, h, &settings)?;
         let gain = sampling.gain() * scene.ambient[0];

@@ -10,6 +10,32 @@ use fvr_core::num::Sample;
 use fvr_core::spectrum::Spectrum;
 use rayon::prelude::*;
 
+/// What a model is built for: [`Probes::None`], Parseval's bound alone
+/// (no field held); [`Probes::Few`], Parseval's bound raised by a few
+/// probes (one field held, the reference from the preparation when
+/// known); [`Probes::Search`], the exact bound's search (the reference
+/// transformed, and its field kept when memory allows).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Probes {
+    None,
+    Few,
+    Search,
+}
+
+/// A threshold and what backs it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Found {
+    /// The magnitude threshold.
+    pub(super) tau: f64,
+    /// The error energy relative to the reference: evaluated, or, when not
+    /// `evaluated`, Parseval's bound on it.
+    pub(super) ratio: f64,
+    /// The probe transforms run.
+    pub(super) probes: usize,
+    /// Whether `ratio` was evaluated.
+    pub(super) evaluated: bool,
+}
+
 /// The spectrum and grid the exact bound works on: the stored samples in
 /// f32 and the large filter's response per signed grid index.
 pub(super) struct ErrorModel {
@@ -48,7 +74,7 @@ impl ErrorModel {
     pub(super) fn new<S: Sample>(
         view: &Spectrum<'_, S>,
         prepared: Option<&PreparedEnergy>,
-        probes: bool,
+        probes: Probes,
     ) -> Result<Self, String> {
         let n = view.n();
         let cells = (n as u64).pow(3);
@@ -64,7 +90,7 @@ impl ErrorModel {
             }
             budget
         };
-        let floor_only = prepared.is_some() && !probes;
+        let floor_only = prepared.is_some() && probes != Probes::Search;
         fields(if floor_only { 1 } else { 2 })
             .check(crate::budget::limit(), "use --adaptive-bound paper")
             .map_err(|e| e.to_string())?;
@@ -102,6 +128,11 @@ impl ErrorModel {
             .and_then(|p| reference_floor(p, n, stored, peak));
         if let (true, Some(floor)) = (floor_only, floor) {
             model.reference = floor;
+            // Room for the probes' field, if the budget allows it; else
+            // Parseval's bound stands alone.
+            if probes == Probes::Few && fields(2).check(crate::budget::limit(), "").is_ok() {
+                model.work = vec![0.0; n * n * n];
+            }
             return Ok(model);
         }
         fields(2)
@@ -244,12 +275,17 @@ impl ErrorModel {
     /// ratio varies slowly with `τ`); the rest bisect. The search starts
     /// from the largest step that Parseval's bound with the weight's peak
     /// accepts without a probe; the energy it returns is always evaluated.
+    ///
+    /// With a `limit` on the probes ([`ErrorModel::raised`]), the search
+    /// stops after that many, and a seed never beaten keeps Parseval's
+    /// bound on its energy instead of an evaluation.
     pub(super) fn threshold(
         &mut self,
         small: &Filter,
         gain: f64,
         budget: f64,
-    ) -> Result<(f64, f64, usize), String> {
+        limit: Option<usize>,
+    ) -> Result<Found, String> {
         let n = self.n;
         let hs = Self::responses(small, n);
         let hl = self.large_response.clone();
@@ -259,7 +295,12 @@ impl ErrorModel {
             large: &hl,
         };
         if self.bins.is_empty() || self.reference <= 0.0 {
-            return Ok((0.0, 0.0, 0));
+            return Ok(Found {
+                tau: 0.0,
+                ratio: 0.0,
+                probes: 0,
+                evaluated: limit.is_none(),
+            });
         }
         // mean(w²) of the separable weight, from per-axis sums of products.
         let axis_mean = |f: &dyn Fn(usize) -> f64| (0..n).map(f).sum::<f64>() / n as f64;
@@ -278,9 +319,17 @@ impl ErrorModel {
         if let Some((b, _)) = seed {
             good = (b, None);
         }
-        let mut scale = 1.0;
+        // Limited, the first probe takes its scale from the every-sample-
+        // weak error energy, which for the zero filter (w = −ĥ₁) is the
+        // reference itself: a guess at where the first probe lands, no
+        // part of the guarantee. The full search starts from the raw
+        // estimate.
+        let mut scale = match limit {
+            Some(_) => self.reference / self.estimate(top, mean_square).max(f64::MIN_POSITIVE),
+            None => 1.0,
+        };
         let mut probes = 0;
-        while bad - good.0 > 1 {
+        while bad - good.0 > 1 && limit.is_none_or(|l| probes < l) {
             let b = if probes < 3 {
                 (good.0 + 1..bad)
                     .rev()
@@ -301,15 +350,48 @@ impl ErrorModel {
                 bad = b;
             }
         }
-        Ok(match good.1 {
-            Some(r) => (tau_of(good.0), r, probes),
-            // The seed, never beaten: its energy, evaluated once.
-            None if seed.is_some() => {
-                let e = self.probe(tau_of(good.0), &weight, budget)?;
-                (tau_of(good.0), e / self.reference, probes + 1)
+        let found = |tau: f64, ratio: f64, probes: usize, evaluated: bool| Found {
+            tau,
+            ratio,
+            probes,
+            evaluated,
+        };
+        Ok(match (good.1, seed) {
+            (Some(r), _) => found(tau_of(good.0), r, probes, true),
+            // The seed, never beaten: Parseval's bound on its energy when
+            // the probes are limited, else its energy, evaluated once.
+            (None, Some((b, e))) if limit.is_some() => {
+                found(tau_of(b), e / self.reference, probes, false)
             }
-            None => (0.0, 0.0, probes),
+            (None, Some(_)) => {
+                let e = self.probe(tau_of(good.0), &weight, budget)?;
+                found(tau_of(good.0), e / self.reference, probes + 1, true)
+            }
+            (None, None) => found(0.0, 0.0, probes, limit.is_none()),
         })
+    }
+
+    /// [`super::Bound::Parseval`] raised by at most `probes` evaluations
+    /// of the error field above Parseval's threshold ([`ErrorModel::threshold`]
+    /// with a limit), when the model holds room for a field; else
+    /// [`ErrorModel::peak_threshold`].
+    pub(super) fn raised(
+        &mut self,
+        small: &Filter,
+        gain: f64,
+        budget: f64,
+        probes: usize,
+    ) -> Result<Found, String> {
+        if probes == 0 || self.work.len() != self.n * self.n * self.n {
+            let (tau, ratio) = self.peak_threshold(small, gain, budget);
+            return Ok(Found {
+                tau,
+                ratio,
+                probes: 0,
+                evaluated: false,
+            });
+        }
+        self.threshold(small, gain, budget, Some(probes))
     }
 }
 
@@ -633,8 +715,10 @@ mod tests {
         fn check<S: FastStore, T: FastReal>(v: &crate::volume::Volume, f: Filter, db: f64) {
             let spec = OwnedSpectrum::<S>::prepare::<T>(v, f).unwrap();
             let view = spec.view();
-            let measured = ErrorModel::new(&view, None, true).unwrap().reference;
-            let floor = ErrorModel::new(&view, spec.prepared_energy(), false)
+            let measured = ErrorModel::new(&view, None, Probes::Search)
+                .unwrap()
+                .reference;
+            let floor = ErrorModel::new(&view, spec.prepared_energy(), Probes::None)
                 .unwrap()
                 .reference;
             let what = format!(
