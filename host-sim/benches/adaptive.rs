@@ -4,10 +4,12 @@
 //! 40 dB: with the exact bound the 1³ filter (`adaptive_40db_nearest`), the
 //! zero filter (`adaptive_40db_zero`) and both (`adaptive_40db_zero_nearest`);
 //! the zero filter with Parseval's bound (`adaptive_40db_zero_parseval`,
-//! `fvr render --adaptive`'s default), also with the large filter's points
-//! summed point by point in the core's arithmetic
-//! (`adaptive_40db_zero_parseval_exact`, [`Walk::Exact`]) instead of by the
-//! strip walk:
+//! `fvr render --adaptive`'s defaults, which also decide per view between
+//! the adaptive and the plain walk), also raised by one probe
+//! (`adaptive_40db_zero_parseval_probe`) and
+//! with the large filter's points summed point by point in the core's
+//! arithmetic (`adaptive_40db_zero_parseval_exact`, [`Walk::Exact`])
+//! instead of by the strip walk:
 //!
 //! - `adaptive_kb3_os2_128`: kb3, oversampling 2, on a 128³ Gaussian
 //!   mixture (f16);
@@ -17,8 +19,9 @@
 //!
 //! each also with the core's single-threaded adaptive extraction of the
 //! 1³ filter (`adaptive_40db_core`); `marks_kb6_256`: the marks at 40 dB
-//! for each chain (`marks_40db_<chain>`) against the preprocessing they follow
-//! (`prepare`), on the same volume; and `breakeven_kb4_256`,
+//! for each chain (`marks_40db_<chain>`, and Parseval's bound raised by
+//! one probe, `marks_40db_zero_parseval_probe`) against the preprocessing
+//! they follow (`prepare`), on the same volume; and `breakeven_kb4_256`,
 //! `breakeven_kb6_256`: the plain view (`plain`) against the adaptive walk
 //! (never the plain fallback) at tolerances that substitute from none to
 //! nearly all of the view's samples (`adaptive_<dB>db_<share>pct`, the
@@ -83,11 +86,17 @@ fn group(c: &mut Criterion, name: &str, volume: &Volume, filter: Filter) {
         })
     });
     for (label, chain, bound) in CHAINS {
+        // `fvr render`'s defaults also decide between the walks per view.
+        let plain_below = match bound {
+            Bound::Parseval => AdaptiveSettings::new(40.0).plain_below,
+            _ => settings.plain_below,
+        };
         let marks = AdaptiveMarks::build(
             &spec,
             &AdaptiveSettings {
                 chain: chain.to_vec(),
                 bound,
+                plain_below,
                 ..settings.clone()
             },
         )
@@ -101,6 +110,25 @@ fn group(c: &mut Criterion, name: &str, volume: &Volume, filter: Filter) {
             })
         });
         if label == "zero_parseval" {
+            let probe_marks = AdaptiveMarks::build(
+                &spec,
+                &AdaptiveSettings {
+                    chain: chain.to_vec(),
+                    bound,
+                    plain_below,
+                    probes: 1,
+                    ..settings.clone()
+                },
+            )
+            .unwrap();
+            let mut probed = AdaptiveRenderer::<f32>::new(&probe_marks, &spec).unwrap();
+            group.bench_function(format!("adaptive_40db_{label}_probe"), |b| {
+                b.iter(|| {
+                    probed
+                        .render_into(&spec, black_box(&view), side, side, &mut out)
+                        .unwrap()
+                })
+            });
             let mut exact = AdaptiveRenderer::<f32>::new(&marks, &spec)
                 .unwrap()
                 .with_walk(Walk::Exact);
@@ -142,6 +170,15 @@ fn marking(c: &mut Criterion, name: &str, volume: &Volume, filter: Filter) {
         group.bench_function(format!("marks_40db_{label}"), |b| {
             b.iter(|| AdaptiveMarks::build(black_box(&spec), &settings).unwrap())
         });
+        if bound == Bound::Parseval {
+            let probe = AdaptiveSettings {
+                probes: 1,
+                ..settings.clone()
+            };
+            group.bench_function(format!("marks_40db_{label}_probe"), |b| {
+                b.iter(|| AdaptiveMarks::build(black_box(&spec), &probe).unwrap())
+            });
+        }
     }
     group.finish();
 }
