@@ -62,9 +62,12 @@ impl AdaptiveReport {
             match (l.error_ratio, self.marks.bound) {
                 (Some(r), Bound::Parseval) if !l.evaluated => println!(
                     "  error field   at least {:.1} dB below the volume (Parseval's bound on \
-                     eq. 15; {}, none accepted)",
+                     eq. 15; {})",
                     -10.0 * r.log10(),
-                    transforms(l.probes)
+                    match l.probes.unwrap_or(0) {
+                        0 => "no probe transforms".to_string(),
+                        _ => format!("{}, none accepted", transforms(l.probes)),
+                    }
                 ),
                 (Some(r), Bound::Parseval) => println!(
                     "  error field   {:.1} dB below the volume (Parseval's bound on eq. 15, \
