@@ -1,7 +1,8 @@
 //! The fast Hartley transforms against direct O(N²) summation in f64.
 
 use fvr_core::dht::{
-    dht, dht_2d, dht_2d_lines, dht_3d, dht_3d_scratch_len, idht, idht_2d, Twiddles,
+    dht, dht_2d, dht_2d_lines, dht_2d_sparse_len, dht_3d, dht_3d_scratch_len, idht, idht_2d,
+    Twiddles,
 };
 use fvr_core::Error;
 use fvr_host::reference::{naive_dht, naive_dht_2d, naive_dht_3d};
@@ -174,37 +175,53 @@ fn batched_2d_dht_matches_naive_and_the_line_path_bit_for_bit() {
 #[test]
 fn square_2d_dht_with_few_nonzero_rows_matches_the_line_path() {
     // From side 128, at most n/4 rows holding a nonzero value take their
-    // row pass one row at a time and the zero rows are skipped; one more
-    // row takes the batched pass. Either way the values are the line
-    // path's bit for bit (a zero only up to its sign).
+    // row pass alone, the zero rows skipped: as the lanes of one batched
+    // transform with `dht_2d_sparse_len(n)` of scratch, else one row at a
+    // time; one more row takes the full batched pass. Either way the
+    // values are the line path's bit for bit (a zero only up to its sign).
     twiddles!(256; tw32: f32);
     for n in [128, 256] {
-        for rows in [1, n / 8, n / 4, n / 4 + 1] {
-            let x = signal(n * n, (n * 7 + rows) as u64);
-            // Rows `0 … a` and `n − b … n − 1` (a slice's low
-            // frequencies on both sides of zero), the rest zero.
-            let (a, b) = (rows.div_ceil(2), rows / 2);
-            let held = |y: usize| y < a || y >= n - b;
-            let x32: Vec<f32> = x
-                .iter()
-                .enumerate()
-                .map(|(i, &v)| if held(i / n) { v as f32 } else { 0.0 })
-                .collect();
-            let mut batched = x32.clone();
-            let mut lines = x32;
-            let mut col = vec![0.0f32; n];
-            dht_2d(&mut batched, n, n, &mut col, &tw32).unwrap();
-            dht_2d_lines(&mut lines, n, n, &mut col, &tw32).unwrap();
-            let mut zeros = 0;
-            for (i, (a, b)) in batched.iter().zip(&lines).enumerate() {
-                match *a == 0.0 {
-                    true => zeros += 1,
-                    false => assert_eq!(a.to_bits(), b.to_bits(), "{n}² with {rows} rows at {i}"),
+        for rows in [1, 2, n / 8, n / 4, n / 4 + 1] {
+            for (scattered, scratch) in [
+                (false, n),
+                (false, dht_2d_sparse_len(n)),
+                (true, dht_2d_sparse_len(n)),
+            ] {
+                let x = signal(n * n, (n * 7 + rows) as u64);
+                // Rows `0 … a` and `n − b … n − 1` (a slice's low
+                // frequencies on both sides of zero), or rows spread over
+                // the array with a zero first value; the rest zero.
+                let (a, b) = (rows.div_ceil(2), rows / 2);
+                let held = |y: usize| match scattered {
+                    false => y < a || y >= n - b,
+                    true => (y * 37 + 5) % n < rows,
+                };
+                let x32: Vec<f32> = x
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &v)| match held(i / n) && !(scattered && i % n == 0) {
+                        true => v as f32,
+                        false => 0.0,
+                    })
+                    .collect();
+                let mut batched = x32.clone();
+                let mut lines = x32;
+                let mut col = vec![0.0f32; scratch];
+                dht_2d(&mut batched, n, n, &mut col, &tw32).unwrap();
+                dht_2d_lines(&mut lines, n, n, &mut col, &tw32).unwrap();
+                let case =
+                    format!("{n}² with {rows} rows (scattered {scattered}, scratch {scratch})");
+                let mut zeros = 0;
+                for (i, (a, b)) in batched.iter().zip(&lines).enumerate() {
+                    match *a == 0.0 {
+                        true => zeros += 1,
+                        false => assert_eq!(a.to_bits(), b.to_bits(), "{case} at {i}"),
+                    }
+                    assert_eq!(a, b, "{case} at {i}");
                 }
-                assert_eq!(a, b, "{n}² with {rows} rows at {i}");
+                // Values that are zero are rare in a transform of noise.
+                assert!(zeros < n, "{case}: {zeros} zeros");
             }
-            // Values that are zero are rare in a transform of noise.
-            assert!(zeros < n, "{n}² with {rows} rows: {zeros} zeros");
         }
     }
 }

@@ -55,7 +55,7 @@ impl<T: Real> Inverse<'_, T> {
     /// The unnormalized 2D DHT of the `m × m` grid in place.
     fn transform(&self, grid: &mut [T], m: usize, aux: &mut [T]) -> Result<()> {
         match self {
-            Inverse::Radix2(tw) => dht_2d(grid, m, m, &mut aux[..m], tw),
+            Inverse::Radix2(tw) => dht_2d(grid, m, m, aux, tw),
             Inverse::Mixed(plan) => {
                 let need = dht_2d_mixed_scratch_len(m, m);
                 require_len("auxiliary scratch (mixed radix)", need, aux.len())?;
@@ -122,7 +122,9 @@ impl Crop {
 /// DHT, then the [`Crop`].
 ///
 /// `grid` needs [`grid_len`]`(m)` elements, `aux` [`aux_len`]`(m)`, `out`
-/// `width·height·channels`.
+/// `width·height·channels`. An `aux` of [`crate::dht::dht_2d_sparse_len`]`(m)` or more
+/// lets a slice with few nonzero rows (an adaptive view's) batch the row
+/// pass of its transform ([`dht_2d`]); the image is the same.
 ///
 /// # Errors
 /// An image side of 0 or above `m`, `channel ≥ channels`, short buffers, or
@@ -196,10 +198,16 @@ pub fn finish_with<T: Real>(
         let gy = row0.wrapping_sub(row) & mask;
         let grid_row = &grid[gy * m..(gy + 1) * m];
         if channels == 1 {
-            // One channel (plain and cued frames): a plain loop over the
-            // row, without the per-pixel chunking of interleaved ones.
-            for (col, o) in line.iter_mut().enumerate() {
-                *o = grid_row[col0.wrapping_add(col) & mask] * g;
+            // One channel (plain and cued frames): the row in at most two
+            // runs of the grid row (the second wrapped round to its
+            // start), each a loop that vectorizes.
+            let start = col0 & mask;
+            let (head, tail) = line.split_at_mut(width.min(m - start));
+            let runs = [(head, &grid_row[start..]), (tail, grid_row)];
+            for (run, from) in runs {
+                for (o, &v) in run.iter_mut().zip(from) {
+                    *o = v * g;
+                }
             }
         } else {
             for (col, o) in line.chunks_exact_mut(channels).enumerate() {

@@ -15,7 +15,7 @@
 //! ([`fast_adaptive::extract_with_strip_if`]; [`fast_adaptive::tally`]
 //! first for the exact walk).
 
-use fvr_core::dht::Twiddles;
+use fvr_core::dht::{dht_2d_sparse_len, Twiddles};
 use fvr_core::filter::KernelTable;
 use fvr_core::geometry::{Sampling, View};
 use fvr_core::image::{aux_len, check_image, finish, placement, placement_on_axes, Crop};
@@ -85,7 +85,9 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
             tables: marks.tables(),
             tw,
             grid: vec![T::ZERO; n * n],
-            aux: vec![T::ZERO; aux_len(n)],
+            // Room for the 2D inverse to batch the row pass of a slice
+            // whose strong samples lie on few rows.
+            aux: vec![T::ZERO; aux_len(n).max(dht_2d_sparse_len(n))],
             along: Vec::new(),
             strong: Vec::new(),
             walk: Walk::default(),
