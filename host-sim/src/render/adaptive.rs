@@ -444,8 +444,8 @@ impl AdaptiveMarks {
         self.levels.first().map(|l| &l.summary)
     }
 
-    /// Bytes of marks held (1 bit per voxel per level, and 1 byte per brick
-    /// of 512 voxels in the summaries).
+    /// Bytes of marks held (1 bit per voxel per level, and in the summaries
+    /// 1 byte per brick of 512 voxels and 6 per brick not held whole).
     pub fn bytes(&self) -> usize {
         self.levels
             .iter()

@@ -36,7 +36,8 @@ use rayon::prelude::*;
 
 use super::fast_slice::{row_interval, supports, tap_sum, Tiling};
 use super::fast_strip;
-use super::marks_summary::{MarksSummary, BRICK};
+use super::marks_summary::MarksSummary;
+use super::partial_spans::PartialSpans;
 
 /// One filter of the chain as the walk applies it.
 #[derive(Clone, Copy)]
@@ -75,11 +76,10 @@ struct Walk<'a, S, T> {
     marks: [Option<Marks<'a>>; MAX_LEVELS],
     /// The bricks the first level's marks hold whole.
     whole: Option<&'a MarksSummary>,
-    /// When the first level is the zero filter, its summary, whose
-    /// distances let runs of points be counted without their marks.
-    zero_runs: Option<&'a MarksSummary>,
-    /// `1/|right_a|` (infinite for 0).
-    inverse_step: [T; 3],
+    /// When the first level is the zero filter, the parts of each row
+    /// that may reach the bricks its marks do not hold whole: the rest of
+    /// the row is counted without settling its points.
+    spans: Option<PartialSpans>,
     raw_gain: T,
     chunk: i32,
     /// Points on the large filter are left at zero for the strip walk
@@ -363,8 +363,12 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
             filters,
             marks,
             whole: whole.filter(|_| !levels.is_empty()),
-            zero_runs: whole.filter(|_| levels.first().is_some_and(|l| l.gain == T::ZERO)),
-            inverse_step: frame.right.map(|r| T::from_f64(1.0 / r.abs())),
+            spans: whole
+                .filter(|_| levels.first().is_some_and(|l| l.gain == T::ZERO))
+                .and_then(|summary| {
+                    let rounded = |v: [f64; 3]| v.map(|c| T::from_f64(c).to_f64());
+                    PartialSpans::new(summary, n, rounded(frame.right), rounded(frame.up))
+                }),
             raw_gain: T::exp2i(T::raw_exponent::<S>()),
             chunk: tiling.chunk.clamp(1, n) as i32,
             defer: false,
@@ -449,30 +453,29 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
     }
 
     /// Points `kx = from … to` of `row`, each as the core computes it. With
-    /// a zero first level, a point whose brick is whole starts a run of
-    /// points that stay among whole bricks, which are only counted (cells
-    /// already zero, no taps).
+    /// a zero first level, only the points in the row's spans (those that
+    /// may reach a brick not held whole) are settled one by one; the others
+    /// are only counted (cells already zero, no taps).
     #[inline(always)]
     fn fill_row(&self, row: &mut Row<'_, T>, from: i32, to: i32, stats: &mut AdaptiveStats) {
-        let summary = match self.zero_runs {
-            Some(summary) => summary,
+        let spans = match &self.spans {
+            Some(spans) => spans.row(row.index),
             None => return self.fill_points(row, from, to, stats),
         };
-        let mask = self.n - 1;
         let mut k = from;
-        while k <= to {
-            let q = self.position(k, row.kyu);
-            let s = q.map(|c| (c + T::HALF).floor_i64());
-            let d = summary.distance(s.map(|c| c as usize & mask));
-            if d == 0 {
-                self.fill_points(row, k, k, stats);
-                k += 1;
+        for &(low, high) in spans {
+            if high < k {
                 continue;
             }
-            let run = self.run(s, i32::from(d)).min(to - k);
-            self.count_zero(row.kyu, k, k + run, stats);
-            k += run + 1;
+            if low > to {
+                break;
+            }
+            self.count_zero(row.kyu, k, low - 1, stats);
+            let end = high.min(to);
+            self.fill_points(row, low.max(k), end, stats);
+            k = end + 1;
         }
+        self.count_zero(row.kyu, k, to, stats);
     }
 
     /// The position `q = kx·right + kyu` of point `kx = k`, in `T` as the
@@ -481,32 +484,6 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
     fn position(&self, k: i32, kyu: [T; 3]) -> [T; 3] {
         let kx = T::from_i32(k);
         core::array::from_fn(|a| kx * self.right[a] + kyu[a])
-    }
-
-    /// How many points past one whose nearest sample is `s`, in a brick at
-    /// distance `d ≥ 1`, certainly have their nearest samples in whole
-    /// bricks. On axis `a` the next points' nearest samples move one way
-    /// (rounding is monotonic), `j` points on by less than `j·|right_a| + 1`
-    /// (the positions' rounding is far below the `0.01` kept), and stay
-    /// among whole bricks up to `8(d − 1)` samples beyond the brick's face.
-    #[inline(always)]
-    fn run(&self, s: [i64; 3], d: i32) -> i32 {
-        let brick = BRICK as i32;
-        let beyond = brick * (d - 1);
-        let mut run = i32::MAX;
-        for a in 0..3 {
-            let offset = (s[a] & (BRICK as i64 - 1)) as i32;
-            let room = match self.right[a] > T::ZERO {
-                true => brick - 1 - offset + beyond,
-                false => offset + beyond,
-            };
-            if self.right[a] != T::ZERO {
-                let j =
-                    ((T::from_i32(room) - T::from_f64(0.01)) * self.inverse_step[a]).floor_i64();
-                run = run.min(j.clamp(0, i32::MAX as i64) as i32);
-            }
-        }
-        run
     }
 
     /// Count points `kx = from … to` of the row at `kyu` inside the cube

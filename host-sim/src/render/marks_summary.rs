@@ -1,23 +1,23 @@
-//! Which bricks of `8³` samples a level's marks hold whole, and how far
-//! each whole brick is from one that is not: one byte per brick (`n³/512`
-//! bytes, 32 KiB at `n = 256`), so that the adaptive walk
+//! Which bricks of `8³` samples a level's marks hold whole: one byte per
+//! brick (`n³/512` bytes, 32 KiB at `n = 256`), so that the adaptive walk
 //! ([`super::fast_adaptive`]) settles most points of a weak spectrum from
-//! a table that stays in cache, skips runs of points that stay among whole
-//! bricks, and reads the marks themselves (`n³/8` bytes, scattered along a
-//! slice) only in the bricks at the edge of the marked region.
+//! a table that stays in cache, and the list of the others, so that it
+//! walks point by point only the parts of a slice's rows that may reach
+//! them ([`super::partial_spans`]) and reads the marks themselves (`n³/8`
+//! bytes, scattered along a slice) only there.
 
 /// Side of a brick, in samples.
 pub const BRICK: usize = 8;
 
-/// The bricks of one level's marks that are marked in every sample, with
-/// their distances to the others.
+/// The bricks of one level's marks that are marked in every sample, and
+/// the others.
 #[derive(Clone, Debug, Default)]
 pub struct MarksSummary {
-    /// Per brick (numbered `bx + m·(by + m·bz)`, `m = n/8`): 0 if some
-    /// sample is not marked, else the Chebyshev distance in bricks, on the
-    /// periodic grid, to the nearest such brick (at most 255, which it
-    /// also is when there is none). Empty where the side is not served.
-    distance: Vec<u8>,
+    /// Per brick (numbered `bx + m·(by + m·bz)`, `m = n/8`): whether every
+    /// sample is marked. Empty where the side is not served.
+    whole: Vec<bool>,
+    /// The bricks not held whole, `[bx, by, bz]` in that order.
+    partial: Vec<[u16; 3]>,
     /// `log₂ m`.
     bits: u32,
 }
@@ -25,85 +25,56 @@ pub struct MarksSummary {
 impl MarksSummary {
     /// The summary of `words`, the marks of a cube of side `n` (sample
     /// `x + n·(y + n·z)` at bit `i mod 32` of word `i/32`). A side that is
-    /// not a power of two of at least [`BRICK`], or too few words, gives a
-    /// summary that holds no brick (the walk then reads every mark).
+    /// not a power of two from [`BRICK`] to `2^16`, or too few words,
+    /// gives a summary that holds no brick (the walk then reads every
+    /// mark).
     pub fn new(words: &[u32], n: usize) -> Self {
-        if !n.is_power_of_two() || n < BRICK || words.len() * 32 < n * n * n {
+        if !n.is_power_of_two() || !(BRICK..=1 << 16).contains(&n) || words.len() * 32 < n * n * n {
             return Self::default();
         }
         let m = n / BRICK;
         // A brick's row of 8 samples along x starts at a multiple of 8: one
         // byte of one word.
         let byte = |i: usize| (words[i / 32] >> (i % 32)) & 0xFF;
-        let mut distance: Vec<u8> = (0..m * m * m)
+        let whole: Vec<bool> = (0..m * m * m)
             .map(|b| {
                 let (bx, by, bz) = (b % m, b / m % m, b / (m * m));
-                let whole = (0..BRICK * BRICK).all(|r| {
+                (0..BRICK * BRICK).all(|r| {
                     let (y, z) = (by * BRICK + r % BRICK, bz * BRICK + r / BRICK);
                     byte(bx * BRICK + n * (y + n * z)) == 0xFF
-                });
-                if whole {
-                    u8::MAX
-                } else {
-                    0
-                }
+                })
             })
             .collect();
-        chebyshev(&mut distance, m);
+        let partial = (0..m * m * m)
+            .filter(|&b| !whole[b])
+            .map(|b| [b % m, b / m % m, b / (m * m)].map(|c| c as u16))
+            .collect();
         Self {
-            distance,
+            whole,
+            partial,
             bits: m.trailing_zeros(),
         }
     }
 
-    /// Whether every sample of the brick holding sample `(x, y, z)` is
-    /// marked (`false` for a summary that serves no side).
+    /// Whether every sample of the brick holding sample `(x, y, z)`
+    /// (indices `0 … n − 1`) is marked (`false` for a summary that serves
+    /// no side).
     #[inline(always)]
-    pub fn holds(&self, at: [usize; 3]) -> bool {
-        self.distance(at) > 0
-    }
-
-    /// 0 if the brick holding sample `(x, y, z)` (indices `0 … n − 1`) is
-    /// not held whole (or the summary serves no side), else `d ≥ 1` such
-    /// that every brick within `d − 1` bricks of it on each axis (the grid
-    /// periodic) is held whole.
-    #[inline(always)]
-    pub fn distance(&self, [x, y, z]: [usize; 3]) -> u8 {
+    pub fn holds(&self, [x, y, z]: [usize; 3]) -> bool {
         let s = BRICK.trailing_zeros();
         let b = (x >> s) | ((y >> s) << self.bits) | ((z >> s) << (2 * self.bits));
-        self.distance.get(b).copied().unwrap_or(0)
+        self.whole.get(b).copied().unwrap_or(false)
+    }
+
+    /// The bricks not held whole (`[bx, by, bz]`, samples `8·b … 8·b + 7`
+    /// on each axis); `None` for a summary that serves no side.
+    pub fn partial(&self) -> Option<&[[u16; 3]]> {
+        (!self.whole.is_empty()).then_some(&self.partial[..])
     }
 
     /// Bytes held.
     pub fn bytes(&self) -> usize {
-        self.distance.len()
-    }
-}
-
-/// Replace each nonzero entry of the periodic `m³` grid `d` (`x` fastest)
-/// by its Chebyshev distance to the nearest zero entry, saturating at 255:
-/// the distance is separable, so one pass per axis, each taking at every
-/// cell the least `max(|Δ|, d)` along its line (`m ≤ 512`: at most `m⁴`
-/// steps a pass).
-fn chebyshev(d: &mut [u8], m: usize) {
-    let mut line = vec![0u8; m];
-    for stride in [1, m, m * m] {
-        for start in 0..m * m * m {
-            // Each line once, from its first cell.
-            if (start / stride) % m != 0 {
-                continue;
-            }
-            for (i, v) in line.iter_mut().enumerate() {
-                *v = d[start + i * stride];
-            }
-            for i in 0..m {
-                let best = (0..m).fold(u8::MAX, |best, j| {
-                    let gap = i.abs_diff(j).min(m - i.abs_diff(j));
-                    best.min(line[j].max(gap.min(255) as u8))
-                });
-                d[start + i * stride] = best;
-            }
-        }
+        self.whole.len() + self.partial.len() * size_of::<[u16; 3]>()
     }
 }
 
@@ -161,67 +132,14 @@ mod tests {
                 whole += usize::from(expected);
             }
             assert!(whole > 0 && whole < total, "n {n}: {whole} of {total}");
-            distances_agree(&summary, n);
-            assert_eq!(summary.bytes(), m * m * m);
+            let partial = summary.partial().unwrap();
+            let unheld: Vec<[u16; 3]> = (0..m * m * m)
+                .filter(|&b| !brick_whole[b])
+                .map(|b| [b % m, b / m % m, b / (m * m)].map(|c| c as u16))
+                .collect();
+            assert_eq!(partial, &unheld[..], "n {n}");
+            assert_eq!(summary.bytes(), m * m * m + 6 * unheld.len());
         }
-    }
-
-    /// The distance of every brick against a search over all bricks: the
-    /// cyclic Chebyshev distance to the nearest brick not held, 0 for those,
-    /// 255 when there is none. Returns how many bricks are at 2 or more.
-    fn distances_agree(summary: &MarksSummary, n: usize) -> usize {
-        let m = n / BRICK;
-        let at = |b: usize| [b % m, b / m % m, b / (m * m)].map(|c| c * BRICK);
-        let unheld: Vec<[usize; 3]> = (0..m * m * m)
-            .map(at)
-            .filter(|&s| !summary.holds(s))
-            .collect();
-        let gap = |a: usize, b: usize| {
-            let d = a.abs_diff(b) / BRICK;
-            d.min(m - d)
-        };
-        let mut far = 0;
-        for b in 0..m * m * m {
-            let s = at(b);
-            let expected = unheld
-                .iter()
-                .map(|u| (0..3).map(|a| gap(s[a], u[a])).max().unwrap_or(0))
-                .min()
-                .map_or(255, |d| d.min(255) as u8);
-            assert_eq!(summary.distance(s), expected, "n {n}, brick at {s:?}");
-            far += usize::from(expected >= 2);
-        }
-        far
-    }
-
-    /// Marks set everywhere but in a few boxes of samples (signed
-    /// coordinates, inclusive, wrapped): the distances of every brick are
-    /// the search's, and without any box every brick is at 255.
-    #[test]
-    fn distances_reach_the_nearest_unheld_brick() {
-        let n = 64usize;
-        let unmarked = |boxes: &[([i32; 3], [i32; 3])]| {
-            let mut words = vec![u32::MAX; (n * n * n).div_ceil(32)];
-            for &(lo, hi) in boxes {
-                for z in lo[2]..=hi[2] {
-                    for y in lo[1]..=hi[1] {
-                        for x in lo[0]..=hi[0] {
-                            let [x, y, z] = [x, y, z].map(|c| c.rem_euclid(n as i32) as usize);
-                            let i = x + n * (y + n * z);
-                            words[i / 32] &= !(1 << (i % 32));
-                        }
-                    }
-                }
-            }
-            MarksSummary::new(&words, n)
-        };
-        let summary = unmarked(&[([-3, -17, 5], [9, -10, 5])]);
-        assert!(distances_agree(&summary, n) > 0);
-        let summary = unmarked(&[([0, 0, 0], [0, 0, 0]), ([32, 1, -20], [32, 1, -20])]);
-        assert!(distances_agree(&summary, n) > 0);
-        let all = unmarked(&[]);
-        assert_eq!(distances_agree(&all, n), (n / BRICK).pow(3));
-        assert_eq!(all.distance([5, 9, 63]), 255);
     }
 
     #[test]
@@ -233,7 +151,7 @@ mod tests {
         ] {
             let summary = MarksSummary::new(&words, n);
             assert!(!summary.holds([0, 0, 0]), "n {n}");
-            assert_eq!(summary.distance([0, 0, 0]), 0, "n {n}");
+            assert!(summary.partial().is_none(), "n {n}");
             assert_eq!(summary.bytes(), 0);
         }
     }

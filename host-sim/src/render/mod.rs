@@ -21,6 +21,7 @@ mod fast_tests;
 pub mod fast_transpose;
 pub mod filter;
 pub mod marks_summary;
+pub mod partial_spans;
 pub mod plan;
 pub mod scene_file;
 pub mod shaded;
