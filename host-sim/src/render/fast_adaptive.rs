@@ -239,16 +239,12 @@ pub fn extract_with_strip_if<S: Sample, T: Real + Send + Sync>(
         return extract(spec, kernel, levels, whole, frame, tiling, parallel, grid)
             .map(Settled::Extracted);
     }
-    let strong = &*strong;
-    let copy = |band: &mut Vec<Row<'_, T>>| {
-        for row in band.iter_mut() {
-            let at = row.index * n;
-            walk.copy_strong(row, &strong[at..at + n]);
-        }
-    };
-    match parallel {
-        true => bands.par_iter_mut().for_each(copy),
-        false => bands.iter_mut().for_each(copy),
+    // On this thread: the strong points are few (about 1,400 on a kb6
+    // view at 40 dB on a 256³ volume), and waking the pool for them cost
+    // more than copying them.
+    for row in bands.iter_mut().flatten() {
+        let at = row.index * n;
+        walk.copy_strong(row, &strong[at..at + n]);
     }
     Some(Settled::Extracted(stats))
 }
