@@ -101,6 +101,12 @@ impl PartialSpans {
         Some(Self { at, spans })
     }
 
+    /// Points in all the spans.
+    pub fn points(&self) -> usize {
+        let length = |&(from, to): &(i32, i32)| (to - from) as usize + 1;
+        self.spans.iter().map(length).sum()
+    }
+
     /// The spans of row `index` (`ky mod n`); none for a row out of range.
     #[inline]
     pub fn row(&self, index: usize) -> &[(i32, i32)] {
