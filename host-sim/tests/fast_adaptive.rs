@@ -220,8 +220,9 @@ fn points_among_whole_zero_bricks_are_counted_as_the_core_walks_them() {
         let marks = AdaptiveMarks::build(&spec, &settings).unwrap();
         let partial = marks.summary().unwrap().partial().unwrap().len();
         let m = n / 8;
+        // Few enough for the walk to take spans (at most 2m²).
         assert!(
-            partial > 0 && partial < m * m * m / 2,
+            partial > 0 && partial <= 2 * m * m,
             "{partial} bricks not whole"
         );
         for dir in DIRECTIONS {

@@ -34,10 +34,17 @@ pub struct PartialSpans {
 impl PartialSpans {
     /// The spans of the `n × n` slice with axes `right` and `up` (as the
     /// walk rounds them), row `ky mod n` holding frequency `ky`, against
-    /// `summary`'s bricks; `None` where the summary serves no side or the
-    /// axes span no plane.
+    /// `summary`'s bricks; `None` where the summary serves no side, the
+    /// axes span no plane, or more bricks than a slice can cross (`2m²` of
+    /// the `m³`, `m = n/8`; a plane crosses at most `√3·m²`) are not held
+    /// whole: then the spans would cost more than settling every point (a
+    /// CT head's marks at 40 dB).
     pub fn new(summary: &MarksSummary, n: usize, right: [f64; 3], up: [f64; 3]) -> Option<Self> {
         let partial = summary.partial()?;
+        let m = n / BRICK;
+        if partial.len() > 2 * m * m {
+            return None;
+        }
         let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
         let (rr, ru, uu) = (dot(right, right), dot(right, up), dot(up, up));
         let det = rr * uu - ru * ru;
@@ -239,15 +246,20 @@ mod tests {
     }
 
     /// A summary of a side it does not serve gives no spans, nor do axes
-    /// that span no plane.
+    /// that span no plane, nor marks that hold too few bricks whole.
     #[test]
     fn no_spans_without_bricks_or_plane() {
         let words = vec![u32::MAX; 64];
         let unserved = MarksSummary::new(&words, 12);
         assert!(PartialSpans::new(&unserved, 12, [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]).is_none());
-        let served = MarksSummary::new(&[0u32; 16 * 16 * 16 / 32], 16);
-        assert!(PartialSpans::new(&served, 16, [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]).is_none());
-        assert!(PartialSpans::new(&served, 16, [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]).is_some());
+        let mut words = [u32::MAX; 32 * 32 * 32 / 32];
+        words[5] = 0;
+        let served = MarksSummary::new(&words, 32);
+        assert!(PartialSpans::new(&served, 32, [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]).is_none());
+        assert!(PartialSpans::new(&served, 32, [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]).is_some());
+        // Every brick not held whole: more than a slice can cross.
+        let none = MarksSummary::new(&[0u32; 32 * 32 * 32 / 32], 32);
+        assert!(PartialSpans::new(&none, 32, [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]).is_none());
     }
 
     fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
