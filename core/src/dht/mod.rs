@@ -23,6 +23,7 @@ pub mod fixed;
 mod line;
 pub mod mixed;
 mod plane;
+mod sparse;
 mod store;
 mod twiddles;
 
@@ -33,7 +34,8 @@ pub use mixed::{
     dht_3d_mixed_store, dht_mixed, fast_len, idht_mixed, is_fast_len, mixed_scratch_len,
     mixed_table_len, MixedPlan,
 };
-pub use plane::{dht_2d, dht_2d_lines, dht_2d_sparse_len, idht_2d};
+pub use plane::{dht_2d, dht_2d_lines, idht_2d};
+pub use sparse::dht_2d_sparse_len;
 pub use store::{Elements, LineBlocks, LineStore, Pass};
 pub use twiddles::Twiddles;
 

@@ -3,6 +3,7 @@
 
 use super::line::butterfly_pair;
 use super::line::{dht_unchecked, for_each_bit_reversed_swap};
+use super::sparse::sparse_rows;
 use super::Twiddles;
 use crate::error::{check_len, require_len, Result};
 use crate::num::Real;
@@ -26,7 +27,7 @@ use crate::num::Real;
 /// nonzero values lie on at most a quarter of its rows (an adaptive view's
 /// slice) transforms only those rows in its row pass: batched, as the
 /// lanes of one column transform in `column`, when `column` holds
-/// [`dht_2d_sparse_len`] elements, else one by one.
+/// [`dht_2d_sparse_len`](super::dht_2d_sparse_len) elements, else one by one.
 ///
 /// # Errors
 /// A side not a power of two or longer than the table, a `data` length other
@@ -61,71 +62,6 @@ pub fn dht_2d<T: Real>(
         hao_bracewell_2d(data, nx, ny);
     }
     Ok(())
-}
-
-/// At most one row in this many holding a nonzero value, [`dht_2d`]'s
-/// row pass of a square array from side 128 transforms only those rows.
-const SPARSE_ROWS: usize = 4;
-
-/// Scratch elements (`column`) with which [`dht_2d`] batches the row pass
-/// of an `n × n` array with few nonzero rows: its nonzero rows, at most
-/// `n / 4`, as the lanes of one `n`-point column transform.
-pub const fn dht_2d_sparse_len(n: usize) -> usize {
-    n * (n / SPARSE_ROWS)
-}
-
-/// The row pass of an `n × n` array whose nonzero values lie on at most
-/// `n / SPARSE_ROWS` rows (an adaptive view's slice, whose weak samples are
-/// left at zero): those rows transformed, the others left as they are
-/// (the transform of zeros is zero, up to the sign of zero), instead of
-/// every row between two transposes. With `n·k` elements of `scratch` for
-/// the `k` rows, they go there as the lanes of an `n × k` array for the
-/// batched column transform, and back; else each is transformed on its
-/// own. `false`, and nothing done, for more rows. The values are the
-/// batched pass's bit for bit, as [`dht_2d`] says.
-#[inline]
-fn sparse_rows<T: Real>(data: &mut [T], n: usize, scratch: &mut [T], tw: &Twiddles<'_, T>) -> bool {
-    // A whole-row test without early exit: the compare and OR vectorize.
-    let nonzero = |row: &[T]| row.iter().fold(false, |any, &v| any | (v != T::ZERO));
-    let k = data.chunks_exact(n).filter(|row| nonzero(row));
-    let k = k.take(n / SPARSE_ROWS + 1).count();
-    if k > n / SPARSE_ROWS {
-        return false;
-    }
-    let Some(lanes) = scratch.get_mut(..n * k).filter(|_| k > 1) else {
-        for row in data.chunks_exact_mut(n).filter(|row| nonzero(row)) {
-            dht_unchecked(row, tw);
-        }
-        return true;
-    };
-    // Rows go to lanes and back a tile at a time, so each lane row (`k`
-    // values) is written in runs of `TILE`, not one value per cache line.
-    const TILE: usize = 8;
-    let mut rows = data.chunks_exact_mut(n).filter(|row| nonzero(row));
-    for j in (0..k).step_by(TILE) {
-        let mut tile: heapless::Vec<&mut [T], TILE> = rows.by_ref().take(TILE).collect();
-        for (x, lane) in lanes.chunks_exact_mut(k).enumerate() {
-            for (v, row) in lane[j..].iter_mut().zip(&tile) {
-                *v = row[x];
-            }
-        }
-        // Row 0 marks the rows taken (their values are in `lanes`), so
-        // the way back finds them without testing whole rows again.
-        for row in &mut tile {
-            row[0] = T::ONE;
-        }
-    }
-    dht_columns(lanes, k, n, tw);
-    let mut rows = data.chunks_exact_mut(n).filter(|row| row[0] != T::ZERO);
-    for j in (0..k).step_by(TILE) {
-        let mut tile: heapless::Vec<&mut [T], TILE> = rows.by_ref().take(TILE).collect();
-        for (x, lane) in lanes.chunks_exact(k).enumerate() {
-            for (v, row) in lane[j..].iter().zip(&mut tile) {
-                row[x] = *v;
-            }
-        }
-    }
-    true
 }
 
 /// The square path of [`dht_2d`] for `4 ≤ n < 128`. (Compiling it once per
@@ -473,7 +409,7 @@ fn bit_reverse_rows<T>(data: &mut [T], nx: usize, ny: usize) {
 /// cached hosts, where the four-row butterfly loops vectorize and the
 /// radix-2² kernels (eight rows, six twiddles) run out of SIMD registers.
 #[inline]
-fn dht_columns<T: Real>(data: &mut [T], nx: usize, ny: usize, tw: &Twiddles<'_, T>) {
+pub(super) fn dht_columns<T: Real>(data: &mut [T], nx: usize, ny: usize, tw: &Twiddles<'_, T>) {
     bit_reverse_rows(data, nx, ny);
     let mut m = 1;
     while m < ny {
