@@ -258,7 +258,7 @@ fn make_tables(out: &Path) -> Vec<Made> {
     let n = padded_size(DIMS, OVERSAMPLE).expect("phantom size");
 
     // |∇f| of the samples, in f64 and rounded to f32, as the host's
-    // `fvr_host::render::shaded::gradient_volume` makes it; only if a stored
+    // `fvr_engine::render::shaded::gradient_volume` makes it; only if a stored
     // spectrum needs it.
     let gradient_voxels: Option<Vec<f32>> = STORED
         .iter()

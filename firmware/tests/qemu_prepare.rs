@@ -14,6 +14,8 @@
 use std::path::Path;
 
 use fvr_core::f16;
+use fvr_engine::spectrum::{AnySpectrum, OwnedSpectrum};
+use fvr_engine::volume::Volume;
 use fvr_firmware::frame::InstructionClock;
 use fvr_firmware::prepare::{
     fnv1a_f16, prepare_and_render, scratch_len, spectrum_len, view_lens, PrepBuffers, PrepInput,
@@ -23,8 +25,6 @@ use fvr_firmware::scene::VIEW;
 use fvr_firmware::stored::twiddles;
 use fvr_host::io::nrrd::parse_nrrd;
 use fvr_host::reference::snr_db;
-use fvr_host::render::spectrum::{AnySpectrum, OwnedSpectrum};
-use fvr_host::volume::Volume;
 
 /// The unit roundoff of f16.
 const U: f64 = 1.0 / 2048.0;

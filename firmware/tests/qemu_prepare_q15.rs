@@ -28,6 +28,8 @@ use std::path::Path;
 use fvr_core::f16;
 use fvr_core::num::Q15;
 use fvr_core::slice::fixed::FixedPhases;
+use fvr_engine::spectrum::{AnySpectrum, OwnedSpectrum};
+use fvr_engine::volume::Volume;
 use fvr_firmware::frame::InstructionClock;
 use fvr_firmware::prepare::{PrepInput, PREP_32, PREP_64};
 use fvr_firmware::prepare_q15::{
@@ -36,8 +38,6 @@ use fvr_firmware::prepare_q15::{
 };
 use fvr_firmware::scene::VIEW;
 use fvr_host::reference::snr_db;
-use fvr_host::render::spectrum::{AnySpectrum, OwnedSpectrum};
-use fvr_host::volume::Volume;
 
 /// The goal of the integer view against the f64 pipeline.
 const VIEW_GOAL_DB: f64 = 40.0;

@@ -13,6 +13,9 @@ use fvr_core::filter::{DerivativeTable, Filter, FilterKind, KernelTable};
 use fvr_core::shading::ViewPlan;
 use fvr_core::spectrum::Spectrum;
 use fvr_core::volume::DenseVolume;
+use fvr_engine::render::shaded::{gradient_volume, SceneSpectra};
+use fvr_engine::spectrum::{AnySpectrum, Precision, Preparation};
+use fvr_engine::volume::Volume;
 use fvr_firmware::frame::{
     check_linked_tables, render_frame, tables_for, FrameBuffers, FrameError, InstructionClock,
     Split, AUX_LEN, IMAGE_LEN,
@@ -26,9 +29,6 @@ use fvr_firmware::stored::{
     all, all_derivatives, twiddles, DENSITY_KB3, DENSITY_KB4, DENSITY_KB6, DERIVATIVE_KB3,
     GRADIENT_KB3,
 };
-use fvr_host::render::shaded::{gradient_volume, SceneSpectra};
-use fvr_host::render::spectrum::{AnySpectrum, Precision, Preparation};
-use fvr_host::volume::Volume;
 use std::cell::Cell;
 
 /// A clock that advances by one per reading, so counts are positive and

@@ -1,6 +1,6 @@
 //! What every volume-reader fuzz target asserts of an accepted file.
 
-use fvr_host::volume::Volume;
+use fvr_engine::volume::Volume;
 
 /// An accepted file gives a consistent volume: as many samples as the
 /// sizes claim, finite samples, and finite, positive spacing. A refused file

@@ -36,12 +36,13 @@ use std::hint::black_box;
 use criterion::{criterion_group, criterion_main, Criterion};
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
-use fvr_host::render::adaptive::{AdaptiveMarks, AdaptiveSettings, Bound, Cheaper};
-use fvr_host::render::adaptive_view::AdaptiveRenderer;
-use fvr_host::render::spectrum::{OwnedSpectrum, ViewRenderer};
-use fvr_host::render::view::Walk;
-use fvr_host::sources::phantom::{sample, GaussianMixture};
-use fvr_host::volume::Volume;
+use fvr_engine::render::adaptive::AdaptiveRenderer;
+use fvr_engine::render::view::ViewRenderer;
+use fvr_engine::render::view::Walk;
+use fvr_engine::slice::adaptive::{AdaptiveMarks, AdaptiveSettings, Bound, Cheaper};
+use fvr_engine::spectrum::OwnedSpectrum;
+use fvr_engine::volume::phantom::{sample, GaussianMixture};
+use fvr_engine::volume::Volume;
 use half::f16;
 
 /// The chains compared, each with its bound: the 1³ filter, the zero

@@ -11,9 +11,9 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
 use fvr_core::shading::{DepthCue, Scene};
-use fvr_host::render::shaded::{gradient_volume, light_ring, SceneRenderer, TypedSpectra};
-use fvr_host::render::spectrum::OwnedSpectrum;
-use fvr_host::sources::phantom::{sample, GaussianMixture};
+use fvr_engine::render::shaded::{gradient_volume, light_ring, SceneRenderer, TypedSpectra};
+use fvr_engine::spectrum::OwnedSpectrum;
+use fvr_engine::volume::phantom::{sample, GaussianMixture};
 use half::f16;
 
 fn scenes(view: &View) -> Vec<(&'static str, Scene)> {

@@ -16,12 +16,14 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use fvr_core::filter::FilterKind;
 use fvr_core::geometry::View;
 use fvr_core::volume::GridOversampling;
+use fvr_engine::plan::filter::KbDesign;
+use fvr_engine::plan::{grid_filter, image_side, AXIS_VIEWS};
+use fvr_engine::render::view::ViewRenderer;
+use fvr_engine::spectrum::OwnedSpectrum;
+use fvr_engine::volume::Volume;
 use fvr_host::reference::axis::axis_projection;
 use fvr_host::reference::snr_db;
-use fvr_host::render::plan::{grid_filter, image_side, AXIS_VIEWS};
-use fvr_host::render::spectrum::{KbDesign, OwnedSpectrum, ViewRenderer};
 use fvr_host::sources::datasets::load_dataset;
-use fvr_host::volume::Volume;
 use half::f16;
 
 /// Filter and grid: 2× padding with kb4, then the mixed-radix grids with

@@ -14,7 +14,7 @@ use std::hint::black_box;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use fvr_core::dht::{mixed_table_len, MixedPlan, Twiddles};
 use fvr_core::image::{aux_len, finish_with, Crop, Inverse, Placement};
-use fvr_host::render::fast_inverse::{finish_threaded, MixedFinish};
+use fvr_engine::image::inverse::{finish_threaded, MixedFinish};
 
 /// Image side, as the CT head's default view.
 const IMAGE: usize = 256;

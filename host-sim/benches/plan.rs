@@ -1,4 +1,4 @@
-//! Criterion benchmarks of the accuracy planner (`fvr_host::render::plan`),
+//! Criterion benchmarks of the accuracy planner (`fvr_engine::plan`),
 //! beside the preparation of the spectrum it plans for (its peer: the
 //! planner runs before it, on every `fvr render` and `fvr turntable`):
 //!
@@ -18,10 +18,11 @@ use std::hint::black_box;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use fvr_core::filter::FilterKind;
 use fvr_core::volume::GridOversampling;
-use fvr_host::render::plan::{
+use fvr_engine::plan::filter::KbDesign;
+use fvr_engine::plan::{
     choose_among, grid_filter, predict_grid, Candidate, Constraints, ALL_GRIDS,
 };
-use fvr_host::render::spectrum::{AnySpectrum, KbDesign, Precision};
+use fvr_engine::spectrum::{AnySpectrum, Precision};
 use fvr_host::sources::load_volume;
 
 fn benches(c: &mut Criterion) {

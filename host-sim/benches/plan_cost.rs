@@ -1,5 +1,5 @@
 //! The per-view cost the accuracy planner compares
-//! (`fvr_host::render::plan::cost_grid`), measured: CPU time per view on
+//! (`fvr_engine::plan::cost_grid`), measured: CPU time per view on
 //! one thread (the thread's own user + system time, so a loaded machine
 //! counts little) for each candidate filter × grid on a real head, over an
 //! orbit of views, and the least-squares fit of the model
@@ -10,7 +10,7 @@
 //! `Cranium.inv3` (`bash scripts/fetch-ct-head.sh`), else `brainsmall`.
 //!
 //! Beside each whole view, the slice extraction alone
-//! (`fvr_host::render::fast_slice::extract` on one thread, the rest of
+//! (`fvr_engine::slice::exact::extract` on one thread, the rest of
 //! the view being the 2D inverse transform and the crop).
 //!
 //! Run: `FVR_CT_HEAD=$(bash scripts/fetch-ct-head.sh) cargo bench -p fvr-host --bench plan_cost`
@@ -21,10 +21,12 @@ use std::hint::black_box;
 use fvr_core::filter::KernelTable;
 use fvr_core::geometry::Sampling;
 use fvr_core::volume::GridOversampling;
-use fvr_host::render::fast_slice::{self, Tiling};
-use fvr_host::render::plan::{grid_filter, image_side, ALL_GRIDS, CANDIDATE_FILTERS};
-use fvr_host::render::spectrum::{KbDesign, OwnedSpectrum, ViewRenderer};
-use fvr_host::render::turntable::orbit;
+use fvr_engine::plan::filter::KbDesign;
+use fvr_engine::plan::{grid_filter, image_side, ALL_GRIDS, CANDIDATE_FILTERS};
+use fvr_engine::render::turntable::orbit;
+use fvr_engine::render::view::ViewRenderer;
+use fvr_engine::slice::exact::{self, Tiling};
+use fvr_engine::spectrum::OwnedSpectrum;
 use fvr_host::sources::datasets::load_dataset;
 use half::f16;
 
@@ -124,7 +126,7 @@ fn main() {
             let start = thread_cpu_ms();
             for a in &axes {
                 let (spec, tiling) = (spec.view(), Tiling::default());
-                assert!(fast_slice::extract(
+                assert!(exact::extract(
                     &spec,
                     &kernel,
                     black_box(a),

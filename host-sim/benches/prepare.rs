@@ -9,8 +9,8 @@ use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use fvr_core::filter::{Filter, FilterKind};
-use fvr_host::render::spectrum::OwnedSpectrum;
-use fvr_host::sources::phantom::{sample, GaussianMixture};
+use fvr_engine::spectrum::OwnedSpectrum;
+use fvr_engine::volume::phantom::{sample, GaussianMixture};
 use half::f16;
 
 fn benches(c: &mut Criterion) {

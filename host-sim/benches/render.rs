@@ -9,8 +9,9 @@ use std::hint::black_box;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
-use fvr_host::render::spectrum::{OwnedSpectrum, ViewRenderer};
-use fvr_host::sources::phantom::{sample, GaussianMixture};
+use fvr_engine::render::view::ViewRenderer;
+use fvr_engine::spectrum::OwnedSpectrum;
+use fvr_engine::volume::phantom::{sample, GaussianMixture};
 use half::f16;
 
 fn benches(c: &mut Criterion) {

@@ -1,5 +1,5 @@
 //! Criterion benchmarks of one view at 256³ (f16): the host extraction
-//! (`fvr_host::render::fast_slice`, on all cores and on one) against the
+//! (`fvr_engine::slice::exact`, on all cores and on one) against the
 //! core's single-threaded render, for kb4 and kb6, along an axis, an
 //! oblique direction and an orbit direction (45° in the xy-plane, the
 //! turntable's slowest); and kb4 at 128³ and 512³ on the oblique
@@ -15,10 +15,11 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
 use fvr_core::render::Request;
-use fvr_host::render::fast_slice::Tiling;
-use fvr_host::render::spectrum::{OwnedSpectrum, ViewRenderer};
-use fvr_host::render::view::render_once;
-use fvr_host::sources::phantom::{sample, GaussianMixture};
+use fvr_engine::render::view::render_once;
+use fvr_engine::render::view::ViewRenderer;
+use fvr_engine::slice::exact::Tiling;
+use fvr_engine::spectrum::OwnedSpectrum;
+use fvr_engine::volume::phantom::{sample, GaussianMixture};
 use half::f16;
 
 fn tiling() -> Tiling {

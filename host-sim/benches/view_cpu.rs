@@ -1,9 +1,9 @@
 //! CPU time per view on one thread (the thread's own user + system time
 //! from `/proc/thread-self/stat`, so time the thread spends waiting for a
 //! core shared with other processes is not counted): the host extraction
-//! (`fvr_host::render::fast_column` where the slice contains an axis,
-//! `fvr_host::render::fast_strip` where its rows hold a coordinate, the
-//! exact walk `fvr_host::render::fast_slice` beside it; and each walk's
+//! (`fvr_engine::slice::column` where the slice contains an axis,
+//! `fvr_engine::slice::strip` where its rows hold a coordinate, the
+//! exact walk `fvr_engine::slice::exact` beside it; and each walk's
 //! slice alone, the strip walk also on the exchanged copy for rows along y)
 //! against the core's render, at 256³
 //! f16, kb4 and kb6, along an axis, an oblique direction and the orbit
@@ -18,7 +18,7 @@
 //! `FVR_BENCH_DIRS="x,y,z;x,y,z"` replaces the three directions.
 //! `FVR_BENCH_BRICKS=4x4x4,8x4x4` times the slice alone instead, from the
 //! linear spectrum and from bricked copies of it
-//! (`fvr_host::render::fast_bricks`), alternating, one thread.
+//! (`fvr_engine::spectrum::bricks`), alternating, one thread.
 //! `FVR_BENCH_AHEAD=0,8` times whole views instead, on renderers that
 //! prefetch that many lines ahead (`Tiling::ahead`), alternating, one
 //! thread.
@@ -29,13 +29,14 @@ use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::{Sampling, View};
 use fvr_core::render::Request;
 use fvr_core::volume::GridOversampling;
-use fvr_host::render::fast_bricks::Bricked;
-use fvr_host::render::fast_slice::{extract, extract_bricked, Tiling};
-use fvr_host::render::fast_transpose::{exchanged, rows_along_y};
-use fvr_host::render::spectrum::{OwnedSpectrum, ViewRenderer};
-use fvr_host::render::view::{render_once, Walk};
-use fvr_host::render::{fast_column, fast_strip};
-use fvr_host::sources::phantom::{sample, GaussianMixture};
+use fvr_engine::render::view::ViewRenderer;
+use fvr_engine::render::view::{render_once, Walk};
+use fvr_engine::slice::exact::{extract, extract_bricked, Tiling};
+use fvr_engine::slice::{column, strip};
+use fvr_engine::spectrum::bricks::Bricked;
+use fvr_engine::spectrum::exchange::{exchanged, rows_along_y};
+use fvr_engine::spectrum::OwnedSpectrum;
+use fvr_engine::volume::phantom::{sample, GaussianMixture};
 use half::f16;
 
 /// This thread's user + system time in ms (clock ticks of 10 ms).
@@ -166,7 +167,7 @@ fn slice_walks(spec: &OwnedSpectrum<f16>, view: &View, tiling: Tiling, views: us
     };
     let along = std::cell::RefCell::new(Vec::new());
     let column = time(&|g| {
-        fast_column::extract(
+        column::extract(
             &spec,
             &kernel,
             &axes,
@@ -176,14 +177,14 @@ fn slice_walks(spec: &OwnedSpectrum<f16>, view: &View, tiling: Tiling, views: us
             &mut along.borrow_mut(),
         )
     });
-    let strip = time(&|g| fast_strip::extract(&spec, &kernel, &axes, tiling, false, g));
+    let strip = time(&|g| strip::extract(&spec, &kernel, &axes, tiling, false, g));
     // Built before the timing, on all cores, where the memory limit holds it.
     let swapped = owned.exchanged_xy().filter(|_| rows_along_y(&axes));
     let swapped_axes = exchanged(&axes);
     let exchanged = time(&|g| {
-        swapped.as_ref().is_some_and(|s| {
-            fast_strip::extract_exchanged(s, &kernel, &swapped_axes, tiling, false, g)
-        })
+        swapped
+            .as_ref()
+            .is_some_and(|s| strip::extract_exchanged(s, &kernel, &swapped_axes, tiling, false, g))
     });
     let exact = time(&|g| extract(&spec, &kernel, &axes, tiling, false, g));
     format!("column {column}  strip {strip}  exchanged {exchanged}  exact {exact}")

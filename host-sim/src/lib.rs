@@ -13,10 +13,10 @@
 pub mod budget;
 pub mod image;
 pub mod io;
+pub mod options;
 pub mod progress;
 pub mod reference;
-pub mod render;
+pub mod scene_file;
 pub mod sources;
 pub mod studies;
 pub mod text;
-pub mod volume;

@@ -2,19 +2,20 @@
 //! (`AdaptiveMarks::plain_below`): marks that substitute too little give
 //! the full filter's image bit for bit and say so; marks that substitute
 //! enough keep the adaptive walk; the count that decides
-//! (`fast_adaptive::tally`) is the adaptive walk's own.
+//! (`walk::tally`) is the adaptive walk's own.
 
 mod common;
 use common::{assert_ok, fvr, temp_dir};
 
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::View;
-use fvr_host::render::adaptive::{AdaptiveMarks, AdaptiveSettings};
-use fvr_host::render::adaptive_view::{AdaptiveRenderer, Walked};
-use fvr_host::render::fast_adaptive::{extract, tally};
-use fvr_host::render::fast_slice::Tiling;
-use fvr_host::render::spectrum::{AnySpectrum, OwnedSpectrum, ViewRenderer};
-use fvr_host::sources::phantom::{sample, GaussianMixture};
+use fvr_engine::render::adaptive::{AdaptiveRenderer, Walked};
+use fvr_engine::render::view::ViewRenderer;
+use fvr_engine::slice::adaptive::walk::{extract, tally};
+use fvr_engine::slice::adaptive::{AdaptiveMarks, AdaptiveSettings};
+use fvr_engine::slice::exact::Tiling;
+use fvr_engine::spectrum::{AnySpectrum, OwnedSpectrum};
+use fvr_engine::volume::phantom::{sample, GaussianMixture};
 use half::f16;
 
 const DIRECTIONS: [[f64; 3]; 3] = [[1.0, 0.3, 0.2], [0.0, -1.0, 0.0], [-0.4, 0.7, -0.6]];

@@ -8,9 +8,9 @@ use common::{assert_error, assert_ok, fvr, fvr_line, temp_dir};
 use std::path::Path;
 
 use fvr_core::geometry::{Sampling, View};
+use fvr_engine::volume::phantom::{sample_spaced, GaussianMixture};
 use fvr_host::io::nrrd::read_nrrd;
 use fvr_host::reference::{exact_projection_sampled, snr_db};
-use fvr_host::sources::phantom::{sample_spaced, GaussianMixture};
 
 const SPACING: [f64; 3] = [0.8, 0.8, 1.5];
 /// 33 × 1.5 = 49.5 mm ≤ 64 × 0.8: the default pixel size is the smallest

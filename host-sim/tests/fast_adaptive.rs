@@ -1,4 +1,4 @@
-//! The host's adaptive extraction (`fvr_host::render::fast_adaptive`)
+//! The host's adaptive extraction (`fvr_engine::slice::adaptive::walk`)
 //! against the core's (`fvr_core::slice::adaptive::extract_slice_adaptive`):
 //! the same slice bit for bit and the same statistics, for chains of one
 //! and two cheaper filters, f16 and f32 storage, f32 and f64 arithmetic,
@@ -16,18 +16,18 @@ use fvr_core::geometry::View;
 use fvr_core::image::{aux_len, finish, placement, Crop};
 use fvr_core::num::{Real, Sample};
 use fvr_core::slice::adaptive::{extract_slice_adaptive, AdaptiveStats};
-use fvr_host::render::adaptive::{AdaptiveMarks, AdaptiveSettings, Bound, Cheaper};
-use fvr_host::render::adaptive_view::AdaptiveRenderer;
-use fvr_host::render::fast_adaptive::{
+use fvr_engine::render::adaptive::AdaptiveRenderer;
+use fvr_engine::render::view::Walk;
+use fvr_engine::slice::adaptive::summary::MarksSummary;
+use fvr_engine::slice::adaptive::walk::{
     extract, extract_with_strip, extract_with_strip_if, Settled,
 };
-use fvr_host::render::fast_slice::Tiling;
-use fvr_host::render::fast_strip;
-use fvr_host::render::marks_summary::MarksSummary;
-use fvr_host::render::spectrum::OwnedSpectrum;
-use fvr_host::render::view::Walk;
-use fvr_host::sources::phantom::{sample, GaussianMixture};
-use fvr_host::volume::Volume;
+use fvr_engine::slice::adaptive::{AdaptiveMarks, AdaptiveSettings, Bound, Cheaper};
+use fvr_engine::slice::exact::Tiling;
+use fvr_engine::slice::strip;
+use fvr_engine::spectrum::OwnedSpectrum;
+use fvr_engine::volume::phantom::{sample, GaussianMixture};
+use fvr_engine::volume::Volume;
 use half::f16;
 
 const DIRECTIONS: [[f64; 3]; 5] = [
@@ -411,7 +411,7 @@ fn strip_walk_sums_the_large_filters_points_and_nothing_else() {
                 extract_slice_adaptive(&view_spec, &kernel, &levels, &frame, &mut core).unwrap();
             let mut plain = vec![0f32; n * n];
             let tiling = Tiling::default();
-            assert!(fast_strip::extract(
+            assert!(strip::extract(
                 &view_spec, &kernel, &axes, tiling, true, &mut plain
             ));
             let large = core_stats.per_filter[0] as usize;

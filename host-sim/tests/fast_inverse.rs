@@ -8,7 +8,7 @@
 use fvr_core::dht::{dht_2d_mixed, dht_2d_mixed_scratch_len, mixed_table_len, MixedPlan, Twiddles};
 use fvr_core::image::{aux_len, finish_with, Crop, Inverse, Placement};
 use fvr_core::num::Real;
-use fvr_host::render::fast_inverse::{finish_threaded, MixedFinish};
+use fvr_engine::image::inverse::{finish_threaded, MixedFinish};
 
 /// A fixed-seed pseudo-random grid in [−0.5, 0.5), with the rows of a
 /// weak slice: every fourth row from row 2 `+0` (its mirror too, where `m`

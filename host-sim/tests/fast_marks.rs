@@ -1,10 +1,10 @@
-//! The host's marking (`fvr_host::render::fast_marks::mark`) against the
+//! The host's marking (`fvr_engine::slice::adaptive::marks::mark`) against the
 //! core's (`fvr_core::slice::adaptive::mark`): the same words and count,
 //! for sides served by the word-wide erosion (32, 64) and one that goes to
 //! the core (16), radii from 0 to beyond half the side.
 
 use fvr_core::slice::adaptive::{mark as core_mark, marks_words};
-use fvr_host::render::fast_marks::mark;
+use fvr_engine::slice::adaptive::marks::mark;
 
 /// A smooth field with noise (fixed-seed LCG), so that the erosion keeps
 /// some samples and removes others.

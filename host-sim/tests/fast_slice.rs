@@ -1,4 +1,4 @@
-//! The host extraction (`fvr_host::render::fast_slice`) against the
+//! The host extraction (`fvr_engine::slice::exact`) against the
 //! core's (`fvr_core::slice::extract_slice_rows`): the same slice bit for
 //! bit, for every filter width, f16 and f32 storage, f32 and f64
 //! arithmetic, axis-aligned, oblique and wrap-heavy directions (slices
@@ -6,7 +6,7 @@
 //! runs straddle x = n − 1 → 0), physical-unit axes that are not
 //! orthonormal, and every tiling and thread split; on power-of-two and
 //! on mixed-radix sides; from the linear spectrum and from bricked
-//! copies of it (`fvr_host::render::fast_bricks`).
+//! copies of it (`fvr_engine::spectrum::bricks`).
 
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::{Sampling, SliceAxes, View};
@@ -14,11 +14,12 @@ use fvr_core::num::{Real, Sample};
 use fvr_core::render::Request;
 use fvr_core::slice::extract_slice_rows;
 use fvr_core::volume::GridOversampling;
-use fvr_host::render::fast_bricks::Bricked;
-use fvr_host::render::fast_slice::{extract, extract_bricked, supports, Tiling};
-use fvr_host::render::spectrum::{OwnedSpectrum, ViewRenderer};
-use fvr_host::render::view::{render_once, Walk};
-use fvr_host::volume::Volume;
+use fvr_engine::render::view::ViewRenderer;
+use fvr_engine::render::view::{render_once, Walk};
+use fvr_engine::slice::exact::{extract, extract_bricked, supports, Tiling};
+use fvr_engine::spectrum::bricks::Bricked;
+use fvr_engine::spectrum::OwnedSpectrum;
+use fvr_engine::volume::Volume;
 use half::f16;
 
 /// Uniform values in `[−0.5, 1.5)` from a fixed-seed LCG: white noise, so

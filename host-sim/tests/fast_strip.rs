@@ -1,5 +1,5 @@
-//! The strip walk (`fvr_host::render::fast_strip`) and the column walk
-//! (`fvr_host::render::fast_column`) against the core's extraction
+//! The strip walk (`fvr_engine::slice::strip`) and the column walk
+//! (`fvr_engine::slice::column`) against the core's extraction
 //! (`fvr_core::slice::extract_slice_rows`): the same slice to within the
 //! rounding of two sums of the same `W³` products,
 //! `|walk − core| ≤ 2·γ·Σ|w·c|` at every point, `Σ|w·c|` being the
@@ -19,15 +19,16 @@ use fvr_core::render::Request;
 use fvr_core::slice::extract_slice_rows;
 use fvr_core::spectrum::Spectrum;
 use fvr_core::volume::GridOversampling;
-use fvr_host::render::fast_column::{self, column_axis};
-use fvr_host::render::fast_slice::Tiling;
-use fvr_host::render::fast_strip::{self, held_axis};
-use fvr_host::render::fast_transpose::{exchange_xy, exchanged, rows_along_y};
-use fvr_host::render::spectrum::{OwnedSpectrum, ViewRenderer};
-use fvr_host::render::turntable::orbit;
-use fvr_host::render::view::{render_once, Walk};
-use fvr_host::sources::phantom::{sample, GaussianMixture};
-use fvr_host::volume::Volume;
+use fvr_engine::render::turntable::orbit;
+use fvr_engine::render::view::ViewRenderer;
+use fvr_engine::render::view::{render_once, Walk};
+use fvr_engine::slice::column::{self, column_axis};
+use fvr_engine::slice::exact::Tiling;
+use fvr_engine::slice::strip::{self, held_axis};
+use fvr_engine::spectrum::exchange::{exchange_xy, exchanged, rows_along_y};
+use fvr_engine::spectrum::OwnedSpectrum;
+use fvr_engine::volume::phantom::{sample, GaussianMixture};
+use fvr_engine::volume::Volume;
 use half::f16;
 
 /// Uniform values in `[−1, 1)` from a fixed-seed LCG: white noise, so the
@@ -123,7 +124,7 @@ enum Fast {
     Strip,
     Column,
     /// The strip walk on the spectrum with x and y exchanged, with the
-    /// axes exchanged to match (`fvr_host::render::fast_transpose`): also
+    /// axes exchanged to match (`fvr_engine::spectrum::exchange`): also
     /// checked bit for bit against the strip walk on the spectrum itself.
     Exchanged,
 }
@@ -139,9 +140,9 @@ impl Fast {
     ) -> bool {
         let tiling = Tiling::default();
         match self {
-            Self::Strip => fast_strip::extract(spec, kernel, axes, tiling, parallel, grid),
+            Self::Strip => strip::extract(spec, kernel, axes, tiling, parallel, grid),
             Self::Column => {
-                fast_column::extract(spec, kernel, axes, tiling, parallel, grid, &mut Vec::new())
+                column::extract(spec, kernel, axes, tiling, parallel, grid, &mut Vec::new())
             }
             Self::Exchanged => {
                 let n = spec.n();
@@ -152,10 +153,10 @@ impl Fast {
                         .unwrap();
                 let axes = exchanged(axes);
                 let done =
-                    fast_strip::extract_exchanged(&swapped, kernel, &axes, tiling, parallel, grid);
+                    strip::extract_exchanged(&swapped, kernel, &axes, tiling, parallel, grid);
                 // Summed as the strip walk sums on the spectrum itself.
                 let mut linear = vec![T::from_f64(3.0); grid.len()];
-                assert!(fast_strip::extract(
+                assert!(strip::extract(
                     spec,
                     kernel,
                     &exchanged(&axes),
@@ -494,13 +495,13 @@ fn prefetching_leaves_every_value_unchanged() {
         let column = Sampling::UNIT.slice_axes(&View::along([1.0, -0.3, 0.0]).frame().unwrap());
         let walks: [(&str, &Walker); 3] = [
             ("strip", &|t, p, g| {
-                fast_strip::extract(&view, &kernel, &strip, t, p, g)
+                strip::extract(&view, &kernel, &strip, t, p, g)
             }),
             ("exchanged", &|t, p, g| {
-                fast_strip::extract_exchanged(&swapped, &kernel, &exchanged(&strip), t, p, g)
+                strip::extract_exchanged(&swapped, &kernel, &exchanged(&strip), t, p, g)
             }),
             ("column", &|t, p, g| {
-                fast_column::extract(&view, &kernel, &column, t, p, g, &mut Vec::new())
+                column::extract(&view, &kernel, &column, t, p, g, &mut Vec::new())
             }),
         ];
         for (what, walk) in walks {

@@ -4,6 +4,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use fvr_engine::volume::{check_spacing, Volume, DEFAULT_SPACING};
 use fvr_host::io::den::{encode_den, parse_den, HEADER_BYTES as DEN_HEADER};
 use fvr_host::io::inv3::{encode_archive, encode_inv3_i16, main_plist_text, parse_inv3};
 use fvr_host::io::nifti::{encode_nifti_f32, offsets, parse_nifti, read_nifti};
@@ -11,7 +12,6 @@ use fvr_host::io::nrrd::Encoding::Raw;
 use fvr_host::io::nrrd::{encode_nrrd, parse_nrrd, read_nrrd, Endian, IoError, SampleType};
 use fvr_host::io::{detect, read_volume, Format};
 use fvr_host::sources::datasets::{BRAINSMALL_DEN_GZ, BRAINSMALL_DIMS};
-use fvr_host::volume::{check_spacing, Volume, DEFAULT_SPACING};
 
 fn temp_dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("fvr-formats-{name}-{}", std::process::id()));

@@ -10,10 +10,12 @@ use fvr_core::render::{render, Buffers, Request, Source};
 use fvr_core::spectrum::Spectrum;
 use fvr_core::volume::{check_side, GridOversampling};
 use fvr_core::Error;
+use fvr_engine::plan::filter::KbDesign;
+use fvr_engine::plan::grid_filter;
+use fvr_engine::render::view::ViewRenderer;
+use fvr_engine::render::view::Walk;
+use fvr_engine::spectrum::{AnySpectrum, OwnedSpectrum, Precision};
 use fvr_host::reference::{exact_projection, snr_db};
-use fvr_host::render::plan::grid_filter;
-use fvr_host::render::spectrum::{AnySpectrum, KbDesign, OwnedSpectrum, Precision, ViewRenderer};
-use fvr_host::render::view::Walk;
 use fvr_host::sources::phantom_by_name;
 
 #[test]
@@ -75,7 +77,7 @@ fn mixed_grids_image_as_well_as_two_fold_padding() {
         let views = [
             View::along([1.0, 0.3, 0.2]),
             View::along([-0.4, 1.0, 0.7]),
-            fvr_host::render::plan::AXIS_VIEWS[2],
+            fvr_engine::plan::AXIS_VIEWS[2],
         ];
         let measure = |grid: GridOversampling| -> Vec<f64> {
             let filter = grid_filter(volume, FilterKind::Kb6, grid, KbDesign::Auto).unwrap();
@@ -134,7 +136,7 @@ fn threads_levels_and_one_shot_agree_on_mixed_sides() {
         out.iter().map(|v| v.to_f64()).collect::<Vec<f64>>()
     };
     let once =
-        fvr_host::render::view::render_once::<_, f32>(&spec.view(), &Request::new(view, 48, 48))
+        fvr_engine::render::view::render_once::<_, f32>(&spec.view(), &Request::new(view, 48, 48))
             .unwrap();
     // The exact walk keeps the core's bits on any thread count.
     let exact = render(1, Walk::Exact);
@@ -187,9 +189,9 @@ fn scenes_refuse_mixed_sides_by_name() {
     let scene = fvr_core::shading::Scene::default();
     let request = Request {
         scene: Some(&scene),
-        ..Request::new(fvr_host::render::plan::AXIS_VIEWS[2], 32, 32)
+        ..Request::new(fvr_engine::plan::AXIS_VIEWS[2], 32, 32)
     };
-    let err = fvr_host::render::view::render_once::<_, f32>(&s.view(), &request).unwrap_err();
+    let err = fvr_engine::render::view::render_once::<_, f32>(&s.view(), &request).unwrap_err();
     assert!(
         err.to_string().contains("mixed-radix grid"),
         "scene on a mixed side: {err}"
@@ -225,8 +227,8 @@ fn scenes_refuse_mixed_sides_by_name() {
 #[test]
 #[ignore = "needs FVR_CT_HEAD; prints the CT head's mixed-grid candidates"]
 fn ct_head_on_mixed_grids() {
+    use fvr_engine::plan::{image_side, predict_grid, Candidate, AXIS_VIEWS};
     use fvr_host::reference::axis::axis_projection;
-    use fvr_host::render::plan::{image_side, predict_grid, Candidate, AXIS_VIEWS};
     let ct = fvr_host::sources::datasets::load_dataset("ct-head")
         .unwrap()
         .unwrap()
@@ -234,7 +236,7 @@ fn ct_head_on_mixed_grids() {
         .unwrap();
     // Even sizes put the axis views' pixels on voxels.
     let dims = ct.dims.map(|d| d - d % 2);
-    let mut volume = fvr_host::volume::Volume::zeros(dims);
+    let mut volume = fvr_engine::volume::Volume::zeros(dims);
     for k in 0..dims[2] {
         for j in 0..dims[1] {
             for i in 0..dims[0] {

@@ -4,13 +4,12 @@ use std::path::{Path, PathBuf};
 
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::Sampling;
+use fvr_engine::render::turntable::{orbit, render_views};
+use fvr_engine::spectrum::{AnySpectrum, Precision};
+use fvr_engine::volume::phantom::{sample, GaussianMixture};
 use fvr_host::image::output::{
     percentile_range, write_apng, write_png, Bits, Colormap, Style, Window,
 };
-use fvr_host::render::spectrum::{AnySpectrum, Precision};
-use fvr_host::render::turntable::{orbit, render_views};
-use fvr_host::sources::phantom::{sample, GaussianMixture};
-use indicatif::ProgressBar;
 
 fn temp_dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("fvr-output-{name}-{}", std::process::id()));
@@ -241,9 +240,12 @@ fn turntable_frames_equal_single_renders_of_the_same_views() {
     let views = orbit([1.0, 0.3, 0.2], [0.0, 0.0, 1.0], 6).unwrap();
     for precision in [Precision::F16, Precision::F64] {
         let spec = AnySpectrum::prepare(&volume, filter, precision).unwrap();
-        let bar = ProgressBar::hidden();
-        let frames = render_views(&spec, &views, &Sampling::UNIT, 32, 24, &bar).unwrap();
-        assert_eq!(bar.position(), 6);
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        let progress = || {
+            done.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        };
+        let frames = render_views(&spec, &views, &Sampling::UNIT, 32, 24, &progress).unwrap();
+        assert_eq!(done.into_inner(), 6);
         for (view, frame) in views.iter().zip(&frames) {
             assert_eq!(frame, &spec.render(view, 32, 24).unwrap(), "{precision}");
         }

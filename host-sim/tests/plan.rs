@@ -10,17 +10,17 @@
 
 use fvr_core::filter::FilterKind;
 use fvr_core::volume::GridOversampling;
-use fvr_host::reference::axis::axis_projection;
-use fvr_host::reference::snr_db;
-use fvr_host::render::filter::KbDesign;
-use fvr_host::render::plan::{
+use fvr_engine::plan::filter::KbDesign;
+use fvr_engine::plan::{
     choose, choose_among, cost_grid, grid_filter, image_side, predict_grid, Candidate, Constraints,
     ALL_GRIDS, AXIS_VIEWS, MARGIN_DB,
 };
-use fvr_host::render::spectrum::{AnySpectrum, Precision};
+use fvr_engine::spectrum::{AnySpectrum, Precision};
+use fvr_engine::volume::Volume;
+use fvr_host::reference::axis::axis_projection;
+use fvr_host::reference::snr_db;
 use fvr_host::sources::datasets::load_dataset;
 use fvr_host::sources::phantom_by_name;
-use fvr_host::volume::Volume;
 
 /// Never optimistic by more than this (dB).
 const OPTIMISM_LIMIT_DB: f64 = 3.0;
@@ -253,7 +253,7 @@ fn the_walk_chooses_as_predicting_every_candidate_does() {
         // by cost, ties in that order.
         let mut all = Vec::new();
         for grid in ALL_GRIDS {
-            for filter in fvr_host::render::plan::CANDIDATE_FILTERS {
+            for filter in fvr_engine::plan::CANDIDATE_FILTERS {
                 for precision in [Precision::F16, Precision::F32] {
                     let c = Candidate {
                         filter,

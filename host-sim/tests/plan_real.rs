@@ -18,17 +18,17 @@
 use fvr_core::filter::FilterKind;
 use fvr_core::geometry::View;
 use fvr_core::volume::GridOversampling;
-use fvr_host::reference::axis::axis_projection;
-use fvr_host::reference::slice_dft::slice_dft_projection;
-use fvr_host::reference::snr_db;
-use fvr_host::render::filter::KbDesign;
-use fvr_host::render::plan::{
+use fvr_engine::plan::filter::KbDesign;
+use fvr_engine::plan::{
     choose, choose_among, grid_filter, image_side, predict_grid, Candidate, Constraints, ALL_GRIDS,
     AXIS_VIEWS,
 };
-use fvr_host::render::spectrum::{AnySpectrum, Precision};
+use fvr_engine::spectrum::{AnySpectrum, Precision};
+use fvr_engine::volume::Volume;
+use fvr_host::reference::axis::axis_projection;
+use fvr_host::reference::slice_dft::slice_dft_projection;
+use fvr_host::reference::snr_db;
 use fvr_host::sources::datasets::{ct_head_path, load_dataset, MRI_HEAD_ENV};
-use fvr_host::volume::Volume;
 
 /// Never optimistic by more than this (dB).
 const OPTIMISM_LIMIT_DB: f64 = 3.0;

@@ -156,7 +156,7 @@ fn example_scenes_parse_and_render() {
     scenes.sort();
     assert!(scenes.len() >= 4, "{scenes:?}");
     for path in &scenes {
-        let scene = fvr_host::render::scene_file::SceneFile::load(path)
+        let scene = fvr_host::scene_file::SceneFile::load(path)
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let spec = scene
             .volume

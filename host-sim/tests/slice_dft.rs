@@ -8,14 +8,14 @@
 use fvr_core::filter::FilterKind;
 use fvr_core::geometry::View;
 use fvr_core::volume::{padded_size, GridOversampling};
+use fvr_engine::plan::filter::KbDesign;
+use fvr_engine::plan::{grid_filter, predict_grid, Candidate, AXIS_VIEWS};
+use fvr_engine::spectrum::{AnySpectrum, Precision};
+use fvr_engine::volume::Volume;
 use fvr_host::reference::axis::axis_projection;
 use fvr_host::reference::slice_dft::slice_dft_projection;
 use fvr_host::reference::{ideal_projection, max_abs_error, snr_db};
-use fvr_host::render::filter::KbDesign;
-use fvr_host::render::plan::{grid_filter, predict_grid, Candidate, AXIS_VIEWS};
-use fvr_host::render::spectrum::{AnySpectrum, Precision};
 use fvr_host::sources::datasets::load_dataset;
-use fvr_host::volume::Volume;
 
 /// Uniform noise in [0, 1) (fixed seed): every frequency present, content
 /// at every face.

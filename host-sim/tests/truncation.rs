@@ -4,13 +4,13 @@
 
 use std::io::Write;
 
+use fvr_engine::volume::Volume;
 use fvr_host::io::den::{encode_den, parse_den};
 use fvr_host::io::dicom::{parse_slice, CtSlice};
 use fvr_host::io::inv3::{encode_inv3_i16, parse_inv3};
 use fvr_host::io::nifti::{encode_nifti_f32, parse_nifti};
 use fvr_host::io::nrrd::IoError;
 use fvr_host::io::nrrd::{encode_nrrd, parse_nrrd, Encoding, Endian, Endian::Little, SampleType};
-use fvr_host::volume::Volume;
 
 fn gzip(bytes: &[u8]) -> Vec<u8> {
     let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());

@@ -2,10 +2,10 @@
 //! the setup they share.
 
 use fvr_core::filter::{Filter, FilterKind};
-use fvr_host::render::fast_dht::FastReal;
-use fvr_host::render::fast_store::FastStore;
-use fvr_host::render::spectrum::OwnedSpectrum;
-use fvr_host::sources::phantom::{sample, GaussianMixture};
+use fvr_engine::dht::real_fft::FastReal;
+use fvr_engine::dht::store::FastStore;
+use fvr_engine::spectrum::OwnedSpectrum;
+use fvr_engine::volume::phantom::{sample, GaussianMixture};
 
 /// A random Gaussian mixture (`GaussianMixture::random(seed, n, count)`)
 /// sampled on `dims`, prepared for `kind` at `oversample` in storage `S`

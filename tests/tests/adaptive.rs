@@ -4,12 +4,11 @@
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
 use fvr_core::slice::adaptive::{mark, marks_words, threshold_for, Marks};
+use fvr_engine::slice::adaptive::{AdaptiveMarks, AdaptiveSettings, Bound, Cheaper};
+use fvr_engine::spectrum::{AnySpectrum, OwnedSpectrum};
+use fvr_engine::volume::phantom::{sample, GaussianMixture, SheppLogan};
+use fvr_host::options::{parse_chain, parse_tolerance};
 use fvr_host::reference::snr_db;
-use fvr_host::render::adaptive::{
-    parse_chain, parse_tolerance, AdaptiveMarks, AdaptiveSettings, Bound, Cheaper,
-};
-use fvr_host::render::spectrum::{AnySpectrum, OwnedSpectrum};
-use fvr_host::sources::phantom::{sample, GaussianMixture, SheppLogan};
 use fvr_tests::mixture_spectrum;
 use half::f16;
 

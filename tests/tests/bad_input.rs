@@ -6,9 +6,9 @@ use fvr_core::geometry::View;
 use fvr_core::spectrum::{prepare_scratch_len, Spectrum};
 use fvr_core::volume::DenseVolume;
 use fvr_core::Error;
+use fvr_engine::spectrum::{AnySpectrum, OwnedSpectrum, Precision};
+use fvr_engine::volume::Volume;
 use fvr_host::reference::snr_db;
-use fvr_host::render::spectrum::{AnySpectrum, OwnedSpectrum, Precision};
-use fvr_host::volume::Volume;
 use half::f16;
 
 /// Prepare `vol` into an f16 spectrum of `storage` elements with tables
@@ -131,8 +131,8 @@ fn ill_conditioned_premultiplication_is_flagged() {
         "the flag is not a false alarm: {measured:.1} dB"
     );
 
-    let phantom = fvr_host::sources::phantom::GaussianMixture::random(1, n, 8);
-    let volume = fvr_host::sources::phantom::sample(&phantom, [n, n, n]);
+    let phantom = fvr_engine::volume::phantom::GaussianMixture::random(1, n, 8);
+    let volume = fvr_engine::volume::phantom::sample(&phantom, [n, n, n]);
     let sum: f64 = volume.data.iter().map(|&v| v as f64).sum();
     let spec = AnySpectrum::prepare(&volume, filter, Precision::F16).unwrap();
     assert!(spec.storage_snr_estimate_db(sum) > 70.0);

@@ -6,8 +6,8 @@ use fvr_core::filter::{DerivativeTable, Filter, FilterKind, TABLE_RESOLUTION};
 use fvr_core::shading::gradient::{gradient_magnitude, gradient_scratch_len};
 use fvr_core::shading::{CueTerms, DepthCue};
 use fvr_core::volume::DenseVolume;
+use fvr_engine::volume::phantom::{sample, Gaussian, Phantom};
 use fvr_host::reference::snr_db;
-use fvr_host::sources::phantom::{sample, Gaussian, Phantom};
 
 /// `k'` in closed form against central differences of `k` (step 1e-5:
 /// truncation ≈ h²/6·|k'''| ≈ 1e-9, rounding ≈ ε/h ≈ 2e-11), away from the

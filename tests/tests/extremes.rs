@@ -15,12 +15,12 @@ use fvr_core::geometry::View;
 use fvr_core::num::Sample;
 use fvr_core::num::{Arithmetic, BlockLayout, Blocking, Format, FormatName};
 use fvr_core::spectrum::{premultiplier_table, scale_for_target};
-use fvr_host::reference::snr_db;
-use fvr_host::render::spectrum::{
+use fvr_engine::plan::filter::{
     choose_filter, choose_oversampling, premultiplication_gain_db, KbDesign, CONDITIONING_LIMIT_DB,
 };
+use fvr_engine::volume::Volume;
+use fvr_host::reference::snr_db;
 use fvr_host::studies::precision::{measure_extremes, ExtremeRow, Subject};
-use fvr_host::volume::Volume;
 
 const N: usize = 32;
 const LINE: Blocking = Blocking::Blocks(BlockLayout::Line);
@@ -125,7 +125,7 @@ fn constant_volume_projects_to_c_times_n_along_an_axis_up_to_kb4_aliasing_in_f64
     let volume = Volume {
         dims: [N; 3],
         data: vec![c; N * N * N],
-        spacing: fvr_host::volume::DEFAULT_SPACING,
+        spacing: fvr_engine::volume::DEFAULT_SPACING,
     };
     assert_eq!(
         choose_oversampling(&volume, FilterKind::Kb4, KbDesign::Auto),
@@ -292,7 +292,7 @@ fn full_range_u16_volume_at_512_cubed_cannot_overflow_any_format_by_the_scaling_
 #[test]
 fn volume_scaled_by_2_pow_minus_20_is_bit_identical_and_by_1e_minus_6_or_1e_minus_30_keeps_its_floor(
 ) {
-    use fvr_host::sources::phantom::{sample, GaussianMixture};
+    use fvr_engine::volume::phantom::{sample, GaussianMixture};
     let base = sample(&GaussianMixture::random(1, N, 8), [N; 3]);
     let filter = choose_filter(&base, FilterKind::Kb4, 1, KbDesign::Auto).unwrap();
     let views: Vec<View> = fvr_host::studies::precision::VIEWS
@@ -312,7 +312,7 @@ fn volume_scaled_by_2_pow_minus_20_is_bit_identical_and_by_1e_minus_6_or_1e_minu
         let scaled = Volume {
             dims: base.dims,
             data: base.data.iter().map(|v| v * factor).collect(),
-            spacing: fvr_host::volume::DEFAULT_SPACING,
+            spacing: fvr_engine::volume::DEFAULT_SPACING,
         };
         let mut b = Subject::new("scaled", scaled, None, filter, views.clone());
         let (rb, _) = b.render_format(Format::F64, Arithmetic::PerPass).unwrap();
@@ -359,7 +359,7 @@ fn hounsfield_units_fill_the_box_and_need_oversampling_2_mixed_sign_gaussians_do
         .all(|r| r.gain_db > CONDITIONING_LIMIT_DB && r.oversample == 2));
     assert_floors(&hu);
 
-    use fvr_host::sources::phantom::{sample, GaussianMixture};
+    use fvr_engine::volume::phantom::{sample, GaussianMixture};
     let mut mix = GaussianMixture::random(3, N, 8);
     for (i, g) in mix.components.iter_mut().enumerate() {
         if i % 2 == 1 {
@@ -410,7 +410,7 @@ fn hounsfield_units_fill_the_box_and_need_oversampling_2_mixed_sign_gaussians_do
 /// the f32 rounding of the weights).
 #[test]
 fn views_1e_minus_7_rad_off_an_axis_or_diagonal_are_continuous_in_every_format() {
-    use fvr_host::sources::phantom::{sample, GaussianMixture};
+    use fvr_engine::volume::phantom::{sample, GaussianMixture};
     let phantom = GaussianMixture::random(1, N, 8);
     let volume = sample(&phantom, [N; 3]);
     let filter = choose_filter(&volume, FilterKind::Kb4, 1, KbDesign::Auto).unwrap();
@@ -452,7 +452,7 @@ fn views_1e_minus_7_rad_off_an_axis_or_diagonal_are_continuous_in_every_format()
 /// f64), and auto picks 2.
 #[test]
 fn sizes_1_2_and_4_work_in_every_format() {
-    use fvr_host::sources::phantom::SplitMix64;
+    use fvr_engine::volume::phantom::SplitMix64;
     let mut rng = SplitMix64::new(11);
     for n in [1usize, 2, 4] {
         let volume = Volume {
@@ -460,7 +460,7 @@ fn sizes_1_2_and_4_work_in_every_format() {
             data: (0..n * n * n)
                 .map(|_| rng.next_f64() as f32 + 0.5)
                 .collect(),
-            spacing: fvr_host::volume::DEFAULT_SPACING,
+            spacing: fvr_engine::volume::DEFAULT_SPACING,
         };
         for o in [1u32, 2] {
             let filter = choose_filter(&volume, FilterKind::Kb4, o, KbDesign::Auto).unwrap();

@@ -9,8 +9,8 @@ use fvr_core::image::{aux_len, grid_len};
 use fvr_core::render::{render, Buffers, Request, Source};
 use fvr_core::spectrum::{CubeSide, Spectrum};
 use fvr_core::Error;
-use fvr_host::render::spectrum::OwnedSpectrum;
-use fvr_host::sources::phantom::{sample, GaussianMixture};
+use fvr_engine::spectrum::OwnedSpectrum;
+use fvr_engine::volume::phantom::{sample, GaussianMixture};
 use fvr_tests::mixture_spectrum;
 use half::f16;
 

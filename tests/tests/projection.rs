@@ -4,9 +4,10 @@
 
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
+use fvr_engine::plan::filter::{choose_filter, KbDesign};
+use fvr_engine::spectrum::{AnySpectrum, Precision};
+use fvr_engine::volume::phantom::{sample, Gaussian, GaussianMixture};
 use fvr_host::reference::{exact_projection, ideal_projection, snr_db, spatial_projection};
-use fvr_host::render::spectrum::{choose_filter, AnySpectrum, KbDesign, Precision};
-use fvr_host::sources::phantom::{sample, Gaussian, GaussianMixture};
 use fvr_host::studies::accuracy::{measure, CONFIGS};
 
 /// The README floors, at 64³ and 128³, on all three views.

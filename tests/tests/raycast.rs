@@ -1,9 +1,9 @@
 //! The spatial-domain peer ray caster: correct before it is fast.
 
 use fvr_core::geometry::View;
+use fvr_engine::volume::phantom::{sample, GaussianMixture};
 use fvr_host::reference::raycast::RayCaster;
 use fvr_host::reference::{exact_projection, snr_db, spatial_projection};
-use fvr_host::sources::phantom::{sample, GaussianMixture};
 
 /// Against the f64 trilinear ray integrator at a fine step, the f32 caster
 /// at the same step differs only by f32 accumulation (≈ 2⁻²⁴·√samples) and

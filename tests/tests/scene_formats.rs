@@ -11,9 +11,9 @@ use fvr_core::render::{render, Buffers, Request, Source};
 use fvr_core::shading::fields_len;
 use fvr_core::shading::{DepthCue, Scene};
 use fvr_core::spectrum::Spectrum;
+use fvr_engine::render::shaded::gradient_volume;
+use fvr_engine::volume::phantom::{sample, GaussianMixture};
 use fvr_host::reference::snr_db;
-use fvr_host::render::shaded::gradient_volume;
-use fvr_host::sources::phantom::{sample, GaussianMixture};
 use fvr_host::studies::precision::StoredSpectrum;
 
 fn render_scene<S: fvr_core::num::Sample>(

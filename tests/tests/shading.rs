@@ -11,11 +11,12 @@ use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
 use fvr_core::shading::{DepthCue, Light, Scene, MAX_LIGHTS};
 use fvr_core::Error;
+use fvr_engine::plan::filter::{choose_filter, KbDesign};
+use fvr_engine::render::shaded::{SceneRenderer, SceneSpectra};
+use fvr_engine::spectrum::{AnySpectrum, Precision};
+use fvr_engine::volume::phantom::{sample, Gaussian, GaussianMixture};
 use fvr_host::reference::shaded::{exact_scene_projection, spatial_scene_projection};
 use fvr_host::reference::snr_db;
-use fvr_host::render::shaded::{SceneRenderer, SceneSpectra};
-use fvr_host::render::spectrum::{choose_filter, AnySpectrum, KbDesign, Precision};
-use fvr_host::sources::phantom::{sample, Gaussian, GaussianMixture};
 
 const N: usize = 64;
 /// Simpson step for the numerically integrated `|∇f|` term (voxels):

@@ -5,8 +5,9 @@ use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::View;
 use fvr_core::slice::{extract_slice, extract_slice_rows};
 use fvr_core::Error;
-use fvr_host::render::spectrum::{OwnedSpectrum, ViewRenderer};
-use fvr_host::sources::phantom::{sample, GaussianMixture};
+use fvr_engine::render::view::ViewRenderer;
+use fvr_engine::spectrum::OwnedSpectrum;
+use fvr_engine::volume::phantom::{sample, GaussianMixture};
 use fvr_tests::mixture_spectrum;
 use half::f16;
 

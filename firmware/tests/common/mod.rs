@@ -7,11 +7,11 @@ use fvr_core::geometry::{center, Frame};
 use fvr_core::image::{aux_len, grid_len};
 use fvr_core::render::{render, Buffers, Request, Source};
 use fvr_core::shading::fields_len;
+use fvr_engine::volume::phantom::{Gaussian, GaussianMixture, Phantom};
 use fvr_firmware::frame::{tables_for, FrameTables};
 use fvr_firmware::scene::{Blob, FrameSpec, Shading, BLOBS, DIMS, IMAGE_SIDE};
 use fvr_firmware::stored::{all, all_derivatives, twiddles};
 use fvr_host::reference::shaded::exact_scene_projection;
-use fvr_host::sources::phantom::{Gaussian, GaussianMixture, Phantom};
 
 /// Simpson step (voxels) of the exact references' numerically integrated
 /// `|∇f|` term, as in tests/tests/shading.rs: for Gaussians of σ ≥ 1.8

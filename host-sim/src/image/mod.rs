@@ -28,38 +28,27 @@ pub fn to_gray8(pixels: &[f64], window: (f64, f64)) -> Vec<u8> {
         .collect()
 }
 
-/// An image of 1 (grey) or 3 (RGB) interleaved channels, row 0 at the top.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Image {
-    /// Channels per pixel.
-    pub channels: usize,
-    /// Width in pixels.
-    pub width: usize,
-    /// Height in pixels.
-    pub height: usize,
-    /// `data[(row·width + col)·channels + c]`.
-    pub data: Vec<f64>,
-}
+pub use fvr_engine::image::Image;
 
-impl Image {
-    /// Channel `c` as its own `width × height` image.
-    pub fn channel(&self, c: usize) -> Vec<f64> {
-        self.data
-            .iter()
-            .skip(c)
-            .step_by(self.channels)
-            .copied()
-            .collect()
-    }
-}
-
-impl Image {
+/// Writing an [`Image`] to the files the program produces.
+pub trait ImageFiles {
     /// Write as a float32 NRRD: `sizes: W H` for grey, `sizes: 3 W H`
     /// (channel fastest) for RGB.
     ///
     /// # Errors
     /// File errors, with the path.
-    pub fn write_nrrd(&self, path: &std::path::Path) -> Result<(), String> {
+    fn write_nrrd(&self, path: &std::path::Path) -> Result<(), String>;
+
+    /// Write as an 8-bit PNG, grey or RGB, auto-windowed over all channels
+    /// together (one window keeps the lights' colour balance).
+    ///
+    /// # Errors
+    /// File or encoding errors, with the path.
+    fn write_png(&self, path: &std::path::Path) -> Result<(), String>;
+}
+
+impl ImageFiles for Image {
+    fn write_nrrd(&self, path: &std::path::Path) -> Result<(), String> {
         let data: Vec<f32> = self.data.iter().map(|&v| v as f32).collect();
         let sizes: Vec<usize> = if self.channels == 1 {
             vec![self.width, self.height]
@@ -69,12 +58,7 @@ impl Image {
         crate::io::nrrd::write_nrrd_f32(path, &sizes, &data).map_err(|e| e.to_string())
     }
 
-    /// Write as an 8-bit PNG, grey or RGB, auto-windowed over all channels
-    /// together (one window keeps the lights' colour balance).
-    ///
-    /// # Errors
-    /// File or encoding errors, with the path.
-    pub fn write_png(&self, path: &std::path::Path) -> Result<(), String> {
+    fn write_png(&self, path: &std::path::Path) -> Result<(), String> {
         let (lo, hi) = AUTO_WINDOW_PERCENTILES;
         let bytes = to_gray8(&self.data, percentile_range(&self.data, lo, hi));
         let color = if self.channels == 1 {

@@ -23,7 +23,7 @@ use indicatif::ProgressBar;
 
 use super::{decode_samples, open_counted, MaybeGzip};
 use crate::io::nrrd::{format_error, Endian, IoError, SampleType};
-use crate::volume::Volume;
+use fvr_engine::volume::Volume;
 
 /// Bytes of the header.
 pub const HEADER_BYTES: usize = 62;

@@ -20,7 +20,7 @@ use plist::{Dictionary, Value};
 
 use super::{decode_samples, open_counted, MaybeGzip};
 use crate::io::nrrd::{excerpt, format_error, Endian, IoError, SampleType};
-use crate::volume::{check_spacing, Volume};
+use fvr_engine::volume::{check_spacing, Volume};
 
 /// Format name of the archive in error messages.
 const ARCHIVE: &str = "InVesalius .inv3 archive";

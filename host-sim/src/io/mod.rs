@@ -36,8 +36,8 @@ use std::path::Path;
 use flate2::bufread::MultiGzDecoder;
 use indicatif::ProgressBar;
 
-use crate::volume::Volume;
 pub use error::IoError;
+use fvr_engine::volume::Volume;
 
 /// Read buffer for files.
 const FILE_BUFFER_BYTES: usize = 1 << 16;

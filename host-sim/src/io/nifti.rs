@@ -37,7 +37,7 @@ use indicatif::ProgressBar;
 
 use super::{decode_samples, open_counted, MaybeGzip};
 use crate::io::nrrd::{format_error, Endian, IoError, SampleType};
-use crate::volume::{check_spacing, Volume};
+use fvr_engine::volume::{check_spacing, Volume};
 
 /// Bytes of a NIfTI-1 header.
 pub const HEADER_BYTES: usize = 348;
@@ -427,7 +427,7 @@ fn parse_spacing(h: &NiftiHeader) -> Result<[f64; 3], IoError> {
             ))
         }
     };
-    let mut spacing = crate::volume::DEFAULT_SPACING;
+    let mut spacing = fvr_engine::volume::DEFAULT_SPACING;
     for axis in 0..rank {
         spacing[axis] = h.pixdim[axis + 1] as f64 * to_mm;
     }

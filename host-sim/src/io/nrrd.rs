@@ -41,7 +41,7 @@ use std::path::Path;
 use flate2::bufread::MultiGzDecoder;
 use indicatif::ProgressBar;
 
-use crate::volume::Volume;
+use fvr_engine::volume::Volume;
 
 pub use error::IoError;
 pub use samples::{Encoding, Endian, SampleType};
@@ -465,7 +465,7 @@ pub fn write_volume_nrrd(path: &Path, volume: &Volume) -> Result<(), IoError> {
     use std::io::Write;
     let write = || -> Result<(), IoError> {
         check_sizes(&volume.dims, volume.data.len())?;
-        crate::volume::check_spacing(volume.spacing)
+        fvr_engine::volume::check_spacing(volume.spacing)
             .map_err(|e| invalid_argument(e.to_string()))?;
         let mut text = header_text(&volume.dims, SampleType::F32, Encoding::Raw, Endian::Little);
         // The header ends with its blank line: the spacing goes before it.

@@ -7,7 +7,7 @@
 
 use fvr_core::geometry::{center, View};
 
-use crate::volume::Volume;
+use fvr_engine::volume::Volume;
 
 /// The exact `width × height` X-ray image of `volume` along `view`, or
 /// `None` unless the view is along a grid axis (right and up along axes,

@@ -5,7 +5,7 @@
 //! 2. [`exact_projection`]: exact line integrals of analytic phantoms.
 //! 3. [`ideal_projection`]: the volume's DFT evaluated directly on the slice
 //!    points (the ideal interpolation filter), for small volumes.
-//! 4. The full pipeline in f64: [`crate::render::spectrum::Precision::F64`].
+//! 4. The full pipeline in f64: [`fvr_engine::spectrum::Precision::F64`].
 //! 5. [`spatial_projection`]: a spatial-domain ray integrator.
 //! 6. [`axis::axis_projection`]: the exact image of the band-limited
 //!    interpolant for views along an axis with pixels on voxels.
@@ -26,34 +26,10 @@ use fvr_core::geometry::{center, Frame, Sampling, View};
 use fvr_core::image::{check_image, finish, placement, Crop};
 use fvr_core::volume::padded_size;
 
-use crate::sources::phantom::Phantom;
-use crate::volume::Volume;
+use fvr_engine::volume::phantom::Phantom;
+use fvr_engine::volume::Volume;
 
-/// Agreement of `test` with `reference` in dB:
-/// `10·log10(Σ ref² / Σ (test − ref)²)`. Identical images give `+∞`.
-///
-/// # Panics
-/// If the lengths differ.
-pub fn snr_db<T: Copy + Into<f64>>(reference: &[T], test: &[T]) -> f64 {
-    assert_eq!(reference.len(), test.len(), "images must have equal sizes");
-    let (signal, noise) = reference
-        .iter()
-        .zip(test)
-        .fold((0.0f64, 0.0f64), |(s, n), (&r, &t)| {
-            let (r, t): (f64, f64) = (r.into(), t.into());
-            (s + r * r, n + (t - r) * (t - r))
-        });
-    10.0 * (signal / noise).log10()
-}
-
-/// Largest absolute pixel difference.
-pub fn max_abs_error<T: Copy + Into<f64>>(reference: &[T], test: &[T]) -> f64 {
-    reference
-        .iter()
-        .zip(test)
-        .map(|(&r, &t)| (t.into() - r.into()).abs())
-        .fold(0.0, f64::max)
-}
+pub use fvr_engine::image::{max_abs_error, snr_db};
 
 fn cas_exact(k: usize, x: usize, n: usize) -> f64 {
     // Reduce k·x modulo n in integers so the angle is exact to f64 rounding.

@@ -15,8 +15,8 @@
 //!
 //! Same geometry contract as the core ([`fvr_core::geometry`]).
 
-use crate::volume::Volume;
 use fvr_core::geometry::{center, View};
+use fvr_engine::volume::Volume;
 
 /// A volume ready for ray casting.
 #[derive(Clone, Debug)]

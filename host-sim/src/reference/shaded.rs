@@ -18,13 +18,13 @@
 
 use crate::image::Image;
 use crate::reference::trilinear;
-use crate::sources::phantom::{Gaussian, GaussianMixture};
-use crate::volume::Volume;
 use fvr_core::dht::Twiddles;
 use fvr_core::geometry::{center, Sampling, View};
 use fvr_core::shading::gradient::{gradient_scratch_len, partial_derivative};
 use fvr_core::shading::{CueTerms, Scene};
 use fvr_core::volume::DenseVolume;
+use fvr_engine::volume::phantom::{Gaussian, GaussianMixture};
+use fvr_engine::volume::Volume;
 
 /// Per-channel coefficients `(A_c, K_c, M_c)`.
 fn channel_terms(scene: &Scene) -> Vec<(f64, f64, [f64; 3])> {

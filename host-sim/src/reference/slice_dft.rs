@@ -28,7 +28,7 @@ use fvr_core::image::check_image;
 use fvr_core::volume::padded_size;
 
 use super::finish_f64;
-use crate::volume::Volume;
+use fvr_engine::volume::Volume;
 
 /// The ideal `width × height` projection of `volume` along `view` on an
 /// `m × m` slice (`m` a power of two at least the volume's power-of-two

@@ -21,7 +21,7 @@ use indicatif::ProgressBar;
 
 use crate::io::den::parse_den;
 use crate::io::read_volume_with_progress;
-use crate::volume::Volume;
+use fvr_engine::volume::Volume;
 
 /// Environment variable that points at the CT head's `.inv3` file.
 pub const CT_HEAD_ENV: &str = "FVR_CT_HEAD";

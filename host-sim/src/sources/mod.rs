@@ -1,7 +1,7 @@
 //! Volumes by name: files on disk, named data sets or built-in phantoms.
 
 pub mod datasets;
-pub mod phantom;
+pub use fvr_engine::volume::phantom;
 pub mod teapot;
 
 use std::path::Path;
@@ -11,9 +11,9 @@ use indicatif::ProgressBar;
 use crate::io::nrrd::{read_raw, Endian, SampleType};
 use crate::io::{read_volume_with_progress, FORMATS_HELP};
 use crate::sources::datasets::{load_dataset_with_progress, DATASETS_HELP};
-use crate::sources::phantom::{sample, GaussianMixture, Phantom, SheppLogan, Sphere};
 use crate::sources::teapot::{voxelize_teapot, DEFAULT_TEAPOT_SIZE};
-use crate::volume::Volume;
+use fvr_engine::volume::phantom::{sample, GaussianMixture, Phantom, SheppLogan, Sphere};
+use fvr_engine::volume::Volume;
 
 /// Default side of built-in phantoms.
 pub const DEFAULT_PHANTOM_SIZE: usize = 64;

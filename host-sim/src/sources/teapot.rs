@@ -32,7 +32,7 @@
 //! axis then smooths the edges over about two voxels, so that the
 //! band-limited interpolant of the samples does not ring at the surface.
 
-use crate::volume::Volume;
+use fvr_engine::volume::Volume;
 
 /// Side of `teapot` when no `@N` is given.
 pub const DEFAULT_TEAPOT_SIZE: usize = 128;

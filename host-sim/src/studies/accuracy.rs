@@ -5,9 +5,10 @@ use fvr_core::filter::FilterKind;
 use fvr_core::geometry::View;
 
 use crate::reference::{exact_projection, snr_db};
-use crate::render::spectrum::{choose_filter, AnySpectrum, KbDesign, PipelineError, Precision};
-use crate::sources::phantom::{sample, GaussianMixture};
 use crate::sources::{DEFAULT_SEED, GAUSSIAN_COUNT};
+use fvr_engine::plan::filter::{choose_filter, KbDesign};
+use fvr_engine::spectrum::{AnySpectrum, PipelineError, Precision};
+use fvr_engine::volume::phantom::{sample, GaussianMixture};
 
 /// The three views: along an axis, along (1, 0.3, 0.2) and along (1, 1, 1).
 pub const VIEWS: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [1.0, 0.3, 0.2], [1.0, 1.0, 1.0]];

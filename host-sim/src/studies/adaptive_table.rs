@@ -5,9 +5,9 @@
 use fvr_core::filter::Filter;
 use fvr_core::geometry::View;
 
-use crate::render::adaptive::{AdaptiveMarks, AdaptiveSettings};
-use crate::render::spectrum::OwnedSpectrum;
 use crate::studies::timing::median_ms;
+use fvr_engine::slice::adaptive::{AdaptiveMarks, AdaptiveSettings};
+use fvr_engine::spectrum::OwnedSpectrum;
 
 /// One row of the paper's Table 1, measured.
 #[derive(Clone, Debug)]
@@ -42,7 +42,7 @@ pub struct Table1Row {
 /// As [`AdaptiveMarks::build`] and the renderers.
 pub fn table1_row(
     name: &str,
-    volume: &crate::volume::Volume,
+    volume: &fvr_engine::volume::Volume,
     filter: Filter,
     settings: &AdaptiveSettings,
     view: &View,
@@ -52,7 +52,7 @@ pub fn table1_row(
         OwnedSpectrum::<half::f16>::prepare::<f32>(volume, filter).map_err(|e| e.to_string())?;
     let n = spec.n();
     let side = n / filter.oversample() as usize;
-    let any = crate::render::spectrum::AnySpectrum::F16(spec.clone());
+    let any = fvr_engine::spectrum::AnySpectrum::F16(spec.clone());
     let t_marks = std::time::Instant::now();
     let marks = AdaptiveMarks::build(&spec, settings)?;
     let mark_ms = t_marks.elapsed().as_secs_f64() * 1e3;

@@ -19,8 +19,9 @@ use half::f16;
 
 use crate::image::plot::{Canvas, Rgb};
 use crate::reference::raycast::RayCaster;
-use crate::render::spectrum::{OwnedSpectrum, ViewRenderer};
-use crate::sources::phantom::{sample, GaussianMixture};
+use fvr_engine::render::view::ViewRenderer;
+use fvr_engine::spectrum::OwnedSpectrum;
+use fvr_engine::volume::phantom::{sample, GaussianMixture};
 
 /// Time per view at one size.
 #[derive(Clone, Debug, PartialEq)]

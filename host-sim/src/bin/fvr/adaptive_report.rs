@@ -5,15 +5,15 @@ use serde::Serialize;
 use std::time::Instant;
 
 use fvr_core::geometry::View;
+use fvr_engine::render::adaptive::{AdaptiveRenderer, Walked};
+use fvr_engine::slice::adaptive::{AdaptiveSettings, Bound};
+use fvr_engine::spectrum::AnySpectrum;
 use fvr_host::reference::snr_db;
-use fvr_host::render::adaptive::{AdaptiveSettings, Bound};
-use fvr_host::render::adaptive_view::{AdaptiveRenderer, Walked};
-use fvr_host::render::spectrum::AnySpectrum;
 
 /// An adaptive render with what it did.
 pub(crate) struct AdaptiveReport {
     pub(crate) image: Vec<f64>,
-    pub(crate) marks: fvr_host::render::adaptive::AdaptiveMarks,
+    pub(crate) marks: fvr_engine::slice::adaptive::AdaptiveMarks,
     pub(crate) stats: fvr_core::slice::adaptive::AdaptiveStats,
     pub(crate) walked: Walked,
     pub(crate) mark_time: std::time::Duration,
@@ -148,14 +148,14 @@ pub(crate) fn adaptive_render(
 ) -> Result<AdaptiveReport, Error> {
     pub(crate) fn go<S: fvr_core::num::Sample, T: fvr_core::num::Real>(
         any: &AnySpectrum,
-        spec: &fvr_host::render::spectrum::OwnedSpectrum<S>,
+        spec: &fvr_engine::spectrum::OwnedSpectrum<S>,
         view: &View,
         w: usize,
         h: usize,
         settings: &AdaptiveSettings,
     ) -> Result<AdaptiveReport, Error> {
         let t0 = Instant::now();
-        let marks = fvr_host::render::adaptive::AdaptiveMarks::build(spec, settings)?;
+        let marks = fvr_engine::slice::adaptive::AdaptiveMarks::build(spec, settings)?;
         let mark_time = t0.elapsed();
         let t1 = Instant::now();
         let (image, stats, walked) = {

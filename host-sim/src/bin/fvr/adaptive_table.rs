@@ -4,11 +4,11 @@ use crate::args::{load_with_progress, parse_filter};
 use crate::Error;
 
 use clap::Args;
-use fvr_host::render::adaptive::parse_tolerance;
+use fvr_host::options::parse_tolerance;
 
 use fvr_core::filter::FilterKind;
 use fvr_core::geometry::View;
-use fvr_host::render::adaptive::{AdaptiveSettings, Bound};
+use fvr_engine::slice::adaptive::{AdaptiveSettings, Bound};
 
 #[derive(Args)]
 pub(crate) struct AdaptiveTableArgs {

@@ -6,14 +6,15 @@ use fvr_core::filter::FilterKind;
 use fvr_core::geometry::Sampling;
 use fvr_core::shading::Scene;
 use fvr_core::volume::GridOversampling;
+use fvr_engine::plan::filter::KbDesign;
+use fvr_engine::plan::grid_filter;
+use fvr_engine::render::shaded::SceneSpectra;
+use fvr_engine::spectrum::{AnySpectrum, Precision};
 use fvr_host::image::output::{Bits, Colormap, Style, Window};
 use fvr_host::io::nrrd::{Endian, SampleType};
 use fvr_host::io::FORMATS_HELP;
 use fvr_host::progress;
-use fvr_host::render::plan::grid_filter;
-use fvr_host::render::scene_file::parse_endian;
-use fvr_host::render::shaded::SceneSpectra;
-use fvr_host::render::spectrum::{AnySpectrum, KbDesign, Precision};
+use fvr_host::scene_file::parse_endian;
 use fvr_host::sources::datasets::DATASETS_HELP;
 use fvr_host::sources::{load_volume_with_progress, RawLayout, PHANTOM_HELP};
 
@@ -94,7 +95,7 @@ impl UnitArgs {
     /// side exceeds the image grid's period `n·p`.
     pub(crate) fn sampling(
         &self,
-        volume: &fvr_host::volume::Volume,
+        volume: &fvr_engine::volume::Volume,
         n: usize,
         default_side: usize,
     ) -> Result<Sampling, Error> {
@@ -226,7 +227,7 @@ impl Default for InputArgs {
 
 impl InputArgs {
     /// Load `spec` with a progress bar, then subtract the background.
-    pub(crate) fn load(&self, spec: &str) -> Result<fvr_host::volume::Volume, Error> {
+    pub(crate) fn load(&self, spec: &str) -> Result<fvr_engine::volume::Volume, Error> {
         let raw = self.raw_dims.map(|dims| RawLayout {
             dims,
             ty: self.raw_type,
@@ -301,7 +302,7 @@ pub(crate) fn parse_filter(s: &str) -> Result<FilterKind, String> {
 pub(crate) fn load_with_progress(
     spec: &str,
     raw: Option<RawLayout>,
-) -> Result<fvr_host::volume::Volume, Error> {
+) -> Result<fvr_engine::volume::Volume, Error> {
     let bar = progress::bytes("loading");
     let volume = load_volume_with_progress(spec, raw, &bar);
     bar.finish_and_clear();
@@ -310,7 +311,7 @@ pub(crate) fn load_with_progress(
 
 /// Fit the filter and prepare the scene's spectra, with a spinner.
 pub(crate) fn prepare_scene_with_progress(
-    volume: &fvr_host::volume::Volume,
+    volume: &fvr_engine::volume::Volume,
     kind: FilterKind,
     grid: GridOversampling,
     design: KbDesign,
@@ -349,7 +350,7 @@ pub(crate) fn prepare_scene_with_progress(
 /// Fit the filter and prepare the spectrum, with a spinner (the core's
 /// preparation is one call with no progress of its own).
 pub(crate) fn prepare_with_progress(
-    volume: &fvr_host::volume::Volume,
+    volume: &fvr_engine::volume::Volume,
     kind: FilterKind,
     grid: GridOversampling,
     design: KbDesign,
@@ -366,11 +367,11 @@ pub(crate) fn prepare_with_progress(
     result
 }
 
-/// [`fvr_host::volume::check_padding`] for the grid `volume` gets at
+/// [`fvr_engine::volume::check_padding`] for the grid `volume` gets at
 /// `grid`.
-fn check_padding(volume: &fvr_host::volume::Volume, grid: GridOversampling) -> Result<(), Error> {
+fn check_padding(volume: &fvr_engine::volume::Volume, grid: GridOversampling) -> Result<(), Error> {
     let n = grid.side(volume.dims)?;
-    Ok(fvr_host::volume::check_padding(volume.dims, n)?)
+    Ok(fvr_engine::volume::check_padding(volume.dims, n)?)
 }
 
 /// Declare, before loading, what the job builds from its volume: `spectra`
@@ -395,12 +396,13 @@ pub(crate) fn plan_job(
         let largest = resample.unwrap_or_else(|| dims.iter().copied().max().unwrap_or(1));
         let n = grid.side([largest, 1, 1]).map_or(u64::MAX, |n| n as u64);
         // A grid too large for the volume's shape is refused later, by name.
-        let thin = resample.is_none() && fvr_host::volume::check_padding(dims, n as usize).is_err();
+        let thin =
+            resample.is_none() && fvr_engine::volume::check_padding(dims, n as usize).is_err();
         let cells = if thin { 0 } else { n.saturating_pow(3) };
         let mut budget = fvr_host::budget::Budget::new();
         budget.hold("spectrum", cells.saturating_mul(spectra), bytes);
         // The fast preparation's complex half spectrum, one spectrum at a
-        // time (fvr_host::render::fast_prepare::fast_budget).
+        // time (fvr_engine::spectrum::prepare::fast_budget).
         let complex = if bytes == 8 { 16 } else { 8 };
         budget.hold(
             "preparation half spectrum",
@@ -418,7 +420,7 @@ pub(crate) fn plan_job(
         if let Some(r) = resample {
             budget.hold("resampled volume", (r as u64).saturating_pow(3), 4);
         }
-        // fvr_host::render::plan::image_side, from the largest side.
+        // fvr_engine::plan::image_side, from the largest side.
         let side = (largest as u64)
             .checked_next_power_of_two()
             .unwrap_or(u64::MAX)

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use fvr_host::volume::Volume;
+use fvr_engine::volume::Volume;
 
 use crate::Error;
 

@@ -40,10 +40,10 @@ pub(crate) type Error = Box<dyn std::error::Error>;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use fvr_core::geometry::DEFAULT_UP;
+use fvr_engine::render::shaded::DEFAULT_PROFILE_HARMONICS;
 use fvr_host::image::output::{Bits, Colormap};
 use fvr_host::progress;
-use fvr_host::render::scene_file::SceneFile;
-use fvr_host::render::shaded::DEFAULT_PROFILE_HARMONICS;
+use fvr_host::scene_file::SceneFile;
 
 const GEOMETRY: &str = "\
 GEOMETRY CONTRACT
@@ -157,6 +157,7 @@ where
         Err(e) => return clap_exit(&e),
     };
     progress::set_quiet(cli.quiet);
+    fvr_host::budget::install();
     if let Some(text) = &cli.max_memory {
         match fvr_host::budget::parse_bytes("--max-memory", text) {
             Ok(bytes) => fvr_host::budget::set_max_memory(bytes),
@@ -230,8 +231,8 @@ fn default_scene() -> Result<(), Error> {
         adaptive_chain: render::DEFAULT_CHAIN.into(),
         adaptive_hd: None,
         adaptive_bound: None,
-        adaptive_plain_below: fvr_host::render::adaptive::DEFAULT_PLAIN_BELOW,
-        adaptive_probes: fvr_host::render::adaptive::DEFAULT_PROBES,
+        adaptive_plain_below: fvr_engine::slice::adaptive::DEFAULT_PLAIN_BELOW,
+        adaptive_probes: fvr_engine::slice::adaptive::DEFAULT_PROBES,
         preview_level: 0,
         exact: false,
         input: InputArgs::default(),

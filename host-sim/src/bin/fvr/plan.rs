@@ -1,5 +1,5 @@
 //! `--accuracy DB` for render and turntable: the configuration chosen by
-//! [`fvr_host::render::plan`], its warnings, and its lines in `--stats` and
+//! [`fvr_engine::plan`], its warnings, and its lines in `--stats` and
 //! `--stats-json`.
 
 use crate::args::SpectrumArgs;
@@ -8,10 +8,10 @@ use crate::turntable::TurntableArgs;
 use crate::Error;
 
 use fvr_core::volume::GridOversampling;
-use fvr_host::render::plan::{
+use fvr_engine::plan::{
     choose_among, predict_grid, Candidate, Constraints, Prediction, ALL_GRIDS, POW2_GRIDS,
 };
-use fvr_host::volume::Volume;
+use fvr_engine::volume::Volume;
 use serde::Serialize;
 
 /// Below this prediction a render whose settings were given warns.
@@ -118,7 +118,7 @@ fn apply(s: &mut SpectrumArgs, volume: &Volume, grids: Grids) -> Result<(), Erro
     } else {
         GridOversampling::X1
     };
-    fvr_host::volume::check_padding(volume.dims, least.side(volume.dims)?)?;
+    fvr_engine::volume::check_padding(volume.dims, least.side(volume.dims)?)?;
     let explicit = s.accuracy.is_some();
     let target = s.accuracy.unwrap_or(DEFAULT_ACCURACY_DB);
     if !explicit && s.given.all() {

@@ -10,9 +10,9 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use fvr_core::filter::Filter;
-use fvr_host::image::Image;
-use fvr_host::render::shaded::SceneSpectra;
-use fvr_host::volume::Volume;
+use fvr_engine::render::shaded::SceneSpectra;
+use fvr_engine::volume::Volume;
+use fvr_host::image::{Image, ImageFiles};
 use serde::Serialize;
 use serde_json::value::RawValue;
 
@@ -23,19 +23,19 @@ use crate::json::{debug_triple, one_line};
 use clap::Args;
 use fvr_core::geometry::{Sampling, View};
 use fvr_core::shading::{Light, Scene, MAX_LIGHTS};
+use fvr_engine::render::shaded::{
+    light_ring, negative_cue_share, SceneRenderer, DEFAULT_PROFILE_HARMONICS,
+};
+use fvr_engine::render::view::ViewRenderer;
+use fvr_engine::slice::adaptive::{AdaptiveSettings, Bound, DEFAULT_PLAIN_BELOW, DEFAULT_PROBES};
+use fvr_engine::spectrum::Precision;
 use fvr_host::image::output::write_png;
+use fvr_host::options::{parse_chain, parse_percent, parse_tolerance};
+use fvr_host::options::{
+    parse_depth_cue, parse_light, parse_light_ring, parse_rgb, DEPTH_CUE_HELP,
+};
 use fvr_host::reference::shaded::exact_scene_projection_sampled;
 use fvr_host::reference::{exact_projection_sampled, snr_db};
-use fvr_host::render::adaptive::{
-    parse_chain, parse_percent, parse_tolerance, AdaptiveSettings, Bound, DEFAULT_PLAIN_BELOW,
-    DEFAULT_PROBES,
-};
-use fvr_host::render::shaded::{
-    light_ring, negative_cue_share, parse_depth_cue, parse_light, parse_light_ring, parse_rgb,
-    SceneRenderer, DEFAULT_PROFILE_HARMONICS, DEPTH_CUE_HELP,
-};
-use fvr_host::render::spectrum::Precision;
-use fvr_host::render::view::ViewRenderer;
 use fvr_host::sources::phantom_by_name;
 
 /// Below this estimated storage SNR the renderer warns (see
@@ -283,7 +283,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         );
     }
     let n = spectra.density.n();
-    let default_side = fvr_host::render::plan::image_side(volume.dims, n)?;
+    let default_side = fvr_engine::plan::image_side(volume.dims, n)?;
     let (w, h) = args.frame.size.unwrap_or((default_side, default_side));
     fvr_core::image::check_image(w, h, n)?;
     let sampling = args.frame.units.sampling(&volume, n, default_side)?;

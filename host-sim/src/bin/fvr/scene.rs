@@ -10,7 +10,7 @@ use std::path::Path;
 
 use clap::parser::ValueSource;
 use clap::ArgMatches;
-use fvr_host::render::scene_file::SceneFile;
+use fvr_host::scene_file::SceneFile;
 
 /// Whether the argument `id` was given on the command line (not defaulted).
 pub(crate) fn given_on_command_line(matches: &ArgMatches, id: &str) -> bool {
@@ -193,7 +193,7 @@ pub(crate) fn apply_scene_to_turntable(
         ("volume.resample", scene.volume.resample.is_some()),
         (
             "[shading]",
-            scene.shading != fvr_host::render::scene_file::ShadingSection::default(),
+            scene.shading != fvr_host::scene_file::ShadingSection::default(),
         ),
         (
             "[[lights]]",

@@ -7,8 +7,9 @@ use clap::ArgMatches;
 use fvr_core::filter::FilterKind;
 use fvr_core::shading::Light;
 use fvr_core::volume::GridOversampling;
+use fvr_engine::plan::filter::KbDesign;
+use fvr_engine::spectrum::Precision;
 use fvr_host::io::nrrd::{Endian, SampleType};
-use fvr_host::render::spectrum::{KbDesign, Precision};
 use std::path::PathBuf;
 
 /// A scene that sets every key `fvr render` reads.

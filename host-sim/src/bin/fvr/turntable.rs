@@ -11,10 +11,10 @@ use std::time::Instant;
 
 use clap::Args;
 use fvr_core::geometry::{Sampling, View};
+use fvr_engine::render::turntable;
+use fvr_engine::spectrum::AnySpectrum;
 use fvr_host::image::output::{write_apng, ApngStream, Window};
 use fvr_host::progress;
-use fvr_host::render::spectrum::AnySpectrum;
-use fvr_host::render::turntable;
 use indicatif::ProgressBar;
 use std::time::Duration;
 
@@ -119,7 +119,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     )?;
     let t_prep = t1.elapsed();
     let n = spec.n();
-    let side = fvr_host::render::plan::image_side(volume.dims, n)?;
+    let side = fvr_engine::plan::image_side(volume.dims, n)?;
     let (w, h) = args.frame.size.unwrap_or((side, side));
     fvr_core::image::check_image(w, h, n)?;
     let sampling = args.frame.units.sampling(&volume, n, side)?;
@@ -202,13 +202,13 @@ fn write_frames(
         Window::Percentiles(..) if sampled => {
             let k = SAMPLE_FRAMES.min(views.len());
             let picks: Vec<View> = (0..k).map(|i| views[i * views.len() / k]).collect();
-            let frames = turntable::render_views(spec, &picks, sampling, w, h, bar)?;
+            let frames = turntable::render_views(spec, &picks, sampling, w, h, &|| bar.inc(1))?;
             Some(style.window.resolve(&frames.concat()))
         }
         Window::Percentiles(..) => None,
     };
     let Some(range) = range else {
-        let frames = turntable::render_views(spec, views, sampling, w, h, bar)?;
+        let frames = turntable::render_views(spec, views, sampling, w, h, &|| bar.inc(1))?;
         for frame in &frames {
             crate::checks::check_finite(frame)?;
         }
@@ -218,7 +218,7 @@ fn write_frames(
     };
     let mut stream = ApngStream::create(&args.out, (w, h), views.len(), args.fps, style, range)?;
     let mut encode = Duration::ZERO;
-    turntable::render_each(spec, views, sampling, (w, h), bar, |_, frame| {
+    turntable::render_each(spec, views, sampling, (w, h), &|| bar.inc(1), |_, frame| {
         crate::checks::check_finite(frame)?;
         let t = Instant::now();
         stream.push(frame)?;

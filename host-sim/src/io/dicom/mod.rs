@@ -51,7 +51,7 @@ use dicom_pixeldata::{ConvertOptions, ModalityLutOption, PixelDecoder};
 use indicatif::ProgressBar;
 
 use crate::io::nrrd::{excerpt, format_error, IoError};
-use crate::volume::{check_spacing, Volume};
+use fvr_engine::volume::{check_spacing, Volume};
 
 /// Format name in error messages.
 pub(crate) const FORMAT: &str = "DICOM";

@@ -56,7 +56,7 @@ impl Layout {
             encoding: Encoding::Raw,
             line_skip: 0,
             byte_skip: 0,
-            spacing: crate::volume::DEFAULT_SPACING,
+            spacing: fvr_engine::volume::DEFAULT_SPACING,
             data_file: None,
         }
     }
@@ -135,7 +135,7 @@ impl Fields {
             // The format forbids both; `space directions` is the fuller one.
             (_, Some(d)) => parse_space_directions(&d, dimension)?,
             (Some(s), None) => parse_spacings(&s, dimension)?,
-            (None, None) => crate::volume::DEFAULT_SPACING,
+            (None, None) => fvr_engine::volume::DEFAULT_SPACING,
         };
         let data_file = match self.data_file {
             Some(f) => Some(parse_data_file(&f)?),
@@ -206,13 +206,13 @@ fn parse_spacings(value: &str, dimension: usize) -> Result<[f64; 3], IoError> {
             ),
         ));
     }
-    let mut spacing = crate::volume::DEFAULT_SPACING;
+    let mut spacing = fvr_engine::volume::DEFAULT_SPACING;
     for (slot, word) in spacing.iter_mut().zip(&words) {
         *slot = word
             .parse::<f64>()
             .map_err(|_| field_error("spacings", format!("`{}` is not a number", excerpt(word))))?;
     }
-    crate::volume::check_spacing(spacing).map_err(|e| field_error("spacings", e.to_string()))
+    fvr_engine::volume::check_spacing(spacing).map_err(|e| field_error("spacings", e.to_string()))
 }
 
 /// The `space directions` field: per axis a vector `(x,y,z)` (or `none`);
@@ -220,7 +220,7 @@ fn parse_spacings(value: &str, dimension: usize) -> Result<[f64; 3], IoError> {
 /// in index space, scaled per axis.
 fn parse_space_directions(value: &str, dimension: usize) -> Result<[f64; 3], IoError> {
     let bad = |why: String| field_error("space directions", why);
-    let mut spacing = crate::volume::DEFAULT_SPACING;
+    let mut spacing = fvr_engine::volume::DEFAULT_SPACING;
     let mut units: Vec<[f64; 3]> = Vec::new();
     let mut rest = value.trim();
     let mut axis = 0;

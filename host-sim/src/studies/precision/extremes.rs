@@ -8,8 +8,8 @@ use fvr_core::geometry::View;
 use fvr_core::num::{Arithmetic, Format, FormatName};
 
 use crate::reference::snr_db;
-use crate::render::spectrum::{choose_filter, choose_oversampling, KbDesign};
-use crate::volume::Volume;
+use fvr_engine::plan::filter::{choose_filter, choose_oversampling, KbDesign};
+use fvr_engine::volume::Volume;
 
 use super::{db, modes_for, Subject, VIEWS};
 
@@ -29,7 +29,7 @@ pub struct ExtremeCase {
 /// full-range u16 volume, the Gaussian phantom scaled by 1e-6, and a
 /// Shepp–Logan head in Hounsfield units (air −1000).
 pub fn extreme_cases(n: usize) -> Vec<ExtremeCase> {
-    use crate::sources::phantom::{sample, GaussianMixture, SheppLogan};
+    use fvr_engine::volume::phantom::{sample, GaussianMixture, SheppLogan};
     let dims = [n, n, n];
     let views = || VIEWS.iter().map(|&d| View::along(d)).collect::<Vec<_>>();
     let filled = |f: &dyn Fn(usize, usize, usize) -> f32| {
@@ -114,7 +114,7 @@ pub fn measure_extremes(
     formats: &[Format],
     oversample: Option<u32>,
 ) -> Result<Vec<ExtremeRow>, String> {
-    use crate::render::spectrum::premultiplication_gain_db;
+    use fvr_engine::plan::filter::premultiplication_gain_db;
     let mut rows = Vec::new();
     for case in extreme_cases(n) {
         let kind = FilterKind::Kb4;

@@ -29,10 +29,10 @@ use fvr_core::volume::padded_size;
 use half::f16;
 
 use crate::reference::{exact_projection, snr_db};
-use crate::render::spectrum::{choose_filter, choose_oversampling, KbDesign};
-use crate::sources::phantom::Phantom;
 use crate::sources::{load_volume, phantom_by_name};
-use crate::volume::Volume;
+use fvr_engine::plan::filter::{choose_filter, choose_oversampling, KbDesign};
+use fvr_engine::volume::phantom::Phantom;
+use fvr_engine::volume::Volume;
 
 /// Everything a cell of the study needs about one volume at one size.
 pub struct Subject {
@@ -55,7 +55,7 @@ pub struct Subject {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Oversampling {
     /// 2 when premultiplication would amplify storage noise by more than
-    /// [`crate::render::spectrum::CONDITIONING_LIMIT_DB`], else 1.
+    /// [`fvr_engine::spectrum::CONDITIONING_LIMIT_DB`], else 1.
     Auto,
     /// Fixed.
     Fixed(u32),

@@ -1,7 +1,6 @@
 //! A spectrum held in any storage format, with block exponents for block
 //! floating point: prepared in place or rounded once from f32.
 
-use crate::render::view::render_once;
 use fvr_core::dht::{Rounding, Twiddles};
 use fvr_core::filter::Filter;
 use fvr_core::geometry::View;
@@ -10,9 +9,10 @@ use fvr_core::num::{Real, Sample};
 use fvr_core::render::Request;
 use fvr_core::spectrum::{prepare_scratch_len, LineBlockStorage, Spectrum};
 use fvr_core::volume::{padded_size, DenseVolume};
+use fvr_engine::render::view::render_once;
 
-use crate::render::spectrum::PipelineError;
-use crate::volume::Volume;
+use fvr_engine::spectrum::PipelineError;
+use fvr_engine::volume::Volume;
 
 /// A spectrum in storage format `S`, owned, with block exponents if any.
 #[derive(Clone, Debug)]
@@ -187,7 +187,7 @@ fn buffers<S: Sample, T: Real>(
     filter: Filter,
 ) -> Result<PrepareBuffers<S, T>, PipelineError> {
     let n = padded_size(volume.dims, filter.oversample())?;
-    crate::render::spectrum::check_memory(n, std::mem::size_of::<S>())?;
+    fvr_engine::spectrum::check_memory(n, std::mem::size_of::<S>())?;
     Ok((
         n,
         vec![S::default(); n * n * n],

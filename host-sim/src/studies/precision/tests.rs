@@ -1,7 +1,7 @@
 //! Unit tests of the stored formats against the f64 pipeline.
 
 use super::*;
-use crate::sources::phantom::{sample, GaussianMixture};
+use fvr_engine::volume::phantom::{sample, GaussianMixture};
 
 fn gaussians(n: usize) -> Volume {
     sample(&GaussianMixture::random(1, n, 8), [n, n, n])

@@ -15,13 +15,13 @@ use fvr_core::spectrum::Spectrum;
 use half::f16;
 
 use crate::reference::snr_db;
-use crate::render::adaptive::{AdaptiveMarks, AdaptiveSettings, Bound};
-use crate::render::fast_adaptive;
-use crate::render::fast_slice::Tiling;
-use crate::render::spectrum::{choose_filter, KbDesign};
-use crate::sources::phantom::{sample, Phantom};
 use crate::studies::precision::StoredSpectrum;
-use crate::volume::Volume;
+use fvr_engine::plan::filter::{choose_filter, KbDesign};
+use fvr_engine::slice::adaptive::walk;
+use fvr_engine::slice::adaptive::{AdaptiveMarks, AdaptiveSettings, Bound};
+use fvr_engine::slice::exact::Tiling;
+use fvr_engine::volume::phantom::{sample, Phantom};
+use fvr_engine::volume::Volume;
 
 use super::{mark_fronts, Row, Setting, Sweep, TradePhantom, ADAPTIVE_CHAIN, FORMATS_HELP};
 
@@ -178,7 +178,7 @@ impl<'s, 'm, S: Sample> Renderer<'s, 'm, S> {
             // walk where it serves the spectrum, else the core's.
             let (kernel, grid) = (&self.kernel, &mut self.grid);
             let tiling = Tiling::default();
-            let stats = match fast_adaptive::extract(
+            let stats = match walk::extract(
                 self.spec,
                 kernel,
                 &levels,

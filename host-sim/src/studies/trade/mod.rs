@@ -35,10 +35,11 @@ use fvr_core::num::{BlockLayout, Blocking, Format, FormatName};
 use fvr_core::slice::adaptive::marks_words;
 use fvr_core::spectrum::prepare_scratch_len;
 
-use crate::render::adaptive::{parse_tolerance, Cheaper};
-use crate::sources::phantom::GaussianMixture;
+use crate::options::parse_tolerance;
 use crate::sources::{BLOB_COUNT, BLOB_SIGMA_FRACTION, DEFAULT_SEED, GAUSSIAN_COUNT};
 use crate::studies::precision::parse_format;
+use fvr_engine::slice::adaptive::Cheaper;
+use fvr_engine::volume::phantom::GaussianMixture;
 
 /// Largest volume side without `--large`.
 pub const MAX_SIZE: usize = 256;

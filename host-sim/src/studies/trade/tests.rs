@@ -1,14 +1,14 @@
 //! Unit tests of the sweep's parsing, fronts and outputs.
 
 use super::*;
-use crate::sources::phantom::SplitMix64;
-use crate::sources::phantom::{sample, GaussianMixture};
 use crate::studies::precision::StoredSpectrum;
 use fvr_core::dht::Rounding;
 use fvr_core::filter::Filter;
 use fvr_core::geometry::View;
 use fvr_core::num::Q15;
 use fvr_core::volume::padded_size;
+use fvr_engine::volume::phantom::SplitMix64;
+use fvr_engine::volume::phantom::{sample, GaussianMixture};
 use half::f16;
 
 /// On a random cloud with ties, no front point is dominated by any

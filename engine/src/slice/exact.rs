@@ -1,0 +1,650 @@
+//! The host's slice extraction for plain spectra, of power-of-two and of
+//! even mixed-radix side: the core's phase-table extraction
+//! (`fvr_core::slice`), point for point the same arithmetic in the same
+//! order, so the slice is the same bit for bit, but walked for the host's
+//! caches and cores.
+//!
+//! - **Mirror pairs stay together.** Row `p` and row `−p` share every
+//!   point's setup (taps reflected through the origin, same weights), so
+//!   the unit of work is a *band* of consecutive pairs `p = p0 … p0 + B − 1`
+//!   with both of their rows, and the bands go to the threads by work
+//!   stealing (rayon): rows near `ky = 0` have the longest intervals inside
+//!   the Nyquist cube, and stealing evens that out, as well as a core taken
+//!   by another process.
+//! - **Tiles.** Inside a band the points are visited in chunks of `C`
+//!   columns, every pair of the band per chunk, instead of whole rows, so
+//!   that the lines a chunk's taps share between neighbouring rows are read
+//!   while they are still close. On the 2-core AMD EPYC machine of
+//!   docs/performance.md this measured within the run-to-run spread of
+//!   whole rows (`cargo bench -p fvr-host --bench view_cpu`); the tiling is
+//!   a tunable ([`Tiling`]).
+//! - **Wide filters** (kb6) sum every plane of a point side by side.
+//!
+//! A point's fixed-point position is the row's anchor plus `(k − anchor)`
+//! steps, exactly the integer the core's running sum reaches, so the visit
+//! order changes nothing in the values.
+//!
+//! Indices wrap around the cube as the core wraps them: by masks on a
+//! power-of-two side, else by one remainder per axis and a conditional
+//! subtraction per tap ([`Side`]); the sums are the same either way.
+
+use fvr_core::filter::{KernelTable, PhaseTable, MAX_WIDTH};
+use fvr_core::geometry::SliceAxes;
+use fvr_core::num::{Real, Sample};
+use fvr_core::spectrum::Spectrum;
+use rayon::prelude::*;
+
+use crate::spectrum::bricks::Bricked;
+
+/// How the host extraction walks the slice: `band` mirror pairs per unit
+/// of work, `chunk` columns per tile, and how far ahead the strip and
+/// column walks prefetch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tiling {
+    /// Mirror pairs (rows `p` and `−p`) per unit of work (≥ 1).
+    pub band: usize,
+    /// Columns per tile inside a band (≥ 1).
+    pub chunk: usize,
+    /// Lines of cells the strip and column walks prefetch ahead of the one
+    /// they reduce (0: none; [`crate::slice::prefetch`]).
+    pub ahead: usize,
+}
+
+impl Tiling {
+    /// `band` pairs by `chunk` columns, prefetching `ahead` lines.
+    pub const fn new(band: usize, chunk: usize, ahead: usize) -> Self {
+        Self { band, chunk, ahead }
+    }
+}
+
+impl Default for Tiling {
+    /// 8 pairs by 32 columns (`cargo bench -p fvr-host --bench view`),
+    /// prefetching 8 lines ahead (`cargo bench -p fvr-host --bench
+    /// view_cpu`, side 512).
+    fn default() -> Self {
+        Self::new(8, 32, 8)
+    }
+}
+
+impl core::str::FromStr for Tiling {
+    type Err = String;
+
+    /// `band,chunk` or `band,chunk,ahead` (the benches' `FVR_BENCH_TILING`);
+    /// `ahead` defaults to [`Tiling::default`]'s.
+    fn from_str(s: &str) -> Result<Self, String> {
+        let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+        let number = |i: usize| -> Result<usize, String> {
+            parts[i]
+                .parse()
+                .map_err(|_| format!("tiling {s:?}: {:?} is not a whole number", parts[i]))
+        };
+        match parts.len() {
+            2 | 3 => Ok(Self {
+                band: number(0)?,
+                chunk: number(1)?,
+                ahead: if parts.len() == 3 {
+                    number(2)?
+                } else {
+                    Self::default().ahead
+                },
+            }),
+            _ => Err(format!("tiling {s:?}: give band,chunk or band,chunk,ahead")),
+        }
+    }
+}
+
+/// Whether [`extract`] serves `spec`: plain coefficients (no block
+/// exponents), exactly `n³` of them, and a power-of-two or an even side
+/// (the sides spectra take; the walk pairs rows as the core does on both).
+pub fn supports<S: Sample>(spec: &Spectrum<'_, S>) -> bool {
+    let n = spec.n();
+    (n.is_power_of_two() || n % 2 == 0) && spec.blocks().is_none() && spec.data().len() == n * n * n
+}
+
+/// Fill the `n × n` slice `grid` (`kx` fastest, natural DHT order) on
+/// `axes`, as `fvr_core::slice::extract_slice_rows` over all rows would,
+/// bit for bit: on the current rayon pool's threads when `parallel`, else
+/// on this thread. `false` (grid untouched)
+/// when [`supports`] does not hold, the grid is not `n²` or `kernel`
+/// is not the spectrum's filter.
+pub fn extract<S: Sample, T: Real + Send + Sync>(
+    spec: &Spectrum<'_, S>,
+    kernel: &KernelTable<T>,
+    axes: &SliceAxes,
+    tiling: Tiling,
+    parallel: bool,
+    grid: &mut [T],
+) -> bool {
+    let n = spec.n();
+    if !supports(spec) || grid.len() != n * n || kernel.filter() != spec.filter() {
+        return false;
+    }
+    let geometry = Geometry::new(axes, n, tiling, parallel);
+    let data = spec.data();
+    if n.is_power_of_two() {
+        let source = Linear::<S, true> {
+            data,
+            side: Side { n },
+        };
+        by_width::<true, S, T, _>(&source, kernel, &geometry, grid)
+    } else {
+        let source = Linear::<S, false> {
+            data,
+            side: Side { n },
+        };
+        by_width::<false, S, T, _>(&source, kernel, &geometry, grid)
+    }
+}
+
+/// [`extract`] from a bricked copy of the spectrum: the same slice, bit
+/// for bit. `false` (grid untouched) when the grid is not `n²` or `kernel`
+/// is not the spectrum's filter.
+pub fn extract_bricked<S: Sample + Sync, T: Real + Send + Sync>(
+    spec: &Bricked<S>,
+    kernel: &KernelTable<T>,
+    axes: &SliceAxes,
+    tiling: Tiling,
+    parallel: bool,
+    grid: &mut [T],
+) -> bool {
+    let n = spec.n();
+    if grid.len() != n * n || *kernel.filter() != spec.filter() {
+        return false;
+    }
+    let geometry = Geometry::new(axes, n, tiling, parallel);
+    // The bricked sums need no wrapping; `POW2` only picks how grid rows
+    // are indexed.
+    if n.is_power_of_two() {
+        by_width::<true, S, T, _>(spec, kernel, &geometry, grid)
+    } else {
+        by_width::<false, S, T, _>(spec, kernel, &geometry, grid)
+    }
+}
+
+/// Where a walk reads a point's tap sum from.
+trait TapSource<S>: Sync {
+    /// `Σ_c wz_c Σ_b wy_b Σ_t wx_t·c[z + c, y + b, x + t]` in the core's
+    /// order ([`tap_sum_on`]).
+    fn sum<const W: usize, T: Real>(&self, taps: [i32; 3], weights: [&[T; W]; 3]) -> T;
+}
+
+/// The linear layout (x fastest, then y, then z).
+struct Linear<'a, S, const POW2: bool> {
+    data: &'a [S],
+    side: Side<POW2>,
+}
+
+impl<S: Sample + Sync, const POW2: bool> TapSource<S> for Linear<'_, S, POW2> {
+    #[inline(always)]
+    fn sum<const W: usize, T: Real>(&self, taps: [i32; 3], weights: [&[T; W]; 3]) -> T {
+        tap_sum_on(self.data, self.side, taps, weights)
+    }
+}
+
+impl<S: Sample + Sync> TapSource<S> for Bricked<S> {
+    #[inline(always)]
+    fn sum<const W: usize, T: Real>(&self, taps: [i32; 3], weights: [&[T; W]; 3]) -> T {
+        self.tap_sum(taps, weights)
+    }
+}
+
+/// [`walk`] for the kernel's width.
+fn by_width<const POW2: bool, S: Sample, T: Real + Send + Sync, Src: TapSource<S>>(
+    source: &Src,
+    kernel: &KernelTable<T>,
+    geometry: &Geometry<T>,
+    grid: &mut [T],
+) -> bool {
+    match kernel.filter().width() {
+        1 => walk::<1, POW2, S, T, Src>(source, kernel, geometry, grid),
+        2 => walk::<2, POW2, S, T, Src>(source, kernel, geometry, grid),
+        3 => walk::<3, POW2, S, T, Src>(source, kernel, geometry, grid),
+        4 => walk::<4, POW2, S, T, Src>(source, kernel, geometry, grid),
+        5 => walk::<5, POW2, S, T, Src>(source, kernel, geometry, grid),
+        _ => walk::<MAX_WIDTH, POW2, S, T, Src>(source, kernel, geometry, grid),
+    }
+}
+
+/// `i mod n` for the indices of one cube side: a mask when `POW2` (`n` a
+/// power of two), else as the core's mixed-radix walk: a remainder per
+/// axis and, for taps, a conditional subtraction.
+#[derive(Clone, Copy)]
+struct Side<const POW2: bool> {
+    n: usize,
+}
+
+impl<const POW2: bool> Side<POW2> {
+    /// `j mod n` for any `j`.
+    #[inline(always)]
+    fn wrap(self, j: i64) -> usize {
+        if POW2 {
+            j as usize & (self.n - 1)
+        } else {
+            j.rem_euclid(self.n as i64) as usize
+        }
+    }
+
+    /// `k mod n` for a signed frequency `|k| ≤ n/2`.
+    #[inline(always)]
+    fn signed(self, k: i32) -> usize {
+        if POW2 {
+            k as usize & (self.n - 1)
+        } else if k < 0 {
+            (k + self.n as i32) as usize
+        } else {
+            k as usize
+        }
+    }
+
+    /// `(i + t) mod n` for `i < n` and a tap offset `t < W`.
+    #[inline(always)]
+    fn step(self, i: usize, t: usize) -> usize {
+        if POW2 {
+            (i + t) & (self.n - 1)
+        } else {
+            let mut v = i + t;
+            while v >= self.n {
+                v -= self.n;
+            }
+            v
+        }
+    }
+}
+
+/// The slice's axes in `T`, the cube side and the walk.
+pub(crate) struct Geometry<T> {
+    pub(crate) right: [T; 3],
+    pub(crate) up: [T; 3],
+    pub(crate) n: usize,
+    pub(crate) tiling: Tiling,
+    pub(crate) parallel: bool,
+}
+
+impl<T: Real> Geometry<T> {
+    pub(crate) fn new(axes: &SliceAxes, n: usize, tiling: Tiling, parallel: bool) -> Self {
+        Self {
+            right: axes.right.map(T::from_f64),
+            up: axes.up.map(T::from_f64),
+            n,
+            tiling: Tiling {
+                band: tiling.band.max(1),
+                chunk: tiling.chunk.max(1),
+                ahead: tiling.ahead,
+            },
+            parallel,
+        }
+    }
+}
+
+/// One mirror pair of a band: row `p` (`plus`, absent for `p = n/2`) and
+/// row `−p` (`minus`; row 0 is its own mirror and holds both halves), the
+/// pair's interval of `kx` inside the Nyquist cube and its anchor's
+/// fixed-point position.
+pub(crate) struct Pair<'g, T> {
+    pub(crate) p: usize,
+    pub(crate) plus: Option<&'g mut [T]>,
+    pub(crate) minus: Option<&'g mut [T]>,
+    pub(crate) low: i32,
+    pub(crate) high: i32,
+    pub(crate) anchor: i32,
+    pub(crate) base: [i64; 3],
+}
+
+/// The walk for filter width `W`: rows split into bands of pairs, each
+/// band set up, then filled tile by tile.
+#[inline(never)]
+fn walk<const W: usize, const POW2: bool, S: Sample, T: Real + Send + Sync, Src: TapSource<S>>(
+    source: &Src,
+    kernel: &KernelTable<T>,
+    g: &Geometry<T>,
+    grid: &mut [T],
+) -> bool {
+    let mut phases = Box::new(PhaseTable::<T, W>::zeroed());
+    if phases.fill(kernel).is_err() {
+        return false;
+    }
+    let n = g.n;
+    let side = Side::<POW2> { n };
+    let mut bands = bands_of_pairs(grid, n, g.tiling.band);
+    let taps = Taps::<W, POW2, S, T, Src> {
+        source,
+        _sample: core::marker::PhantomData,
+        side,
+        phases: &phases,
+        raw_gain: T::exp2i(T::raw_exponent::<S>()),
+        step: g.right.map(PhaseTable::<T, W>::fixed_step),
+    };
+    let fill = |band: &mut Vec<Pair<'_, T>>| fill_band(&taps, g, band);
+    if g.parallel {
+        bands.par_iter_mut().for_each(fill);
+    } else {
+        bands.iter_mut().for_each(fill);
+    }
+    true
+}
+
+/// The grid's rows as mirror pairs (`p`, `−p`) for `p = 0 … n/2`, in
+/// bands of `band` consecutive pairs.
+pub(crate) fn bands_of_pairs<T>(grid: &mut [T], n: usize, band: usize) -> Vec<Vec<Pair<'_, T>>> {
+    let side = Side::<false> { n };
+    let mut rows: Vec<Option<&mut [T]>> = grid.chunks_exact_mut(n).map(Some).collect();
+    // Signed frequencies of a row: −n/2 … n/2 − 1; row `p` holds `ky = p`
+    // for `p ≤ k_max`, row `(n − p) mod n` holds `ky = −p`.
+    let k_max = (n - 1) / 2;
+    let pairs: Vec<Pair<'_, T>> = (0..=n / 2)
+        .map(|p| {
+            let plus = if p <= k_max { rows[p].take() } else { None };
+            let minus = if p == 0 {
+                None
+            } else {
+                rows[side.signed(-(p as i32))].take()
+            };
+            Pair {
+                p,
+                plus,
+                minus,
+                low: 1,
+                high: 0,
+                anchor: 0,
+                base: [0; 3],
+            }
+        })
+        .collect();
+    let mut bands: Vec<Vec<Pair<'_, T>>> = Vec::new();
+    let mut pairs = pairs.into_iter().peekable();
+    while pairs.peek().is_some() {
+        bands.push(pairs.by_ref().take(band.max(1)).collect());
+    }
+    bands
+}
+
+/// Row `p`'s interval of `kx` inside the Nyquist cube (`kx ≥ 0` on row 0,
+/// whose mirrors hold the rest), its anchor and the anchor's fixed-point
+/// position, as the core sets its rows up; `None` when the interval is
+/// empty.
+pub(crate) fn row_setup<const W: usize, T: Real>(
+    g: &Geometry<T>,
+    p: usize,
+) -> Option<(i32, i32, i32, [i64; 3])> {
+    let half = (g.n / 2) as i32;
+    let ky = T::from_usize(p);
+    let kyu = g.up.map(|c| ky * c);
+    let (low, high) = row_interval(g.n, &g.right, kyu);
+    let k_low = if p == 0 { 0 } else { -half };
+    let (low, high) = (low.max(k_low), high.min(half));
+    if low > high {
+        return None;
+    }
+    let anchor = 0.clamp(low, high);
+    let kx = T::from_i32(anchor);
+    let base =
+        core::array::from_fn(|a| PhaseTable::<T, W>::fixed_position(kx * g.right[a] + kyu[a]));
+    Some((low, high, anchor, base))
+}
+
+/// Zero the pair's rows and set its interval inside the Nyquist cube,
+/// anchor and anchor position ([`row_setup`]); `false` when the interval
+/// is empty.
+pub(crate) fn set_up_pair<const W: usize, T: Real>(
+    g: &Geometry<T>,
+    pair: &mut Pair<'_, T>,
+) -> bool {
+    for row in [&mut pair.plus, &mut pair.minus].into_iter().flatten() {
+        row.fill(T::ZERO);
+    }
+    let Some((low, high, anchor, base)) = row_setup::<W, T>(g, pair.p) else {
+        return false;
+    };
+    (pair.low, pair.high, pair.anchor, pair.base) = (low, high, anchor, base);
+    true
+}
+
+/// Set up and fill one band of pairs.
+fn fill_band<const W: usize, const POW2: bool, S: Sample, T: Real, Src: TapSource<S>>(
+    taps: &Taps<'_, W, POW2, S, T, Src>,
+    g: &Geometry<T>,
+    band: &mut [Pair<'_, T>],
+) {
+    let n = g.n;
+    let (mut first, mut last) = (i32::MAX, i32::MIN);
+    for pair in band.iter_mut() {
+        if set_up_pair::<W, T>(g, pair) {
+            first = first.min(pair.low);
+            last = last.max(pair.high);
+        }
+    }
+    let chunk = g.tiling.chunk.min(n) as i32;
+    let mut start = first;
+    while start <= last {
+        let end = start.saturating_add(chunk - 1).min(last);
+        for pair in band.iter_mut() {
+            fill_pair(taps, pair, start.max(pair.low), end.min(pair.high), n);
+        }
+        start = end.saturating_add(1);
+    }
+}
+
+/// Points `k = from … to` of one pair, with their mirrors.
+#[inline(always)]
+fn fill_pair<const W: usize, const POW2: bool, S: Sample, T: Real, Src: TapSource<S>>(
+    taps: &Taps<'_, W, POW2, S, T, Src>,
+    pair: &mut Pair<'_, T>,
+    from: i32,
+    to: i32,
+    n: usize,
+) {
+    let k_max = ((n - 1) / 2) as i32;
+    let side = taps.side;
+    let p = pair.p;
+    let has_plus = pair.plus.is_some();
+    // Row 0's mirrors land in row 0 itself.
+    let has_minus = pair.minus.is_some() || p == 0;
+    for k in from..=to {
+        let plus = has_plus && k <= k_max;
+        let minus = has_minus && -k <= k_max && (p > 0 || k > 0);
+        if !(plus || minus) {
+            continue;
+        }
+        let steps = (k - pair.anchor) as i64;
+        let y: [i64; 3] = core::array::from_fn(|a| pair.base[a] + steps * taps.step[a]);
+        let (value, mirror) = taps.point(y, plus, minus);
+        if plus {
+            if let Some(g) = pair
+                .plus
+                .as_deref_mut()
+                .and_then(|r| r.get_mut(side.signed(k)))
+            {
+                *g = value;
+            }
+        }
+        if minus {
+            let row = match pair.minus.as_deref_mut() {
+                Some(r) => Some(r),
+                None => pair.plus.as_deref_mut(),
+            };
+            if let Some(g) = row.and_then(|r| r.get_mut(side.signed(k.wrapping_neg()))) {
+                *g = mirror;
+            }
+        }
+    }
+}
+
+/// The integers `kx` with `|kx·r_a + c_a| ≤ n/2` on every axis, as the
+/// core's row interval computes them (the same operations in `T`, so the
+/// same interval).
+pub(crate) fn row_interval<T: Real>(n: usize, right: &[T; 3], c: [T; 3]) -> (i32, i32) {
+    let half = T::from_usize(n) * T::HALF;
+    let (mut low, mut high) = (-T::from_usize(n), T::from_usize(n));
+    for a in 0..3 {
+        let (r, c) = (right[a], c[a]);
+        if r == T::ZERO {
+            if c > half || -c > half {
+                return (1, 0);
+            }
+            continue;
+        }
+        let (t1, t2) = ((-half - c) / r, (half - c) / r);
+        let (t_low, t_high) = if t1 < t2 { (t1, t2) } else { (t2, t1) };
+        if t_low > low {
+            low = t_low;
+        }
+        if t_high < high {
+            high = t_high;
+        }
+    }
+    (-((-low).floor_i64() as i32), high.floor_i64() as i32)
+}
+
+/// The tap sums of one point and its mirror from the phase table.
+struct Taps<'a, const W: usize, const POW2: bool, S, T, Src> {
+    source: &'a Src,
+    _sample: core::marker::PhantomData<S>,
+    side: Side<POW2>,
+    phases: &'a PhaseTable<T, W>,
+    raw_gain: T,
+    step: [i64; 3],
+}
+
+impl<const W: usize, const POW2: bool, S: Sample, T: Real, Src: TapSource<S>>
+    Taps<'_, W, POW2, S, T, Src>
+{
+    /// The value at fixed-point position `y` (when `plus`) and at its
+    /// mirror `−q` (when `minus`): taps `−j − t`, the run from
+    /// `−j − (W − 1)` with the weights reversed.
+    #[inline(always)]
+    fn point(&self, y: [i64; 3], plus: bool, minus: bool) -> (T, T) {
+        let (jx, wx) = self.phases.taps_fixed_point(y[0]);
+        let (jy, wy) = self.phases.taps_fixed_point(y[1]);
+        let (jz, wz) = self.phases.taps_fixed_point(y[2]);
+        let wx = wx.map(|w| w * self.raw_gain);
+        let value = if plus {
+            self.value(jx, &wx, jy, &wy, jz, &wz)
+        } else {
+            T::ZERO
+        };
+        let mirrored = if minus {
+            let mirror = |j: i32| -j - (W as i32 - 1);
+            let reversed = |w: &[T; W]| -> [T; W] { core::array::from_fn(|t| w[W - 1 - t]) };
+            let (rx, ry, rz) = (reversed(&wx), reversed(&wy), reversed(&wz));
+            self.value(mirror(jx), &rx, mirror(jy), &ry, mirror(jz), &rz)
+        } else {
+            T::ZERO
+        };
+        (value, mirrored)
+    }
+
+    /// [`tap_sum`] on this spectrum.
+    #[inline(always)]
+    fn value(&self, jx: i32, wx: &[T; W], jy: i32, wy: &[T; W], jz: i32, wz: &[T; W]) -> T {
+        self.source.sum([jx, jy, jz], [wx, wy, wz])
+    }
+}
+
+/// `Σ_c wz_c Σ_b wy_b Σ_t wx_t·c[z + c, y + b, x + t]` (indices wrapping
+/// around the cube of power-of-two side `n`), as [`tap_sum_on`].
+#[inline(always)]
+pub(crate) fn tap_sum<const W: usize, S: Sample, T: Real>(
+    data: &[S],
+    n: usize,
+    taps: [i32; 3],
+    weights: [&[T; W]; 3],
+) -> T {
+    tap_sum_on(data, Side::<true> { n }, taps, weights)
+}
+
+/// `Σ_c wz_c Σ_b wy_b Σ_t wx_t·c[z + c, y + b, x + t]` (indices wrapping
+/// around the cube), summed in the core's order: each x-line from
+/// zero, tap by tap, then lines into planes, planes into the value. The
+/// samples are read raw ([`Real::load_raw`]): `wx` carries `2^e`
+/// ([`Real::raw_exponent`]), which leaves every product as the core's.
+#[inline(always)]
+fn tap_sum_on<const W: usize, const POW2: bool, S: Sample, T: Real>(
+    data: &[S],
+    side: Side<POW2>,
+    [jx, jy, jz]: [i32; 3],
+    [wx, wy, wz]: [&[T; W]; 3],
+) -> T {
+    let n = side.n;
+    let nn = n * n;
+    let (lines, planes, x0): ([usize; W], [usize; W], usize) = if POW2 {
+        // `((j + b) mod n)·n` as `(j·n + b·n) mod n²`, in wrapping usize.
+        let (y0, z0) = (
+            (jy as usize).wrapping_mul(n),
+            (jz as usize).wrapping_mul(nn),
+        );
+        (
+            core::array::from_fn(|b| y0.wrapping_add(b * n) & (nn - n)),
+            core::array::from_fn(|c| z0.wrapping_add(c * nn) & (nn * n - nn)),
+            side.wrap(jx as i64),
+        )
+    } else {
+        let (y0, z0) = (side.wrap(jy as i64), side.wrap(jz as i64));
+        (
+            core::array::from_fn(|b| side.step(y0, b) * n),
+            core::array::from_fn(|c| side.step(z0, c) * nn),
+            side.wrap(jx as i64),
+        )
+    };
+    let mut acc = T::ZERO;
+    // Up to W = 5 plane by plane: kb5 side by side took 1.03 to 1.5× the
+    // CPU time (`FVR_BENCH_FILTERS=kb5 cargo bench -p fvr-host --bench
+    // view_cpu`, sides 256 and 320).
+    if x0 + W <= n && W <= 5 {
+        for c in 0..W {
+            let mut acc_y = T::ZERO;
+            for b in 0..W {
+                let start = planes[c] + lines[b] + x0;
+                let mut acc_x = T::ZERO;
+                if let Some(run) = data.get(start..start + W) {
+                    for t in 0..W {
+                        acc_x += wx[t] * T::load_raw(run[t]);
+                    }
+                }
+                acc_y += wy[b] * acc_x;
+            }
+            acc += wz[c] * acc_y;
+        }
+    } else if x0 + W <= n {
+        // kb6: every plane's sums side by side (lanes `c`),
+        // each in the core's order: the same operations per plane,
+        // interleaved, which the compiler vectorizes (kb6 about 1.1 to
+        // 1.5× less CPU time a view; kb4 compiles slower this way).
+        let mut acc_y = [T::ZERO; W];
+        for b in 0..W {
+            let runs: [[S; W]; W] = core::array::from_fn(|c| {
+                let start = planes[c] + lines[b] + x0;
+                data.get(start..start + W)
+                    .and_then(|s| <[S; W]>::try_from(s).ok())
+                    .unwrap_or([S::default(); W])
+            });
+            let mut acc_x = [T::ZERO; W];
+            for t in 0..W {
+                for c in 0..W {
+                    acc_x[c] += wx[t] * T::load_raw(runs[c][t]);
+                }
+            }
+            for c in 0..W {
+                acc_y[c] += wy[b] * acc_x[c];
+            }
+        }
+        for c in 0..W {
+            acc += wz[c] * acc_y[c];
+        }
+    } else {
+        let xs: [usize; W] = core::array::from_fn(|t| side.step(x0, t));
+        for c in 0..W {
+            let mut acc_y = T::ZERO;
+            for b in 0..W {
+                let line = planes[c] + lines[b];
+                let mut acc_x = T::ZERO;
+                for t in 0..W {
+                    let v = data.get(line + xs[t]).copied().unwrap_or_default();
+                    acc_x += wx[t] * T::load_raw(v);
+                }
+                acc_y += wy[b] * acc_x;
+            }
+            acc += wz[c] * acc_y;
+        }
+    }
+    acc
+}
