@@ -18,6 +18,9 @@ export FVR_MRI_HEAD
 echo "== no_std core for thumbv7em-none-eabihf"
 cargo build --locked -p fvr-core --target thumbv7em-none-eabihf --release
 
+echo "== layout: no fast_ files, none over 700 lines, no import cycle in the engine"
+python3 scripts/check-layout.py
+
 echo "== lints"
 cargo fmt --all -- --check
 cargo clippy --locked --workspace --all-targets -- -D warnings

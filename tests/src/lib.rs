@@ -2,15 +2,15 @@
 //! the setup they share.
 
 use fvr_core::filter::{Filter, FilterKind};
-use fvr_engine::dht::real_fft::FastReal;
-use fvr_engine::dht::store::FastStore;
+use fvr_engine::dht::real::FftReal;
+use fvr_engine::dht::store::StoreFormat;
 use fvr_engine::spectrum::OwnedSpectrum;
 use fvr_engine::volume::phantom::{sample, GaussianMixture};
 
 /// A random Gaussian mixture (`GaussianMixture::random(seed, n, count)`)
 /// sampled on `dims`, prepared for `kind` at `oversample` in storage `S`
 /// with arithmetic `T`; with the filter.
-pub fn mixture_spectrum<S: FastStore, T: FastReal>(
+pub fn mixture_spectrum<S: StoreFormat, T: FftReal>(
     (seed, n, count): (u64, usize, usize),
     dims: [usize; 3],
     kind: FilterKind,

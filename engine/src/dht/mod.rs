@@ -3,5 +3,6 @@
 //! rounding of the result to the storage format ([`store`]).
 
 pub mod lanes;
+pub mod real;
 pub mod real_fft;
 pub mod store;

@@ -23,13 +23,10 @@ use fvr_core::num::Real;
 use rayon::prelude::*;
 use realfft::RealFftPlanner;
 use rustfft::num_complex::Complex;
-use rustfft::{FftNum, FftPlanner};
+use rustfft::FftPlanner;
 
-use crate::dht::store::FastStore;
-
-/// Arithmetic the fast transform runs in: f32 or f64.
-pub trait FastReal: Real + FftNum {}
-impl<T: Real + FftNum> FastReal for T {}
+use crate::dht::real::FftReal;
+use crate::dht::store::StoreFormat;
 
 /// A real cube of even side `n` (a power of two or any even length rustfft
 /// plans, e.g. `2^a·3^b·5^c`) that is zero except
@@ -76,7 +73,7 @@ pub fn tile_bytes<T>(n: usize) -> u64 {
 /// # Panics
 /// If `n` is odd or below 2, or `out` or the row masks have the wrong
 /// length.
-pub fn dht_3d_real<T: FastReal, S: FastStore>(
+pub fn dht_3d_real<T: FftReal, S: StoreFormat>(
     cube: &SparseCube<'_, T>,
     out: &mut [S],
 ) -> Result<(), Error> {
@@ -203,7 +200,7 @@ pub fn dht_3d_real<T: FastReal, S: FastStore>(
 /// Output rows `(·, v, w)` for every `w` from the z-transformed columns at
 /// `v` (`at`) and at `−v` (`at_m`), each `at[w·h + u] = F(u, ±v, w)` with
 /// `h = n/2 + 1`. `false` if a value is not finite in `S`.
-fn hartley_rows<T: FastReal, S: FastStore>(
+fn hartley_rows<T: FftReal, S: StoreFormat>(
     at: &[Complex<T>],
     at_m: &[Complex<T>],
     rows: &mut [&mut [S]],

@@ -1,14 +1,14 @@
 //! Rounding a row of arithmetic values to a storage format, a row at a time
-//! ([`FastStore`]); for f16 from f32 without branches, so that the loop
+//! ([`StoreFormat`]); for f16 from f32 without branches, so that the loop
 //! vectorizes on baseline x86-64 (which has no f32 → f16 instruction).
 
 use fvr_core::num::{Real, Sample};
 use half::f16;
 
-use crate::dht::real_fft::FastReal;
+use crate::dht::real::FftReal;
 
 /// A storage format the fast preparation writes ([`crate::spectrum::prepare`]).
-pub trait FastStore: Sample {
+pub trait StoreFormat: Sample {
     /// Unit roundoff: a value rounded to `Self` in its normal range is within
     /// this share of it.
     const UNIT_ROUNDOFF: f64;
@@ -17,7 +17,7 @@ pub trait FastStore: Sample {
     const SUBNORMAL_HALF_SPACING: f64;
     /// `dst[i] = src[i]` rounded to nearest even; `false` if a value is not
     /// finite in `Self`.
-    fn store_row<T: FastReal>(src: &[T], dst: &mut [Self]) -> bool {
+    fn store_row<T: FftReal>(src: &[T], dst: &mut [Self]) -> bool {
         let mut finite = true;
         for (d, &s) in dst.iter_mut().zip(src) {
             *d = s.store();
@@ -27,23 +27,23 @@ pub trait FastStore: Sample {
     }
 }
 
-impl FastStore for f32 {
+impl StoreFormat for f32 {
     const UNIT_ROUNDOFF: f64 = f32::EPSILON as f64 / 2.0;
     // 2^−150.
     const SUBNORMAL_HALF_SPACING: f64 = f32::MIN_POSITIVE as f64 * f32::EPSILON as f64 / 2.0;
 }
 
-impl FastStore for f64 {
+impl StoreFormat for f64 {
     const UNIT_ROUNDOFF: f64 = f64::EPSILON / 2.0;
     // The spacing itself (2^−1074): half of it is not an f64.
     const SUBNORMAL_HALF_SPACING: f64 = f64::MIN_POSITIVE * f64::EPSILON;
 }
 
-impl FastStore for f16 {
+impl StoreFormat for f16 {
     const UNIT_ROUNDOFF: f64 = 1.0 / 2048.0;
     // 2^−25.
     const SUBNORMAL_HALF_SPACING: f64 = 1.0 / 33_554_432.0;
-    fn store_row<T: FastReal>(src: &[T], dst: &mut [Self]) -> bool {
+    fn store_row<T: FftReal>(src: &[T], dst: &mut [Self]) -> bool {
         if T::EPSILON_HALF != f32::EPSILON_HALF {
             // f64 → f16 must round once, from f64.
             let mut finite = true;

@@ -6,7 +6,7 @@ use std::sync::OnceLock;
 use fvr_core::filter::{EnergyProfile, Filter, FilterKind};
 use fvr_core::volume::{padded_size, DenseVolume, GridOversampling};
 
-use super::{combine, grid_filter, interpolation, Candidate, Prediction, POW2_GRIDS};
+use super::model::{combine, grid_filter, interpolation, Candidate, Prediction, POW2_GRIDS};
 use crate::plan::filter::KbDesign;
 use crate::spectrum::{check_memory, Precision};
 use crate::volume::Volume;
@@ -232,7 +232,7 @@ pub fn choose_among(
         if let Some(&(_, w)) = wraps.iter().find(|&&(m, _)| m == n) {
             return Ok(w);
         }
-        let w = shadows.worst_ratio(n, super::image_side(volume.dims, n)?);
+        let w = shadows.worst_ratio(n, super::model::image_side(volume.dims, n)?);
         wraps.push((n, w));
         Ok(w)
     };

@@ -14,7 +14,7 @@
 //! rows are read in blocks that keep the pixel sums being added to in
 //! cache.
 
-use super::AxisWeights;
+use super::weights::AxisWeights;
 use crate::volume::Volume;
 
 /// Per-view sums over the projection axis, split by edge (0) and interior
@@ -208,7 +208,7 @@ mod tests {
                     let gv = v * w.p[g[0]] * w.p[g[1]] * w.p[g[2]];
                     g2 += gv * gv;
                     for (a, s) in sums.iter_mut().enumerate() {
-                        let (pa, qa) = super::super::in_plane(a);
+                        let (pa, qa) = super::super::weights::in_plane(a);
                         let at = g[pa] + n * g[qa];
                         s.plain[b][at] += v;
                         s.cos[b][at] += v * w.c[g[a]];
@@ -234,7 +234,7 @@ mod tests {
             for n in [16, 20] {
                 let mut compared = 0;
                 let filter = fvr_core::filter::Filter::new(kind, 1).expect("filter");
-                let w = super::super::axis_weights(&filter, n);
+                let w = super::super::weights::axis_weights(&filter, n);
                 assert!(w.edge.iter().any(|&e| e) && w.edge.iter().any(|&e| !e));
                 let (fast, g2) = view_sums(&volume, &w, n).expect("finite");
                 let (slow, g2_ref) = reference(&volume, &w, n);
@@ -283,7 +283,7 @@ mod tests {
         let volume = Volume::new([4; 3], data);
         let filter =
             fvr_core::filter::Filter::new(fvr_core::filter::FilterKind::Kb3, 1).expect("filter");
-        let w = super::super::axis_weights(&filter, 4);
+        let w = super::super::weights::axis_weights(&filter, 4);
         match view_sums(&volume, &w, 4) {
             Err(fvr_core::Error::NonFiniteVoxel { index, .. }) => assert_eq!(index, [3, 1, 2]),
             other => panic!("{:?}", other.map(|r| r.1)),

@@ -271,3 +271,38 @@ fn plain<S: Sample, T: Real>(
         || exact::extract(spec, kernel, &axes, tiling, parallel, grid);
     walked.then_some(axes)
 }
+
+impl AdaptiveMarks {
+    /// Render one view adaptively; returns the image (f64) and statistics.
+    /// For many views, keep an [`AdaptiveRenderer`] instead.
+    ///
+    /// # Errors
+    /// As [`fvr_core::render::render`].
+    pub fn render<S: Sample, T: Real>(
+        &self,
+        spec: &OwnedSpectrum<S>,
+        view: &View,
+        width: usize,
+        height: usize,
+    ) -> Result<(Vec<f64>, AdaptiveStats), fvr_core::Error> {
+        let mut out = vec![T::ZERO; width * height];
+        let stats = AdaptiveRenderer::<T>::new(self, spec)?
+            .render_into(spec, view, width, height, &mut out)?;
+        Ok((out.into_iter().map(T::to_f64).collect(), stats))
+    }
+
+    /// A sentence on how a view was walked and whether adaptivity had any
+    /// effect in its `stats`.
+    pub fn note(&self, stats: &AdaptiveStats, walked: Walked) -> Option<String> {
+        match walked {
+            Walked::Plain { share } => Some(format!(
+                "the marks allow {:.1}% of this view's samples on the cheaper filters, below \
+                 the {:.1}% at which the adaptive walk pays: 0.0% of samples substituted, plain \
+                 walk used (the full filter's image)",
+                100.0 * share,
+                100.0 * self.plain_below
+            )),
+            Walked::Adaptive => self.effect(stats),
+        }
+    }
+}

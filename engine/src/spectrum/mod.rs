@@ -24,8 +24,8 @@ use fvr_core::spectrum::{prepare_scratch_len, Spectrum};
 use fvr_core::volume::{padded_size, DenseVolume, GridOversampling};
 use half::f16;
 
-use crate::dht::real_fft::FastReal;
-use crate::dht::store::FastStore;
+use crate::dht::real::FftReal;
+use crate::dht::store::StoreFormat;
 use crate::spectrum::exchange::exchange_xy;
 use crate::spectrum::prepare::{prepare_fast_on, PreparedEnergy};
 use crate::volume::Volume;
@@ -108,9 +108,9 @@ impl<S: Sample> OwnedSpectrum<S> {
     /// As [`Spectrum::prepare`]; also a volume whose padded cube and
     /// transient buffers would not fit in memory is refused before
     /// allocating.
-    pub fn prepare<T: FastReal>(volume: &Volume, filter: Filter) -> Result<Self, PipelineError>
+    pub fn prepare<T: FftReal>(volume: &Volume, filter: Filter) -> Result<Self, PipelineError>
     where
-        S: FastStore,
+        S: StoreFormat,
     {
         let n = padded_size(volume.dims, filter.oversample())?;
         if n < 2 {
@@ -128,13 +128,13 @@ impl<S: Sample> OwnedSpectrum<S> {
     /// # Errors
     /// As [`OwnedSpectrum::prepare`]; also a side the volume and filter do
     /// not allow.
-    pub fn prepare_on<T: FastReal>(
+    pub fn prepare_on<T: FftReal>(
         volume: &Volume,
         filter: Filter,
         n: usize,
     ) -> Result<Self, PipelineError>
     where
-        S: FastStore,
+        S: StoreFormat,
     {
         let spec = prepare_fast_on::<T, S>(volume, filter, n)?;
         Ok(Self {

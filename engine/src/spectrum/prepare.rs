@@ -11,10 +11,11 @@ use fvr_core::spectrum::{check_scale, premultiplier_table, scale_for_target};
 use fvr_core::volume::padded_size;
 use rayon::prelude::*;
 
-use crate::dht::real_fft::{dht_3d_real, half_spectrum_bytes, tile_bytes, FastReal, SparseCube};
-use crate::dht::store::FastStore;
+use crate::dht::real::FftReal;
+use crate::dht::real_fft::{dht_3d_real, half_spectrum_bytes, tile_bytes, SparseCube};
+use crate::dht::store::StoreFormat;
+use crate::error::PipelineError;
 use crate::memory::{self, Budget};
-use crate::spectrum::PipelineError;
 use crate::volume::Volume;
 
 /// A spectrum prepared by [`prepare_fast`].
@@ -108,7 +109,7 @@ const LANES: usize = 8;
 /// A NaN or infinite voxel (the first in storage order, as the core names
 /// it), a volume beyond the memory limit (checked before allocating, with
 /// [`fast_budget`]), or an overflow.
-pub fn prepare_fast<T: FastReal, S: FastStore>(
+pub fn prepare_fast<T: FftReal, S: StoreFormat>(
     volume: &Volume,
     filter: Filter,
 ) -> Result<FastSpectrum<S>, PipelineError> {
@@ -122,7 +123,7 @@ pub fn prepare_fast<T: FastReal, S: FastStore>(
 ///
 /// # Errors
 /// As [`prepare_fast`]; also a side `n` the volume and filter do not allow.
-pub fn prepare_fast_on<T: FastReal, S: FastStore>(
+pub fn prepare_fast_on<T: FftReal, S: StoreFormat>(
     volume: &Volume,
     filter: Filter,
     n: usize,

@@ -58,7 +58,7 @@ const CASES: [([usize; 3], FilterKind, u32); 6] = [
 /// products, each rounded once) adds about `ε`. Measured: 1.7–2.9 `ε` in
 /// f32 and 2–4.8 `ε` in f64 at `log₂N` = 9 to 21. `c = 1/2` keeps a factor
 /// 2 above the worst of these, while a wrong sign or index costs O(1).
-fn agrees_with_core<T: crate::dht::real_fft::FastReal>(eps: f64) {
+fn agrees_with_core<T: crate::dht::real::FftReal>(eps: f64) {
     for (seed, (dims, kind, oversample)) in CASES.into_iter().enumerate() {
         let filter = Filter::new(kind, oversample).unwrap();
         let volume = random_volume(dims, seed as u64 + 1);

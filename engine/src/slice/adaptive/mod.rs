@@ -9,14 +9,11 @@ pub mod walk;
 
 mod bound;
 
-use crate::render::adaptive::{AdaptiveRenderer, Walked};
-
 use crate::slice::adaptive::summary::MarksSummary;
 use crate::spectrum::prepare::PreparedEnergy;
 use crate::spectrum::OwnedSpectrum;
 use bound::{ErrorModel, Probes};
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
-use fvr_core::geometry::View;
 use fvr_core::num::{Real, Sample};
 use fvr_core::slice::adaptive::{
     marks_words, response_difference, threshold_for, AdaptiveLevel, AdaptiveStats, Marks,
@@ -415,39 +412,6 @@ impl AdaptiveMarks {
             .iter()
             .map(|l| l.words.len() * 4 + l.summary.bytes())
             .sum()
-    }
-
-    /// Render one view adaptively; returns the image (f64) and statistics.
-    /// For many views, keep an [`AdaptiveRenderer`] instead.
-    ///
-    /// # Errors
-    /// As [`fvr_core::render::render`].
-    pub fn render<S: Sample, T: Real>(
-        &self,
-        spec: &OwnedSpectrum<S>,
-        view: &View,
-        width: usize,
-        height: usize,
-    ) -> Result<(Vec<f64>, AdaptiveStats), fvr_core::Error> {
-        let mut out = vec![T::ZERO; width * height];
-        let stats = AdaptiveRenderer::<T>::new(self, spec)?
-            .render_into(spec, view, width, height, &mut out)?;
-        Ok((out.into_iter().map(T::to_f64).collect(), stats))
-    }
-
-    /// A sentence on how a view was walked and whether adaptivity had any
-    /// effect in its `stats`.
-    pub fn note(&self, stats: &AdaptiveStats, walked: Walked) -> Option<String> {
-        match walked {
-            Walked::Plain { share } => Some(format!(
-                "the marks allow {:.1}% of this view's samples on the cheaper filters, below \
-                 the {:.1}% at which the adaptive walk pays: 0.0% of samples substituted, plain \
-                 walk used (the full filter's image)",
-                100.0 * share,
-                100.0 * self.plain_below
-            )),
-            Walked::Adaptive => self.effect(stats),
-        }
     }
 
     /// A sentence on whether adaptivity had any effect in `stats`.

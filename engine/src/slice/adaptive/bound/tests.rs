@@ -80,11 +80,11 @@ fn volumes() -> Vec<crate::volume::Volume> {
 /// kb6 at σ = 1 and 2 and both arithmetics.
 #[test]
 fn the_prepared_floor_is_below_the_transformed_reference_and_close() {
-    use crate::dht::real_fft::FastReal;
-    use crate::dht::store::FastStore;
+    use crate::dht::real::FftReal;
+    use crate::dht::store::StoreFormat;
     use crate::spectrum::OwnedSpectrum;
     use fvr_core::filter::FilterKind;
-    fn check<S: FastStore, T: FastReal>(v: &crate::volume::Volume, f: Filter, db: f64) {
+    fn check<S: StoreFormat, T: FftReal>(v: &crate::volume::Volume, f: Filter, db: f64) {
         let spec = OwnedSpectrum::<S>::prepare::<T>(v, f).unwrap();
         let view = spec.view();
         let measured = ErrorModel::new(&view, None, Probes::Search)
