@@ -16,4 +16,7 @@ pub enum PipelineError {
         /// Side of the padded cube.
         n: usize,
     },
+    /// Settings that no view can render, or a planner's refusal; one line.
+    #[error("{0}")]
+    Settings(String),
 }

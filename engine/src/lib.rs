@@ -14,7 +14,9 @@
 //! - [`render`]: views, shaded scenes, adaptive views, turntables;
 //! - [`plan`]: the accuracy planner that chooses filter, grid and precision.
 //!
-//! [`memory`] is the one budget every allocation is checked against.
+//! [`Renderer`] is the one entry point over them: settings in, a plan, a
+//! preparation, then views. [`memory`] is the one budget every allocation is
+//! checked against.
 
 pub mod dht;
 mod error;
@@ -22,7 +24,12 @@ pub mod image;
 pub mod memory;
 pub mod plan;
 pub mod render;
+mod renderer;
 pub mod slice;
 pub mod spectrum;
 pub mod volume;
 pub use error::PipelineError;
+pub use renderer::{
+    describe, AdaptiveView, Plan, Renderer, Settings, Units, ViewReport, DEFAULT_ACCURACY_DB,
+    PREDICTION_WARNING_DB, STORAGE_SNR_WARNING_DB,
+};

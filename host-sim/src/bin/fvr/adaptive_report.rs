@@ -5,15 +5,15 @@ use serde::Serialize;
 use std::time::Instant;
 
 use fvr_core::geometry::View;
-use fvr_engine::render::adaptive::{AdaptiveRenderer, Walked};
-use fvr_engine::slice::adaptive::{AdaptiveSettings, Bound};
-use fvr_engine::spectrum::AnySpectrum;
+use fvr_engine::image::Image;
+use fvr_engine::render::adaptive::Walked;
+use fvr_engine::slice::adaptive::{AdaptiveMarks, Bound};
+use fvr_engine::{AdaptiveView, Renderer, ViewReport};
 use fvr_host::reference::snr_db;
 
 /// An adaptive render with what it did.
-pub(crate) struct AdaptiveReport {
-    pub(crate) image: Vec<f64>,
-    pub(crate) marks: fvr_engine::slice::adaptive::AdaptiveMarks,
+pub(crate) struct AdaptiveReport<'a> {
+    pub(crate) marks: &'a AdaptiveMarks,
     pub(crate) stats: fvr_core::slice::adaptive::AdaptiveStats,
     pub(crate) walked: Walked,
     pub(crate) mark_time: std::time::Duration,
@@ -22,7 +22,49 @@ pub(crate) struct AdaptiveReport {
     pub(crate) snr_vs_full: f64,
 }
 
-impl AdaptiveReport {
+impl<'a> AdaptiveReport<'a> {
+    /// The report of the adaptive view `image` of `view`, with the full
+    /// filter's view rendered for comparison.
+    pub(crate) fn new(
+        renderer: &'a Renderer,
+        adaptive: &AdaptiveView,
+        view: &View,
+        report: &ViewReport,
+        image: &Image,
+    ) -> Result<Self, Error> {
+        let marks = renderer
+            .marks()
+            .ok_or("an adaptive view was rendered without marks")?;
+        if let (Walked::Plain { share }, false) = (adaptive.walked, fvr_host::progress::quiet()) {
+            eprintln!(
+                "fvr: note: adaptive: the marks allow {:.1}% of the samples on the cheaper \
+                 filters, below {:.1}% (--adaptive-plain-below): 0.0% of samples substituted, \
+                 plain walk used",
+                100.0 * share,
+                100.0 * marks.plain_below
+            );
+        }
+        // The full filter's view in the same units: voxel units, times the
+        // gain the adaptive image carries.
+        let gain = renderer.sampling().gain() * renderer.settings().scene.ambient[0];
+        let t = Instant::now();
+        let full = renderer
+            .spectra()
+            .density
+            .render(view, image.width, image.height)?;
+        let full_view_time = t.elapsed();
+        let full: Vec<f64> = full.iter().map(|v| v * gain).collect();
+        Ok(Self {
+            snr_vs_full: snr_db(&full, &image.data),
+            marks,
+            stats: adaptive.stats,
+            walked: adaptive.walked,
+            mark_time: adaptive.mark_time.unwrap_or_default(),
+            view_time: report.time,
+            full_view_time,
+        })
+    }
+
     pub(crate) fn print_human(&self) {
         let s = &self.stats;
         let pct = |v: u64, of: u64| 100.0 * v as f64 / of.max(1) as f64;
@@ -134,65 +176,6 @@ impl AdaptiveReport {
             plain_below: self.marks.plain_below,
             note: self.marks.note(s, self.walked),
         }
-    }
-}
-
-/// Mark the spectrum, render adaptively, and render with the full filter
-/// for comparison.
-pub(crate) fn adaptive_render(
-    spec: &AnySpectrum,
-    view: &View,
-    w: usize,
-    h: usize,
-    settings: &AdaptiveSettings,
-) -> Result<AdaptiveReport, Error> {
-    pub(crate) fn go<S: fvr_core::num::Sample, T: fvr_core::num::Real>(
-        any: &AnySpectrum,
-        spec: &fvr_engine::spectrum::OwnedSpectrum<S>,
-        view: &View,
-        w: usize,
-        h: usize,
-        settings: &AdaptiveSettings,
-    ) -> Result<AdaptiveReport, Error> {
-        let t0 = Instant::now();
-        let marks = fvr_engine::slice::adaptive::AdaptiveMarks::build(spec, settings)?;
-        let mark_time = t0.elapsed();
-        let t1 = Instant::now();
-        let (image, stats, walked) = {
-            let mut renderer = AdaptiveRenderer::<T>::new(&marks, spec)?;
-            let mut out = vec![T::ZERO; w * h];
-            let stats = renderer.render_into(spec, view, w, h, &mut out)?;
-            let image: Vec<f64> = out.into_iter().map(T::to_f64).collect();
-            (image, stats, renderer.walked())
-        };
-        let view_time = t1.elapsed();
-        if let (Walked::Plain { share }, false) = (walked, fvr_host::progress::quiet()) {
-            eprintln!(
-                "fvr: note: adaptive: the marks allow {:.1}% of the samples on the cheaper \
-                 filters, below {:.1}% (--adaptive-plain-below): 0.0% of samples substituted, \
-                 plain walk used",
-                100.0 * share,
-                100.0 * marks.plain_below
-            );
-        }
-        let t2 = Instant::now();
-        let full = any.render(view, w, h)?;
-        let full_view_time = t2.elapsed();
-        Ok(AdaptiveReport {
-            snr_vs_full: snr_db(&full, &image),
-            image,
-            marks,
-            stats,
-            walked,
-            mark_time,
-            view_time,
-            full_view_time,
-        })
-    }
-    match spec {
-        AnySpectrum::F16(s) => go::<_, f32>(spec, s, view, w, h, settings),
-        AnySpectrum::F32(s) => go::<_, f32>(spec, s, view, w, h, settings),
-        AnySpectrum::F64(s) => go::<_, f64>(spec, s, view, w, h, settings),
     }
 }
 

@@ -3,13 +3,10 @@
 use crate::Error;
 use clap::Args;
 use fvr_core::filter::FilterKind;
-use fvr_core::geometry::Sampling;
-use fvr_core::shading::Scene;
 use fvr_core::volume::GridOversampling;
 use fvr_engine::plan::filter::KbDesign;
-use fvr_engine::plan::grid_filter;
-use fvr_engine::render::shaded::SceneSpectra;
-use fvr_engine::spectrum::{AnySpectrum, Precision};
+use fvr_engine::spectrum::Precision;
+use fvr_engine::{Plan, Renderer, Settings, Units};
 use fvr_host::image::output::{Bits, Colormap, Style, Window};
 use fvr_host::io::nrrd::{Endian, SampleType};
 use fvr_host::io::FORMATS_HELP;
@@ -88,42 +85,12 @@ pub(crate) struct UnitArgs {
 }
 
 impl UnitArgs {
-    /// The voxel spacing and pixel size: the volume's spacing, or 1 mm
-    /// with `--ignore-spacing`; `--pixel-size`, or by default the smallest
-    /// spacing, raised if need be so that the longest physical side fits
-    /// `default_side` pixels (the default image). Warns when the longest
-    /// side exceeds the image grid's period `n·p`.
-    pub(crate) fn sampling(
-        &self,
-        volume: &fvr_engine::volume::Volume,
-        n: usize,
-        default_side: usize,
-    ) -> Result<Sampling, Error> {
-        if self.ignore_spacing {
-            return Ok(Sampling::UNIT);
+    /// The engine's units for these flags.
+    pub(crate) fn units(&self) -> Units {
+        Units {
+            ignore_spacing: self.ignore_spacing,
+            pixel_size: self.pixel_size,
         }
-        let spacing = volume.spacing;
-        let longest = (0..3)
-            .map(|a| volume.dims[a] as f64 * spacing[a])
-            .fold(0.0, f64::max);
-        let pixel_size = match self.pixel_size {
-            Some(p) => p,
-            None => {
-                let finest = spacing.iter().copied().fold(f64::INFINITY, f64::min);
-                finest.max(longest / default_side.max(1) as f64)
-            }
-        };
-        let sampling =
-            Sampling::new(spacing, pixel_size).map_err(|e| format!("--pixel-size: {e}"))?;
-        let period = n as f64 * pixel_size;
-        if longest > period {
-            eprintln!(
-                "fvr: warning: the volume's longest side ({longest:.1} mm) exceeds the image \
-                 grid's period ({n} pixels of {pixel_size} mm = {period:.1} mm): views across \
-                 it wrap around. Use a larger --pixel-size or --oversample 2."
-            );
-        }
-        Ok(sampling)
     }
 }
 
@@ -309,69 +276,20 @@ pub(crate) fn load_with_progress(
     Ok(volume?)
 }
 
-/// Fit the filter and prepare the scene's spectra, with a spinner.
-pub(crate) fn prepare_scene_with_progress(
-    volume: &fvr_engine::volume::Volume,
-    kind: FilterKind,
-    grid: GridOversampling,
-    design: KbDesign,
-    precision: Precision,
-    scene: &Scene,
-) -> Result<(SceneSpectra, fvr_core::filter::Filter), Error> {
-    let bar = progress::spinner("fitting filter");
-    let result = (|| -> Result<_, Error> {
-        check_padding(volume, grid)?;
-        let filter = grid_filter(volume, kind, grid, design)?;
-        bar.set_message(if scene.needs_gradient_spectrum() {
-            "preprocess (density and |grad f| spectra)"
-        } else {
-            "preprocess"
-        });
-        let spectra = if grid.is_pow2() {
-            SceneSpectra::prepare(volume, filter, precision, scene)?
-        } else if scene.needs_gradient_spectrum() {
-            return Err(format!(
-                "--oversample {} works on plain X-ray views: lights need --oversample 1 or 2",
-                grid.name()
-            )
-            .into());
-        } else {
-            SceneSpectra {
-                density: AnySpectrum::prepare_grid(volume, filter, precision, grid)?,
-                gradient: None,
-            }
-        };
-        Ok((spectra, filter))
-    })();
-    bar.finish_and_clear();
-    result
-}
-
-/// Fit the filter and prepare the spectrum, with a spinner (the core's
-/// preparation is one call with no progress of its own).
+/// Prepare `volume` for `plan` ([`Renderer::prepare`]), with a spinner
+/// naming the stage (the core's preparation is one call with no progress
+/// of its own).
 pub(crate) fn prepare_with_progress(
     volume: &fvr_engine::volume::Volume,
-    kind: FilterKind,
-    grid: GridOversampling,
-    design: KbDesign,
-    precision: Precision,
-) -> Result<AnySpectrum, Error> {
+    settings: Settings,
+    plan: Plan,
+) -> Result<Renderer, Error> {
     let bar = progress::spinner("fitting filter");
-    let result = (|| -> Result<_, Error> {
-        check_padding(volume, grid)?;
-        let filter = grid_filter(volume, kind, grid, design)?;
-        bar.set_message("preprocess");
-        Ok(AnySpectrum::prepare_grid(volume, filter, precision, grid)?)
-    })();
+    let renderer = Renderer::prepare(volume, settings, plan, &|stage: &str| {
+        bar.set_message(stage.to_string())
+    });
     bar.finish_and_clear();
-    result
-}
-
-/// [`fvr_engine::volume::check_padding`] for the grid `volume` gets at
-/// `grid`.
-fn check_padding(volume: &fvr_engine::volume::Volume, grid: GridOversampling) -> Result<(), Error> {
-    let n = grid.side(volume.dims)?;
-    Ok(fvr_engine::volume::check_padding(volume.dims, n)?)
+    Ok(renderer?)
 }
 
 /// Declare, before loading, what the job builds from its volume: `spectra`

@@ -1,11 +1,9 @@
 //! `fvr render`: one view of a volume, X-ray, depth-cued or shaded.
 
-use crate::adaptive_report::adaptive_render;
-use crate::args::{
-    parse_vec3, prepare_scene_with_progress, volume_help, FrameArgs, InputArgs, PngArgs,
-};
+use crate::args::{parse_vec3, prepare_with_progress, volume_help, FrameArgs, InputArgs, PngArgs};
 use crate::scene::SCENE_HELP;
 use crate::Error;
+use fvr_engine::{Plan, Settings};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -37,10 +35,6 @@ use fvr_host::options::{
 use fvr_host::reference::shaded::exact_scene_projection_sampled;
 use fvr_host::reference::{exact_projection_sampled, snr_db};
 use fvr_host::sources::phantom_by_name;
-
-/// Below this estimated storage SNR the renderer warns (see
-/// `OwnedSpectrum::storage_snr_estimate_db`).
-pub(crate) const STORAGE_SNR_WARNING_DB: f64 = 50.0;
 
 /// Above this share of negatively weighted density (−30 dB) a depth cue
 /// warns (see `negative_cue_share`).
@@ -210,6 +204,32 @@ fn declare_job(args: &RenderArgs, scene: &Scene) {
     );
 }
 
+/// The engine's settings for `args` and `scene`: the spectrum flags given,
+/// the scene, adaptive filtering, the preview level and the units.
+fn settings(args: &RenderArgs, scene: Scene) -> Result<Settings, Error> {
+    let adaptive = match args.adaptive {
+        Some(tolerance_db) => Some(AdaptiveSettings {
+            tolerance_db,
+            chain: parse_chain(&args.adaptive_chain)?,
+            h_d: args.adaptive_hd,
+            bound: args.adaptive_bound.unwrap_or(match args.adaptive_hd {
+                Some(_) => Bound::Paper,
+                None => Bound::Parseval,
+            }),
+            plain_below: args.adaptive_plain_below,
+            probes: args.adaptive_probes,
+        }),
+        None => None,
+    };
+    Ok(Settings {
+        scene,
+        adaptive,
+        preview_level: args.preview_level,
+        units: args.frame.units.units(),
+        ..crate::plan::settings(&args.frame.spectrum)
+    })
+}
+
 /// The chain of `--adaptive` by default: the zero filter, which reads
 /// nothing. On `gaussians@256` with kb6 at 40 dB its views take about half
 /// the time of the 1³ filter's (docs/adaptive.md).
@@ -238,39 +258,18 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     }
     fvr_host::budget::check_plan(volume.dims)?;
     let t_load = t0.elapsed();
-    let plain_view = scene.channels() == 1 && !scene.has_partner_terms();
-    let grids = if plain_view && args.adaptive.is_none() {
-        crate::plan::Grids::All
-    } else {
-        crate::plan::Grids::PowersOfTwo
-    };
-    let t_planning = Instant::now();
-    let args = &crate::plan::planned(args, &volume, grids)?;
-    let t_plan = t_planning.elapsed();
+    let settings = settings(args, scene.clone())?;
+    settings.check()?;
+    let plan = Plan::choose(&volume, &settings)?;
+    let mut planned = args.clone();
+    crate::plan::apply(&mut planned.frame.spectrum, &plan);
+    let args = &planned;
     // The planner may have changed the spectrum's settings.
     declare_job(args, &scene);
     fvr_host::budget::check_plan(volume.dims)?;
-    let t1 = Instant::now();
-    let (spectra, filter) = prepare_scene_with_progress(
-        &volume,
-        args.frame.spectrum.filter,
-        args.frame.spectrum.oversample,
-        args.frame.spectrum.kb_design,
-        args.frame.spectrum.precision,
-        &scene,
-    )?;
-    let t_prep = t1.elapsed();
-    let volume_sum: f64 = volume.data.iter().map(|&v| v as f64).sum();
-    let storage_snr = spectra.density.storage_snr_estimate_db(volume_sum);
-    if storage_snr < STORAGE_SNR_WARNING_DB {
-        eprintln!(
-            "fvr: warning: premultiplying for {} at oversample {} amplifies this volume's edges; \
-             the {} spectrum is estimated to hold only {storage_snr:.1} dB. \
-             Use --oversample 2, --filter cubic, or --precision f32.",
-            args.frame.spectrum.filter.name(),
-            args.frame.spectrum.oversample.name(),
-            args.frame.spectrum.precision
-        );
+    let renderer = prepare_with_progress(&volume, settings, plan)?;
+    for w in renderer.warnings() {
+        eprintln!("fvr: warning: {w}");
     }
     let (lowest, share) = negative_cue_share(&volume, &scene, &view)?;
     if share > NEGATIVE_CUE_WARNING_SHARE {
@@ -282,84 +281,20 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
             100.0 * share
         );
     }
-    let n = spectra.density.n();
-    let default_side = fvr_engine::plan::image_side(volume.dims, n)?;
-    let (w, h) = args.frame.size.unwrap_or((default_side, default_side));
-    fvr_core::image::check_image(w, h, n)?;
-    let sampling = args.frame.units.sampling(&volume, n, default_side)?;
-    if (args.preview_level > 0 || args.adaptive.is_some()) && !plain_view {
-        return Err(
-            "--preview-level and --adaptive work on plain X-ray views: leave out --depth-cue, \
-                    --light, --light-ring and a coloured --ambient"
-                .into(),
-        );
-    }
-    if args.preview_level > 0 && args.adaptive.is_some() {
-        return Err("--preview-level and --adaptive cannot be combined: choose one".into());
-    }
-    // Cubic voxels imaged at their own size read the slice along the frame's
-    // own axes: only the gain ΔV/p² = Δ differs from voxel units.
-    if args.adaptive.is_some() && sampling.uniform_pitch().is_none() {
-        return Err(format!(
-            "--adaptive needs cubic voxels imaged at their own size (or voxel units), and this \
-             render uses {} mm voxels and {} mm pixels: add --resample N, drop --pixel-size, \
-             or add --ignore-spacing",
-            fmt_spacing(sampling.spacing()),
-            sampling.pixel_size()
-        )
-        .into());
-    }
-    let mut adaptive_report = None;
-    let t2 = Instant::now();
-    let (image, w, h) = if args.preview_level > 0 {
-        let (pw, ph) = fvr_core::render::preview_size(w, h, args.preview_level);
-        let data =
-            spectra
-                .density
-                .render_level_sampled(&view, &sampling, pw, ph, args.preview_level)?;
-        (
-            fvr_host::image::Image {
-                channels: 1,
-                width: pw,
-                height: ph,
-                data: data.into_iter().map(|v| v * scene.ambient[0]).collect(),
-            },
-            pw,
-            ph,
-        )
-    } else if let Some(tolerance) = args.adaptive {
-        let settings = AdaptiveSettings {
-            tolerance_db: tolerance,
-            chain: parse_chain(&args.adaptive_chain)?,
-            h_d: args.adaptive_hd,
-            bound: args.adaptive_bound.unwrap_or(match args.adaptive_hd {
-                Some(_) => Bound::Paper,
-                None => Bound::Parseval,
-            }),
-            plain_below: args.adaptive_plain_below,
-            probes: args.adaptive_probes,
-        };
-        let report = adaptive_render(&spectra.density, &view, w, h, &settings)?;
-        let gain = sampling.gain() * scene.ambient[0];
-        let data = report.image.iter().map(|v| v * gain).collect();
-        adaptive_report = Some(report);
-        (
-            fvr_host::image::Image {
-                channels: 1,
-                width: w,
-                height: h,
-                data,
-            },
-            w,
-            h,
-        )
-    } else {
-        let image = spectra.render_sampled(&scene, &view, &sampling, w, h)?;
-        (image, w, h)
+    let (w, h) = renderer.image_size(args.frame.size)?;
+    let (image, view_report) = renderer.render(&view, Some((w, h)))?;
+    let (w, h) = (image.width, image.height);
+    let adaptive_report = match &view_report.adaptive {
+        Some(a) => Some(AdaptiveReport::new(
+            &renderer,
+            a,
+            &view,
+            &view_report,
+            &image,
+        )?),
+        None => None,
     };
-    let t_view = adaptive_report
-        .as_ref()
-        .map_or(t2.elapsed(), |r| r.view_time);
+    let t_view = view_report.time;
     check_finite(&image.data)?;
     if ext == "png" {
         if image.channels == 1 {
@@ -378,17 +313,17 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         volume,
         view,
         scene,
-        sampling,
-        spectra,
-        filter,
-        storage_snr,
+        sampling: *renderer.sampling(),
+        n: renderer.n(),
+        filter: renderer.filter(),
+        storage_snr: renderer.storage_snr_db(),
+        t_plan: renderer.plan().time,
+        t_prep: renderer.prepare_time(),
+        spectra: renderer.spectra(),
         image,
         w,
         h,
-        n,
         t_load,
-        t_plan,
-        t_prep,
         t_view,
         adaptive_report,
     };
@@ -402,10 +337,6 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         rendered.print_exact()?;
     }
     Ok(())
-}
-
-pub(crate) fn fmt_spacing(s: [f64; 3]) -> String {
-    format!("{} x {} x {}", s[0], s[1], s[2])
 }
 
 /// The scene from the command line: cue, ambient, lights.
@@ -471,7 +402,7 @@ struct Rendered<'a> {
     view: View,
     scene: Scene,
     sampling: Sampling,
-    spectra: SceneSpectra,
+    spectra: &'a SceneSpectra,
     filter: Filter,
     storage_snr: f64,
     image: Image,
@@ -482,7 +413,7 @@ struct Rendered<'a> {
     t_plan: Duration,
     t_prep: Duration,
     t_view: Duration,
-    adaptive_report: Option<AdaptiveReport>,
+    adaptive_report: Option<AdaptiveReport<'a>>,
 }
 
 impl Rendered<'_> {
@@ -494,7 +425,7 @@ impl Rendered<'_> {
             ref volume,
             ref scene,
             ref sampling,
-            ref spectra,
+            spectra,
             filter,
             storage_snr,
             w,
@@ -603,7 +534,7 @@ impl Rendered<'_> {
             volume_spec,
             ref volume,
             ref sampling,
-            ref spectra,
+            spectra,
             filter,
             storage_snr,
             ref image,

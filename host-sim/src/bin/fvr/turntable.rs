@@ -13,6 +13,7 @@ use clap::Args;
 use fvr_core::geometry::{Sampling, View};
 use fvr_engine::render::turntable;
 use fvr_engine::spectrum::AnySpectrum;
+use fvr_engine::{Plan, Settings};
 use fvr_host::image::output::{write_apng, ApngStream, Window};
 use fvr_host::progress;
 use indicatif::ProgressBar;
@@ -103,26 +104,27 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     let _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
     fvr_host::budget::check_plan(volume.dims)?;
     let t_load = t0.elapsed();
-    let t_planning = Instant::now();
-    let args = &crate::plan::planned(args, &volume, crate::plan::Grids::All)?;
-    let t_plan = t_planning.elapsed();
+    let settings = Settings {
+        units: args.frame.units.units(),
+        ..crate::plan::settings(&args.frame.spectrum)
+    };
+    let plan = Plan::choose(&volume, &settings)?;
+    let t_plan = plan.time;
+    let mut planned = args.clone();
+    crate::plan::apply(&mut planned.frame.spectrum, &plan);
+    let args = &planned;
     // The planner may have changed the spectrum's settings.
     declare_job(args, views.len());
     fvr_host::budget::check_plan(volume.dims)?;
-    let t1 = Instant::now();
-    let spec = prepare_with_progress(
-        &volume,
-        args.frame.spectrum.filter,
-        args.frame.spectrum.oversample,
-        args.frame.spectrum.kb_design,
-        args.frame.spectrum.precision,
-    )?;
-    let t_prep = t1.elapsed();
-    let n = spec.n();
-    let side = fvr_engine::plan::image_side(volume.dims, n)?;
-    let (w, h) = args.frame.size.unwrap_or((side, side));
-    fvr_core::image::check_image(w, h, n)?;
-    let sampling = args.frame.units.sampling(&volume, n, side)?;
+    let renderer = prepare_with_progress(&volume, settings, plan)?;
+    for w in renderer.warnings() {
+        eprintln!("fvr: warning: {w}");
+    }
+    let t_prep = renderer.prepare_time();
+    let spec = &renderer.spectra().density;
+    let n = renderer.n();
+    let (w, h) = renderer.image_size(args.frame.size)?;
+    let sampling = *renderer.sampling();
     let all_bytes = (views.len() as u64).saturating_mul((w * h * 8) as u64);
     let sampled = !matches!(style.window, Window::Range(..)) && all_bytes > HOLD_FRAMES_BYTES;
     let extra = if sampled {
@@ -132,7 +134,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     };
     let bar = progress::count((views.len() + extra) as u64, "frames");
     let t2 = Instant::now();
-    let result = write_frames(&spec, &views, &sampling, (w, h), &bar, args, sampled);
+    let result = write_frames(spec, &views, &sampling, (w, h), &bar, args, sampled);
     bar.finish_and_clear();
     let encode = result?;
     let t_views = t2.elapsed().saturating_sub(encode);
