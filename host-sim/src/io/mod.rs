@@ -21,6 +21,7 @@
 //! decompressed far beyond what the header calls for, and every problem is
 //! an [`IoError`] that names the file and the field.
 
+pub mod atomic;
 pub mod den;
 pub mod dicom;
 mod error;

@@ -453,7 +453,12 @@ fn gzip(bytes: &[u8]) -> Vec<u8> {
 /// equal `data.len()`. Errors carry the path.
 pub fn write_nrrd_f32(path: &Path, sizes: &[usize], data: &[f32]) -> Result<(), IoError> {
     check_sizes(sizes, data.len())
-        .and_then(|()| Ok(std::fs::write(path, encode_nrrd_f32(sizes, data))?))
+        .and_then(|()| {
+            Ok(super::atomic::write_bytes(
+                path,
+                &encode_nrrd_f32(sizes, data),
+            )?)
+        })
         .map_err(|e| e.in_file(path))
 }
 
@@ -472,12 +477,12 @@ pub fn write_volume_nrrd(path: &Path, volume: &Volume) -> Result<(), IoError> {
         text.truncate(text.len() - 1);
         let [sx, sy, sz] = volume.spacing;
         text.push_str(&format!("spacings: {sx} {sy} {sz}\n\n"));
-        let mut out = io::BufWriter::with_capacity(FILE_BUFFER_BYTES, std::fs::File::create(path)?);
+        let mut out = super::atomic::Output::create(path)?;
         out.write_all(text.as_bytes())?;
         for chunk in volume.data.chunks(CHUNK_BYTES / 4) {
             out.write_all(&samples::encode_f32_le(chunk))?;
         }
-        out.flush()?;
+        out.commit()?;
         Ok(())
     };
     write().map_err(|e| e.in_file(path))

@@ -335,10 +335,7 @@ pub fn run(
     let rows = measure(sizes, runs, large, progress)?;
     std::fs::create_dir_all(out_dir)
         .map_err(|e| format!("cannot create `{}`: {e}", out_dir.display()))?;
-    let write = |name: &str, text: &str| {
-        let p = out_dir.join(name);
-        std::fs::write(&p, text).map_err(|e| format!("cannot write `{}`: {e}", p.display()))
-    };
+    let write = |name: &str, text: &str| crate::io::atomic::write_text(&out_dir.join(name), text);
     write("growth.csv", &csv(&rows))?;
     let md = markdown(&rows);
     write("growth.md", &md)?;

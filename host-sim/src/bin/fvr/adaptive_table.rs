@@ -67,7 +67,7 @@ pub(crate) fn adaptive_table(args: &AdaptiveTableArgs) -> Result<(), Error> {
         )?);
         eprintln!("fvr: measured {name}");
     }
-    print!(
+    say_part!(
         "{}",
         fvr_host::studies::adaptive_table::table1_markdown(&rows, tolerance)
     );

@@ -138,7 +138,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     let t_views = t2.elapsed().saturating_sub(encode);
     let frames = views.len();
     let secs = t_views.as_secs_f64();
-    println!(
+    say!(
         "wrote {} ({} frames, {w}x{h}, {} fps)",
         args.out.display(),
         frames,
@@ -166,9 +166,9 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
             views_per_second,
             accuracy: crate::plan::json(&args.frame.spectrum),
         };
-        println!("{}", one_line(&stats));
+        say!("{}", one_line(&stats));
     } else {
-        println!(
+        say!(
             "  load {:.1} ms, plan {:.1} ms, preprocess {:.1} ms ({n}^3 {}), {} views in {:.1} ms = {:.1} views/s",
             t_load.as_secs_f64() * 1e3,
             t_plan.as_secs_f64() * 1e3,
