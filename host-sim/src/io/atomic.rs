@@ -123,7 +123,8 @@ impl Output {
     /// Flush, sync and rename the temporary file over the target.
     ///
     /// # Errors
-    /// A write, sync or rename failure; the temporary file is then removed
+    /// A write, sync or rename failure, or a target that is one of the
+    /// job's inputs ([`super::inputs`]); the temporary file is then removed
     /// and the target left as it was.
     pub fn commit(self) -> io::Result<()> {
         let mut inner = self.lock();
@@ -139,6 +140,9 @@ impl Output {
             .and_then(|file| file.sync_all())
             .and_then(|()| {
                 let _live = live();
+                // Never over a file this job read (checked before the render
+                // too; this holds for every writer).
+                super::inputs::check_output(&target).map_err(io::Error::other)?;
                 temp.persist(&target).map_err(|e| e.error)
             });
         forget(&mut live(), &name);

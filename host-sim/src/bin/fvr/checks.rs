@@ -18,6 +18,15 @@ pub(crate) fn check_output(
     Ok(())
 }
 
+/// Refuse an output that is any file the job has read so far (the volume,
+/// a detached NRRD's data file, a data set, a DICOM series' files, a scene,
+/// a depth profile), by file identity. Run once the inputs are read, before
+/// the render.
+pub(crate) fn check_not_input(out: &Path) -> Result<(), Error> {
+    fvr_host::io::inputs::check_output(out)?;
+    Ok(())
+}
+
 /// Refuse a resampled volume beyond the memory limit before allocating it.
 pub(crate) fn check_resample(volume: &Volume, largest: usize) -> Result<(), Error> {
     let dims = volume.resampled_dims(largest)?;

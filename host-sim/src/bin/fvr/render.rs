@@ -230,6 +230,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     declare_job(args, &scene);
     let t0 = Instant::now();
     let mut volume = args.input.load(volume_spec)?;
+    crate::checks::check_not_input(out)?;
     let mut _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
     if let Some(largest) = args.resample {
         check_resample(&volume, largest)?;

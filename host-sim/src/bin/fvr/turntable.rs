@@ -100,6 +100,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     crate::checks::check_output(&args.out, &["apng", "png"], volume_spec)?;
     declare_job(args, views.len());
     let volume = args.input.load(volume_spec)?;
+    crate::checks::check_not_input(&args.out)?;
     let _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
     fvr_host::budget::check_plan(volume.dims)?;
     let t_load = t0.elapsed();

@@ -496,6 +496,7 @@ pub fn read_dicom_with_progress(path: &Path, progress: &ProgressBar) -> Result<V
             (path.to_path_buf(), None)
         } else {
             let bytes = fs::read(path)?;
+            crate::io::inputs::record(path);
             let obj = open_bytes(&bytes)?;
             let uid =
                 text(&obj, tags::SERIES_INSTANCE_UID, "SeriesInstanceUID")?.unwrap_or_default();
@@ -527,6 +528,7 @@ pub fn read_dicom_with_progress(path: &Path, progress: &ProgressBar) -> Result<V
                     return Ok(None);
                 }
                 let bytes = fs::read(&file)?;
+                crate::io::inputs::record(&file);
                 let obj = open_bytes(&bytes)?;
                 if !has_pixel_data(&obj) {
                     return Ok(None);
