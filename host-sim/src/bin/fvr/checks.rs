@@ -27,6 +27,46 @@ pub(crate) fn check_not_input(out: &Path) -> Result<(), Error> {
     Ok(())
 }
 
+/// Refuse a direction that cannot be normalised to a finite unit vector
+/// (its squared length underflows, e.g. `1e-320,0,0`, or overflows), naming
+/// `what` (the option). The zero vector is left to the view's own check.
+pub(crate) fn check_direction(what: &str, v: [f64; 3]) -> Result<(), Error> {
+    let length2: f64 = v.iter().map(|c| c * c).sum();
+    if v == [0.0; 3] || length2.is_normal() {
+        return Ok(());
+    }
+    Err(format!(
+        "{what} {:?},{:?},{:?}: this direction cannot be normalised (its length squared is {}); \
+         give components of ordinary size, such as 1,0,0",
+        v[0],
+        v[1],
+        v[2],
+        if length2 == 0.0 || length2.is_subnormal() {
+            "below the smallest double"
+        } else {
+            "beyond the largest double"
+        }
+    )
+    .into())
+}
+
+/// The samples `--resample` (or a scene's `volume.resample`) may ask for
+/// along the longest side; one rule for both.
+pub(crate) const RESAMPLE_RANGE: std::ops::RangeInclusive<usize> = 2..=4096;
+
+/// Refuse a `--resample` outside [`RESAMPLE_RANGE`] before any work.
+pub(crate) fn check_resample_count(resample: Option<usize>) -> Result<(), Error> {
+    match resample {
+        Some(n) if !RESAMPLE_RANGE.contains(&n) => Err(format!(
+            "--resample {n}: give {} to {} samples along the volume's longest side",
+            RESAMPLE_RANGE.start(),
+            RESAMPLE_RANGE.end()
+        )
+        .into()),
+        _ => Ok(()),
+    }
+}
+
 /// Refuse a resampled volume beyond the memory limit before allocating it.
 pub(crate) fn check_resample(volume: &Volume, largest: usize) -> Result<(), Error> {
     let dims = volume.resampled_dims(largest)?;
@@ -40,15 +80,40 @@ pub(crate) fn check_resample(volume: &Volume, largest: usize) -> Result<(), Erro
     Ok(())
 }
 
-/// Refuse to write an image with a NaN or infinite pixel.
-pub(crate) fn check_finite(data: &[f64]) -> Result<(), Error> {
-    match data.iter().position(|v| !v.is_finite()) {
+/// Refuse to write an image with a NaN or infinite pixel, in f64 or once
+/// narrowed to the f32 of a NRRD image (a `--precision f64` render can
+/// exceed 3.4e38). `cause` says what overflowed, naming only settings the
+/// job was given ([`overflow_cause`]).
+pub(crate) fn check_finite(data: &[f64], cause: &str) -> Result<(), Error> {
+    match data.iter().position(|&v| !(v as f32).is_finite()) {
         None => Ok(()),
         Some(i) => Err(format!(
-            "the image has non-finite pixels (the first is pixel {i}, value {:e}): a setting overflowed; \
-             lower --ambient, the --light colours or the --depth-cue weights",
+            "the image has pixels that are not finite numbers in f32 (the first is pixel {i}, \
+             value {:e}): {cause}",
             data[i]
         )
         .into()),
+    }
+}
+
+/// What to lower when an image overflows: the shading settings given
+/// (`--ambient`, lights, a depth cue), or else the volume itself.
+pub(crate) fn overflow_cause(ambient: bool, lights: bool, depth_cue: bool) -> String {
+    let given: Vec<&str> = [
+        (ambient, "--ambient"),
+        (lights, "the --light colours"),
+        (depth_cue, "the --depth-cue weights"),
+    ]
+    .iter()
+    .filter(|(g, _)| *g)
+    .map(|(_, name)| *name)
+    .collect();
+    match given.as_slice() {
+        [] => "the volume's values (times its voxel size in mm) are too large; rescale the \
+               volume, or add --ignore-spacing"
+            .to_string(),
+        [one] => format!("a setting overflowed; lower {one}"),
+        [a, b] => format!("a setting overflowed; lower {a} or {b}"),
+        _ => format!("a setting overflowed; lower {}", given.join(", ")),
     }
 }

@@ -73,6 +73,9 @@ pub(crate) fn run(args: &PrecisionArgs) -> Result<(), Error> {
         "2" => Oversampling::Fixed(2),
         o => return Err(format!("oversampling `{o}` must be auto, 1 or 2").into()),
     };
+    if let Some(dir) = &args.out_dir {
+        fvr_host::studies::prepare_out_dir(dir)?;
+    }
     if let Some(n) = args.extremes {
         if n < 2 || n % 2 != 0 || n > 128 {
             return Err(format!("--extremes {n}: the side must be even, from 2 to 128").into());
@@ -98,8 +101,6 @@ pub(crate) fn run(args: &PrecisionArgs) -> Result<(), Error> {
                 Ok(())
             }
             Some(dir) => {
-                std::fs::create_dir_all(dir)
-                    .map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
                 fvr_host::io::atomic::write_text(&dir.join("extremes.md"), &md)?;
                 Ok(())
             }
@@ -157,8 +158,6 @@ pub(crate) fn run(args: &PrecisionArgs) -> Result<(), Error> {
     match &args.out_dir {
         None => say_part!("{md}"),
         Some(dir) => {
-            std::fs::create_dir_all(dir)
-                .map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
             let write =
                 |name: &str, text: &str| fvr_host::io::atomic::write_text(&dir.join(name), text);
             write("precision.md", &md)?;

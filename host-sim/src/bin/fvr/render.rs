@@ -224,6 +224,12 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     }
     check_output(out, &["png", "nrrd"], volume_spec)?;
     let view = args.view()?;
+    crate::checks::check_resample_count(args.resample)?;
+    crate::checks::check_direction("--dir (camera.dir in a scene)", view.dir)?;
+    crate::checks::check_direction("--up (camera.up in a scene)", view.up)?;
+    for light in &args.lights {
+        crate::checks::check_direction("--light (a scene light's direction)", light.towards)?;
+    }
     view.frame()?;
     let style = args.png.style()?;
     let scene = build_scene(args)?;
@@ -361,7 +367,14 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     let t_view = adaptive_report
         .as_ref()
         .map_or(t2.elapsed(), |r| r.view_time);
-    check_finite(&image.data)?;
+    check_finite(
+        &image.data,
+        &crate::checks::overflow_cause(
+            args.ambient.is_some(),
+            !args.lights.is_empty() || args.light_ring.is_some(),
+            args.depth_cue != "none",
+        ),
+    )?;
     if ext == "png" {
         if image.channels == 1 {
             write_png(out, w, h, &image.data, &style)?;

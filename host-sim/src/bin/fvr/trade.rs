@@ -100,7 +100,7 @@ pub(crate) fn run(args: &TradeArgs) -> Result<(), Error> {
     };
     sweep.check_memory(available, &source)?;
     let dir = &args.out_dir;
-    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
+    fvr_host::studies::prepare_out_dir(dir)?;
     let total = sweep.settings().len();
     eprintln!("fvr trade: {total} points");
     let mut done = 0;

@@ -91,6 +91,8 @@ fn declare_job(args: &TurntableArgs, frames: usize) {
 }
 
 pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
+    crate::checks::check_direction("--dir (camera.dir in a scene)", args.dir)?;
+    crate::checks::check_direction("--up (camera.up in a scene)", args.up)?;
     let views = turntable::orbit(args.dir, args.up, args.frames as usize)?;
     let style = args.png.style()?;
     let t0 = Instant::now();
@@ -211,7 +213,10 @@ fn write_frames(
     let Some(range) = range else {
         let frames = turntable::render_views(spec, views, sampling, w, h, bar)?;
         for frame in &frames {
-            crate::checks::check_finite(frame)?;
+            crate::checks::check_finite(
+                frame,
+                &crate::checks::overflow_cause(false, false, false),
+            )?;
         }
         let t = Instant::now();
         write_apng(&args.out, w, h, &frames, args.fps, style)?;
@@ -220,7 +225,7 @@ fn write_frames(
     let mut stream = ApngStream::create(&args.out, (w, h), views.len(), args.fps, style, range)?;
     let mut encode = Duration::ZERO;
     turntable::render_each(spec, views, sampling, (w, h), bar, |_, frame| {
-        crate::checks::check_finite(frame)?;
+        crate::checks::check_finite(frame, &crate::checks::overflow_cause(false, false, false))?;
         let t = Instant::now();
         stream.push(frame)?;
         encode += t.elapsed();
