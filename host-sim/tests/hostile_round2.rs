@@ -176,3 +176,100 @@ fn study_output_directories_are_checked_first() {
         assert_eq!(err.lines().count(), 1, "`{line}` measured first: {err}");
     }
 }
+
+/// Class 13: namespace-prefixed collections count towards the plist depth
+/// guard (55,000 levels of `<x:array>` once overflowed the stack).
+#[test]
+fn prefixed_plist_collections_are_depth_limited() {
+    use fvr_host::io::inv3::parse_plist;
+    for open in ["<x:array>", "<ns:dict>", "<a:b:array >"] {
+        let deep = format!("<plist>{}", open.repeat(55_000));
+        let e = parse_plist(&deep).unwrap_err();
+        assert!(e.contains("nested deeper"), "{open}: {e}");
+    }
+    // A shallow prefixed document still parses.
+    assert!(parse_plist("<plist><array><x:array></x:array></array></plist>").is_ok());
+}
+
+/// Class 14: a scene's depth profile stays in the scene's directory, and a
+/// profile that is not numbers is never quoted (it may hold secrets).
+#[test]
+fn scene_profiles_are_confined_and_never_quoted() {
+    let dir = temp_dir("round2-profile");
+    std::fs::create_dir_all(dir.join("scene")).unwrap();
+    std::fs::write(dir.join("secret.txt"), "API_TOKEN=hunter2hunter2\n").unwrap();
+    std::fs::write(dir.join("scene/secret.txt"), "API_TOKEN=hunter2hunter2\n").unwrap();
+    for (cue, needle) in [
+        ("profile:@../secret.txt", "inside the scene's directory"),
+        ("profile:@/etc/hostname", "inside the scene's directory"),
+        ("profile:@secret.txt", "not a list of numbers"),
+    ] {
+        std::fs::write(
+            dir.join("scene/s.toml"),
+            format!(
+                "[volume]\nbuiltin = \"sphere@16\"\n[camera]\ndir = [1, 0, 0]\n\
+                 [shading]\ndepth_cue = \"{cue}\"\n[output]\npath = \"a.png\"\n"
+            ),
+        )
+        .unwrap();
+        refused(
+            &dir,
+            "render --scene scene/s.toml",
+            &[needle],
+            &["hunter2", "API_TOKEN"],
+            "scene/a.png",
+        );
+    }
+    refused(
+        &dir,
+        "render sphere@16 --dir 1,0,0 --depth-cue profile:@secret.txt --out a.png",
+        &["secret.txt", "not a list of numbers"],
+        &["hunter2", "API_TOKEN"],
+        "a.png",
+    );
+}
+
+/// Class 15: DICOM samples keep only their BitsStored low bits (0xF123 with
+/// 12 bits stored is 0x123 = 291), and a raw file longer than `--raw-dims`
+/// is refused like a shorter one.
+#[test]
+fn dicom_high_bits_are_masked_and_raw_sizes_must_match() {
+    use fvr_host::io::dicom::{parse_slice, CtSlice};
+    let pixels = [0xF123u16 as i16, 0x0123, 0x0FFF, 0];
+    let mut bytes = CtSlice::axial([2, 2], &pixels).encode();
+    // BitsStored 16 → 12, HighBit 15 → 11, PixelRepresentation 1 → 0
+    // (explicit VR little endian: group, element, "US", length 2, value).
+    for (element, value) in [(0x0101u16, 12u16), (0x0102, 11), (0x0103, 0)] {
+        let mut key = vec![0x28, 0x00];
+        key.extend(element.to_le_bytes());
+        key.extend(b"US\x02\x00");
+        let at = bytes
+            .windows(key.len())
+            .position(|w| w == key.as_slice())
+            .expect("the element");
+        bytes[at + 8..at + 10].copy_from_slice(&value.to_le_bytes());
+    }
+    let slice = parse_slice(&bytes).unwrap();
+    assert_eq!(slice.pixels, [291.0, 291.0, 4095.0, 0.0]);
+
+    let dir = temp_dir("round2-raw");
+    std::fs::write(dir.join("r.raw"), vec![7u8; 1000]).unwrap();
+    refused(
+        &dir,
+        "render r.raw --raw-dims 10,10,9 --dir 1,0,0 --out a.png",
+        &["--raw-dims", "holds more"],
+        &[],
+        "a.png",
+    );
+    assert_error(
+        &fvr_line(
+            "render r.raw --raw-dims 10,10,11 --dir 1,0,0 --out a.png",
+            &dir,
+        ),
+        &["truncated"],
+    );
+    common::assert_ok(&fvr_line(
+        "render r.raw --raw-dims 10,10,10 --dir 1,0,0 --out a.png",
+        &dir,
+    ));
+}

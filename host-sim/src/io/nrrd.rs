@@ -401,6 +401,26 @@ fn read_raw_from<R: Read>(
     check_memory(dims, count, ty, limit)?;
     let layout = Layout::samples(dims, count, data_bytes, ty, endian);
     let data = decode_stream(reader, &layout, Source::Raw)?;
+    // A file longer than the dimensions say is refused like a shorter one:
+    // the dimensions are wrong, and the image would be skewed.
+    let mut extra = [0u8; 1];
+    let more = loop {
+        match reader.read(&mut extra) {
+            Ok(n) => break n > 0,
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
+            Err(source) => return Err(IoError::Io { source }),
+        }
+    };
+    if more {
+        return Err(invalid_argument(format!(
+            "--raw-dims {}x{}x{} of {} samples make {data_bytes} bytes, but the file holds more; \
+             give the file's own dimensions",
+            dims[0],
+            dims[1],
+            dims[2],
+            ty.nrrd_name()
+        )));
+    }
     Ok(Volume::new(dims, data))
 }
 
