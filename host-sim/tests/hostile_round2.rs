@@ -31,7 +31,7 @@ fn values_beyond_f32_are_never_written() {
     refused(
         &dir,
         "render sphere@16 --dir 1,0,0 --precision f64 --ambient 1e300 --out p.nrrd",
-        &["not finite", "--ambient"],
+        &["non-finite", "--ambient"],
         &["--light", "--depth-cue"],
         "p.nrrd",
     );
@@ -84,13 +84,7 @@ fn subnormal_vectors_are_refused_by_name() {
             "--dir",
         ),
     ] {
-        refused(
-            &dir,
-            line,
-            &[option, "normalised"],
-            &["non-finite"],
-            "a.png",
-        );
+        refused(&dir, line, &[option, "too short"], &["non-finite"], "a.png");
     }
     std::fs::write(
         dir.join("s.toml"),
@@ -101,7 +95,7 @@ fn subnormal_vectors_are_refused_by_name() {
     refused(
         &dir,
         "render --scene s.toml",
-        &["camera.dir", "normalised"],
+        &["camera.dir", "too short"],
         &[],
         "a.png",
     );

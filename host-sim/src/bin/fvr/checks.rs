@@ -27,25 +27,21 @@ pub(crate) fn check_not_input(out: &Path) -> Result<(), Error> {
     Ok(())
 }
 
-/// Refuse a direction that cannot be normalised to a finite unit vector
-/// (its squared length underflows, e.g. `1e-320,0,0`, or overflows), naming
-/// `what` (the option). The zero vector is left to the view's own check.
+/// Refuse a direction too short to normalise: all its components
+/// subnormal (`1e-320,0,0`), which pass a test for zero but turn into NaN
+/// on the way to a unit vector. Named by `what` (the option), before any
+/// work. The zero vector is left to the view's own check; tiny normal
+/// components (`1e-300`) and huge ones (`1e308`) are scaled by the
+/// renderer and keep their direction.
 pub(crate) fn check_direction(what: &str, v: [f64; 3]) -> Result<(), Error> {
-    let length2: f64 = v.iter().map(|c| c * c).sum();
-    if v == [0.0; 3] || length2.is_normal() {
+    let largest = v.iter().fold(0.0f64, |m, c| m.max(c.abs()));
+    if largest == 0.0 || largest >= f64::MIN_POSITIVE {
         return Ok(());
     }
     Err(format!(
-        "{what} {:?},{:?},{:?}: this direction cannot be normalised (its length squared is {}); \
-         give components of ordinary size, such as 1,0,0",
-        v[0],
-        v[1],
-        v[2],
-        if length2 == 0.0 || length2.is_subnormal() {
-            "below the smallest double"
-        } else {
-            "beyond the largest double"
-        }
+        "{what} {:?},{:?},{:?}: this direction is too short to be normalised (its components \
+         are subnormal numbers); give components of ordinary size, such as 1,0,0",
+        v[0], v[1], v[2]
     )
     .into())
 }
@@ -88,7 +84,7 @@ pub(crate) fn check_finite(data: &[f64], cause: &str) -> Result<(), Error> {
     match data.iter().position(|&v| !(v as f32).is_finite()) {
         None => Ok(()),
         Some(i) => Err(format!(
-            "the image has pixels that are not finite numbers in f32 (the first is pixel {i}, \
+            "the image has non-finite pixels once stored as f32 (the first is pixel {i}, \
              value {:e}): {cause}",
             data[i]
         )
