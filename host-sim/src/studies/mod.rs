@@ -21,7 +21,9 @@ pub fn check_repeats(option: &str, n: usize) -> Result<(), String> {
     if (1..=MAX_REPEATS).contains(&n) {
         Ok(())
     } else {
-        Err(format!("{option} {n}: give 1 to {MAX_REPEATS}"))
+        Err(format!(
+            "{option} {n}: must be at least 1 and at most {MAX_REPEATS}"
+        ))
     }
 }
 
