@@ -176,8 +176,16 @@ fn study_output_directories_are_checked_first() {
 #[test]
 fn prefixed_plist_collections_are_depth_limited() {
     use fvr_host::io::inv3::parse_plist;
-    for open in ["<x:array>", "<ns:dict>", "<a:b:array >"] {
-        let deep = format!("<plist>{}", open.repeat(55_000));
+    for (open, close) in [
+        ("<x:array>", "</x:array>"),
+        ("<ns:dict>", "</ns:dict>"),
+        ("<a:b:array >", "</a:b:array>"),
+    ] {
+        let deep = format!(
+            "<plist>{}{}</plist>",
+            open.repeat(55_000),
+            close.repeat(55_000)
+        );
         let e = parse_plist(&deep).unwrap_err();
         assert!(e.contains("nested deeper"), "{open}: {e}");
     }
