@@ -77,7 +77,13 @@ pub fn parse_depth_cue(spec: &str, harmonics: usize) -> Result<DepthCue, String>
     } else if let Some(path) = spec.strip_prefix("profile:@") {
         let text =
             crate::io::read_small_text(std::path::Path::new(path), "depth profile", 1 << 20)?;
-        weights(parse_numbers(&text).map_err(|e| format!("depth profile `{path}`: {e}"))?)
+        // The file's text is never quoted (it may be any file, even secrets).
+        weights(parse_numbers(&text).map_err(|_| {
+            format!(
+                "depth profile `{path}`: not a list of numbers (separated by commas, spaces or \
+                 newlines; # starts a comment)"
+            )
+        })?)
     } else if let Some(rest) = spec.strip_prefix("profile:gauss:") {
         let (c, s) = pair(rest, "profile:gauss")?;
         if !(s.is_finite() && s > 0.0 && c.is_finite()) {

@@ -192,7 +192,7 @@ pub fn dht_3d_real<T: FftReal, S: StoreFormat>(
         Ok(())
     } else {
         Err(Error::Overflow {
-            stage: "rounding the fast 3D transform to the storage format",
+            stage: "fast 3D transform's rounding to the storage format",
         })
     }
 }

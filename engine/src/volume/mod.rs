@@ -151,6 +151,17 @@ impl Volume {
         if !background.is_finite() {
             return Err(format!("background {background} must be a finite number"));
         }
+        // A background beyond −3.4e38 would turn every voxel into +inf.
+        if let Some(&v) = self
+            .data
+            .iter()
+            .find(|&&v| !((v as f64 - background).max(0.0) as f32).is_finite())
+        {
+            return Err(format!(
+                "--background {background:?}: a voxel of {v:?} minus the background exceeds the \
+                 largest f32 (3.4e38); give a background of the volume's own scale"
+            ));
+        }
         for v in &mut self.data {
             *v = ((*v as f64 - background).max(0.0)) as f32;
         }

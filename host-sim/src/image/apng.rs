@@ -1,21 +1,21 @@
 //! Animated PNGs, written a frame at a time.
 //!
-//! The animation goes to a temporary file beside the output and is renamed
-//! over it only when the last frame is in, so a failed or interrupted job
-//! never leaves a truncated animation, nor destroys the file it replaces.
+//! The animation goes to a temporary file beside the output
+//! ([`crate::io::atomic::Output`]) and is renamed over it only when the last
+//! frame is in, so a failed or interrupted job never leaves a truncated
+//! animation, nor destroys the file it replaces.
 
-use std::fs::File;
-use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
 use super::output::{Style, Window};
+use crate::io::atomic::Output;
 
 /// An APNG being written: [`ApngStream::push`] each frame as it is rendered,
 /// then [`ApngStream::finish`]. Memory: one encoded frame.
 pub struct ApngStream {
-    writer: Option<png::Writer<BufWriter<File>>>,
+    writer: Option<png::Writer<Output>>,
+    out: Output,
     path: PathBuf,
-    partial: PathBuf,
     pixels: usize,
     range: (f64, f64),
     style: Style,
@@ -48,30 +48,24 @@ impl ApngStream {
             )));
         }
         let count = u32::try_from(frames).map_err(|e| fail(&e))?;
-        let partial = partial_path(path);
-        let file = File::create(&partial).map_err(|e| fail(&e))?;
+        let out = Output::create(path).map_err(|e| fail(&e))?;
         let mut stream = Self {
             writer: None,
+            out: out.clone(),
             path: path.to_path_buf(),
-            partial,
             pixels: width.saturating_mul(height),
             range,
             style: *style,
             left: frames,
         };
         let header = (|| {
-            let mut enc = super::png::encoder(
-                BufWriter::new(file),
-                width,
-                height,
-                style.png_color(),
-                style.png_depth(),
-            )?;
+            let mut enc =
+                super::png::encoder(out, width, height, style.png_color(), style.png_depth())?;
             enc.set_animated(count, 0).map_err(|e| e.to_string())?;
             enc.set_frame_delay(1, fps).map_err(|e| e.to_string())?;
             enc.write_header().map_err(|e| e.to_string())
         })();
-        // On error, `stream` drops here and removes the partial file.
+        // On error, `stream` drops here and removes the temporary file.
         stream.writer = Some(header.map_err(|e| fail(&e))?);
         Ok(stream)
     }
@@ -117,27 +111,8 @@ impl ApngStream {
         }
         let writer = self.writer.take().ok_or_else(|| fail(&"already failed"))?;
         writer.finish().map_err(|e| fail(&e))?;
-        std::fs::rename(&self.partial, &self.path).map_err(|e| fail(&e))
+        self.out.commit().map_err(|e| fail(&e))
     }
-}
-
-impl Drop for ApngStream {
-    /// An unfinished animation leaves nothing behind.
-    fn drop(&mut self) {
-        if self.writer.is_some() || self.left != 0 || self.partial.exists() {
-            drop(self.writer.take());
-            let _ = std::fs::remove_file(&self.partial);
-        }
-    }
-}
-
-/// `dir/.name.partial` beside `path`.
-fn partial_path(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    path.with_file_name(format!(".{name}.partial"))
 }
 
 fn apng_error(path: &Path, e: &dyn std::fmt::Display) -> String {

@@ -1,9 +1,11 @@
 //! The one PNG writer: raw samples of a given colour type and depth to a
-//! file, with the path in every error.
+//! file (through [`crate::io::atomic::Output`]: the previous file stays
+//! whole until the new one is), with the path in every error.
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::Path;
+
+use crate::io::atomic::Output;
 
 /// `"cannot write PNG `path`: {e}"`.
 pub(crate) fn png_error(path: &Path, e: &dyn std::fmt::Display) -> String {
@@ -46,9 +48,10 @@ pub(crate) fn write(
     data: &[u8],
 ) -> Result<(), String> {
     let fail = |e: &dyn std::fmt::Display| png_error(path, e);
-    let file = File::create(path).map_err(|e| fail(&e))?;
-    let enc = encoder(BufWriter::new(file), width, height, color, depth).map_err(|e| fail(&e))?;
+    let mut out = Output::create(path).map_err(|e| fail(&e))?;
+    let enc = encoder(&mut out, width, height, color, depth).map_err(|e| fail(&e))?;
     let mut writer = enc.write_header().map_err(|e| fail(&e))?;
     writer.write_image_data(data).map_err(|e| fail(&e))?;
-    writer.finish().map_err(|e| fail(&e))
+    writer.finish().map_err(|e| fail(&e))?;
+    out.commit().map_err(|e| fail(&e))
 }

@@ -102,18 +102,32 @@ pub const MAX_PLIST_DEPTH: usize = 64;
 pub fn parse_plist(text: &str) -> Result<Value, String> {
     // Text cannot hold a raw `<`, so every `<` opens markup; a comment that
     // mentions a collection can only make this count stricter.
+    // The XML reader matches elements by their local name, so a prefixed
+    // `<x:array>` is an array too: the prefix is dropped before comparing.
     let mut depth = 0usize;
     for (i, _) in text.match_indices('<') {
         let tag = &text[i + 1..];
         let end = tag.find('>').map_or(tag.len(), |e| e);
         let self_closing = tag[..end].ends_with('/');
-        if (tag.starts_with("array") || tag.starts_with("dict")) && !self_closing {
+        let (closing, tag) = match tag.strip_prefix('/') {
+            Some(t) => (true, t),
+            None => (false, tag),
+        };
+        let name_end = tag
+            .find(|c: char| c.is_whitespace() || c == '>' || c == '/')
+            .unwrap_or(tag.len());
+        let name = &tag[..name_end];
+        let local = name.rsplit(':').next().unwrap_or(name);
+        if local != "array" && local != "dict" {
+            continue;
+        }
+        if closing {
+            depth = depth.saturating_sub(1);
+        } else if !self_closing {
             depth += 1;
             if depth > MAX_PLIST_DEPTH {
                 return Err(format!("nested deeper than {MAX_PLIST_DEPTH}"));
             }
-        } else if tag.starts_with("/array") || tag.starts_with("/dict") {
-            depth = depth.saturating_sub(1);
         }
     }
     Value::from_reader_xml(text.as_bytes()).map_err(|e| e.to_string())

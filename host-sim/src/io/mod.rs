@@ -21,9 +21,11 @@
 //! decompressed far beyond what the header calls for, and every problem is
 //! an [`IoError`] that names the file and the field.
 
+pub mod atomic;
 pub mod den;
 pub mod dicom;
 mod error;
+pub mod inputs;
 pub mod inv3;
 pub mod nifti;
 pub mod nrrd;
@@ -222,9 +224,10 @@ pub(crate) fn spans_independent_axes(units: &[[f64; 3]]) -> bool {
     }
 }
 
-/// Open `path` for reading if it is a regular file. A FIFO, a device such
-/// as `/dev/zero` or a directory is refused before it is opened: reading
-/// one could block or never end.
+/// Open `path` for reading if it is a regular file, and record it as an
+/// input of the job ([`inputs`]). A FIFO, a device such as `/dev/zero` or a
+/// directory is refused before it is opened: reading one could block or
+/// never end.
 ///
 /// # Errors
 /// The path does not exist, cannot be opened, or is not a regular file.
@@ -235,7 +238,9 @@ pub fn open_file(path: &Path) -> io::Result<File> {
             "not a regular file (a directory, FIFO or device cannot be read as data)",
         ));
     }
-    File::open(path)
+    let file = File::open(path)?;
+    inputs::record(path);
+    Ok(file)
 }
 
 /// The text of the small file `path` (a scene or a depth profile): a

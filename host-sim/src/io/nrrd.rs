@@ -401,6 +401,26 @@ fn read_raw_from<R: Read>(
     check_memory(dims, count, ty, limit)?;
     let layout = Layout::samples(dims, count, data_bytes, ty, endian);
     let data = decode_stream(reader, &layout, Source::Raw)?;
+    // A file longer than the dimensions say is refused like a shorter one:
+    // the dimensions are wrong, and the image would be skewed.
+    let mut extra = [0u8; 1];
+    let more = loop {
+        match reader.read(&mut extra) {
+            Ok(n) => break n > 0,
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
+            Err(source) => return Err(IoError::Io { source }),
+        }
+    };
+    if more {
+        return Err(invalid_argument(format!(
+            "--raw-dims {}x{}x{} of {} samples make {data_bytes} bytes, but the file holds more; \
+             give the file's own dimensions",
+            dims[0],
+            dims[1],
+            dims[2],
+            ty.nrrd_name()
+        )));
+    }
     Ok(Volume::new(dims, data))
 }
 
@@ -453,7 +473,12 @@ fn gzip(bytes: &[u8]) -> Vec<u8> {
 /// equal `data.len()`. Errors carry the path.
 pub fn write_nrrd_f32(path: &Path, sizes: &[usize], data: &[f32]) -> Result<(), IoError> {
     check_sizes(sizes, data.len())
-        .and_then(|()| Ok(std::fs::write(path, encode_nrrd_f32(sizes, data))?))
+        .and_then(|()| {
+            Ok(super::atomic::write_bytes(
+                path,
+                &encode_nrrd_f32(sizes, data),
+            )?)
+        })
         .map_err(|e| e.in_file(path))
 }
 
@@ -472,12 +497,12 @@ pub fn write_volume_nrrd(path: &Path, volume: &Volume) -> Result<(), IoError> {
         text.truncate(text.len() - 1);
         let [sx, sy, sz] = volume.spacing;
         text.push_str(&format!("spacings: {sx} {sy} {sz}\n\n"));
-        let mut out = io::BufWriter::with_capacity(FILE_BUFFER_BYTES, std::fs::File::create(path)?);
+        let mut out = super::atomic::Output::create(path)?;
         out.write_all(text.as_bytes())?;
         for chunk in volume.data.chunks(CHUNK_BYTES / 4) {
             out.write_all(&samples::encode_f32_le(chunk))?;
         }
-        out.flush()?;
+        out.commit()?;
         Ok(())
     };
     write().map_err(|e| e.in_file(path))

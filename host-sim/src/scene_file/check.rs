@@ -463,7 +463,17 @@ impl Checker<'_> {
             .map(|v| v as usize);
         let depth_cue = self.string(t, p, "depth_cue").and_then(|s| {
             let s = match s.strip_prefix("profile:@") {
-                Some(file) => format!("profile:@{}", self.base.join(file).display()),
+                // Confined like the outputs: a shared scene reads no file elsewhere.
+                Some(file) => match crate::io::paths::inside(self.base, Path::new(file)) {
+                    Some(path) if !file.is_empty() => format!("profile:@{}", path.display()),
+                    _ => {
+                        self.bad(
+                            "shading.depth_cue",
+                            "profile:@FILE must name a file inside the scene's directory".into(),
+                        );
+                        return None;
+                    }
+                },
                 None => s.to_string(),
             };
             match parse_depth_cue(&s, harmonics.unwrap_or(DEFAULT_PROFILE_HARMONICS)) {

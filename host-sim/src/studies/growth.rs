@@ -77,9 +77,7 @@ pub fn measure(
     mut progress: impl FnMut(&GrowthRow),
 ) -> Result<Vec<GrowthRow>, String> {
     check_sizes(sizes, large)?;
-    if runs == 0 {
-        return Err("--runs must be at least 1".into());
-    }
+    super::check_repeats("--runs", runs)?;
     let view = View::along([1.0, 0.3, 0.2]);
     let filter = Filter::new(FilterKind::Kb3, 1).map_err(|e| e.to_string())?;
     struct Setup {
@@ -333,13 +331,10 @@ pub fn run(
     progress: impl FnMut(&GrowthRow),
 ) -> Result<String, String> {
     check_sizes(sizes, large)?;
+    super::check_repeats("--runs", runs)?;
+    super::prepare_out_dir(out_dir)?;
     let rows = measure(sizes, runs, large, progress)?;
-    std::fs::create_dir_all(out_dir)
-        .map_err(|e| format!("cannot create `{}`: {e}", out_dir.display()))?;
-    let write = |name: &str, text: &str| {
-        let p = out_dir.join(name);
-        std::fs::write(&p, text).map_err(|e| format!("cannot write `{}`: {e}", p.display()))
-    };
+    let write = |name: &str, text: &str| crate::io::atomic::write_text(&out_dir.join(name), text);
     write("growth.csv", &csv(&rows))?;
     let md = markdown(&rows);
     write("growth.md", &md)?;

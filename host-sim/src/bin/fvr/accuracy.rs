@@ -19,6 +19,6 @@ pub(crate) fn accuracy(args: &AccuracyArgs) -> Result<(), Error> {
         return Err(format!("--sizes: {bad} is not a power of two from 8 to 512").into());
     }
     let rows = fvr_host::studies::accuracy::accuracy_table(&args.sizes)?;
-    print!("{}", fvr_host::studies::accuracy::markdown(&rows));
+    say_part!("{}", fvr_host::studies::accuracy::markdown(&rows));
     Ok(())
 }

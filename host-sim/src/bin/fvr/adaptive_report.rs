@@ -68,7 +68,7 @@ impl<'a> AdaptiveReport<'a> {
     pub(crate) fn print_human(&self) {
         let s = &self.stats;
         let pct = |v: u64, of: u64| 100.0 * v as f64 / of.max(1) as f64;
-        println!(
+        say!(
             "  adaptive      {} dB: {} of {} taps ({:.1}%), {:.2} ms per view against {:.2} ms \
              with the full filter; image {:.1} dB from the full-filter image",
             self.marks.tolerance_db,
@@ -79,12 +79,12 @@ impl<'a> AdaptiveReport<'a> {
             self.full_view_time.as_secs_f64() * 1e3,
             self.snr_vs_full
         );
-        println!(
+        say!(
             "  samples       {:.1}% on the full filter",
             pct(s.per_filter[0], s.samples)
         );
         if let Walked::Plain { share } = self.walked {
-            println!(
+            say!(
                 "  adaptive      0.0% of samples substituted, plain walk used (the marks allow \
                  {:.1}%, below --adaptive-plain-below {:.1}%)",
                 100.0 * share,
@@ -92,7 +92,7 @@ impl<'a> AdaptiveReport<'a> {
             );
         }
         for (i, l) in self.marks.levels.iter().enumerate() {
-            println!(
+            say!(
                 "  samples       {:.1}% on {} (h_d {:.3}, threshold {:.3e}, {} of {} spectrum samples marked)",
                 pct(s.per_filter[i + 1], s.samples),
                 l.cheaper.name(),
@@ -102,7 +102,7 @@ impl<'a> AdaptiveReport<'a> {
                 l.words.len() * 32
             );
             match (l.error_ratio, self.marks.bound) {
-                (Some(r), Bound::Parseval) if !l.evaluated => println!(
+                (Some(r), Bound::Parseval) if !l.evaluated => say!(
                     "  error field   at least {:.1} dB below the volume (Parseval's bound on \
                      eq. 15; {})",
                     -10.0 * r.log10(),
@@ -111,13 +111,13 @@ impl<'a> AdaptiveReport<'a> {
                         _ => format!("{}, none accepted", transforms(l.probes)),
                     }
                 ),
-                (Some(r), Bound::Parseval) => println!(
+                (Some(r), Bound::Parseval) => say!(
                     "  error field   {:.1} dB below the volume (Parseval's bound on eq. 15, \
                      raised by {})",
                     -10.0 * r.log10(),
                     transforms(l.probes)
                 ),
-                (Some(r), _) => println!(
+                (Some(r), _) => say!(
                     "  error field   {:.1} dB below the volume (exact bound, eq. 15; {} probe \
                      transforms)",
                     -10.0 * r.log10(),
@@ -126,13 +126,13 @@ impl<'a> AdaptiveReport<'a> {
                 (None, _) => {}
             }
         }
-        println!(
+        say!(
             "  marks         {} bytes (1 bit per voxel and 1 byte per 8^3 brick per level), built in {:.1} ms",
             self.marks.bytes(),
             self.mark_time.as_secs_f64() * 1e3
         );
         if let Some(note) = self.marks.note(s, self.walked) {
-            println!("  note          {note}");
+            say!("  note          {note}");
         }
     }
 

@@ -41,6 +41,7 @@ pub(crate) fn adaptive_table(args: &AdaptiveTableArgs) -> Result<(), Error> {
         ref volumes,
         runs,
     } = *args;
+    fvr_host::studies::check_repeats("--runs", runs)?;
     let filter = fvr_core::filter::Filter::new(kind, oversample)?;
     let view = View::along([1.0, 0.3, 0.2]);
     let mut rows = Vec::new();
@@ -58,16 +59,11 @@ pub(crate) fn adaptive_table(args: &AdaptiveTableArgs) -> Result<(), Error> {
             ..AdaptiveSettings::new(tolerance)
         };
         rows.push(fvr_host::studies::adaptive_table::table1_row(
-            name,
-            &volume,
-            filter,
-            &settings,
-            &view,
-            runs.max(1),
+            name, &volume, filter, &settings, &view, runs,
         )?);
         eprintln!("fvr: measured {name}");
     }
-    print!(
+    say_part!(
         "{}",
         fvr_host::studies::adaptive_table::table1_markdown(&rows, tolerance)
     );

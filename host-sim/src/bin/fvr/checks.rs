@@ -18,6 +18,51 @@ pub(crate) fn check_output(
     Ok(())
 }
 
+/// Refuse an output that is any file the job has read so far (the volume,
+/// a detached NRRD's data file, a data set, a DICOM series' files, a scene,
+/// a depth profile), by file identity. Run once the inputs are read, before
+/// the render.
+pub(crate) fn check_not_input(out: &Path) -> Result<(), Error> {
+    fvr_host::io::inputs::check_output(out)?;
+    Ok(())
+}
+
+/// Refuse a direction too short to normalise: all its components
+/// subnormal (`1e-320,0,0`), which pass a test for zero but turn into NaN
+/// on the way to a unit vector. Named by `what` (the option), before any
+/// work. The zero vector is left to the view's own check; tiny normal
+/// components (`1e-300`) and huge ones (`1e308`) are scaled by the
+/// renderer and keep their direction.
+pub(crate) fn check_direction(what: &str, v: [f64; 3]) -> Result<(), Error> {
+    let largest = v.iter().fold(0.0f64, |m, c| m.max(c.abs()));
+    if largest == 0.0 || largest >= f64::MIN_POSITIVE {
+        return Ok(());
+    }
+    Err(format!(
+        "{what} {:?},{:?},{:?}: this direction is too short to be normalised (its components \
+         are subnormal numbers); give components of ordinary size, such as 1,0,0",
+        v[0], v[1], v[2]
+    )
+    .into())
+}
+
+/// The samples `--resample` (or a scene's `volume.resample`) may ask for
+/// along the longest side; one rule for both.
+pub(crate) const RESAMPLE_RANGE: std::ops::RangeInclusive<usize> = 2..=4096;
+
+/// Refuse a `--resample` outside [`RESAMPLE_RANGE`] before any work.
+pub(crate) fn check_resample_count(resample: Option<usize>) -> Result<(), Error> {
+    match resample {
+        Some(n) if !RESAMPLE_RANGE.contains(&n) => Err(format!(
+            "--resample {n}: give {} to {} samples along the volume's longest side",
+            RESAMPLE_RANGE.start(),
+            RESAMPLE_RANGE.end()
+        )
+        .into()),
+        _ => Ok(()),
+    }
+}
+
 /// Refuse a resampled volume beyond the memory limit before allocating it.
 pub(crate) fn check_resample(volume: &Volume, largest: usize) -> Result<(), Error> {
     let dims = volume.resampled_dims(largest)?;
@@ -31,15 +76,40 @@ pub(crate) fn check_resample(volume: &Volume, largest: usize) -> Result<(), Erro
     Ok(())
 }
 
-/// Refuse to write an image with a NaN or infinite pixel.
-pub(crate) fn check_finite(data: &[f64]) -> Result<(), Error> {
-    match data.iter().position(|v| !v.is_finite()) {
+/// Refuse to write an image with a NaN or infinite pixel, in f64 or once
+/// narrowed to the f32 of a NRRD image (a `--precision f64` render can
+/// exceed 3.4e38). `cause` says what overflowed, naming only settings the
+/// job was given ([`overflow_cause`]).
+pub(crate) fn check_finite(data: &[f64], cause: &str) -> Result<(), Error> {
+    match data.iter().position(|&v| !(v as f32).is_finite()) {
         None => Ok(()),
         Some(i) => Err(format!(
-            "the image has non-finite pixels (the first is pixel {i}, value {:e}): a setting overflowed; \
-             lower --ambient, the --light colours or the --depth-cue weights",
+            "the image has non-finite pixels once stored as f32 (the first is pixel {i}, \
+             value {:e}): {cause}",
             data[i]
         )
         .into()),
+    }
+}
+
+/// What to lower when an image overflows: the shading settings given
+/// (`--ambient`, lights, a depth cue), or else the volume itself.
+pub(crate) fn overflow_cause(ambient: bool, lights: bool, depth_cue: bool) -> String {
+    let given: Vec<&str> = [
+        (ambient, "--ambient"),
+        (lights, "the --light colours"),
+        (depth_cue, "the --depth-cue weights"),
+    ]
+    .iter()
+    .filter(|(g, _)| *g)
+    .map(|(_, name)| *name)
+    .collect();
+    match given.as_slice() {
+        [] => "the volume's values (times its voxel size in mm) are too large; rescale the \
+               volume, or add --ignore-spacing"
+            .to_string(),
+        [one] => format!("a setting overflowed; lower {one}"),
+        [a, b] => format!("a setting overflowed; lower {a} or {b}"),
+        _ => format!("a setting overflowed; lower {}", given.join(", ")),
     }
 }

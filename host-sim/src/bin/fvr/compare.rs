@@ -46,7 +46,7 @@ pub(crate) fn compare(args: &CompareArgs) -> Result<(), Error> {
         )
         .into());
     }
-    println!(
+    say!(
         "SNR of {} against {}: {:.2} dB (max abs error {:.3e})",
         b.display(),
         a.display(),

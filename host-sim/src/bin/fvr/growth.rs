@@ -30,6 +30,6 @@ pub(crate) fn run(args: &GrowthArgs) -> Result<(), Error> {
             r.n, r.frequency_ms, r.raycast_ms
         )
     })
-    .map(|md| print!("{md}"))?;
+    .map(|md| say_part!("{md}"))?;
     Ok(())
 }

@@ -4,6 +4,9 @@
 //! program is a libFuzzer target over arguments and scene files ([`fuzz`]).
 #![cfg_attr(fuzzing, no_main)]
 
+#[macro_use]
+mod stdout;
+
 mod accuracy;
 mod adaptive_report;
 mod adaptive_table;
@@ -19,6 +22,8 @@ mod plan;
 mod precision;
 mod render;
 mod scene;
+#[cfg(not(fuzzing))]
+mod signals;
 #[cfg(test)]
 mod tests;
 mod trade;
@@ -140,6 +145,7 @@ pub(crate) enum Command {
 
 #[cfg(not(fuzzing))]
 fn main() -> ExitCode {
+    signals::install();
     run(std::env::args_os())
 }
 
@@ -239,7 +245,7 @@ fn default_scene() -> Result<(), Error> {
     };
     let scene = SceneFile::parse(DEFAULT_SCENE, "the default scene", Path::new(""))?;
     apply_scene_to_render(&mut args, &scene, &|_| false);
-    println!(
+    say!(
         "fvr: rendering the default scene: the Utah teapot lit by red, green and blue lights \
          120 degrees apart, as in the paper's figure 8 (run `fvr --help` for options)"
     );

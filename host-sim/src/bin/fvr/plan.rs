@@ -81,7 +81,7 @@ pub(crate) fn print_human(s: &SpectrumArgs) {
             Some(t) => format!("chosen for the default --accuracy {t}"),
             None => "as given".to_string(),
         };
-        println!(
+        say!(
             "  accuracy      {:.1} dB predicted for {} ({how}; limited by the {} term: {})",
             p.db,
             describe(&p),

@@ -73,6 +73,9 @@ pub(crate) fn run(args: &PrecisionArgs) -> Result<(), Error> {
         "2" => Oversampling::Fixed(2),
         o => return Err(format!("oversampling `{o}` must be auto, 1 or 2").into()),
     };
+    if let Some(dir) = &args.out_dir {
+        fvr_host::studies::prepare_out_dir(dir)?;
+    }
     if let Some(n) = args.extremes {
         if n < 2 || n % 2 != 0 || n > 128 {
             return Err(format!("--extremes {n}: the side must be even, from 2 to 128").into());
@@ -94,15 +97,11 @@ pub(crate) fn run(args: &PrecisionArgs) -> Result<(), Error> {
         }
         return match &args.out_dir {
             None => {
-                print!("{md}");
+                say_part!("{md}");
                 Ok(())
             }
             Some(dir) => {
-                std::fs::create_dir_all(dir)
-                    .map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
-                let p = dir.join("extremes.md");
-                std::fs::write(&p, md)
-                    .map_err(|e| format!("cannot write `{}`: {e}", p.display()))?;
+                fvr_host::io::atomic::write_text(&dir.join("extremes.md"), &md)?;
                 Ok(())
             }
         };
@@ -157,14 +156,10 @@ pub(crate) fn run(args: &PrecisionArgs) -> Result<(), Error> {
     }
     let md = report(&cells, args);
     match &args.out_dir {
-        None => print!("{md}"),
+        None => say_part!("{md}"),
         Some(dir) => {
-            std::fs::create_dir_all(dir)
-                .map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
-            let write = |name: &str, text: &str| {
-                let p = dir.join(name);
-                std::fs::write(&p, text).map_err(|e| format!("cannot write `{}`: {e}", p.display()))
-            };
+            let write =
+                |name: &str, text: &str| fvr_host::io::atomic::write_text(&dir.join(name), text);
             write("precision.md", &md)?;
             write("precision.csv", &csv(&cells))?;
             plot(&cells).write_png(&dir.join("precision.png"))?;

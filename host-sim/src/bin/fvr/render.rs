@@ -244,12 +244,19 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     }
     check_output(out, &["png", "nrrd"], volume_spec)?;
     let view = args.view()?;
+    crate::checks::check_resample_count(args.resample)?;
+    crate::checks::check_direction("--dir (camera.dir in a scene)", view.dir)?;
+    crate::checks::check_direction("--up (camera.up in a scene)", view.up)?;
+    for light in &args.lights {
+        crate::checks::check_direction("--light (a scene light's direction)", light.towards)?;
+    }
     view.frame()?;
     let style = args.png.style()?;
     let scene = build_scene(args)?;
     declare_job(args, &scene);
     let t0 = Instant::now();
     let mut volume = args.input.load(volume_spec)?;
+    crate::checks::check_not_input(out)?;
     let mut _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
     if let Some(largest) = args.resample {
         check_resample(&volume, largest)?;
@@ -295,7 +302,14 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         None => None,
     };
     let t_view = view_report.time;
-    check_finite(&image.data)?;
+    check_finite(
+        &image.data,
+        &crate::checks::overflow_cause(
+            args.ambient.is_some(),
+            !args.lights.is_empty() || args.light_ring.is_some(),
+            args.depth_cue != "none",
+        ),
+    )?;
     if ext == "png" {
         if image.channels == 1 {
             write_png(out, w, h, &image.data, &style)?;
@@ -306,7 +320,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         image.write_nrrd(out)?;
     }
     let kind = if image.channels == 1 { "grey" } else { "RGB" };
-    println!("wrote {} ({w}x{h} {kind})", out.display());
+    say!("wrote {} ({w}x{h} {kind})", out.display());
     let rendered = Rendered {
         args,
         volume_spec,
@@ -439,12 +453,15 @@ impl Rendered<'_> {
             ..
         } = self;
         let d = volume.dims;
-        println!(
+        say!(
             "  volume        {}x{}x{} ({})",
-            d[0], d[1], d[2], volume_spec
+            d[0],
+            d[1],
+            d[2],
+            volume_spec
         );
         let [dx, dy, dz] = volume.spacing;
-        println!(
+        say!(
             "  spacing       {dx} x {dy} x {dz} mm{}",
             if args.frame.units.ignore_spacing {
                 " (ignored: --ignore-spacing, voxel units)"
@@ -452,7 +469,7 @@ impl Rendered<'_> {
                 ""
             }
         );
-        println!(
+        say!(
             "  pixel size    {} {}",
             sampling.pixel_size(),
             if args.frame.units.ignore_spacing {
@@ -461,18 +478,18 @@ impl Rendered<'_> {
                 "mm (values in mm x volume units)"
             }
         );
-        println!(
+        say!(
             "  spectrum      {n}^3 {} = {} bytes ({} bytes/voxel)",
             args.frame.spectrum.precision,
             spectra.density.bytes(),
             args.frame.spectrum.precision.bytes()
         );
         match &spectra.gradient {
-            Some(g) => println!(
+            Some(g) => say!(
                 "  |grad f|      {} bytes (second spectrum, for the lights)",
                 g.bytes()
             ),
-            None => println!("  |grad f|      not built (no light needs it)"),
+            None => say!("  |grad f|      not built (no light needs it)"),
         }
         // Plain X-ray views go through the view renderer (any grid side).
         let plain = scene.channels() == 1 && !scene.has_partner_terms();
@@ -482,34 +499,34 @@ impl Rendered<'_> {
             (Precision::F64, false) => SceneRenderer::<f64>::new(n, filter, scene)?.bytes(),
             (_, false) => SceneRenderer::<f32>::new(n, filter, scene)?.bytes(),
         };
-        println!(
+        say!(
             "  per view      {working} bytes ({} slice fields, tables, twiddles)",
             scene.field_count()
         );
-        println!("  held          {} bytes in all", spectra.bytes() + working);
+        say!("  held          {} bytes in all", spectra.bytes() + working);
         let f = spectra.density.filter();
         if f.kind().is_kaiser_bessel() {
-            println!(
+            say!(
                 "  filter        {} (oversample {}, beta {:.3})",
                 f.kind().name(),
                 args.frame.spectrum.oversample.name(),
                 f.beta()
             );
         } else {
-            println!(
+            say!(
                 "  filter        {} (oversample {})",
                 f.kind().name(),
                 args.frame.spectrum.oversample.name()
             );
         }
-        println!("  storage SNR   {storage_snr:.1} dB (estimate, against the f64 pipeline)");
+        say!("  storage SNR   {storage_snr:.1} dB (estimate, against the f64 pipeline)");
         crate::plan::print_human(&args.frame.spectrum);
-        println!("  load          {:.1} ms", t_load.as_secs_f64() * 1e3);
-        println!("  plan          {:.1} ms", t_plan.as_secs_f64() * 1e3);
-        println!("  preprocess    {:.1} ms", t_prep.as_secs_f64() * 1e3);
-        println!("  view          {:.2} ms", t_view.as_secs_f64() * 1e3);
+        say!("  load          {:.1} ms", t_load.as_secs_f64() * 1e3);
+        say!("  plan          {:.1} ms", t_plan.as_secs_f64() * 1e3);
+        say!("  preprocess    {:.1} ms", t_prep.as_secs_f64() * 1e3);
+        say!("  view          {:.2} ms", t_view.as_secs_f64() * 1e3);
         if args.preview_level > 0 {
-            println!(
+            say!(
                 "  level         {} ({w}x{h} at pitch {} {}, central 1/{} of the slice)",
                 args.preview_level,
                 (1u64 << args.preview_level) as f64 * sampling.pixel_size(),
@@ -570,7 +587,7 @@ impl Rendered<'_> {
             accuracy: crate::plan::json(&args.frame.spectrum),
             adaptive: adaptive_report.as_ref().map(AdaptiveReport::json),
         };
-        println!("{}", one_line(&stats));
+        say!("{}", one_line(&stats));
     }
 
     /// `--exact`: the SNR against the phantom's exact image, where there is one.
@@ -599,7 +616,7 @@ impl Rendered<'_> {
                 )?;
                 let ambient = scene.ambient[0];
                 let exact: Vec<f64> = exact.iter().map(|v| v * ambient).collect();
-                println!("  SNR vs exact  {:.2} dB", snr_db(&exact, &image.data));
+                say!("  SNR vs exact  {:.2} dB", snr_db(&exact, &image.data));
             }
             Some(Ok(p)) => match p.phantom.as_gaussian_mixture() {
                 Some(mixture) => {
@@ -612,13 +629,13 @@ impl Rendered<'_> {
                         (w, h),
                         0.05,
                     )?;
-                    println!("  SNR vs exact  {:.2} dB", snr_db(&exact.data, &image.data));
+                    say!("  SNR vs exact  {:.2} dB", snr_db(&exact.data, &image.data));
                 }
-                None => println!(
-                    "  SNR vs exact  n/a (cued or shaded references exist for gaussians only)"
-                ),
+                None => {
+                    say!("  SNR vs exact  n/a (cued or shaded references exist for gaussians only)")
+                }
             },
-            _ => println!("  SNR vs exact  n/a (not a built-in phantom)"),
+            _ => say!("  SNR vs exact  n/a (not a built-in phantom)"),
         }
         Ok(())
     }

@@ -100,7 +100,7 @@ pub(crate) fn run(args: &TradeArgs) -> Result<(), Error> {
     };
     sweep.check_memory(available, &source)?;
     let dir = &args.out_dir;
-    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
+    fvr_host::studies::prepare_out_dir(dir)?;
     let total = sweep.settings().len();
     eprintln!("fvr trade: {total} points");
     let mut done = 0;
@@ -115,10 +115,7 @@ pub(crate) fn run(args: &TradeArgs) -> Result<(), Error> {
             human_bytes(r.memory.held())
         );
     })?;
-    let write = |name: &str, text: &str| {
-        let p = dir.join(name);
-        std::fs::write(&p, text).map_err(|e| format!("cannot write `{}`: {e}", p.display()))
-    };
+    let write = |name: &str, text: &str| fvr_host::io::atomic::write_text(&dir.join(name), text);
     write("trade.csv", &csv(&rows, sweep.views, sweep.repeats))?;
     write("trade.md", &summary(&rows, &sweep, &command_line()))?;
     plot(&rows).write_png(&dir.join("trade.png"))?;

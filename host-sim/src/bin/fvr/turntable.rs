@@ -92,6 +92,8 @@ fn declare_job(args: &TurntableArgs, frames: usize) {
 }
 
 pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
+    crate::checks::check_direction("--dir (camera.dir in a scene)", args.dir)?;
+    crate::checks::check_direction("--up (camera.up in a scene)", args.up)?;
     let views = turntable::orbit(args.dir, args.up, args.frames as usize)?;
     let style = args.png.style()?;
     let t0 = Instant::now();
@@ -101,6 +103,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     crate::checks::check_output(&args.out, &["apng", "png"], volume_spec)?;
     declare_job(args, views.len());
     let volume = args.input.load(volume_spec)?;
+    crate::checks::check_not_input(&args.out)?;
     let _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
     fvr_host::budget::check_plan(volume.dims)?;
     let t_load = t0.elapsed();
@@ -140,7 +143,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     let t_views = t2.elapsed().saturating_sub(encode);
     let frames = views.len();
     let secs = t_views.as_secs_f64();
-    println!(
+    say!(
         "wrote {} ({} frames, {w}x{h}, {} fps)",
         args.out.display(),
         frames,
@@ -168,9 +171,9 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
             views_per_second,
             accuracy: crate::plan::json(&args.frame.spectrum),
         };
-        println!("{}", one_line(&stats));
+        say!("{}", one_line(&stats));
     } else {
-        println!(
+        say!(
             "  load {:.1} ms, plan {:.1} ms, preprocess {:.1} ms ({n}^3 {}), {} views in {:.1} ms = {:.1} views/s",
             t_load.as_secs_f64() * 1e3,
             t_plan.as_secs_f64() * 1e3,
@@ -212,7 +215,10 @@ fn write_frames(
     let Some(range) = range else {
         let frames = turntable::render_views(spec, views, sampling, w, h, &|| bar.inc(1))?;
         for frame in &frames {
-            crate::checks::check_finite(frame)?;
+            crate::checks::check_finite(
+                frame,
+                &crate::checks::overflow_cause(false, false, false),
+            )?;
         }
         let t = Instant::now();
         write_apng(&args.out, w, h, &frames, args.fps, style)?;
@@ -221,7 +227,7 @@ fn write_frames(
     let mut stream = ApngStream::create(&args.out, (w, h), views.len(), args.fps, style, range)?;
     let mut encode = Duration::ZERO;
     turntable::render_each(spec, views, sampling, (w, h), &|| bar.inc(1), |_, frame| {
-        crate::checks::check_finite(frame)?;
+        crate::checks::check_finite(frame, &crate::checks::overflow_cause(false, false, false))?;
         let t = Instant::now();
         stream.push(frame)?;
         encode += t.elapsed();

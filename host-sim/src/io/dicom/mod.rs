@@ -137,7 +137,7 @@ fn slice_from(obj: &DefaultDicomObject) -> Result<Slice, IoError> {
     let slope = floats(obj, tags::RESCALE_SLOPE, "RescaleSlope", 1)?.map_or(1.0, |v| v[0]);
     let intercept =
         floats(obj, tags::RESCALE_INTERCEPT, "RescaleIntercept", 1)?.map_or(0.0, |v| v[0]);
-    check_bits(obj)?;
+    let bits = check_bits(obj)?;
     check_pixel_size(obj)?;
     let decoded = obj
         .decode_pixel_data()
@@ -178,7 +178,7 @@ fn slice_from(obj: &DefaultDicomObject) -> Result<Slice, IoError> {
         .map_err(|e| format_error(FORMAT, "PixelData", format!("cannot be converted: {e}")))?;
     let pixels: Vec<f32> = raw
         .iter()
-        .map(|&x| (slope * x + intercept) as f32)
+        .map(|&x| (slope * bits.value(x) + intercept) as f32)
         .collect();
     if pixels.len() != size[0] * size[1] {
         return Err(format_error(
@@ -209,9 +209,38 @@ fn slice_from(obj: &DefaultDicomObject) -> Result<Slice, IoError> {
     })
 }
 
+/// The sample layout: `stored` significant bits (the low ones) of
+/// `allocated`, signed (two's complement) or not.
+#[derive(Clone, Copy, Debug)]
+struct Bits {
+    allocated: u32,
+    stored: u32,
+    signed: bool,
+}
+
+impl Bits {
+    /// The value of a sample decoded as a whole `allocated`-bit integer
+    /// `x`: its bits above `stored` (overlay bits or garbage) are masked
+    /// off, and a signed value is sign-extended from bit `stored − 1`.
+    /// E.g. 0xF123 with 12 bits stored reads 0x123 = 291.
+    fn value(self, x: f64) -> f64 {
+        if self.stored >= self.allocated {
+            return x;
+        }
+        let pattern = (x as i64) & ((1i64 << self.allocated) - 1);
+        let low = pattern & ((1i64 << self.stored) - 1);
+        let v = if self.signed && low & (1i64 << (self.stored - 1)) != 0 {
+            low - (1i64 << self.stored)
+        } else {
+            low
+        };
+        v as f64
+    }
+}
+
 /// `BitsAllocated` 8 or 16, and `1 <= BitsStored <= BitsAllocated`, the
 /// greyscale layouts decoded here.
-fn check_bits(obj: &DefaultDicomObject) -> Result<(), IoError> {
+fn check_bits(obj: &DefaultDicomObject) -> Result<Bits, IoError> {
     let int = |tag, name: &'static str| -> Result<Option<i64>, IoError> {
         match obj.get(tag) {
             None => Ok(None),
@@ -238,7 +267,12 @@ fn check_bits(obj: &DefaultDicomObject) -> Result<(), IoError> {
             format!("is {stored}; it must be 1 to BitsAllocated ({allocated})"),
         ));
     }
-    Ok(())
+    let signed = int(tags::PIXEL_REPRESENTATION, "PixelRepresentation")?.unwrap_or(0) == 1;
+    Ok(Bits {
+        allocated: allocated as u32,
+        stored: stored as u32,
+        signed,
+    })
 }
 
 /// Largest ratio accepted between decoded and encapsulated (compressed)
@@ -496,6 +530,7 @@ pub fn read_dicom_with_progress(path: &Path, progress: &ProgressBar) -> Result<V
             (path.to_path_buf(), None)
         } else {
             let bytes = fs::read(path)?;
+            crate::io::inputs::record(path);
             let obj = open_bytes(&bytes)?;
             let uid =
                 text(&obj, tags::SERIES_INSTANCE_UID, "SeriesInstanceUID")?.unwrap_or_default();
@@ -527,6 +562,7 @@ pub fn read_dicom_with_progress(path: &Path, progress: &ProgressBar) -> Result<V
                     return Ok(None);
                 }
                 let bytes = fs::read(&file)?;
+                crate::io::inputs::record(&file);
                 let obj = open_bytes(&bytes)?;
                 if !has_pixel_data(&obj) {
                     return Ok(None);

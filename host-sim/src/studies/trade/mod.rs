@@ -356,6 +356,7 @@ impl Sweep {
                 args.views, args.repeats
             ));
         }
+        super::check_repeats("--repeats", args.repeats)?;
         if args.views > 64 {
             return Err(format!("--views {}: at most 64", args.views));
         }
