@@ -157,7 +157,10 @@ fn a_signal_removes_the_temporary_file_and_keeps_the_previous_output() {
         let dir = temp_dir(&format!("outputs-signal{signal}"));
         std::fs::write(dir.join("spin.apng"), b"the previous animation").unwrap();
         let mut job = Command::new(env!("CARGO_BIN_EXE_fvr"))
+            // A fixed window: each frame is encoded as it is rendered, so
+            // the temporary file exists while most of the turn is to come.
             .args(["turntable", "gaussians@64", "--frames", "3600"])
+            .args(["--window", "2", "--level", "1"])
             .args(["--out", "spin.apng", "--quiet"])
             .current_dir(&dir)
             .stdout(Stdio::null())

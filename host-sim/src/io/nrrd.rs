@@ -36,7 +36,7 @@ mod samples;
 mod tests;
 
 use std::io::{self, BufRead, BufReader, Read};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use flate2::bufread::MultiGzDecoder;
 use indicatif::ProgressBar;
@@ -124,6 +124,19 @@ fn read_nrrd_limited(path: &Path, limit: u64, progress: &ProgressBar) -> Result<
         read_detached().map_err(|e| e.in_file(&data_path))
     };
     open().map_err(|e| e.in_file(path))
+}
+
+/// The data file a detached NRRD header (`.nhdr`) names, resolved against
+/// the header's directory; `None` for an attached header or a file whose
+/// header cannot be read (the reader reports that). Reads the header only.
+pub fn detached_data_file(path: &Path) -> Option<PathBuf> {
+    let file = crate::io::open_file(path).ok()?;
+    let mut reader = BufReader::with_capacity(FILE_BUFFER_BYTES, file);
+    let name = read_header(&mut reader).ok()?.data_file?;
+    Some(match path.parent() {
+        Some(dir) => dir.join(name),
+        None => PathBuf::from(name),
+    })
 }
 
 /// Parse a whole NRRD file held in memory; see [`read_nrrd`].

@@ -152,6 +152,32 @@ pub fn load_volume(spec: &str, raw: Option<RawLayout>) -> Result<Volume, String>
     load_volume_with_progress(spec, raw, &ProgressBar::hidden())
 }
 
+/// The files loading `spec` will read, as far as they are known before
+/// loading: the file itself and the data file of a detached NRRD header,
+/// or the file a data set's environment variable names (`FVR_CT_HEAD`,
+/// `FVR_MRI_HEAD`). Phantoms read none. For checking outputs before any
+/// work; the job's inputs are recorded again as they are opened
+/// ([`crate::io::inputs`]).
+pub fn input_files(spec: &str) -> Vec<std::path::PathBuf> {
+    let path = Path::new(spec);
+    if path.is_file() {
+        let mut files = vec![path.to_path_buf()];
+        files.extend(crate::io::nrrd::detached_data_file(path));
+        return files;
+    }
+    let dataset = match spec {
+        "ct-head" => crate::sources::datasets::ct_head_path(),
+        "mri-head" => crate::sources::datasets::mri_head_path(),
+        _ => return Vec::new(),
+    };
+    let Ok(file) = dataset else {
+        return Vec::new();
+    };
+    let mut files = vec![file.clone()];
+    files.extend(crate::io::nrrd::detached_data_file(&file));
+    files
+}
+
 /// [`load_volume`], advancing `progress` by the bytes read from disk.
 ///
 /// # Errors

@@ -8,13 +8,21 @@ use fvr_engine::volume::Volume;
 use crate::Error;
 
 /// Checks of the output path before any work: its directory exists, and it
-/// is not the input file (compared by file identity).
+/// is none of the files the job will read that are known now (compared by
+/// file identity): the volume, a detached NRRD's data file, a data set's
+/// file, and `others` (a scene, a depth profile). [`check_not_input`]
+/// checks again once the inputs are read.
 pub(crate) fn check_output(
     out: &Path,
     allowed: &'static [&'static str],
     volume_spec: &str,
+    others: &[&Path],
 ) -> Result<(), Error> {
-    fvr_host::io::paths::check_output(out, allowed, &[Path::new(volume_spec)])?;
+    let files = fvr_host::sources::input_files(volume_spec);
+    let mut inputs: Vec<&Path> = vec![Path::new(volume_spec)];
+    inputs.extend(files.iter().map(|p| p.as_path()));
+    inputs.extend(others);
+    fvr_host::io::paths::check_output(out, allowed, &inputs)?;
     Ok(())
 }
 

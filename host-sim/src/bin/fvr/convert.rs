@@ -22,7 +22,7 @@ pub(crate) struct ConvertArgs {
 }
 
 pub(crate) fn convert(args: &ConvertArgs) -> Result<(), Error> {
-    crate::checks::check_output(&args.out, &["nrrd"], &args.volume)?;
+    crate::checks::check_output(&args.out, &["nrrd"], &args.volume, &[])?;
     let volume = args.input.load(&args.volume)?;
     crate::checks::check_not_input(&args.out)?;
     fvr_host::io::nrrd::write_volume_nrrd(&args.out, &volume)?;

@@ -73,10 +73,13 @@ PHYSICAL UNITS (fvr render, fvr turntable)
   imaged at their own size (--resample N makes them so).
 
 EXIT STATUS
-  0  success (also for --help and --version)
+  0  success (also for --help and --version, and when standard output is a
+     pipe closed early: the rest of the printed text is dropped)
   2  any error: bad arguments, unreadable or malformed input, a render that
      cannot be done; the reason is printed on stderr as `fvr: error: ...`
      (argument errors are explained by the parser, with a usage line).
+  130  stopped by SIGINT, SIGTERM or SIGHUP: the output being written is
+     removed and the previous file left as it was.
 
 Progress bars go to stderr only when it is a terminal; --quiet turns them off.";
 

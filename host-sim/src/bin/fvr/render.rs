@@ -242,7 +242,11 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     if ext != "png" && ext != "nrrd" {
         return Err(format!("output `{}` must end in .png or .nrrd", out.display()).into());
     }
-    check_output(out, &["png", "nrrd"], volume_spec)?;
+    let mut others: Vec<&Path> = args.scene.iter().map(|p| p.as_path()).collect();
+    if let Some(profile) = args.depth_cue.strip_prefix("profile:@") {
+        others.push(Path::new(profile));
+    }
+    check_output(out, &["png", "nrrd"], volume_spec, &others)?;
     let view = args.view()?;
     crate::checks::check_resample_count(args.resample)?;
     crate::checks::check_direction("--dir (camera.dir in a scene)", view.dir)?;

@@ -100,7 +100,8 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     let volume_spec = args.volume.as_deref().ok_or_else(|| {
         "no volume: give VOLUME, or `volume.path` or `volume.builtin` in the scene".to_string()
     })?;
-    crate::checks::check_output(&args.out, &["apng", "png"], volume_spec)?;
+    let scene: Vec<&std::path::Path> = args.scene.iter().map(|p| p.as_path()).collect();
+    crate::checks::check_output(&args.out, &["apng", "png"], volume_spec, &scene)?;
     declare_job(args, views.len());
     let volume = args.input.load(volume_spec)?;
     crate::checks::check_not_input(&args.out)?;
