@@ -61,7 +61,10 @@ fn below_the_threshold_exits_1_with_one_line() {
     let dir = temp_dir("compare-fail");
     pair(&dir);
     for json_flag in ["", " --json"] {
-        let out = fvr_line(&format!("compare a.nrrd b.nrrd --min-db 80{json_flag}"), &dir);
+        let out = fvr_line(
+            &format!("compare a.nrrd b.nrrd --min-db 80{json_flag}"),
+            &dir,
+        );
         assert_eq!(out.status.code(), Some(1), "{out:?}");
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(err.lines().count(), 1, "{err}");
@@ -110,7 +113,8 @@ fn a_png_is_refused_without_echoing_its_bytes() {
     assert_error(&out, &["not a NRRD file", "PNG"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        err.chars().all(|c| c == '\n' || c.is_ascii_graphic() || c == ' '),
+        err.chars()
+            .all(|c| c == '\n' || c.is_ascii_graphic() || c == ' '),
         "non-printable or non-ASCII in: {err:?}"
     );
 }

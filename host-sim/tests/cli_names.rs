@@ -2,7 +2,7 @@
 //! answered with the nearest names.
 
 mod common;
-use common::{assert_ok, fvr_line, temp_dir};
+use common::{assert_error, assert_ok, fvr_line, temp_dir};
 
 #[test]
 fn output_extensions_are_case_insensitive_and_the_name_is_kept() {
@@ -13,7 +13,9 @@ fn output_extensions_are_case_insensitive_and_the_name_is_kept() {
         assert!(dir.join(out).is_file(), "{out} not written");
     }
     assert_eq!(&std::fs::read(dir.join("x.PNG")).unwrap()[1..4], b"PNG");
-    assert!(std::fs::read(dir.join("x.Nrrd")).unwrap().starts_with(b"NRRD"));
+    assert!(std::fs::read(dir.join("x.Nrrd"))
+        .unwrap()
+        .starts_with(b"NRRD"));
     assert_ok(&fvr_line(
         "turntable sphere@16 --frames 2 --out spin.APNG --quiet",
         &dir,
@@ -21,4 +23,36 @@ fn output_extensions_are_case_insensitive_and_the_name_is_kept() {
     assert!(dir.join("spin.APNG").is_file());
     assert_ok(&fvr_line("convert sphere@8 --out v.NRRD --quiet", &dir));
     assert!(dir.join("v.NRRD").is_file());
+}
+
+fn one_line_error(out: &std::process::Output, needles: &[&str]) {
+    assert_error(out, needles);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.len() < 200, "short: {err}");
+    assert!(!err.contains("left out"), "{err}");
+}
+
+#[test]
+fn a_misspelt_volume_gets_the_nearest_name() {
+    let dir = temp_dir("names-near");
+    std::fs::write(dir.join("mni152.nii.gz"), b"").unwrap();
+    let out = fvr_line("render mni152.nii --dir 1,0,0 --out x.png", &dir);
+    one_line_error(
+        &out,
+        &["fvr: error: no such file or volume `mni152.nii`; did you mean `mni152.nii.gz`?"],
+    );
+    let out = fvr_line("render brainsmal --dir 1,0,0 --out x.png", &dir);
+    one_line_error(&out, &["did you mean `brainsmall`?"]);
+    let out = fvr_line("render sphre@16 --dir 1,0,0 --out x.png", &dir);
+    one_line_error(&out, &["did you mean `sphere@16`?"]);
+    // A file in another directory: the suggestion keeps the directory.
+    std::fs::create_dir_all(dir.join("sub")).unwrap();
+    std::fs::write(dir.join("sub/head.nrrd"), b"").unwrap();
+    let out = fvr_line("render sub/haed.nrrd --dir 1,0,0 --out x.png", &dir);
+    one_line_error(&out, &["did you mean `sub/head.nrrd`?"]);
+    // Nothing close: no suggestion, still one short line.
+    let out = fvr_line("render zzzqqq --dir 1,0,0 --out x.png", &dir);
+    one_line_error(&out, &["no such file or volume `zzzqqq`", "--help"]);
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("did you mean"));
 }
