@@ -9,8 +9,8 @@ use std::path::Path;
 use indicatif::ProgressBar;
 
 use crate::io::nrrd::{read_raw, Endian, SampleType};
-use crate::io::read_volume_with_progress;
-use crate::sources::datasets::load_dataset_with_progress;
+use crate::io::{read_volume_with_progress, FORMATS_HELP};
+use crate::sources::datasets::{load_dataset_with_progress, DATASETS_HELP};
 use crate::sources::teapot::{voxelize_teapot, DEFAULT_TEAPOT_SIZE};
 use fvr_engine::volume::phantom::{sample, GaussianMixture, Phantom, SheppLogan, Sphere};
 use fvr_engine::volume::Volume;
@@ -220,13 +220,13 @@ const BUILT_IN_NAMES: &[&str] = &[
 
 /// The one-line message for a `VOLUME` that is neither a file nor a known
 /// name: the nearest directory entry or built-in name when one is close,
-/// else a pointer to `--help` (the full lists do not fit one line).
+/// else the formats, data sets and phantoms it could be.
 fn no_such_volume(spec: &str) -> String {
     match nearest_volume_name(spec) {
         Some(near) => format!("no such file or volume `{spec}`; did you mean `{near}`?"),
         None => format!(
             "no such file or volume `{spec}`: neither a file nor a built-in phantom, and no data \
-             set has that name (`fvr render --help` lists the formats, data sets and phantoms)"
+             set has that name; files can be {FORMATS_HELP}; {DATASETS_HELP}; {PHANTOM_HELP}"
         ),
     }
 }
