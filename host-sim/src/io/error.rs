@@ -172,8 +172,8 @@ impl fmt::Display for Gib {
     }
 }
 
-/// A header value fit for an error message: at most 60 characters, control
-/// characters escaped.
+/// A header value fit for an error message: at most 60 characters, all but
+/// printable ASCII escaped.
 pub(crate) fn excerpt(s: &str) -> String {
     const MAX_CHARS: usize = 60;
     let mut out = String::new();
@@ -182,7 +182,10 @@ pub(crate) fn excerpt(s: &str) -> String {
             out.push('…');
             break;
         }
-        if c.is_control() {
+        // Only printable ASCII is echoed: a binary file (a PNG given as a
+        // NRRD) must not put raw bytes or replacement characters on a
+        // terminal, so anything else is escaped (`\r`, `\u{fffd}`).
+        if !(c == ' ' || c.is_ascii_graphic()) {
             out.extend(c.escape_default());
         } else {
             out.push(c);

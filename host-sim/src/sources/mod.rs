@@ -201,10 +201,104 @@ pub fn load_volume_with_progress(
         if let Some(v) = load_dataset_with_progress(spec, progress) {
             return v;
         }
-        return Err(format!(
-            "`{spec}` is neither a file nor a built-in phantom, and no data set has that name; \
-             files can be {FORMATS_HELP}; {DATASETS_HELP}; {PHANTOM_HELP}"
-        ));
+        return Err(no_such_volume(spec));
     }
     read_volume_with_progress(path, progress).map_err(|e| e.to_string())
+}
+
+/// The names `VOLUME` may take besides a file (without `@N` or `:SEED`).
+const BUILT_IN_NAMES: &[&str] = &[
+    "gaussians",
+    "blobs",
+    "shepp-logan",
+    "sphere",
+    "teapot",
+    "brainsmall",
+    "ct-head",
+    "mri-head",
+];
+
+/// The one-line message for a `VOLUME` that is neither a file nor a known
+/// name: the nearest directory entry or built-in name when one is close,
+/// else the formats, data sets and phantoms it could be.
+fn no_such_volume(spec: &str) -> String {
+    match nearest_volume_name(spec) {
+        Some(near) => format!("no such file or volume `{spec}`; did you mean `{near}`?"),
+        None => format!(
+            "no such file or volume `{spec}`: neither a file nor a built-in phantom, and no data \
+             set has that name; files can be {FORMATS_HELP}; {DATASETS_HELP}; {PHANTOM_HELP}"
+        ),
+    }
+}
+
+/// Levenshtein distance over characters.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != cb)).min(row[j] + 1).min(cur + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
+}
+
+/// How close `candidate` is to `name` (lower is closer), or `None` when it
+/// is not close: an edit distance of at most 3 (and less than half the
+/// name), or one name a prefix or suffix of the other (`mni152.nii` and
+/// `mni152.nii.gz`).
+fn closeness(name: &str, candidate: &str) -> Option<usize> {
+    if name == candidate || name.is_empty() {
+        return None;
+    }
+    let d = edit_distance(name, candidate);
+    let len = name.chars().count().min(candidate.chars().count());
+    let affix = len >= 4
+        && (candidate.starts_with(name)
+            || name.starts_with(candidate)
+            || candidate.ends_with(name)
+            || name.ends_with(candidate));
+    (d <= 3 && 2 * d < len.max(1) + 1 || affix).then_some(d)
+}
+
+/// The nearest name to `spec`: among the entries of its directory (at most
+/// 10,000 read) and the built-in names (keeping `@N` or `:SEED`).
+fn nearest_volume_name(spec: &str) -> Option<String> {
+    let mut best: Option<(usize, String)> = None;
+    let mut offer = |d: usize, s: String| {
+        if best.as_ref().is_none_or(|(b, _)| d < *b) {
+            best = Some((d, s));
+        }
+    };
+    let cut = spec.find(['@', ':']).unwrap_or(spec.len());
+    let (head, tail) = spec.split_at(cut);
+    for name in BUILT_IN_NAMES {
+        if let Some(d) = closeness(head, name) {
+            offer(d, format!("{name}{tail}"));
+        }
+    }
+    let path = Path::new(spec);
+    if let Some(file) = path.file_name().and_then(|f| f.to_str()) {
+        let parent = path.parent().filter(|p| !p.as_os_str().is_empty());
+        let dir = parent.unwrap_or(Path::new("."));
+        if let Ok(entries) = std::fs::read_dir(dir) {
+            for entry in entries.flatten().take(10_000) {
+                let Ok(entry_name) = entry.file_name().into_string() else {
+                    continue;
+                };
+                if let Some(d) = closeness(file, &entry_name) {
+                    let shown = match parent {
+                        Some(p) => p.join(&entry_name).display().to_string(),
+                        None => entry_name,
+                    };
+                    offer(d, shown);
+                }
+            }
+        }
+    }
+    best.map(|(_, s)| crate::text::bounded(&s))
 }

@@ -1,4 +1,5 @@
-//! `fvr compare`: the SNR of one NRRD image against another.
+//! `fvr compare`: the SNR of one NRRD image against another, as a line or
+//! as JSON, optionally gated by a least SNR (`--min-db`, exit 1 below it).
 
 use crate::Error;
 use std::path::PathBuf;
@@ -14,7 +15,30 @@ pub(crate) struct CompareArgs {
     pub(crate) a: PathBuf,
     /// Image to measure.
     pub(crate) b: PathBuf,
+    /// Print one JSON object on stdout instead of the line: `a`, `b`,
+    /// `width`, `height`, `dims`, `snr_db`, `identical`, `max_abs_error`,
+    /// and `min_db` and `passed` with --min-db. Identical images have an
+    /// infinite SNR, which JSON cannot hold: `snr_db` is then `null` and
+    /// `identical` is `true`.
+    #[arg(long)]
+    pub(crate) json: bool,
+    /// Exit with status 1 (and one line on stderr) when the SNR is below DB;
+    /// identical images always pass. Errors still exit 2.
+    #[arg(long, value_name = "DB", allow_negative_numbers = true)]
+    pub(crate) min_db: Option<f64>,
 }
+
+/// The SNR fell below `--min-db`: `main` prints this and exits 1.
+#[derive(Debug)]
+pub(crate) struct BelowMinDb(pub(crate) String);
+
+impl std::fmt::Display for BelowMinDb {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for BelowMinDb {}
 
 pub(crate) fn compare(args: &CompareArgs) -> Result<(), Error> {
     let (a, b) = (&args.a, &args.b);
@@ -46,12 +70,50 @@ pub(crate) fn compare(args: &CompareArgs) -> Result<(), Error> {
         )
         .into());
     }
-    say!(
-        "SNR of {} against {}: {:.2} dB (max abs error {:.3e})",
-        b.display(),
-        a.display(),
-        snr_db(ra, rb),
-        max_abs_error(ra, rb)
-    );
+    if let Some(min) = args.min_db {
+        if !min.is_finite() {
+            return Err(format!("--min-db must be a finite number of dB, not {min}").into());
+        }
+    }
+    let db = snr_db(ra, rb);
+    let err = max_abs_error(ra, rb);
+    let identical = ra == rb;
+    let passed = args.min_db.map(|min| identical || db >= min);
+    if args.json {
+        let [width, height, _] = ia.dims;
+        let json = serde_json::json!({
+            "a": a.display().to_string(),
+            "b": b.display().to_string(),
+            "width": width,
+            "height": height,
+            "dims": ia.dims,
+            "snr_db": if db.is_finite() { Some(db) } else { None },
+            "identical": identical,
+            "max_abs_error": err,
+            "min_db": args.min_db,
+            "passed": passed,
+        });
+        let mut json = json;
+        if args.min_db.is_none() {
+            if let Some(o) = json.as_object_mut() {
+                o.remove("min_db");
+                o.remove("passed");
+            }
+        }
+        say!("{json}");
+    } else {
+        say!(
+            "SNR of {} against {}: {:.2} dB (max abs error {:.3e})",
+            b.display(),
+            a.display(),
+            db,
+            err
+        );
+    }
+    if let (Some(min), Some(false)) = (args.min_db, passed) {
+        return Err(Box::new(BelowMinDb(format!(
+            "compare: {db:.2} dB is below --min-db {min}"
+        ))));
+    }
     Ok(())
 }

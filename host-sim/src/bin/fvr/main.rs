@@ -75,6 +75,7 @@ PHYSICAL UNITS (fvr render, fvr turntable)
 EXIT STATUS
   0  success (also for --help and --version, and when standard output is a
      pipe closed early: the rest of the printed text is dropped)
+  1  fvr compare --min-db DB: the SNR is below DB (one line on stderr)
   2  any error: bad arguments, unreadable or malformed input, a render that
      cannot be done; the reason is printed on stderr as `fvr: error: ...`
      (argument errors are explained by the parser, with a usage line).
@@ -114,7 +115,8 @@ pub(crate) enum Command {
     /// FRAMES X-ray views on a full turn about the up axis.
     #[command(after_help = GEOMETRY)]
     Turntable(TurntableArgs),
-    /// Print the SNR in dB of image B against reference image A (NRRD files).
+    /// Print the SNR in dB of image B against reference image A (NRRD files),
+    /// or JSON with --json; --min-db DB exits 1 below DB (for CI).
     Compare(crate::compare::CompareArgs),
     /// Write a volume (after --background) as a float NRRD file with its
     /// voxel spacing, for tools that cannot read the original format.
@@ -201,6 +203,10 @@ where
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if e.downcast_ref::<crate::compare::BelowMinDb>().is_some() => {
+            eprintln!("fvr: {e}");
+            ExitCode::from(1)
+        }
         Err(e) => {
             eprintln!("fvr: error: {}", fvr_host::text::bounded(&e.to_string()));
             ExitCode::from(2)

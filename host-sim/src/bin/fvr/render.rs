@@ -238,7 +238,12 @@ pub(crate) const DEFAULT_CHAIN: &str = "zero";
 pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     let out = args.out_path()?;
     let volume_spec = args.volume_spec()?;
-    let ext = out.extension().and_then(|e| e.to_str()).unwrap_or("");
+    // Case-insensitive (`x.PNG`, `x.Nrrd`); the file keeps the given name.
+    let ext = out
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
     if ext != "png" && ext != "nrrd" {
         return Err(format!("output `{}` must end in .png or .nrrd", out.display()).into());
     }
