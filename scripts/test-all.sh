@@ -34,5 +34,8 @@ cargo test --locked --workspace
 echo "== benchmarks compile"
 cargo test --locked -p fvr-host --benches --no-run
 
+echo "== Python package (python/): a venv in target/, maturin develop --release, pytest"
+bash scripts/test-python.sh
+
 echo "== firmware on a Cortex-M4F in QEMU: bit-for-bit agreement, instruction counts, footprint, budget"
 bash scripts/firmware.sh
