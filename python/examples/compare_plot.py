@@ -35,7 +35,7 @@ def main():
         db = 10 * np.log10((ref.astype(float) ** 2).sum() / (err.astype(float) ** 2).sum())
         rep = r.report
         axes[0, col].imshow(img, cmap="gray")
-        axes[0, col].set_title(f"{target} dB target: {rep['filter']} {rep['precision']}")
+        axes[0, col].set_title(f"{target} dB: {rep['filter']} x{rep['oversample']} {rep['precision']}")
         axes[1, col].imshow(err, cmap="RdBu", vmin=-np.abs(err).max(), vmax=np.abs(err).max())
         axes[1, col].set_title(f"error, {db:.1f} dB")
     for ax in axes.flat:

@@ -3,8 +3,9 @@
     python python/examples/drr.py [--volume ct-head] [--count 64] [--size 256]
                                   [--out drr.npy] [--png drr-grid.png]
 
-Parallel-beam DRRs (line integrals in mm x HU-derived units; fvr renders
-parallel rays only). The rotations are uniform on SO(3) (QR of Gaussian
+Parallel-beam DRRs (fvr renders parallel rays only): for the CT head, line
+integrals in mm of the attenuation relative to water, (HU + 1000) / 1000
+clipped at 0. The rotations are uniform on SO(3) (QR of Gaussian
 matrices) and saved beside the images (`*_rotations.npy`) so each image
 can be matched to its pose. With --png, the first 16 images as a 4x4 grid
 (needs matplotlib).
@@ -39,6 +40,11 @@ def main():
 
     t0 = time.perf_counter()
     vol, spacing = fvr.load(args.volume)
+    if args.volume == "ct-head":
+        # Hounsfield units to attenuation relative to water (air 0, water 1),
+        # so that air adds nothing to a ray and the DRR shows no box.
+        np.maximum(vol + 1000.0, 0.0, out=vol)
+        vol /= 1000.0
     renderer = fvr.Renderer(vol, spacing)
     t1 = time.perf_counter()
     rotations = random_rotations(args.count)
