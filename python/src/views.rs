@@ -47,7 +47,10 @@ fn float64_array<'py>(x: &Bound<'py, PyAny>, what: &str) -> PyResult<(Vec<usize>
     }
     let kwargs = PyDict::new(py);
     kwargs.set_item("dtype", np.getattr("float64")?)?;
-    let arr = np.call_method("ascontiguousarray", (arr,), Some(&kwargs))?;
+    // C-contiguous and aligned (arrays unpickled from out-of-band buffers,
+    // as dask sends them, may be misaligned): a copy only when needed.
+    kwargs.set_item("requirements", "CA")?;
+    let arr = np.call_method("require", (arr,), Some(&kwargs))?;
     let arr = arr
         .cast_into::<PyArrayDyn<f64>>()
         .map_err(|_| type_error(format!("{what} must be a numeric array")))?;

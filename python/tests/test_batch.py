@@ -107,3 +107,21 @@ def test_no_reference_leaks_over_1000_calls(renderer):
 def test_empty_batch(renderer):
     imgs = renderer.project(np.zeros((0, 3)))
     assert imgs.shape == (0, *renderer.default_size)
+
+
+def misaligned(a):
+    """`a` copied into a buffer at an odd address (as unpickled out-of-band
+    buffers can be)."""
+    a = np.ascontiguousarray(a)
+    raw = np.zeros(a.nbytes + 1, np.uint8)
+    out = np.frombuffer(raw.data, dtype=a.dtype, count=a.size, offset=1).reshape(a.shape)
+    out[...] = a
+    assert not out.flags.aligned
+    return out
+
+
+def test_misaligned_views_and_volume_are_copied(renderer):
+    assert np.array_equal(renderer.project(misaligned(DIRS)), renderer.project(DIRS))
+    vol = (np.random.default_rng(2).random((12, 10, 14))).astype(np.float32)
+    want = fvr.Renderer(vol).project(DIRS[:2])
+    assert np.array_equal(fvr.Renderer(misaligned(vol)).project(DIRS[:2]), want)

@@ -1,7 +1,7 @@
 """A batch over several volumes on dask.distributed's LocalCluster (the
 python/examples/dask_batch.py pattern): each chunk equals the same views
 rendered in this process. Skipped when dask.distributed is not installed
-(scripts/test-python.sh does not install it)."""
+(scripts/test-python.sh installs it)."""
 
 import pathlib
 import sys
