@@ -148,3 +148,34 @@ def test_spectrum_is_the_stored_one_read_only():
         # after an f32 transform (error ~1e-7 of the largest, measured).
         bound = rel * np.abs(ref) + 1e-6 * np.abs(ref).max()
         assert np.all(np.abs(got - ref) <= bound), precision
+
+
+def test_the_gil_is_released_while_rendering():
+    r = fvr.Renderer("gaussians@64")
+    views = np.tile(DIRS, (16, 1))
+    count = [0]
+    running = threading.Event()
+    stop = threading.Event()
+
+    def spin():
+        running.set()
+        while not stop.is_set():
+            count[0] += 1
+
+    t = threading.Thread(target=spin)
+    t.start()
+    running.wait()
+    sys.setswitchinterval(1e-4)
+    try:
+        before = count[0]
+        r.project(views)
+        during = count[0] - before
+    finally:
+        stop.set()
+        t.join()
+        sys.setswitchinterval(0.005)
+    # With the GIL held the spinning thread runs only around the call: a
+    # C call holding it for 140 ms (sorted() of 300,000 floats) let it count
+    # 1,821 here. Released, it counts on through the 96 views (about
+    # 200,000 in 60 ms measured, with both cores rendering).
+    assert during > 20_000, during
