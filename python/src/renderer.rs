@@ -56,9 +56,9 @@ fn as_volume_array<'py>(volume: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArr
     let kwargs = PyDict::new(py);
     kwargs.set_item("dtype", np.getattr("float32")?)?;
     // C-contiguous and aligned (arrays unpickled from out-of-band buffers,
-    // as dask sends them, may be misaligned): a copy only when needed.
+    // as dask sends them, may be misaligned): no copy when it already is
+    // float32, C-contiguous and aligned.
     kwargs.set_item("requirements", "CA")?;
-    // No copy when it is already float32 and C-contiguous.
     let arr = np.call_method("require", (arr,), Some(&kwargs))?;
     arr.cast_into::<PyArray3<f32>>()
         .map_err(|_| type_error("volume must be a float32 array"))
