@@ -99,7 +99,8 @@ class Renderer:
         view direction is ``-R[:, 2]``; see docs/python.md). ``up``: the
         up hint for directions, one ``(3,)`` or ``(B, 3)``; default
         ``(0, 0, 1)`` as the CLI's. ``size``: ``(height, width)`` or one
-        side; default the CLI's (the volume's longest side).
+        side; default the CLI's, ``default_size`` (the power of two at or
+        above the volume's longest side, within the grid).
 
         Returns float32 ``(B, H, W)`` (``(B, H, W, 3)`` for coloured scenes;
         ``(H, W)`` for one ``(3,)`` direction), row 0 at the top, each image

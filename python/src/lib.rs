@@ -25,9 +25,13 @@ pub(crate) fn load_volume(py: Python<'_>, spec: &str) -> PyResult<Volume> {
         .map_err(|e| errors::load(spec, e))
 }
 
-/// `fvr.load(spec)`: `(volume, spacing)`, the volume a float32 `(z, y, x)`
-/// array that owns the loaded samples (no copy), the spacing `(dz, dy, dx)`
-/// in mm.
+/// Load whatever the CLI's VOLUME takes: a file (NRRD, NIfTI, DICOM, .den,
+/// .inv3), a data set (brainsmall, ct-head, mri-head) or a phantom
+/// (gaussians@64, sphere@64, teapot@64).
+///
+/// Returns (volume, spacing): a float32 (z, y, x) array that owns the
+/// loaded samples (no copy) and the spacing (dz, dy, dx) in mm. Raises
+/// FileNotFoundError, OSError, MemoryError or ValueError.
 #[pyfunction]
 fn load<'py>(py: Python<'py>, spec: &str) -> PyResult<Bound<'py, PyTuple>> {
     let volume = load_volume(py, spec)?;
@@ -44,8 +48,9 @@ fn load<'py>(py: Python<'py>, spec: &str) -> PyResult<Bound<'py, PyTuple>> {
 /// The limit `set_max_memory` set, if any.
 static MAX_MEMORY: std::sync::OnceLock<u64> = std::sync::OnceLock::new();
 
-/// `fvr.set_max_memory(bytes)`: the CLI's `--max-memory` (an integer of
-/// bytes, or text such as "4G").
+/// The CLI's --max-memory: an integer of bytes, or text such as "4G". Set
+/// once per process, as the flag; a second, different value raises
+/// ValueError.
 #[pyfunction]
 fn set_max_memory(limit: &Bound<'_, PyAny>) -> PyResult<()> {
     let bytes = match limit.extract::<u64>() {
@@ -69,7 +74,7 @@ fn set_max_memory(limit: &Bound<'_, PyAny>) -> PyResult<()> {
     Ok(())
 }
 
-/// `fvr.memory_limit()`: `(bytes, where the limit comes from)`.
+/// The memory limit in force: (bytes, where it comes from).
 #[pyfunction]
 fn memory_limit() -> (u64, String) {
     let limit = fvr_host::budget::limit();

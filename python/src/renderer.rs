@@ -14,8 +14,20 @@ use crate::errors::{over_budget, pipeline, type_error, value};
 use crate::settings::Options;
 use crate::views::shape_text;
 
-/// A volume prepared for rendering: its spectrum, the filter, grid and
-/// precision chosen for the accuracy target, and the physical units.
+/// A volume prepared for rendering: premultiplied, 3D Hartley transformed
+/// and stored once; each view is then a 2D slice and an inverse 2D transform.
+///
+/// `volume` is a 3-D array (z, y, x) of real numbers (converted to aligned
+/// C-contiguous float32 when it is not already) or a VOLUME string as
+/// `fvr.load` takes it; `spacing` is (dz, dy, dx) in mm, or one number.
+/// Settings left None are the accuracy planner's, as `fvr render` leaves
+/// them without the flags: the cheapest filter, grid and precision
+/// predicted to reach `accuracy_db` (50 dB by default). The scene
+/// (`depth_cue`, `lights`, `ambient`) is part of the preparation.
+///
+/// Raises ValueError for bad settings or data, TypeError for non-numeric
+/// input, MemoryError beyond the memory limit, and what `fvr.load` raises
+/// for a VOLUME string. See docs/python.md.
 #[pyclass(module = "fvr", name = "Renderer", frozen)]
 pub(crate) struct PyRenderer {
     inner: Renderer,
@@ -224,7 +236,19 @@ impl PyRenderer {
         })
     }
 
-    /// Render `views` into a float32 array (see the stubs for the shapes).
+    /// Render views on all cores with the GIL released.
+    ///
+    /// `views`: directions (B, 3) from the eye into the volume, in (x, y, z)
+    /// with x the array's last axis (the CLI's --dir); one direction (3,)
+    /// for one (H, W) image; or rotations (B, 3, 3) whose columns are the
+    /// camera's right, up and backward axes (the view direction is
+    /// -R[:, 2]). `up`: the up hint for directions, (3,) or (B, 3), default
+    /// (0, 0, 1). `size`: (height, width) or one side, default
+    /// `default_size`. `out`: a C-contiguous float32 array of the result's
+    /// shape to write into.
+    ///
+    /// Returns float32 (B, H, W), or (B, H, W, 3) for coloured scenes, each
+    /// image bit for bit `fvr render`'s NRRD of the same view.
     #[pyo3(signature = (views, up=None, size=None, out=None))]
     fn project<'py>(
         &self,
@@ -274,14 +298,16 @@ impl PyRenderer {
         Ok(out.into_any())
     }
 
-    /// The choices, predictions, sizes and times, as `fvr render
-    /// --stats-json` reports them.
+    /// The choices, predicted dB, bytes and times, as `fvr render
+    /// --stats-json` reports them, plus `warnings`.
     #[getter]
     fn report<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         crate::report::report(py, &self.inner, &self.source, self.spacing, self.load_ms)
     }
 
-    /// The stored density spectrum (a read-only copy) and its scale.
+    /// A read-only copy of the stored density spectrum, (n, n, n) in its
+    /// storage dtype (float16, float32 or float64), kx fastest in natural
+    /// Hartley order, and the scale images are divided by.
     fn spectrum<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
         crate::report::spectrum(py, &self.inner)
     }
