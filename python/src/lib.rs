@@ -1,5 +1,5 @@
 //! `fvr._fvr`, the extension module behind the Python package `fvr`
-//! (python/fvr): [`load`](load) reads whatever the CLI's VOLUME takes,
+//! (python/fvr): `load` reads whatever the CLI's VOLUME takes,
 //! `Renderer` prepares a volume once and renders batches of views into
 //! numpy arrays on all cores with the GIL released.
 //!
