@@ -48,11 +48,17 @@ fn views() -> Vec<View> {
     v
 }
 
-/// Batch against one by one, frame by frame, bit for bit.
+/// Batch against one by one, frame by frame, bit for bit: a batch of
+/// eleven views (in parallel) and a batch of one (one view at a time, on
+/// all threads).
 fn check(label: &str, volume: &Volume, settings: Settings, size: Option<(usize, usize)>) {
     let renderer = Renderer::new(volume, settings).unwrap();
-    let views = views();
-    let (batch, report) = renderer.render_batch(&views, size).unwrap();
+    check_views(label, &renderer, &views(), size);
+    check_views(label, &renderer, &views()[5..6], size);
+}
+
+fn check_views(label: &str, renderer: &Renderer, views: &[View], size: Option<(usize, usize)>) {
+    let (batch, report) = renderer.render_batch(views, size).unwrap();
     let shape = report.shape;
     assert_eq!(shape.views, views.len(), "{label}");
     assert_eq!(batch.len(), shape.len(), "{label}");

@@ -6,7 +6,9 @@
 //! Plain X-ray views (the main path) are spread over rayon's pool one view
 //! per task, each worker reusing one [`ViewRenderer`] with single-threaded
 //! extraction: the views, not the rows of one slice, are what run in
-//! parallel, so no thread waits on another's inverse transform. Depth-cued,
+//! parallel, so no thread waits on another's inverse transform. A batch of
+//! fewer views than threads is drawn one view at a time with the slice
+//! extracted on all threads, as [`Renderer::render`] draws one. Depth-cued,
 //! shaded, adaptive and preview views go through [`Renderer::render`]
 //! itself, still one view per task.
 
@@ -190,10 +192,12 @@ impl Renderer {
         })
     }
 
-    /// Plain views: one [`ViewRenderer`] per piece rayon splits the batch into (a few
-    /// per thread), extraction
-    /// on the task's own thread (the image is the same bit for bit whatever
-    /// the thread count, see [`ViewRenderer::with_threads`]).
+    /// Plain views: with at least as many views as threads, one
+    /// [`ViewRenderer`] per piece rayon splits the batch into (a few per
+    /// thread), extraction on the task's own thread; with fewer, one
+    /// renderer drawing the views in turn, extraction on all threads. The
+    /// image is the same bit for bit whatever the thread count (see
+    /// [`ViewRenderer::with_threads`]).
     fn plain_batch(
         &self,
         views: &[View],
@@ -204,7 +208,20 @@ impl Renderer {
     ) -> Result<(), PipelineError> {
         let (w, h) = (shape.width, shape.height);
         let density = &self.spectra().density;
+        // Fewer views than threads: one view at a time, each slice
+        // extracted on all of them (as `render` does), rather than cores
+        // left idle.
+        let one_at_a_time = views.len() < rayon::current_num_threads();
         with_arithmetic!(density, s, T => {
+            if one_at_a_time {
+                let mut renderer = ViewRenderer::<T>::new(s.n(), s.filter());
+                let mut frame = vec![<T as Real>::ZERO; w * h];
+                for (dst, view) in out.chunks_mut(shape.frame_len()).zip(views) {
+                    renderer.render_sampled_into(s, view, sampling, w, h, &mut frame)?;
+                    to_f32(dst, &frame, grey);
+                }
+                return Ok(());
+            }
             out.par_chunks_mut(shape.frame_len())
                 .zip(views.par_iter())
                 .try_for_each_init(
@@ -214,11 +231,7 @@ impl Renderer {
                     },
                     |(renderer, frame), (dst, view)| {
                         renderer.render_sampled_into(s, view, sampling, w, h, frame)?;
-                        // As `Renderer::render` then the NRRD writer: to
-                        // f64, times the grey factor, rounded to f32.
-                        for (d, v) in dst.iter_mut().zip(frame.iter()) {
-                            *d = (<T as Real>::to_f64(*v) * grey) as f32;
-                        }
+                        to_f32(dst, frame, grey);
                         Ok::<(), PipelineError>(())
                     },
                 )
@@ -247,5 +260,13 @@ impl Renderer {
         rest.par_chunks_mut(shape.frame_len())
             .zip(views[1..].par_iter())
             .try_for_each(|(dst, view)| one(dst, view))
+    }
+}
+
+/// A frame as `Renderer::render` then the NRRD writer make it: each value
+/// to f64, times the grey factor, rounded to f32.
+fn to_f32<T: Real>(dst: &mut [f32], frame: &[T], grey: f64) {
+    for (d, v) in dst.iter_mut().zip(frame) {
+        *d = (v.to_f64() * grey) as f32;
     }
 }
