@@ -34,5 +34,10 @@ cargo test --locked --workspace
 echo "== benchmarks compile"
 cargo test --locked -p fvr-host --benches --no-run
 
+echo "== Python package (python/): a venv in target/, maturin develop --release, pytest"
+# The fvr binary `cargo test --workspace` built above (test profile) is the
+# CLI the package is compared with bit for bit: no second build of it.
+FVR_BIN="$PWD/target/debug/fvr" bash scripts/test-python.sh
+
 echo "== firmware on a Cortex-M4F in QEMU: bit-for-bit agreement, instruction counts, footprint, budget"
 bash scripts/firmware.sh
