@@ -213,6 +213,7 @@ impl Renderer {
         // left idle.
         let one_at_a_time = views.len() < rayon::current_num_threads();
         with_arithmetic!(density, s, T => {
+            ViewRenderer::<T>::share_for_batch(s, views, sampling);
             if one_at_a_time {
                 let mut renderer = ViewRenderer::<T>::new(s.n(), s.filter());
                 let mut frame = vec![<T as Real>::ZERO; w * h];

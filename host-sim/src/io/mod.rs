@@ -30,6 +30,7 @@ pub mod inv3;
 pub mod nifti;
 pub mod nrrd;
 pub mod paths;
+pub mod stack;
 
 use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read};

@@ -21,6 +21,7 @@ mod growth;
 mod json;
 mod plan;
 mod precision;
+mod project;
 mod render;
 mod scene;
 #[cfg(not(fuzzing))]
@@ -29,6 +30,7 @@ mod signals;
 mod tests;
 mod trade;
 mod turntable;
+mod views;
 
 use crate::accuracy::accuracy;
 use crate::adaptive_table::adaptive_table;
@@ -116,6 +118,10 @@ pub(crate) enum Command {
     /// FRAMES X-ray views on a full turn about the up axis.
     #[command(after_help = GEOMETRY)]
     Turntable(TurntableArgs),
+    /// Render many X-ray views from one preprocessing pass into one float32
+    /// stack (NRRD or .npy): views from a CSV or JSON file, or --random N
+    /// rotations.
+    Project(Box<crate::project::ProjectArgs>),
     /// Print the SNR in dB of image B against reference image A (NRRD files),
     /// or JSON with --json; --min-db DB exits 1 below DB (for CI).
     Compare(crate::compare::CompareArgs),
@@ -194,6 +200,7 @@ where
             args.frame.spectrum.given = plan::Given::from_flags(&|id| given("turntable", id));
             merge_scene(&mut args, &|id| given("turntable", id)).and_then(|()| turntable(&args))
         }
+        Some(Command::Project(args)) => crate::project::project(&args),
         Some(Command::Compare(args)) => compare(&args),
         Some(Command::Convert(args)) => crate::convert::convert(&args),
         Some(Command::Accuracy(args)) => accuracy(&args),

@@ -1,0 +1,255 @@
+//! `fvr project`: many views of one volume from one preparation, written as
+//! one float32 stack (NRRD or `.npy`), for projection sets (digitally
+//! reconstructed radiographs, training data, registration).
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::Args;
+use fvr_engine::{Plan, Settings};
+use fvr_host::io::stack::{write_stack, StackFormat, StackShape};
+use fvr_host::progress;
+use serde::Serialize;
+
+use crate::args::{parse_vec3, prepare_with_progress, volume_help, FrameArgs, InputArgs};
+use crate::json::one_line;
+use crate::views::{random_views, read_views, views_csv, MAX_VIEWS};
+use crate::Error;
+
+#[derive(Args, Clone)]
+pub(crate) struct ProjectArgs {
+    /// A volume file, a raw file with --raw-dims, a data set, or a built-in phantom.
+    #[arg(help = volume_help())]
+    pub(crate) volume: String,
+    /// The views, from a file: CSV, one view a line, `dx,dy,dz` or
+    /// `dx,dy,dz,ux,uy,uz` (`#` comments and a header line allowed), or JSON,
+    /// a list of `[dx,dy,dz]` or `{"dir": [..], "up": [..]}`. Each view is
+    /// what `fvr render --dir D --up U` renders.
+    #[arg(
+        long,
+        value_name = "FILE",
+        required_unless_present = "random",
+        conflicts_with = "random"
+    )]
+    pub(crate) views: Option<PathBuf>,
+    /// N views at uniformly random rotations (direction uniform on the
+    /// sphere, roll uniform about it), drawn from --seed.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=MAX_VIEWS as i64))]
+    pub(crate) random: Option<u32>,
+    /// Seed of --random: the same seed gives the same views on every machine.
+    #[arg(long, default_value_t = 1, requires = "random")]
+    pub(crate) seed: u64,
+    /// Up hint X,Y,Z of the views a --views file gives without one.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,1")]
+    pub(crate) up: [f64; 3],
+    #[command(flatten)]
+    pub(crate) frame: FrameArgs,
+    /// Output: .nrrd (float32, sizes W H B, kinds `space space list`, the
+    /// pixel size as spacing) or .npy (float32, shape (B, H, W)).
+    #[arg(long)]
+    pub(crate) out: PathBuf,
+    /// Also write the views used, one `dx,dy,dz,ux,uy,uz` line each (the CSV
+    /// that --views reads back): the geometry of a --random set.
+    #[arg(long, value_name = "FILE.csv")]
+    pub(crate) save_views: Option<PathBuf>,
+    /// Print the choices and timings after the run.
+    #[arg(long)]
+    pub(crate) stats: bool,
+    /// Print them as one JSON object on stdout instead (and nothing else
+    /// there).
+    #[arg(long)]
+    pub(crate) stats_json: bool,
+    #[command(flatten)]
+    pub(crate) input: InputArgs,
+}
+
+/// Views rendered per call of the engine's batch: each call spreads its
+/// views over every core, and the progress bar moves between calls.
+const VIEWS_PER_CALL: usize = 32;
+
+/// `--stats-json`.
+#[derive(Serialize)]
+struct ProjectStats<'a> {
+    volume: &'a str,
+    dims: [usize; 3],
+    /// `[W, H, channels]`, as `fvr render` gives it.
+    image: [usize; 3],
+    views: usize,
+    pixel_size: f64,
+    ignore_spacing: bool,
+    spectrum_side: usize,
+    precision: &'static str,
+    spectrum_bytes: usize,
+    filter: &'static str,
+    oversample: serde_json::Value,
+    load_ms: f64,
+    plan_ms: f64,
+    preprocess_ms: f64,
+    views_ms: f64,
+    ms_per_view: f64,
+    write_ms: f64,
+    accuracy: Option<crate::plan::AccuracyJson>,
+}
+
+/// What the job holds beside the spectrum: the stack, and per-thread view
+/// buffers ([`crate::args::plan_job`]).
+fn declare_job(args: &ProjectArgs, count: usize) {
+    let size = args.frame.size;
+    let threads = rayon::current_num_threads() as u64;
+    crate::args::plan_job(
+        &args.frame.spectrum,
+        None,
+        1,
+        ("stack and view buffers", move |n, side| {
+            let (w, h) = size.map_or((side, side), |(w, h)| {
+                ((w as u64).min(n), (h as u64).min(n))
+            });
+            let stack = w
+                .saturating_mul(h)
+                .saturating_mul(4)
+                .saturating_mul(count as u64);
+            // Each thread's view grids at f64, as a turntable's.
+            let grids = n
+                .saturating_mul(n)
+                .saturating_mul(40)
+                .saturating_mul(threads);
+            stack.saturating_add(grids)
+        }),
+        "use fewer views, a smaller --size, --precision f16 or --oversample 1",
+    );
+}
+
+pub(crate) fn project(args: &ProjectArgs) -> Result<(), Error> {
+    let format = StackFormat::of(&args.out)
+        .ok_or_else(|| format!("output `{}` must end in .nrrd or .npy", args.out.display()))?;
+    let others: Vec<&Path> = args.views.iter().map(PathBuf::as_path).collect();
+    crate::checks::check_output(&args.out, &["nrrd", "npy"], &args.volume, &others)?;
+    if let Some(csv) = &args.save_views {
+        crate::checks::check_output(csv, &["csv"], &args.volume, &others)?;
+        if csv == &args.out {
+            return Err("--save-views and --out name the same file".into());
+        }
+    }
+    crate::checks::check_direction("--up", args.up)?;
+    let views = match (&args.views, args.random) {
+        (Some(file), _) => read_views(file, args.up)?,
+        (None, Some(n)) => random_views(n as usize, args.seed),
+        (None, None) => return Err("give --views FILE or --random N".into()),
+    };
+    for (i, v) in views.iter().enumerate() {
+        crate::checks::check_direction(&format!("view {i}: the direction"), v.dir)?;
+        crate::checks::check_direction(&format!("view {i}: the up vector"), v.up)?;
+        v.frame()
+            .map_err(|e| format!("view {i} ({:?} up {:?}): {e}", v.dir, v.up))?;
+    }
+    declare_job(args, views.len());
+    let t0 = Instant::now();
+    let volume = args.input.load(&args.volume)?;
+    crate::checks::check_not_input(&args.out)?;
+    if let Some(csv) = &args.save_views {
+        crate::checks::check_not_input(csv)?;
+    }
+    let _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
+    fvr_host::budget::check_plan(volume.dims)?;
+    let t_load = t0.elapsed();
+    let settings = Settings {
+        units: args.frame.units.units(),
+        ..crate::plan::settings(&args.frame.spectrum)
+    };
+    settings.check()?;
+    let plan = Plan::choose(&volume, &settings)?;
+    let mut planned = args.clone();
+    crate::plan::apply(&mut planned.frame.spectrum, &plan);
+    let args = &planned;
+    declare_job(args, views.len());
+    fvr_host::budget::check_plan(volume.dims)?;
+    let renderer = prepare_with_progress(&volume, settings, plan)?;
+    for w in renderer.warnings() {
+        eprintln!("fvr: warning: {w}");
+    }
+    let size = args.frame.size;
+    let shape = renderer.batch_shape(views.len(), size)?;
+    let mut stack = vec![0.0f32; shape.len()];
+    let bar = progress::count(views.len() as u64, "views");
+    let t_views = Instant::now();
+    let frame = shape.frame_len();
+    for (chunk, out) in views
+        .chunks(VIEWS_PER_CALL)
+        .zip(stack.chunks_mut(VIEWS_PER_CALL * frame))
+    {
+        renderer.render_batch_into(chunk, size, out)?;
+        bar.inc(chunk.len() as u64);
+    }
+    bar.finish_and_clear();
+    let t_views = t_views.elapsed();
+    if let Some(i) = stack.iter().position(|v| !v.is_finite()) {
+        return Err(format!(
+            "view {} has non-finite pixels once stored as f32: {}",
+            i / frame.max(1),
+            crate::checks::overflow_cause(false, false, false)
+        )
+        .into());
+    }
+    let t_write = Instant::now();
+    let pixel_size = renderer.sampling().pixel_size();
+    let stack_shape = StackShape {
+        views: shape.views,
+        channels: shape.channels,
+        width: shape.width,
+        height: shape.height,
+    };
+    write_stack(&args.out, format, stack_shape, pixel_size, &stack)?;
+    if let Some(csv) = &args.save_views {
+        fvr_host::io::atomic::write_text(csv, &views_csv(&views))?;
+    }
+    let t_write = t_write.elapsed();
+    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+    let (w, h, c) = (shape.width, shape.height, shape.channels);
+    if !args.stats_json {
+        say!(
+            "wrote {} ({} views of {w}x{h}{})",
+            args.out.display(),
+            views.len(),
+            if c == 1 { " grey" } else { " RGB" }
+        );
+    }
+    if args.stats_json {
+        let stats = ProjectStats {
+            volume: &args.volume,
+            dims: volume.dims,
+            image: [w, h, c],
+            views: views.len(),
+            pixel_size,
+            ignore_spacing: args.frame.units.ignore_spacing,
+            spectrum_side: renderer.n(),
+            precision: args.frame.spectrum.precision.name(),
+            spectrum_bytes: renderer.spectra().density.bytes(),
+            filter: renderer.filter().kind().name(),
+            oversample: crate::plan::oversample_json(args.frame.spectrum.oversample),
+            load_ms: ms(t_load),
+            plan_ms: ms(renderer.plan().time),
+            preprocess_ms: ms(renderer.prepare_time()),
+            views_ms: ms(t_views),
+            ms_per_view: ms(t_views) / views.len() as f64,
+            write_ms: ms(t_write),
+            accuracy: crate::plan::json(&args.frame.spectrum),
+        };
+        say!("{}", one_line(&stats));
+    } else if args.stats {
+        say!(
+            "  load {:.1} ms, plan {:.1} ms, preprocess {:.1} ms ({}^3 {}), {} views in {:.1} ms \
+             = {:.2} ms a view, written in {:.1} ms",
+            ms(t_load),
+            ms(renderer.plan().time),
+            ms(renderer.prepare_time()),
+            renderer.n(),
+            args.frame.spectrum.precision,
+            views.len(),
+            ms(t_views),
+            ms(t_views) / views.len() as f64,
+            ms(t_write)
+        );
+        crate::plan::print_human(&args.frame.spectrum);
+    }
+    Ok(())
+}

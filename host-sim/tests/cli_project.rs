@@ -1,0 +1,171 @@
+//! `fvr project`: a stack of views from one preparation, each frame the
+//! image `fvr render` writes for that view, bit for bit.
+
+mod common;
+use common::{assert_error, assert_ok, fvr_line, temp_dir};
+use std::path::Path;
+
+/// The float32 payload of a NRRD file written by fvr (raw, little endian:
+/// everything after the blank line that ends the header).
+fn nrrd_payload(path: &Path) -> (String, Vec<u8>) {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let end = bytes
+        .windows(2)
+        .position(|w| w == b"\n\n")
+        .expect("a NRRD header")
+        + 2;
+    (
+        String::from_utf8_lossy(&bytes[..end]).into_owned(),
+        bytes[end..].to_vec(),
+    )
+}
+
+#[test]
+fn every_frame_is_the_render_of_its_view_bit_for_bit() {
+    let dir = temp_dir("project-bits");
+    let views = "dx,dy,dz,ux,uy,uz\n1,0.45,0.3\n0,0,1,0,1,0\n# diagonal\n-1 1 1\n";
+    std::fs::write(dir.join("v.csv"), views).unwrap();
+    let out = assert_ok(&fvr_line(
+        "project gaussians@32 --views v.csv --out s.nrrd --quiet",
+        &dir,
+    ));
+    assert!(
+        out.contains("wrote s.nrrd (3 views of 32x32 grey)"),
+        "{out}"
+    );
+    let (header, stack) = nrrd_payload(&dir.join("s.nrrd"));
+    assert!(header.contains("sizes: 32 32 3\n"), "{header}");
+    assert!(header.contains("kinds: space space list\n"), "{header}");
+    assert_eq!(stack.len(), 3 * 32 * 32 * 4);
+    for (i, (d, u)) in [
+        ("1,0.45,0.3", "0,0,1"),
+        ("0,0,1", "0,1,0"),
+        ("-1,1,1", "0,0,1"),
+    ]
+    .iter()
+    .enumerate()
+    {
+        let line = format!("render gaussians@32 --dir {d} --up {u} --out r{i}.nrrd --quiet");
+        assert_ok(&fvr_line(&line, &dir));
+        let (_, image) = nrrd_payload(&dir.join(format!("r{i}.nrrd")));
+        let frame = &stack[i * image.len()..(i + 1) * image.len()];
+        assert!(
+            frame == image.as_slice(),
+            "view {i} differs from fvr render"
+        );
+        // Not vacuous: the frame has content.
+        assert!(image
+            .chunks(4)
+            .any(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]) > 0.0));
+    }
+}
+
+#[test]
+fn random_views_are_saved_and_read_back_to_the_same_stack_in_npy() {
+    let dir = temp_dir("project-random");
+    assert_ok(&fvr_line(
+        "project sphere@16 --random 5 --seed 3 --size 12 --save-views v.csv --out a.npy --quiet",
+        &dir,
+    ));
+    assert_ok(&fvr_line(
+        "project sphere@16 --views v.csv --size 12 --out b.nrrd --quiet",
+        &dir,
+    ));
+    let a = std::fs::read(dir.join("a.npy")).unwrap();
+    assert_eq!(&a[..8], b"\x93NUMPY\x01\x00");
+    let len = u16::from_le_bytes([a[8], a[9]]) as usize;
+    let dict = String::from_utf8_lossy(&a[10..10 + len]);
+    assert!(dict.contains("'descr': '<f4'"), "{dict}");
+    assert!(dict.contains("'shape': (5, 12, 12)"), "{dict}");
+    let (_, b) = nrrd_payload(&dir.join("b.nrrd"));
+    assert!(
+        a[10 + len..] == b[..],
+        "the saved views render the same stack"
+    );
+    // Another seed, other views.
+    assert_ok(&fvr_line(
+        "project sphere@16 --random 5 --seed 4 --size 12 --out c.npy --quiet",
+        &dir,
+    ));
+    assert_ne!(std::fs::read(dir.join("c.npy")).unwrap(), a);
+    let csv = std::fs::read_to_string(dir.join("v.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 6, "{csv}");
+}
+
+#[test]
+fn stats_json_is_alone_on_stdout() {
+    let dir = temp_dir("project-json");
+    let out = assert_ok(&fvr_line(
+        "project sphere@16 --random 3 --out s.npy --stats-json --quiet",
+        &dir,
+    ));
+    assert_eq!(out.lines().count(), 1, "{out}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+    assert_eq!(v["views"], 3);
+    assert_eq!(v["image"], serde_json::json!([16, 16, 1]));
+    assert!(v["ms_per_view"].as_f64().unwrap() > 0.0);
+    assert!(v["accuracy"]["predicted_db"].as_f64().is_some(), "{v}");
+}
+
+#[test]
+fn bad_views_and_outputs_are_one_line_and_write_nothing() {
+    let dir = temp_dir("project-bad");
+    std::fs::write(dir.join("bad.csv"), "1,0,0\n0,zero,1\n").unwrap();
+    std::fs::write(dir.join("par.csv"), "1,0,0\n0,0,1\n").unwrap();
+    std::fs::write(
+        dir.join("bad.json"),
+        r#"[{"dir": [1,0,0], "upp": [0,0,1]}]"#,
+    )
+    .unwrap();
+    std::fs::write(dir.join("empty.csv"), "# nothing\n").unwrap();
+    for (line, needles) in [
+        (
+            "project sphere@16 --views bad.csv --out s.nrrd",
+            &["bad.csv: line 2: `zero` is not a number"][..],
+        ),
+        (
+            "project sphere@16 --views par.csv --out s.nrrd",
+            &["view 1", "parallel"][..],
+        ),
+        (
+            "project sphere@16 --views bad.json --out s.nrrd",
+            &["unknown key `upp`"][..],
+        ),
+        (
+            "project sphere@16 --views empty.csv --out s.nrrd",
+            &["no views"][..],
+        ),
+        (
+            "project sphere@16 --views nope.csv --out s.nrrd",
+            &["nope.csv"][..],
+        ),
+        (
+            "project sphere@16 --random 2 --out s.png",
+            &["must end in .nrrd or .npy"][..],
+        ),
+        (
+            "project sphere@16 --views bad.csv --out bad.csv",
+            &["bad.csv"][..],
+        ),
+        (
+            "project sphere@16 --random 0 --out s.nrrd",
+            &["--random"][..],
+        ),
+        (
+            "project sphere@16 --random 2 --views par.csv --out s.nrrd",
+            &["cannot be used with"][..],
+        ),
+        ("project sphere@16 --out s.nrrd", &["--random"][..]),
+    ] {
+        let out = fvr_line(line, &dir);
+        assert_error(&out, needles);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(err.lines().count(), 1, "{line}: {err}");
+        assert!(!dir.join("s.nrrd").exists(), "{line}");
+    }
+    // The views file named as the output was left as it was.
+    assert_eq!(
+        std::fs::read_to_string(dir.join("bad.csv")).unwrap(),
+        "1,0,0\n0,zero,1\n"
+    );
+}
