@@ -57,3 +57,34 @@ fn a_misspelt_volume_gets_the_nearest_name() {
     assert_eq!(String::from_utf8_lossy(&out.stderr).lines().count(), 1);
     assert!(!String::from_utf8_lossy(&out.stderr).contains("did you mean"));
 }
+
+#[test]
+fn parser_errors_are_one_line_in_the_projects_form() {
+    let dir = temp_dir("names-parser");
+    for (line, needles) in [
+        (
+            "render --bogus",
+            &["unexpected argument '--bogus'", "usage: fvr render"][..],
+        ),
+        (
+            "render brainsmall --dir nan,0,0 --out x.png",
+            &["'--dir", "finite"][..],
+        ),
+        (
+            "render brainsmall",
+            &["not provided", "--dir", "--out", "usage:"][..],
+        ),
+        ("turntable", &["not provided", "usage: fvr turntable"][..]),
+        ("rendr", &["unrecognized subcommand 'rendr'", "render"][..]),
+    ] {
+        let out = fvr_line(line, &dir);
+        one_line_error(&out, needles);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.starts_with("fvr: error: "), "{line}: {err}");
+        assert!(!err.contains("error: error"), "{line}: {err}");
+    }
+    // Help is not an error: whole, on stdout, exit 0.
+    let help = fvr_line("render --help", &dir);
+    assert!(help.status.success());
+    assert!(String::from_utf8_lossy(&help.stdout).lines().count() > 20);
+}

@@ -16,6 +16,7 @@
 //!
 //! `sin(πδ)` is a polynomial without divisions.
 
+use crate::memory::written_zeros;
 use crate::volume::Volume;
 
 /// `sin(πδ)` for `|δ| ≤ ½` to 0.5% (odd Taylor polynomial to degree 5,
@@ -64,7 +65,7 @@ pub(super) fn splat(
     // Voxel i sits at i − ⌊d/2⌋ from the transform origin.
     let c = d.map(|v| (v / 2) as f64);
     let side = (2 * half + 1) as usize;
-    let mut cells = vec![[0.0; 3]; side * side];
+    let mut cells = written_zeros::<[f64; 3]>(side * side);
     // Pixels from the canvas corner, plus ½ so that truncation rounds to
     // the nearest (every coordinate is non-negative).
     let offset = half as f64 + 0.5;
@@ -75,7 +76,7 @@ pub(super) fn splat(
     let [vx, vy, vz] = step.unwrap_or([0, 0, d2]);
     let planes = if step.is_some() { vz as usize + 1 } else { 1 };
     let plane = d[0] * d[1];
-    let mut ring = vec![0.0f64; planes * plane];
+    let mut ring = written_zeros::<f64>(planes * plane);
     let mut row = vec![0.0f64; d[0]];
     // The x range of a row whose voxels have a predecessor `x − v` (and
     // whose line goes on to `x + v`) in the box.

@@ -8,13 +8,16 @@
 //! axis (plain, `c_a`- and `s_a`-weighted) over edge positions of axis `a`,
 //! and three over the others; the pixel's own edge flag then makes them its
 //! `b = 0` and `b = 1` sums, or adds them into its `b = 0` sums. A weight of
-//! zero adds an exact zero, so each sum is the sequence of additions of a
-//! loop over the voxels that skips the others; only the edge pixels' final
-//! addition differs from the voxel-by-voxel loop (tested against it). The
-//! rows are read in blocks that keep the pixel sums being added to in
-//! cache.
+//! zero adds an exact zero, so the y- and z-view sums are the sequence of
+//! additions of a loop over the voxels that skips the others; the x view's
+//! dot products and `Σg²` add in a few independent partial sums, and the
+//! edge pixels' final addition differs too (all tested against the voxel
+//! loop, to rounding). The rows are read in blocks that keep the pixel sums
+//! being added to in cache, and each sum is its own array, so that adding a
+//! row is a vector loop.
 
 use super::weights::AxisWeights;
+use crate::memory::written_zeros;
 use crate::volume::Volume;
 
 /// Per-view sums over the projection axis, split by edge (0) and interior
@@ -27,7 +30,7 @@ pub(super) struct ViewSums {
 
 impl ViewSums {
     fn new(n: usize) -> Self {
-        let z = || [vec![0.0; n * n], vec![0.0; n * n]];
+        let z = || [written_zeros(n * n), written_zeros(n * n)];
         Self {
             plain: z(),
             cos: z(),
@@ -39,6 +42,11 @@ impl ViewSums {
 /// The six sums of a pixel: plain, `c` and `s` over edge positions, then
 /// over the others.
 const SUMS: usize = 6;
+
+/// Independent partial sums in the pass's reductions (`Σg²` and the x
+/// view's dot products), so that their additions do not wait on each
+/// other; the order they add in is the voxel loop's reordered once.
+const LANES: usize = 4;
 
 /// One position along a view axis: its three weights (plain, `c`, `s`)
 /// and where its sums start, 0 for an edge position and 3 for the others
@@ -76,16 +84,92 @@ fn runs(weights: &[Weight]) -> Vec<(usize, usize, usize)> {
 }
 
 /// Rows of `j` and of `k` per block of the pass: the pixel sums of a
-/// block's y- and z-view rows (`2·8·d0·9` values, 288 KiB at `d0 = 256`)
+/// block's y- and z-view lines (`2·8·d0·6` values, 192 KiB at `d0 = 256`)
 /// stay in cache while the block's rows are read.
 const BLOCK: usize = 8;
+
+/// One view's pixel sums, one array per sum ([`SUMS`]), each on the
+/// pixels of the volume's own extent: contiguous along a row, so that
+/// adding a row of voxels is three vector loops.
+struct Lines {
+    sums: [Vec<f64>; SUMS],
+}
+
+impl Lines {
+    fn new(pixels: usize) -> Self {
+        Self {
+            sums: std::array::from_fn(|_| written_zeros(pixels)),
+        }
+    }
+
+    /// Adds the row `row`, weighted by `c`, to the pixels `line·len ..` of
+    /// the sums `c.at ..`: plain, `c` and, unless `sin` is false (all `s`
+    /// weights zero, as for odd widths), `s`.
+    fn add(&mut self, c: Weight, line: usize, row: &[f64], sin: bool) {
+        let len = row.len();
+        let [plain, cos, s] = &mut self.sums[c.at..c.at + 3] else {
+            unreachable!("three sums from 0 or 3");
+        };
+        let pixels = line * len..(line + 1) * len;
+        for (p, &v) in plain[pixels.clone()].iter_mut().zip(row) {
+            *p += v;
+        }
+        for (p, &v) in cos[pixels.clone()].iter_mut().zip(row) {
+            *p += v * c.w[1];
+        }
+        if sin {
+            for (p, &v) in s[pixels].iter_mut().zip(row) {
+                *p += v * c.w[2];
+            }
+        }
+    }
+}
+
+/// `Σ (row·weight)²` in [`LANES`] partial sums.
+fn weighted_squares(row: &[f64], weight: &[f64]) -> f64 {
+    let mut lanes = [0.0; LANES];
+    let chunks = row.chunks_exact(LANES).zip(weight.chunks_exact(LANES));
+    let tail = row.len() / LANES * LANES;
+    for (v, p) in chunks {
+        for l in 0..LANES {
+            let g = v[l] * p[l];
+            lanes[l] += g * g;
+        }
+    }
+    for (&v, &p) in row[tail..].iter().zip(&weight[tail..]) {
+        let g = v * p;
+        lanes[0] += g * g;
+    }
+    lanes.iter().sum()
+}
+
+/// `Σ row·w[t]` over `weights` for the plain, `c` and (if `sin`) `s`
+/// weights, in [`LANES`] partial sums each.
+fn dot3(row: &[f64], weights: &[Weight], sin: bool) -> [f64; 3] {
+    let mut lanes = [[0.0; LANES]; 3];
+    let tail = row.len() / LANES * LANES;
+    let terms = if sin { 3 } else { 2 };
+    for (v, w) in row.chunks_exact(LANES).zip(weights.chunks_exact(LANES)) {
+        for t in 0..terms {
+            for l in 0..LANES {
+                lanes[t][l] += v[l] * w[l].w[t];
+            }
+        }
+    }
+    for (&v, w) in row[tail..].iter().zip(&weights[tail..]) {
+        for t in 0..terms {
+            lanes[t][0] += v * w.w[t];
+        }
+    }
+    lanes.map(|l| l.iter().sum())
+}
 
 /// The sums of the views along x, y and z ([`super::AXIS_VIEWS`]), and
 /// `Σg²` of the premultiplied volume `g = f·p_x·p_y·p_z`.
 ///
-/// Each pixel's sums add their voxels in order along the view axis, as
-/// the voxel loop does, whatever the blocking; `Σg²` adds them in the
-/// blocks' order.
+/// The y- and z-view sums add their voxels in order along the view axis,
+/// as the voxel loop does, whatever the blocking; the x view's and `Σg²`
+/// add theirs in [`LANES`] partial sums.
 ///
 /// # Errors
 /// [`fvr_core::Error::NonFiniteVoxel`] naming a non-finite voxel (the
@@ -95,7 +179,7 @@ pub(super) fn view_sums(
     w: &AxisWeights,
     n: usize,
 ) -> Result<([ViewSums; 3], f64), fvr_core::Error> {
-    if let Some(at) = volume.data.iter().position(|v| !v.is_finite()) {
+    if let Some(at) = volume.first_non_finite() {
         let [d0, d1, _] = volume.dims;
         return Err(fvr_core::Error::NonFiniteVoxel {
             index: [at % d0, at / d0 % d1, at / (d0 * d1)],
@@ -106,13 +190,15 @@ pub(super) fn view_sums(
     let grid = |a: usize| move |i: usize| (i + n - volume.dims[a] / 2 % n) % n;
     let (gx, gy, gz) = (grid(0), grid(1), grid(2));
     let (wx, wy, wz) = (along(w, &gx, d0), along(w, &gy, d1), along(w, &gz, d2));
+    // Odd widths have no `s` weights: their sums stay zero.
+    let sin = w.s.iter().any(|&s| s != 0.0);
     let x_runs = runs(&wx);
     let px: Vec<f64> = (0..d0).map(|i| w.p[gx(i)]).collect();
     // Pixel sums on the volume's own extent: x view (j, k), y view (i, k),
     // z view (i, j).
-    let mut xs = vec![[0.0; SUMS]; d1 * d2];
-    let mut ys = vec![[0.0; SUMS]; d0 * d2];
-    let mut zs = vec![[0.0; SUMS]; d0 * d1];
+    let mut xs = Lines::new(d1 * d2);
+    let mut ys = Lines::new(d0 * d2);
+    let mut zs = Lines::new(d0 * d1);
     let mut row = vec![0.0f64; d0];
     let mut g2 = 0.0;
     for j0 in (0..d1).step_by(BLOCK) {
@@ -123,31 +209,17 @@ pub(super) fn view_sums(
                     for (r, &v) in row.iter_mut().zip(source) {
                         *r = f64::from(v);
                     }
-                    let pyz = (w.p[gy(j)], w.p[gz(k)]);
-                    for (&v, &p) in row.iter().zip(&px) {
-                        if v != 0.0 {
-                            let g = v * p * pyz.0 * pyz.1;
-                            g2 += g * g;
-                        }
-                    }
-                    let mut acc = [0.0; SUMS];
+                    let pyz = w.p[gy(j)] * w.p[gz(k)];
+                    g2 += weighted_squares(&row, &px) * (pyz * pyz);
+                    let pixel = j + d1 * k;
                     for &(start, end, at) in &x_runs {
-                        let acc = &mut acc[at..at + 3];
-                        for (&v, c) in row[start..end].iter().zip(&wx[start..end]) {
-                            for t in 0..3 {
-                                acc[t] += v * c.w[t];
-                            }
+                        let sums = dot3(&row[start..end], &wx[start..end], sin);
+                        for (t, s) in sums.into_iter().enumerate() {
+                            xs.sums[at + t][pixel] += s;
                         }
                     }
-                    xs[j + d1 * k] = acc;
-                    for (sums, c, line) in [(&mut ys, wy[j], k), (&mut zs, wz[k], j)] {
-                        for (s, &v) in sums[d0 * line..][..d0].iter_mut().zip(&row) {
-                            let s = &mut s[c.at..c.at + 3];
-                            for t in 0..3 {
-                                s[t] += v * c.w[t];
-                            }
-                        }
-                    }
+                    ys.add(wy[j], k, &row, sin);
+                    zs.add(wz[k], j, &row, sin);
                 }
             }
         }
@@ -155,7 +227,7 @@ pub(super) fn view_sums(
     let edge = |a: usize, i: usize| w.edge[grid(a)(i)];
     let mut out = [ViewSums::new(n), ViewSums::new(n), ViewSums::new(n)];
     // View `a`: in-plane axes (pa, qa), the pixel sums' extents (lp, lq).
-    for (a, (sums, lp, lq, pa, qa)) in [
+    for (a, (lines, lp, lq, pa, qa)) in [
         (&xs, d1, d2, 1, 2),
         (&ys, d0, d2, 0, 2),
         (&zs, d0, d1, 0, 1),
@@ -164,20 +236,21 @@ pub(super) fn view_sums(
     .enumerate()
     {
         let view = &mut out[a];
+        let s = &lines.sums;
         for q in 0..lq {
             for p in 0..lp {
-                let s = &sums[p + lp * q];
+                let i = p + lp * q;
                 let at = grid(pa)(p) + n * grid(qa)(q);
                 if edge(pa, p) || edge(qa, q) {
                     // Edge pixels: every voxel counts to b = 0.
-                    view.plain[0][at] = s[0] + s[3];
-                    view.cos[0][at] = s[1] + s[4];
-                    view.sin[0][at] = s[2] + s[5];
+                    view.plain[0][at] = s[0][i] + s[3][i];
+                    view.cos[0][at] = s[1][i] + s[4][i];
+                    view.sin[0][at] = s[2][i] + s[5][i];
                 } else {
                     for (b, t) in [(0, 0), (1, 3)] {
-                        view.plain[b][at] = s[t];
-                        view.cos[b][at] = s[t + 1];
-                        view.sin[b][at] = s[t + 2];
+                        view.plain[b][at] = s[t][i];
+                        view.cos[b][at] = s[t + 1][i];
+                        view.sin[b][at] = s[t + 2][i];
                     }
                 }
             }

@@ -36,6 +36,7 @@ use std::sync::OnceLock;
 
 use super::splat::{lattice_step, splat};
 use super::tails::Tails;
+use crate::memory::written_zeros;
 use crate::volume::Volume;
 
 /// The oblique directions: four generic ones (no image axis along a grid
@@ -164,7 +165,7 @@ fn folded(s: &Shadow, n: usize, side: usize) -> (Vec<f64>, f64) {
     let window = |p: i64| p >= -side / 2 && p < side - side / 2;
     let w = (2 * s.half + 1) as usize;
     let len = side as usize;
-    let mut err = vec![0.0; len * len];
+    let mut err = written_zeros::<f64>(len * len);
     let mut signal = 0.0;
     for (row, line) in s.cells.chunks_exact(w).enumerate() {
         let q = row as i64 - s.half;

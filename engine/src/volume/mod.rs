@@ -121,6 +121,20 @@ impl Volume {
         self.data[self.index(i, j, k)]
     }
 
+    /// The linear index of the first NaN or infinite sample, if any.
+    ///
+    /// Checked a chunk at a time without a branch per sample (a vector
+    /// loop): the planner checks every volume it predicts, and a
+    /// `position` over 7 M samples was half of its pass over the CT head.
+    pub fn first_non_finite(&self) -> Option<usize> {
+        const CHUNK: usize = 1024;
+        self.data
+            .chunks(CHUNK)
+            .enumerate()
+            .find(|(_, c)| !c.iter().fold(true, |ok, v| ok & v.is_finite()))
+            .and_then(|(at, c)| Some(at * CHUNK + c.iter().position(|v| !v.is_finite())?))
+    }
+
     /// This volume without its last slice along odd axes, so that the
     /// pixels of axis views fall on voxels (the exact reference is then the
     /// voxel sum), in voxel units ([`DEFAULT_SPACING`]).
@@ -269,5 +283,30 @@ pub fn check_spacing(spacing: [f64; 3]) -> Result<[f64; 3], SpacingError> {
             axis,
             value: spacing[axis],
         }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Volume;
+
+    #[test]
+    fn the_first_non_finite_sample_is_found_in_every_chunk_position() {
+        let len = 3000;
+        assert_eq!(Volume::filled([len, 1, 1], 1.0).first_non_finite(), None);
+        for at in [0, 1, 1023, 1024, 1025, 2047, 2999] {
+            for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+                let mut v = Volume::filled([len, 1, 1], -2.5);
+                v.data[at] = bad;
+                // A later one never hides the first.
+                v.data[len - 1] = f32::NAN;
+                assert_eq!(v.first_non_finite(), Some(at), "{bad} at {at}");
+            }
+        }
+        // Extremes that are finite.
+        let mut v = Volume::filled([4, 1, 1], f32::MAX);
+        v.data[1] = f32::MIN;
+        v.data[2] = f32::MIN_POSITIVE / 2.0;
+        assert_eq!(v.first_non_finite(), None);
     }
 }

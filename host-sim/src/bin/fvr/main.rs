@@ -12,6 +12,7 @@ mod adaptive_report;
 mod adaptive_table;
 mod args;
 mod checks;
+mod clap_error;
 mod compare;
 mod convert;
 #[cfg(fuzzing)]
@@ -78,7 +79,7 @@ EXIT STATUS
   1  fvr compare --min-db DB: the SNR is below DB (one line on stderr)
   2  any error: bad arguments, unreadable or malformed input, a render that
      cannot be done; the reason is printed on stderr as `fvr: error: ...`
-     (argument errors are explained by the parser, with a usage line).
+     (for argument errors too: the parser's message, tip and usage line).
   130  stopped by SIGINT, SIGTERM or SIGHUP: the output being written is
      removed and the previous file left as it was.
 
@@ -165,7 +166,7 @@ where
         .and_then(|m| Cli::from_arg_matches(&m).map(|cli| (m, cli)));
     let (matches, cli) = match parsed {
         Ok(ok) => ok,
-        Err(e) => return clap_exit(&e),
+        Err(e) => return clap_error::exit(&e),
     };
     progress::set_quiet(cli.quiet);
     fvr_host::budget::install();
@@ -259,19 +260,4 @@ fn default_scene() -> Result<(), Error> {
          120 degrees apart, as in the paper's figure 8 (run `fvr --help` for options)"
     );
     render(&args)
-}
-
-/// Print a parser error (or `--help`/`--version`) as clap would, but with
-/// echoed values bounded in length ([`fvr_host::text::bounded`]).
-fn clap_exit(e: &clap::Error) -> ExitCode {
-    let text = e.render();
-    let code = e.exit_code();
-    if e.use_stderr() {
-        eprint!("{}", fvr_host::text::bounded(&text.to_string()));
-        eprintln!();
-    } else {
-        // Help and version text: printed whole (it is ours, not the user's).
-        let _ = e.print();
-    }
-    ExitCode::from(u8::try_from(code).unwrap_or(2))
 }
