@@ -17,7 +17,9 @@ function startPage(moduleUrl) {
   const canvas = $('view');
   const params = new URLSearchParams(location.search);
   const vec = (s, d) => (s ? s.split(',').map(Number) : d);
-  const camera = new Camera(vec(params.get('dir'), [0, 1, 0]), vec(params.get('up'), [0, 0, 1]));
+  // brainsmall's face looks down -x with the top of the head at -y: a
+  // three-quarter view of it by default (?dir=X,Y,Z&up=X,Y,Z to change).
+  const camera = new Camera(vec(params.get('dir'), [1, 0, 0.6]), vec(params.get('up'), [0, -1, 0]));
   const worker = new Worker(moduleUrl, { type: 'module' });
 
   const st = {
@@ -28,6 +30,7 @@ function startPage(moduleUrl) {
   let firstView;
   const firstViewDone = new Promise((r) => (firstView = r));
   const replies = new Map();
+  const shown = []; // every image drawn: level, size, brightest value
 
   // ---------- messages and progress ----------
   function say(text, ok = false) {
@@ -105,14 +108,16 @@ function startPage(moduleUrl) {
       const bytes = await download(await fetchIt(), label);
       progress(`reading ${label}`, null);
       const { info } = await ask({ op: 'load', bytes }, [bytes]);
+      // The worker now holds the new volume: the old renderer is gone.
+      st.prepared = false;
       st.name = label;
       st.info = info;
       st.window = null;
       st.zoom = 1;
       await prepare();
     } catch (e) {
+      // Until the new volume was accepted, the old one is still there.
       say(e.message);
-      st.prepared = st.prepared && st.name !== label ? st.prepared : false;
     } finally {
       st.busy = false;
       progress(null);
@@ -174,6 +179,10 @@ function startPage(moduleUrl) {
       } else st.previewMs = m.image.ms;
       if (!st.window) st.window = autoWindow(m.image);
       st.shownLevel = m.level;
+      let max = -Infinity;
+      for (const v of m.image.data) if (v > max) max = v;
+      shown.push({ level: m.level, w: m.image.w, h: m.image.h, max });
+      if (shown.length > 1000) shown.splice(0, 500);
       draw();
       showInfo();
       if (m.level === 0 && !st.wanted) firstView(true);
@@ -340,6 +349,7 @@ function startPage(moduleUrl) {
   // ---------- the test and benchmark hook ----------
   window.fvr = {
     firstView: firstViewDone,
+    shown,
     state: () => ({ name: st.name, prepared: st.prepared, busy: st.busy, plan: st.plan, shownLevel: st.shownLevel,
       image: st.image && { w: st.image.w, h: st.image.h, channels: st.image.channels, ms: st.image.ms },
       message: $('message').textContent, dir: camera.dir, up: camera.up }),
