@@ -121,19 +121,17 @@ function startPage(moduleUrl) {
     } finally {
       st.busy = false;
       progress(null);
+      afterBusy();
     }
   }
   async function prepare() {
     if (!st.info) return;
     st.prepared = false;
     progress(`preparing ${st.name}: planning, premultiplying and transforming (once per volume)`, null);
-    const { plan } = await ask({
-      op: 'prepare',
-      accuracy: Number($('accuracy').value),
-      cue: Number($('cue').value),
-      lights: $('lights').checked,
-    });
+    const options = { accuracy: Number($('accuracy').value), cue: Number($('cue').value), lights: $('lights').checked };
+    const { plan } = await ask({ op: 'prepare', ...options });
     st.plan = plan;
+    st.shaded = options.cue !== 0 || options.lights;
     st.prepared = true;
     canvas.width = canvas.height = plan.side;
     say(plan.warnings.length ? plan.warnings[0] : `${st.name} ready`, !plan.warnings.length);
@@ -220,7 +218,7 @@ function startPage(moduleUrl) {
     view.fillRect(0, 0, canvas.width, canvas.height);
     // Plain views are zoomed by the engine (a finer pixel); cued and lit
     // ones, which need pixels as large as voxels, are magnified here.
-    const z = img.channels === 3 || Number($('cue').value) ? st.zoom : 1;
+    const z = st.shaded ? st.zoom : 1;
     const sw = img.w / z;
     const sh = img.h / z;
     view.drawImage(scratch, (img.w - sw) / 2, (img.h - sh) / 2, sw, sh, 0, 0, canvas.width, canvas.height);
@@ -314,8 +312,10 @@ function startPage(moduleUrl) {
   // ---------- controls ----------
   for (const b of document.querySelectorAll('#volumes button')) b.onclick = () => openSpec(b.dataset.spec);
   $('file').onchange = (e) => e.target.files[0] && openFile(e.target.files[0]);
+  // An option changed while a preparation runs is applied after it.
   const reprepare = async () => {
-    if (st.busy || !st.info) return;
+    if (st.busy) return void (st.again = true);
+    if (!st.info) return;
     st.busy = true;
     st.window = null;
     try {
@@ -325,8 +325,15 @@ function startPage(moduleUrl) {
     } finally {
       st.busy = false;
       progress(null);
+      afterBusy();
     }
   };
+  function afterBusy() {
+    if (st.again) {
+      st.again = false;
+      reprepare();
+    }
+  }
   for (const id of ['accuracy', 'cue', 'lights']) $(id).onchange = reprepare;
   $('save').onclick = () =>
     canvas.toBlob((blob) => {
