@@ -37,10 +37,10 @@ cargo test --locked -p fvr-host --benches --no-run
 echo "== firmware on a Cortex-M4F in QEMU: bit-for-bit agreement, instruction counts, footprint, budget"
 bash scripts/firmware.sh
 
-# The fvr binary of the tests' build above (the test profile is optimized):
-# a release build would compile everything again.
+# target/debug/fvr is the binary `cargo test` built above for the
+# integration tests (test profile, optimized): a release build, or even
+# `cargo build --profile test`, would compile fvr-host again (9 minutes here).
 echo "== browser viewer: wasm32 + SIMD128 build, then fvr view in headless Chromium (Debian's)"
 bash scripts/web.sh
 command -v chromium >/dev/null || { apt-get update -qq && apt-get install -y -qq chromium >/dev/null; }
-cargo build --locked --profile test -p fvr-host --bin fvr
 python3 scripts/web-test.py --fvr target/debug/fvr
