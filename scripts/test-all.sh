@@ -41,3 +41,11 @@ FVR_BIN="$PWD/target/debug/fvr" bash scripts/test-python.sh
 
 echo "== firmware on a Cortex-M4F in QEMU: bit-for-bit agreement, instruction counts, footprint, budget"
 bash scripts/firmware.sh
+
+# target/debug/fvr is the binary `cargo test` built above for the
+# integration tests (test profile, optimized): a release build, or even
+# `cargo build --profile test`, would compile fvr-host again (9 minutes here).
+echo "== browser viewer: wasm32 + SIMD128 build, then fvr view in headless Chromium (Debian's)"
+bash scripts/web.sh
+command -v chromium >/dev/null || { apt-get update -qq && apt-get install -y -qq chromium >/dev/null; }
+python3 scripts/web-test.py --fvr target/debug/fvr

@@ -18,6 +18,7 @@
 //! preparation, then views. [`memory`] is the one budget every allocation is
 //! checked against.
 
+mod clock;
 pub mod dht;
 mod error;
 pub mod image;

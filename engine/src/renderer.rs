@@ -12,7 +12,9 @@
 //! the preparation; [`Renderer::new`] does both.
 
 use std::sync::OnceLock;
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+use crate::clock::Instant;
 
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::{Sampling, View};

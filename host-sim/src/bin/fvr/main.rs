@@ -18,6 +18,7 @@ mod convert;
 #[cfg(fuzzing)]
 mod fuzz;
 mod growth;
+mod http;
 mod json;
 mod plan;
 mod precision;
@@ -30,6 +31,7 @@ mod signals;
 mod tests;
 mod trade;
 mod turntable;
+mod view;
 mod views;
 
 use crate::accuracy::accuracy;
@@ -153,6 +155,9 @@ pub(crate) enum Command {
     /// the CT head (resampled to 128 along its longest side), a 256³ volume
     /// and a phantom. Prints Markdown.
     AdaptiveTable(crate::adaptive_table::AdaptiveTableArgs),
+    /// Serve the browser viewer (built by `bash scripts/web.sh`) and VOLUME
+    /// on 127.0.0.1 at a free port; prints the address; Ctrl-C stops.
+    View(crate::view::ViewArgs),
 }
 
 #[cfg(not(fuzzing))]
@@ -208,6 +213,7 @@ where
         Some(Command::Precision(args)) => crate::precision::run(&args),
         Some(Command::Trade(args)) => crate::trade::run(&args),
         Some(Command::Growth(args)) => crate::growth::run(&args),
+        Some(Command::View(args)) => crate::view::view(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
