@@ -20,6 +20,7 @@ mod growth;
 mod json;
 mod plan;
 mod precision;
+mod prepare;
 mod render;
 mod scene;
 #[cfg(not(fuzzing))]
@@ -146,6 +147,11 @@ pub(crate) enum Command {
     /// the CT head (resampled to 128 along its longest side), a 256³ volume
     /// and a phantom. Prints Markdown.
     AdaptiveTable(crate::adaptive_table::AdaptiveTableArgs),
+    /// Prepare a volume's spectrum once for a part (m4f, m3, m7 or host):
+    /// a .fvrs image (docs/fvrs.md) checked against the part's flash and
+    /// RAM before anything is written, as the file, a raw image for loading
+    /// at run time, or a C .c/.h pair to link into flash.
+    Prepare(crate::prepare::PrepareArgs),
 }
 
 #[cfg(not(fuzzing))]
@@ -198,6 +204,7 @@ where
         Some(Command::Accuracy(args)) => accuracy(&args),
         Some(Command::AdaptiveTable(args)) => adaptive_table(&args),
         Some(Command::Precision(args)) => crate::precision::run(&args),
+        Some(Command::Prepare(args)) => crate::prepare::prepare(&args),
         Some(Command::Trade(args)) => crate::trade::run(&args),
         Some(Command::Growth(args)) => crate::growth::run(&args),
     };
