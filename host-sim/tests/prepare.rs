@@ -28,7 +28,18 @@ fn brainsmall_for_the_m4f_as_c_is_resampled_to_fit_and_parses() {
     let dir = tempdir();
     let (code, err) = fvr(
         dir.path(),
-        &["prepare", "brainsmall", "--for", "m4f", "--emit", "c", "--out", "bs", "--filter", "kb3"],
+        &[
+            "prepare",
+            "brainsmall",
+            "--for",
+            "m4f",
+            "--emit",
+            "c",
+            "--out",
+            "bs",
+            "--filter",
+            "kb3",
+        ],
     );
     assert_eq!(code, 0, "{err}");
     assert!(err.contains("resampled to 64 x 64 x 42"), "{err}");
@@ -61,7 +72,16 @@ fn too_large_for_the_part_is_refused_with_the_numbers_before_writing() {
     let dir = tempdir();
     let (code, err) = fvr(
         dir.path(),
-        &["prepare", "brainsmall", "--for", "m4f", "--resample", "128", "--out", "x.fvrs"],
+        &[
+            "prepare",
+            "brainsmall",
+            "--for",
+            "m4f",
+            "--resample",
+            "128",
+            "--out",
+            "x.fvrs",
+        ],
     );
     assert_eq!(code, 2);
     assert_eq!(err.lines().count(), 1, "{err}");
@@ -74,7 +94,18 @@ fn too_large_for_the_part_is_refused_with_the_numbers_before_writing() {
     // The RAM budget too: a 64-side image loaded into the M4F's RAM.
     let (code, err) = fvr(
         dir.path(),
-        &["prepare", "brainsmall", "--for", "m4f", "--resample", "64", "--emit", "bin", "--out", "x.bin"],
+        &[
+            "prepare",
+            "brainsmall",
+            "--for",
+            "m4f",
+            "--resample",
+            "64",
+            "--emit",
+            "bin",
+            "--out",
+            "x.bin",
+        ],
     );
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("of RAM") && err.contains("(524288)"), "{err}");
@@ -87,7 +118,21 @@ fn host_f32_fvrs_and_bin_are_the_same_image() {
     for (emit, out) in [("fvrs", "p.fvrs"), ("bin", "p.bin")] {
         let (code, err) = fvr(
             dir.path(),
-            &["prepare", "gaussians@32", "--for", "host", "--precision", "f32", "--filter", "kb4", "--emit", emit, "--out", out, "--quiet"],
+            &[
+                "prepare",
+                "gaussians@32",
+                "--for",
+                "host",
+                "--precision",
+                "f32",
+                "--filter",
+                "kb4",
+                "--emit",
+                emit,
+                "--out",
+                out,
+                "--quiet",
+            ],
         );
         assert_eq!(code, 0, "{err}");
         assert!(err.is_empty(), "--quiet: {err}");
@@ -107,9 +152,36 @@ fn bad_flags_are_one_line_and_write_nothing() {
     let cases: [&[&str]; 5] = [
         &["prepare", "gaussians@32", "--for", "m9", "--out", "a.fvrs"],
         &["prepare", "gaussians@32", "--for", "m4f", "--out", "a.png"],
-        &["prepare", "gaussians@32", "--for", "m4f", "--emit", "c", "--out", "a.txt"],
-        &["prepare", "gaussians@32", "--for", "m4f", "--emit", "c", "--out", "9bad"],
-        &["prepare", "gaussians@32", "--for", "m4f", "--precision", "q15", "--out", "a.fvrs"],
+        &[
+            "prepare",
+            "gaussians@32",
+            "--for",
+            "m4f",
+            "--emit",
+            "c",
+            "--out",
+            "a.txt",
+        ],
+        &[
+            "prepare",
+            "gaussians@32",
+            "--for",
+            "m4f",
+            "--emit",
+            "c",
+            "--out",
+            "9bad",
+        ],
+        &[
+            "prepare",
+            "gaussians@32",
+            "--for",
+            "m4f",
+            "--precision",
+            "q15",
+            "--out",
+            "a.fvrs",
+        ],
     ];
     for args in cases {
         let (code, err) = fvr(dir.path(), args);
@@ -124,7 +196,15 @@ fn a_corrupt_file_is_named_in_one_line() {
     let dir = tempdir();
     let (code, err) = fvr(
         dir.path(),
-        &["prepare", "gaussians@32", "--for", "host", "--out", "p.fvrs", "--quiet"],
+        &[
+            "prepare",
+            "gaussians@32",
+            "--for",
+            "host",
+            "--out",
+            "p.fvrs",
+            "--quiet",
+        ],
     );
     assert_eq!(code, 0, "{err}");
     let path = dir.path().join("p.fvrs");
@@ -133,7 +213,10 @@ fn a_corrupt_file_is_named_in_one_line() {
     bytes[last] ^= 1;
     std::fs::write(&path, &bytes).unwrap();
     let e = FvrsFile::read(&path).err().unwrap();
-    assert!(e.contains("p.fvrs") && e.contains("checksum mismatch in the twiddle section"), "{e}");
+    assert!(
+        e.contains("p.fvrs") && e.contains("checksum mismatch in the twiddle section"),
+        "{e}"
+    );
     std::fs::write(&path, &bytes[..1000]).unwrap();
     let e = FvrsFile::read(&path).err().unwrap();
     assert!(e.contains("truncated"), "{e}");

@@ -28,6 +28,23 @@ impl<'a> Fvrs<'a> {
     /// # Errors
     /// The first fault found, as [`FvrsError`].
     pub fn parse(bytes: &'a [u8]) -> Result<Self, FvrsError> {
+        let f = Self::parse_with(bytes, true)?;
+        f.check_values()?;
+        Ok(f)
+    }
+
+    /// [`Fvrs::parse`] without the sections' CRCs and value scans: every
+    /// header check, in O(1). For an image that [`Fvrs::parse`] accepted
+    /// and that has not changed since (the C API checks an image once, at
+    /// `fvr_source_open`, and then renders each view after this).
+    ///
+    /// # Errors
+    /// As [`Fvrs::parse`], but for the sections' CRCs and values.
+    pub fn parse_trusting_sections(bytes: &'a [u8]) -> Result<Self, FvrsError> {
+        Self::parse_with(bytes, false)
+    }
+
+    fn parse_with(bytes: &'a [u8], check_sections: bool) -> Result<Self, FvrsError> {
         if cfg!(target_endian = "big") {
             return Err(FvrsError::BigEndian);
         }
@@ -145,6 +162,10 @@ impl<'a> Fvrs<'a> {
                 });
             }
             check_zero(bytes, end as usize..offset as usize, "padding")?;
+            end = offset + len;
+            if !check_sections {
+                continue;
+            }
             let stored = u32_at(head, e + 16);
             let computed = crc32(slice(bytes, want));
             if stored != computed {
@@ -158,7 +179,6 @@ impl<'a> Fvrs<'a> {
                     computed,
                 });
             }
-            end = offset + len;
         }
         Ok(Self {
             header,
@@ -186,8 +206,7 @@ impl<'a> Fvrs<'a> {
     /// The f16 spectrum, in place.
     ///
     /// # Errors
-    /// A file of another precision ([`FvrsError::PrecisionMismatch`]); a
-    /// NaN or infinite coefficient ([`Spectrum::check_finite`], O(n³)).
+    /// A file of another precision ([`FvrsError::PrecisionMismatch`]).
     pub fn spectrum_f16(&self) -> Result<Spectrum<'a, f16>, FvrsError> {
         self.expect(Precision::F16)?;
         let data: &'a [f16] = cast(slice(self.bytes, self.layout.spectrum))?;
@@ -216,16 +235,30 @@ impl<'a> Fvrs<'a> {
     /// The twiddles for transforms up to `n`, in place.
     ///
     /// # Errors
-    /// A NaN or infinite entry, or one outside `[-1, 1]`.
+    /// None for a parsed image (kept for tables of other origins).
     pub fn twiddles(&self) -> Result<Twiddles<'a, f32>, FvrsError> {
         let values: &'a [f32] = cast(slice(self.bytes, self.layout.twiddles))?;
+        Ok(Twiddles::from_table(values, self.header.n)?)
+    }
+
+    /// Every coefficient finite ([`Spectrum::check_finite`]), every kernel
+    /// entry finite, every twiddle in `[-1, 1]`: a file whose CRCs were
+    /// made over bad values is refused here, once, not per view.
+    fn check_values(&self) -> Result<(), FvrsError> {
+        let spectrum = slice(self.bytes, self.layout.spectrum);
+        match self.header.precision {
+            Precision::F16 => self.spectrum_of(cast::<f16>(spectrum)?)?.check_finite()?,
+            Precision::F32 => self.spectrum_of(cast::<f32>(spectrum)?)?.check_finite()?,
+        }
+        self.kernel()?;
+        let values: &[f32] = cast(slice(self.bytes, self.layout.twiddles))?;
         if let Some(index) = values.iter().position(|v| v.is_nan() || v.abs() > 1.0) {
             return Err(FvrsError::Core(crate::Error::NonFiniteTableEntry {
                 what: "twiddle table (|sin| <= 1)",
                 index,
             }));
         }
-        Ok(Twiddles::from_table(values, self.header.n)?)
+        Ok(())
     }
 
     fn expect(&self, asked: Precision) -> Result<(), FvrsError> {
@@ -244,9 +277,7 @@ impl<'a> Fvrs<'a> {
         data: &'a [S],
     ) -> Result<Spectrum<'a, S>, FvrsError> {
         let h = &self.header;
-        let spec = Spectrum::from_parts(data, h.n, h.scale, h.filter, h.dims)?;
-        spec.check_finite()?;
-        Ok(spec)
+        Ok(Spectrum::from_parts(data, h.n, h.scale, h.filter, h.dims)?)
     }
 }
 
