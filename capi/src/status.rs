@@ -45,25 +45,28 @@ pub enum fvr_status {
 }
 
 impl fvr_status {
-    /// Every status, in code order.
-    pub const ALL: [fvr_status; 16] = [
-        fvr_status::FVR_OK,
-        fvr_status::FVR_ERR_NULL,
-        fvr_status::FVR_ERR_MISALIGNED,
-        fvr_status::FVR_ERR_OVERLAP,
-        fvr_status::FVR_ERR_BUFFER_TOO_SMALL,
-        fvr_status::FVR_ERR_NOT_OPEN,
-        fvr_status::FVR_ERR_NOT_FVRS,
-        fvr_status::FVR_ERR_VERSION,
-        fvr_status::FVR_ERR_LENGTH,
-        fvr_status::FVR_ERR_HEADER,
-        fvr_status::FVR_ERR_CHECKSUM,
-        fvr_status::FVR_ERR_VALUE,
-        fvr_status::FVR_ERR_VIEW,
-        fvr_status::FVR_ERR_SIZE,
-        fvr_status::FVR_ERR_UNSUPPORTED,
-        fvr_status::FVR_ERR_OTHER,
-    ];
+    /// Every status, in code order (a function, not a constant, so that
+    /// cbindgen leaves it out of the header).
+    pub const fn all() -> [fvr_status; 16] {
+        [
+            fvr_status::FVR_OK,
+            fvr_status::FVR_ERR_NULL,
+            fvr_status::FVR_ERR_MISALIGNED,
+            fvr_status::FVR_ERR_OVERLAP,
+            fvr_status::FVR_ERR_BUFFER_TOO_SMALL,
+            fvr_status::FVR_ERR_NOT_OPEN,
+            fvr_status::FVR_ERR_NOT_FVRS,
+            fvr_status::FVR_ERR_VERSION,
+            fvr_status::FVR_ERR_LENGTH,
+            fvr_status::FVR_ERR_HEADER,
+            fvr_status::FVR_ERR_CHECKSUM,
+            fvr_status::FVR_ERR_VALUE,
+            fvr_status::FVR_ERR_VIEW,
+            fvr_status::FVR_ERR_SIZE,
+            fvr_status::FVR_ERR_UNSUPPORTED,
+            fvr_status::FVR_ERR_OTHER,
+        ]
+    }
 
     /// The text of the status, NUL-terminated for C.
     pub const fn text(self) -> &'static str {
@@ -101,7 +104,7 @@ impl fvr_status {
 
     /// The status of a code from C, which may be any integer.
     pub fn from_code(code: i32) -> Option<Self> {
-        Self::ALL.into_iter().find(|s| *s as i32 == code)
+        Self::all().into_iter().find(|s| *s as i32 == code)
     }
 }
 

@@ -379,7 +379,7 @@ fn bad_views_and_sizes_are_named() {
 
 #[test]
 fn every_status_has_a_text_and_unknown_codes_too() {
-    for s in fvr_status::ALL {
+    for s in fvr_status::all() {
         let text = unsafe { CStr::from_ptr(fvr_status_str(s as i32)) }
             .to_str()
             .unwrap();
