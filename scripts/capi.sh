@@ -81,7 +81,7 @@ gcc "${CFLAGS[@]}" -O2 -Icapi/include capi/tests/c/host.c "$host_lib" -lpthread 
 
 echo "== capi: C firmware example (arm-none-eabi-gcc, QEMU mps2-an386)"
 ARM=(-mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard -O2 -ffreestanding -ffunction-sections -fdata-sections)
-arm-none-eabi-gcc "${CFLAGS[@]}" "${ARM[@]}" -Icapi/include -I"$run" -nostdlib -nostartfiles \
+arm-none-eabi-gcc "${CFLAGS[@]}" "${ARM[@]}" -Icapi/include -I"$run" -nostdlib -nostartfiles -Wl,--no-warn-execstack \
     -T firmware/c-example/link.ld -Wl,--gc-sections \
     firmware/c-example/main.c firmware/c-example/startup.c firmware/c-example/semihost.c "$run/bs.c" \
     "$thumb_lib" -lgcc -o "$run/c-example.elf"

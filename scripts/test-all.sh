@@ -36,3 +36,6 @@ cargo test --locked -p fvr-host --benches --no-run
 
 echo "== firmware on a Cortex-M4F in QEMU: bit-for-bit agreement, instruction counts, footprint, budget"
 bash scripts/firmware.sh
+
+echo "== C API: fvr prepare --emit c, the header with -Werror, a host C program, the C firmware example in QEMU bit for bit"
+bash scripts/capi.sh

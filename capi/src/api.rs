@@ -5,9 +5,10 @@
 
 use fvr_core::fvrs::{Fvrs, Precision};
 use fvr_core::geometry::View;
+use fvr_core::image::Inverse;
 use fvr_core::image::{aux_len, grid_len};
-use fvr_core::render::max_level;
-use fvr_core::{render as core_render, Buffers, Request, Source};
+use fvr_core::render::{max_level, render_projection_with};
+use fvr_core::{Buffers, Request};
 
 use crate::status::fvr_status;
 use crate::types::{fvr_info, fvr_lens, fvr_request};
@@ -71,8 +72,10 @@ pub fn lens(image: &[u8], request: &fvr_request) -> Result<fvr_lens, fvr_status>
     })
 }
 
-/// Render `request` from the opened `image` into the buffers, as
-/// `fvr_core::render` does.
+/// Render `request` from the opened `image` into the buffers: the X-ray
+/// projection `fvr_core::render` makes, through
+/// `render_projection_with`, which is the same code without the scene
+/// path (a device links no shading code it cannot call).
 ///
 /// # Errors
 /// As [`lens`]; a bad view; short buffers.
@@ -102,15 +105,14 @@ pub fn render(
     let kernel = f.kernel()?;
     let twiddles = f.twiddles()?;
     let buffers = Buffers::new(grid, aux, &mut out[..need.out]);
+    let inverse = Inverse::Radix2(&twiddles);
     let done = match f.header().precision {
         Precision::F16 => {
-            let spectrum = f.spectrum_f16()?;
-            core_render(&Source::new(&spectrum, &kernel, &twiddles), &req, buffers)
+            render_projection_with(&f.spectrum_f16()?, &kernel, inverse, &req, buffers)
         }
         Precision::F32 => {
-            let spectrum = f.spectrum_f32()?;
-            core_render(&Source::new(&spectrum, &kernel, &twiddles), &req, buffers)
+            render_projection_with(&f.spectrum_f32()?, &kernel, inverse, &req, buffers)
         }
     };
-    done.map(drop).map_err(fvr_status::from)
+    done.map_err(fvr_status::from)
 }

@@ -250,15 +250,13 @@ pub(crate) fn prepare(args: &PrepareArgs) -> Result<(), Error> {
     // The same check with the filter chosen: the image is never larger than
     // the estimate (the widest filter), but say so if it were.
     let n = renderer.n();
-    parts::check(
-        args.part,
-        parts::need(image.len() as u64, n, placement(args.emit)),
-    )?;
+    let need = parts::need(image.len() as u64, n, placement(args.emit));
+    parts::check(args.part, need)?;
     write_outputs(args, &files, &image)?;
     if !fvr_host::progress::quiet() {
         let d = renderer.dims();
         eprintln!(
-            "fvr: note: wrote {} ({} image: {} {} spectrum n = {n} of {} x {} x {}, filter {}) for {}",
+            "fvr: note: wrote {} ({} image: {} {} spectrum n = {n} of {} x {} x {}, filter {}) for {}{}",
             files
                 .iter()
                 .map(|f| f.display().to_string())
@@ -271,7 +269,11 @@ pub(crate) fn prepare(args: &PrepareArgs) -> Result<(), Error> {
             d[1],
             d[2],
             renderer.filter().kind().name(),
-            args.part.name()
+            args.part.name(),
+            parts::memory(args.part).map_or(String::new(), |m| format!(
+                "; needs {} bytes of flash of {} and {} of RAM of {}",
+                need.flash, m.flash, need.ram, m.ram
+            ))
         );
     }
     Ok(())
