@@ -40,14 +40,19 @@ rustup target list --installed | grep -qx "$TARGET" || rustup target add "$TARGE
 echo "== capi: the FFI boundary's tests and the header's currency"
 cargo test --locked -p fvr-capi
 
-echo "== capi: the static libraries (host and $TARGET) and the fvr program"
-cargo build --locked --release -p fvr-capi -p fvr-host
+# The host's library and fvr in the tests' profile (optimized; what
+# `cargo test --workspace` in scripts/test-all.sh has built already), the
+# thumb libraries in release (as scripts/firmware.sh builds the core).
+echo "== capi: the static libraries (host, $TARGET, thumbv7m-none-eabi) and the fvr program"
+cargo build --locked --profile test -p fvr-capi -p fvr-host
 cargo build --locked --release -p fvr-capi --target "$TARGET"
+rustup target list --installed | grep -qx thumbv7m-none-eabi || rustup target add thumbv7m-none-eabi
+cargo build --locked --release -p fvr-capi --target thumbv7m-none-eabi
 target_dir=$(cargo metadata --format-version 1 --no-deps --locked \
     | python3 -c 'import json, sys; print(json.load(sys.stdin)["target_directory"])')
-host_lib="$target_dir/release/libfvr_capi.a"
+host_lib="$target_dir/debug/libfvr_capi.a"
 thumb_lib="$target_dir/$TARGET/release/libfvr_capi.a"
-fvr="$target_dir/release/fvr"
+fvr="$target_dir/debug/fvr"
 run="$target_dir/fvr-capi-run"
 rm -rf "$run"
 mkdir -p "$run"
