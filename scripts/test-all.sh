@@ -42,6 +42,9 @@ FVR_BIN="$PWD/target/debug/fvr" bash scripts/test-python.sh
 echo "== firmware on a Cortex-M4F in QEMU: bit-for-bit agreement, instruction counts, footprint, budget"
 bash scripts/firmware.sh
 
+echo "== C API: fvr prepare --emit c, the header with -Werror, a host C program, the C firmware example in QEMU bit for bit"
+bash scripts/capi.sh
+
 # target/debug/fvr is the binary `cargo test` built above for the
 # integration tests (test profile, optimized): a release build, or even
 # `cargo build --profile test`, would compile fvr-host again (9 minutes here).

@@ -21,6 +21,7 @@
 pub mod dht;
 pub mod error;
 pub mod filter;
+pub mod fvrs;
 pub mod geometry;
 pub mod image;
 pub mod num;

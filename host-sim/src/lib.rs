@@ -14,6 +14,7 @@ pub mod budget;
 pub mod image;
 pub mod io;
 pub mod options;
+pub mod parts;
 pub mod progress;
 pub mod reference;
 pub mod scene_file;

@@ -22,9 +22,11 @@
 //! an [`IoError`] that names the file and the field.
 
 pub mod atomic;
+pub mod c_array;
 pub mod den;
 pub mod dicom;
 mod error;
+pub mod fvrs;
 pub mod inputs;
 pub mod inv3;
 pub mod nifti;

@@ -23,6 +23,7 @@ mod json;
 mod plan;
 mod precision;
 mod project;
+mod prepare;
 mod render;
 mod scene;
 #[cfg(not(fuzzing))]
@@ -158,6 +159,11 @@ pub(crate) enum Command {
     /// Serve the browser viewer (built by `bash scripts/web.sh`) and VOLUME
     /// on 127.0.0.1 at a free port; prints the address; Ctrl-C stops.
     View(crate::view::ViewArgs),
+    /// Prepare a volume's spectrum once for a part (m4f, m3, m7 or host):
+    /// a .fvrs image (docs/fvrs.md) checked against the part's flash and
+    /// RAM before anything is written, as the file, a raw image for loading
+    /// at run time, or a C .c/.h pair to link into flash.
+    Prepare(crate::prepare::PrepareArgs),
 }
 
 #[cfg(not(fuzzing))]
@@ -211,6 +217,7 @@ where
         Some(Command::Accuracy(args)) => accuracy(&args),
         Some(Command::AdaptiveTable(args)) => adaptive_table(&args),
         Some(Command::Precision(args)) => crate::precision::run(&args),
+        Some(Command::Prepare(args)) => crate::prepare::prepare(&args),
         Some(Command::Trade(args)) => crate::trade::run(&args),
         Some(Command::Growth(args)) => crate::growth::run(&args),
         Some(Command::View(args)) => crate::view::view(&args),
