@@ -22,8 +22,8 @@ mod http;
 mod json;
 mod plan;
 mod precision;
-mod project;
 mod prepare;
+mod project;
 mod render;
 mod scene;
 #[cfg(not(fuzzing))]
