@@ -145,7 +145,7 @@ fn bad_views_and_outputs_are_one_line_and_write_nothing() {
         ),
         (
             "project sphere@16 --views bad.csv --out bad.csv",
-            &["bad.csv"][..],
+            &["must end in .nrrd or .npy"][..],
         ),
         (
             "project sphere@16 --random 0 --out s.nrrd",
@@ -155,7 +155,7 @@ fn bad_views_and_outputs_are_one_line_and_write_nothing() {
             "project sphere@16 --random 2 --views par.csv --out s.nrrd",
             &["cannot be used with"][..],
         ),
-        ("project sphere@16 --out s.nrrd", &["--random"][..]),
+        ("project sphere@16 --out s.nrrd", &["--views"][..]),
     ] {
         let out = fvr_line(line, &dir);
         assert_error(&out, needles);
