@@ -45,6 +45,8 @@ fn write_series(dir: &Path, series: &str, depths: &[f64], orientation: [f64; 6],
             orientation,
             intercept: -1024.0,
             pixels: &pixels(k, 15),
+            // Every other file in implicit VR: a series may mix the two.
+            implicit_vr: k % 2 == 1,
         }
         .encode();
         std::fs::write(dir.join(names[k]), bytes).unwrap();
@@ -207,6 +209,42 @@ fn fuzz_regression_declared_lengths_beyond_the_file_are_refused() {
     bytes[at + 8..at + 12].copy_from_slice(&0xFFFF_FF00u32.to_le_bytes());
     let e = parse_slice(&bytes).unwrap_err().to_string();
     assert!(e.contains("(7FE0,0010) declares 4294967040 bytes"), "{e}");
+}
+
+/// Found by `cargo fuzz run dicom -s none`: in an implicit-VR data set, a
+/// 46-byte (0000,0000), which the dictionary makes a UL, was read as eleven
+/// 4-byte values; the parser then took two bytes of value as the next
+/// header and allocated about 4 GB (`fvr convert` peaked at 4.2 GB
+/// resident). The length walk now takes implicit VRs from the dictionary,
+/// as the parser does, and refuses the file before parsing.
+#[test]
+fn fuzz_regression_implicit_vr_lengths_are_checked_with_the_dictionary_vr() {
+    let found = include_bytes!("data/fuzz/dicom-implicit-ul-out-of-step.dcm");
+    let e = parse_slice(found).unwrap_err().to_string();
+    assert!(
+        e.contains("element (0000,0000) of 4-byte values has length 46, not a multiple of 4"),
+        "{e}"
+    );
+    // A valid implicit-VR slice, with (0028,xxxx) US and DS values whose
+    // sizes come from the dictionary, still reads; a UL group length of
+    // 6 bytes in it is refused.
+    let implicit = CtSlice {
+        implicit_vr: true,
+        ..CtSlice::axial([2, 2], &[1, 2, 3, 4])
+    }
+    .encode();
+    assert_eq!(parse_slice(&implicit).unwrap().pixels, vec![1.0, 2.0, 3.0, 4.0]);
+    let mut bytes = implicit.clone();
+    // (0028,0010) Rows, implicit: tag, 4-byte length 2; renamed to the
+    // group length (0028,0000), a UL, and given 6 bytes (4 of the next
+    // element's header).
+    let at = bytes
+        .windows(8)
+        .position(|w| w == [0x28, 0x00, 0x10, 0x00, 2, 0, 0, 0])
+        .expect("Rows in implicit VR");
+    bytes[at + 2..at + 8].copy_from_slice(&[0, 0, 6, 0, 0, 0]);
+    let e = parse_slice(&bytes).unwrap_err().to_string();
+    assert!(e.contains("(0028,0000) of 4-byte values has length 6"), "{e}");
 }
 
 /// Found by `cargo fuzz run dicom`: a BitsStored of 0 made

@@ -77,18 +77,22 @@ fn prefixes_of_every_format_are_errors() {
 
 #[test]
 fn prefixes_of_a_dicom_slice_are_errors() {
-    let bytes = CtSlice {
-        series: "1.2",
-        pixel_spacing: [0.5, 0.5],
-        intercept: -1024.0,
-        ..CtSlice::axial([3, 2], &[1, 2, 3, 4, 5, 6])
+    // Explicit and implicit VR: the length walk reads each differently.
+    for implicit_vr in [false, true] {
+        let bytes = CtSlice {
+            series: "1.2",
+            pixel_spacing: [0.5, 0.5],
+            intercept: -1024.0,
+            implicit_vr,
+            ..CtSlice::axial([3, 2], &[1, 2, 3, 4, 5, 6])
+        }
+        .encode();
+        let slice = refuse_every_prefix("dicom", &bytes, parse_slice, |s| {
+            format!("a slice of {:?}", s.size)
+        });
+        assert_eq!(
+            slice.pixels,
+            vec![-1023.0, -1022.0, -1021.0, -1020.0, -1019.0, -1018.0]
+        );
     }
-    .encode();
-    let slice = refuse_every_prefix("dicom", &bytes, parse_slice, |s| {
-        format!("a slice of {:?}", s.size)
-    });
-    assert_eq!(
-        slice.pixels,
-        vec![-1023.0, -1022.0, -1021.0, -1020.0, -1019.0, -1018.0]
-    );
 }

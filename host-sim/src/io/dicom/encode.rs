@@ -2,8 +2,8 @@
 
 use dicom_dictionary_std::tags;
 
-/// One CT slice to encode as a DICOM Part 10 file (explicit VR little
-/// endian, 16-bit signed samples, rescale slope 1). A test and fixture
+/// One CT slice to encode as a DICOM Part 10 file (explicit or implicit VR
+/// little endian, 16-bit signed samples, rescale slope 1). A test and fixture
 /// helper.
 #[derive(Clone, Copy, Debug)]
 pub struct CtSlice<'a> {
@@ -23,6 +23,10 @@ pub struct CtSlice<'a> {
     pub intercept: f64,
     /// `columns × rows` samples, row by row.
     pub pixels: &'a [i16],
+    /// Write the data set in implicit VR little endian (the default
+    /// transfer syntax, common in older scanners' files) instead of
+    /// explicit VR little endian.
+    pub implicit_vr: bool,
 }
 
 impl<'a> CtSlice<'a> {
@@ -38,6 +42,7 @@ impl<'a> CtSlice<'a> {
             orientation: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0],
             intercept: 0.0,
             pixels,
+            implicit_vr: false,
         }
     }
 
@@ -55,6 +60,7 @@ impl<'a> CtSlice<'a> {
             orientation,
             intercept,
             pixels,
+            implicit_vr,
         } = *self;
         use dicom_core::{PrimitiveValue, VR};
         use dicom_object::mem::InMemElement;
@@ -166,8 +172,11 @@ impl<'a> CtSlice<'a> {
         );
         let file = obj
             .with_meta(
-                FileMetaTableBuilder::new()
-                    .transfer_syntax(dicom_dictionary_std::uids::EXPLICIT_VR_LITTLE_ENDIAN),
+                FileMetaTableBuilder::new().transfer_syntax(if implicit_vr {
+                    dicom_dictionary_std::uids::IMPLICIT_VR_LITTLE_ENDIAN
+                } else {
+                    dicom_dictionary_std::uids::EXPLICIT_VR_LITTLE_ENDIAN
+                }),
             )
             .expect("a complete file meta table");
         let mut out = Vec::new();

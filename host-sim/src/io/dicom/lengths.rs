@@ -67,6 +67,18 @@ pub(crate) fn check_lengths(bytes: &[u8]) -> Result<(), IoError> {
     Ok(())
 }
 
+/// The VR `dicom-encoding` gives an element in implicit VR: the standard
+/// dictionary's, relaxed, with pixel and overlay data as OW; `None` (read as
+/// bytes) for a tag the dictionary does not know.
+fn implicit_vr((group, elem): (u16, u16)) -> Option<&'static [u8]> {
+    use dicom_core::dictionary::{DataDictionary, DataDictionaryEntry};
+    if (group, elem) == (0x7FE0, 0x0010) || (group >> 8 == 0x60 && elem == 0x3000) {
+        return Some(b"OW");
+    }
+    let entry = dicom_dictionary_std::StandardDataDictionary.by_tag(dicom_core::Tag(group, elem))?;
+    Some(entry.vr().relaxed().to_string().as_bytes())
+}
+
 /// A cursor over DICOM element headers (see [`check_lengths`]).
 struct Walk<'a> {
     bytes: &'a [u8],
@@ -166,13 +178,13 @@ impl<'a> Walk<'a> {
             let Some(len) = self.u32_at(at + 4) else {
                 return Ok(None);
             };
-            (None, len, 8)
+            (implicit_vr(tag), len, 8)
         };
         self.pos = at + header;
         if len == UNDEFINED {
             if tag == (0x7FE0, 0x0010) {
                 self.fragments = true;
-            } else if vr.is_some_and(|v| v != b"SQ" && v != b"UN") {
+            } else if self.explicit && vr.is_some_and(|v| v != b"SQ" && v != b"UN") {
                 return Err(format_error(
                     FORMAT,
                     "element length",
@@ -186,7 +198,11 @@ impl<'a> Walk<'a> {
         }
         // Binary numbers: `dicom-parser` reads whole values, so a length
         // that is not a multiple of the value size would put it out of step
-        // with the element boundaries (and with this walk).
+        // with the element boundaries (and with this walk). In implicit VR
+        // the size comes from the dictionary, as the parser takes it: a
+        // 46-byte (0000,0000), a UL, is read as 44 bytes, and the parser then
+        // takes two bytes of value as the next header (a corrupt file made
+        // it allocate 4 GB that way).
         let size = match vr {
             Some(b"SS" | b"US") => 2,
             Some(b"FL" | b"SL" | b"UL" | b"AT" | b"OF" | b"OL") => 4,
