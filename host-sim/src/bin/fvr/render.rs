@@ -20,25 +20,16 @@ use crate::json::{debug_triple, one_line};
 
 use clap::Args;
 use fvr_core::geometry::{Sampling, View};
-use fvr_core::shading::{Light, Scene, MAX_LIGHTS};
-use fvr_engine::render::shaded::{
-    light_ring, negative_cue_share, SceneRenderer, DEFAULT_PROFILE_HARMONICS,
-};
+use fvr_core::shading::Scene;
+use fvr_engine::render::shaded::SceneRenderer;
 use fvr_engine::render::view::ViewRenderer;
 use fvr_engine::slice::adaptive::{AdaptiveSettings, Bound, DEFAULT_PLAIN_BELOW, DEFAULT_PROBES};
 use fvr_engine::spectrum::Precision;
 use fvr_host::image::output::write_png;
 use fvr_host::options::{parse_chain, parse_percent, parse_tolerance};
-use fvr_host::options::{
-    parse_depth_cue, parse_light, parse_light_ring, parse_rgb, DEPTH_CUE_HELP,
-};
 use fvr_host::reference::shaded::exact_scene_projection_sampled;
 use fvr_host::reference::{exact_projection_sampled, snr_db};
 use fvr_host::sources::phantom_by_name;
-
-/// Above this share of negatively weighted density (−30 dB) a depth cue
-/// warns (see `negative_cue_share`).
-pub(crate) const NEGATIVE_CUE_WARNING_SHARE: f64 = 1e-3;
 
 #[derive(Args, Clone)]
 pub(crate) struct RenderArgs {
@@ -57,32 +48,8 @@ pub(crate) struct RenderArgs {
     pub(crate) up: [f64; 3],
     #[command(flatten)]
     pub(crate) frame: FrameArgs,
-    /// Depth cue: none, linear:FRONT,BACK, sine:FRONT,BACK, profile:W0,W1,...,
-    /// profile:@FILE or profile:gauss:C,S (details with --help).
-    #[arg(long, default_value = "none", long_help = DEPTH_CUE_HELP)]
-    pub(crate) depth_cue: String,
-    /// Cosine harmonics fitted to a profile depth cue (1 to 16).
-    #[arg(long, default_value_t = DEFAULT_PROFILE_HARMONICS)]
-    pub(crate) cue_harmonics: usize,
-    /// Ambient colour R,G,B or one grey value (paper eq. 7). Default: 1 without
-    /// lights, 0.2 with.
-    #[arg(long, value_parser = parse_rgb, allow_hyphen_values = true)]
-    pub(crate) ambient: Option<[f64; 3]>,
-    /// A directional light X,Y,Z:R,G,B: the direction towards the light and
-    /// its colour (or one grey value). Repeatable, up to 8. Surfaces of denser
-    /// structures that face a light are lit (hemispherical model, eq. 8-11).
-    #[arg(long = "light", value_parser = parse_light, allow_hyphen_values = true)]
-    pub(crate) lights: Vec<Light>,
-    /// N lights evenly spaced around the view axis (as in the paper's figure
-    /// 8), saturated colours evenly spaced in hue (3: red at the top, green,
-    /// blue), tilted TILT degrees towards the eye (default 30). Added to any
-    /// --light.
-    #[arg(long, value_name = "N[:TILT]", value_parser = parse_light_ring)]
-    pub(crate) light_ring: Option<(usize, f64)>,
-    /// Leave out the eq. 14 correction when depth cueing and shading are
-    /// combined (only to see what it fixes).
-    #[arg(long)]
-    pub(crate) no_cue_correction: bool,
+    #[command(flatten)]
+    pub(crate) look: crate::look::LookArgs,
     /// Output file: .nrrd (float32; sizes W H, or 3 W H for RGB) or .png
     /// (grey: windowed, see --bits, --window/--level, --percentiles and
     /// --colormap; RGB: 8-bit, one percentile window over all channels).
@@ -93,12 +60,6 @@ pub(crate) struct RenderArgs {
     /// Print timing, memory and filter details.
     #[arg(long)]
     pub(crate) stats: bool,
-    /// Resample to cubic voxels with N samples along the longest physical
-    /// side (trilinear) before rendering. X-ray views of anisotropic data
-    /// such as CT (0.957 x 0.957 x 1.5 mm) are exact without it; depth cues
-    /// and lights need it.
-    #[arg(long, value_name = "N")]
-    pub(crate) resample: Option<usize>,
     /// Print the statistics as one JSON object instead (implies --stats).
     #[arg(long)]
     pub(crate) stats_json: bool,
@@ -143,12 +104,6 @@ pub(crate) struct RenderArgs {
     /// the field allows, for faster views. 0 keeps Parseval's bound alone.
     #[arg(long, value_name = "N", default_value_t = DEFAULT_PROBES)]
     pub(crate) adaptive_probes: usize,
-    /// Progressive preview level: 0 full resolution; L renders the image at
-    /// 1/2^L of the size from the central 1/4^L of the slice (4^L times fewer
-    /// interpolations). Plain X-ray views only. (`--level` is the PNG
-    /// window level, as in radiology viewers.)
-    #[arg(long, value_name = "L", default_value_t = 0)]
-    pub(crate) preview_level: u32,
     /// For a built-in phantom, also print the SNR against its exact line integrals.
     #[arg(long)]
     pub(crate) exact: bool,
@@ -182,7 +137,7 @@ fn declare_job(args: &RenderArgs, scene: &Scene) {
     let size = args.frame.size;
     crate::args::plan_job(
         &args.frame.spectrum,
-        args.resample,
+        args.look.resample,
         if scene.needs_gradient_spectrum() {
             2
         } else {
@@ -224,7 +179,7 @@ fn settings(args: &RenderArgs, scene: Scene) -> Result<Settings, Error> {
     Ok(Settings {
         scene,
         adaptive,
-        preview_level: args.preview_level,
+        preview_level: args.look.preview_level,
         units: args.frame.units.units(),
         ..crate::plan::settings(&args.frame.spectrum)
     })
@@ -248,17 +203,14 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         return Err(format!("output `{}` must end in .png or .nrrd", out.display()).into());
     }
     let mut others: Vec<&Path> = args.scene.iter().map(|p| p.as_path()).collect();
-    if let Some(profile) = args.depth_cue.strip_prefix("profile:@") {
+    if let Some(profile) = args.look.depth_cue.strip_prefix("profile:@") {
         others.push(Path::new(profile));
     }
     check_output(out, &["png", "nrrd"], volume_spec, &others)?;
     let view = args.view()?;
-    crate::checks::check_resample_count(args.resample)?;
     crate::checks::check_direction("--dir (camera.dir in a scene)", view.dir)?;
     crate::checks::check_direction("--up (camera.up in a scene)", view.up)?;
-    for light in &args.lights {
-        crate::checks::check_direction("--light (a scene light's direction)", light.towards)?;
-    }
+    args.look.check()?;
     view.frame()?;
     let style = args.png.style()?;
     let scene = build_scene(args)?;
@@ -267,7 +219,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     let mut volume = args.input.load(volume_spec)?;
     crate::checks::check_not_input(out)?;
     let mut _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
-    if let Some(largest) = args.resample {
+    if let Some(largest) = args.look.resample {
         check_resample(&volume, largest)?;
         volume = volume.resample_isotropic(largest)?;
         _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
@@ -287,16 +239,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     for w in renderer.warnings() {
         eprintln!("fvr: warning: {w}");
     }
-    let (lowest, share) = negative_cue_share(&volume, &scene, &view)?;
-    if share > NEGATIVE_CUE_WARNING_SHARE {
-        eprintln!(
-            "fvr: warning: the depth cue is given between t = -R and +R; extrapolated beyond, \
-             into the volume's corners on this view, it falls to {}, and {:.2}% of the \
-             weighted density counts negatively. Raise the smaller of FRONT and BACK to avoid it.",
-            fvr_host::text::num3(lowest),
-            100.0 * share
-        );
-    }
+    crate::look::warn_negative_cue(&volume, &scene, &view)?;
     let (w, h) = renderer.image_size(args.frame.size)?;
     let (image, view_report) = renderer.render(&view, Some((w, h)))?;
     let (w, h) = (image.width, image.height);
@@ -313,11 +256,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     let t_view = view_report.time;
     check_finite(
         &image.data,
-        &crate::checks::overflow_cause(
-            args.ambient.is_some(),
-            !args.lights.is_empty() || args.light_ring.is_some(),
-            args.depth_cue != "none",
-        ),
+        &args.look.overflow_cause(),
     )?;
     if ext == "png" {
         if image.channels == 1 {
@@ -364,30 +303,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
 
 /// The scene from the command line: cue, ambient, lights.
 pub(crate) fn build_scene(args: &RenderArgs) -> Result<Scene, Error> {
-    let cue = parse_depth_cue(&args.depth_cue, args.cue_harmonics)?;
-    let mut lights = args.lights.clone();
-    if let Some((count, tilt)) = args.light_ring {
-        lights.extend(light_ring(&args.view()?, count, tilt)?);
-    }
-    let default_ambient = if lights.is_empty() { 1.0 } else { 0.2 };
-    let mut scene = Scene {
-        cue,
-        ambient: args.ambient.unwrap_or([default_ambient; 3]),
-        correct_cue_shading: !args.no_cue_correction,
-        ..Scene::xray()
-    };
-    if lights.len() > MAX_LIGHTS {
-        return Err(format!(
-            "{} lights given, but a scene holds at most {MAX_LIGHTS}",
-            lights.len()
-        )
-        .into());
-    }
-    for light in &lights {
-        scene.add_light(*light)?;
-    }
-    scene.validate()?;
-    Ok(scene)
+    args.look.scene(&args.view()?)
 }
 
 /// `fvr render --stats-json`, in the order printed.
@@ -534,17 +450,17 @@ impl Rendered<'_> {
         say!("  plan          {:.1} ms", t_plan.as_secs_f64() * 1e3);
         say!("  preprocess    {:.1} ms", t_prep.as_secs_f64() * 1e3);
         say!("  view          {:.2} ms", t_view.as_secs_f64() * 1e3);
-        if args.preview_level > 0 {
+        if args.look.preview_level > 0 {
             say!(
                 "  level         {} ({w}x{h} at pitch {} {}, central 1/{} of the slice)",
-                args.preview_level,
-                (1u64 << args.preview_level) as f64 * sampling.pixel_size(),
+                args.look.preview_level,
+                (1u64 << args.look.preview_level) as f64 * sampling.pixel_size(),
                 if *sampling == Sampling::UNIT {
                     "voxels"
                 } else {
                     "mm"
                 },
-                1u64 << (2 * args.preview_level)
+                1u64 << (2 * args.look.preview_level)
             );
         }
         if let Some(r) = &adaptive_report {
@@ -592,7 +508,7 @@ impl Rendered<'_> {
             plan_ms: t_plan.as_secs_f64() * 1e3,
             preprocess_ms: t_prep.as_secs_f64() * 1e3,
             view_ms: t_view.as_secs_f64() * 1e3,
-            preview_level: args.preview_level,
+            preview_level: args.look.preview_level,
             accuracy: crate::plan::json(&args.frame.spectrum),
             adaptive: adaptive_report.as_ref().map(AdaptiveReport::json),
         };
