@@ -213,3 +213,34 @@ pub(crate) fn warn_negative_cue(
     }
     Ok(())
 }
+
+/// The cue-aware default window of a PNG: for a depth-cued view and an
+/// automatic (`--percentiles`) window, the percentile window of the same
+/// view without its cue, times the cue's largest weight ([`cue_gain`]).
+/// The automatic window of the cued image itself would stretch it back to
+/// full range and hide the cue. `None` without a cue or with an explicit
+/// `--window/--level`.
+pub(crate) fn cue_window(
+    renderer: &fvr_engine::Renderer,
+    scene: &Scene,
+    view: &View,
+    (width, height): (usize, usize),
+    window: &fvr_host::image::output::Window,
+) -> Result<Option<(f64, f64)>, Error> {
+    use fvr_host::image::output::Window;
+    if matches!(window, Window::Range(..)) {
+        return Ok(None);
+    }
+    let Some(gain) = cue_gain(&scene.cue)? else {
+        return Ok(None);
+    };
+    let plain = renderer.spectra().render_sampled(
+        &uncued(scene),
+        view,
+        renderer.sampling(),
+        width,
+        height,
+    )?;
+    let (lo, hi) = window.resolve(&plain.data);
+    Ok(Some((lo * gain, hi * gain)))
+}

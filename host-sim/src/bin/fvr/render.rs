@@ -5,18 +5,16 @@ use crate::scene::SCENE_HELP;
 use crate::Error;
 use fvr_engine::{Plan, Settings};
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use fvr_core::filter::Filter;
 use fvr_engine::render::shaded::SceneSpectra;
 use fvr_engine::volume::Volume;
 use fvr_host::image::{Image, ImageFiles};
 use serde::Serialize;
-use serde_json::value::RawValue;
 
 use crate::adaptive_report::{AdaptiveJson, AdaptiveReport};
 use crate::checks::{check_finite, check_output, check_resample};
-use crate::json::{debug_triple, one_line};
 
 use clap::Args;
 use fvr_core::geometry::{Sampling, View};
@@ -258,45 +256,98 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         &image.data,
         &args.look.overflow_cause(),
     )?;
+    // A cued view keeps the window of its uncued view (look::cue_window).
+    let cued = match ext.as_str() {
+        "png" => crate::look::cue_window(&renderer, &scene, &view, (w, h), &style.window)?,
+        _ => None,
+    };
+    let mut window = None;
     if ext == "png" {
+        let range = match cued {
+            Some(range) => range,
+            None if image.channels == 1 => style.window.resolve(&image.data),
+            None => {
+                let (lo, hi) = fvr_host::image::AUTO_WINDOW_PERCENTILES;
+                fvr_host::image::output::percentile_range(&image.data, lo, hi)
+            }
+        };
+        window = Some(range);
         if image.channels == 1 {
+            let style = fvr_host::image::output::Style {
+                window: fvr_host::image::output::Window::Range(range.0, range.1),
+                ..style
+            };
             write_png(out, w, h, &image.data, &style)?;
         } else {
-            image.write_png(out)?;
+            image.write_png_window(out, range)?;
         }
     } else {
         image.write_nrrd(out)?;
     }
-    let kind = if image.channels == 1 { "grey" } else { "RGB" };
-    say!("wrote {} ({w}x{h} {kind})", out.display());
+    if !args.stats_json {
+        let kind = crate::stats::kind(image.channels);
+        say!("wrote {} ({w}x{h} {kind})", out.display());
+    }
+    let job = crate::stats::Job {
+        command: "render",
+        volume_spec,
+        volume: &volume,
+        renderer: &renderer,
+        frame: &args.frame,
+        image: [w, h, image.channels],
+        load: t_load,
+        views: 1,
+        views_time: t_view,
+        output: out,
+    };
     let rendered = Rendered {
         args,
         volume_spec,
-        volume,
+        volume: &volume,
         view,
         scene,
         sampling: *renderer.sampling(),
         n: renderer.n(),
         filter: renderer.filter(),
-        storage_snr: renderer.storage_snr_db(),
-        t_plan: renderer.plan().time,
-        t_prep: renderer.prepare_time(),
         spectra: renderer.spectra(),
         image,
         w,
         h,
-        t_load,
-        t_view,
         adaptive_report,
     };
-    if args.stats && !args.stats_json {
-        rendered.print_human()?;
-    }
+    let exact = if args.exact {
+        Some(rendered.exact()?)
+    } else {
+        None
+    };
     if args.stats_json {
-        rendered.print_json();
+        job.print_json(&RenderExtra {
+            preview_level: args.look.preview_level,
+            window: window.map(|(lo, hi)| [lo, hi]),
+            cue_window: cued.is_some(),
+            adaptive: rendered.adaptive_report.as_ref().map(AdaptiveReport::json),
+            exact_snr_db: exact.as_ref().map(|e| e.as_ref().ok().copied()),
+        });
+        return Ok(());
     }
-    if args.exact {
-        rendered.print_exact()?;
+    if args.stats {
+        job.print_human();
+        rendered.print_human()?;
+        if let Some((lo, hi)) = window {
+            say!(
+                "  window        {lo} to {hi}{}",
+                if cued.is_some() {
+                    " (the uncued view's window times the cue's largest weight)"
+                } else {
+                    ""
+                }
+            );
+        }
+    }
+    match exact {
+        Some(Ok(db)) => say!("  SNR vs exact  {db:.2} dB"),
+        Some(Err(why)) => say!("  SNR vs exact  n/a ({why})"),
+        None => {}
     }
     Ok(())
 }
@@ -306,116 +357,56 @@ pub(crate) fn build_scene(args: &RenderArgs) -> Result<Scene, Error> {
     args.look.scene(&args.view()?)
 }
 
-/// `fvr render --stats-json`, in the order printed.
+/// `fvr render --stats-json`: its members after the common ones.
 #[derive(Serialize)]
-struct RenderStats<'a> {
-    volume: &'a str,
-    dims: [usize; 3],
-    spacing_mm: Box<RawValue>,
-    pixel_size: f64,
-    ignore_spacing: bool,
-    image: [usize; 3],
-    spectrum_side: usize,
-    precision: &'a str,
-    spectrum_bytes: usize,
-    gradient_spectrum_bytes: Option<usize>,
-    filter: &'a str,
-    oversample: serde_json::Value,
-    storage_snr_db: f64,
-    load_ms: f64,
-    plan_ms: f64,
-    preprocess_ms: f64,
-    view_ms: f64,
+struct RenderExtra {
     preview_level: u32,
-    accuracy: Option<crate::plan::AccuracyJson>,
+    /// The PNG window `[low, high]` (null for NRRD).
+    window: Option<[f64; 2]>,
+    /// Whether the window is the cue-aware one (look::cue_window).
+    cue_window: bool,
     #[serde(skip_serializing_if = "Option::is_none")]
     adaptive: Option<AdaptiveJson>,
+    /// With --exact: the SNR against the exact image, null where there is
+    /// none.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    exact_snr_db: Option<Option<f64>>,
 }
 
-/// A finished render and what `--stats`, `--stats-json` and `--exact`
-/// report of it.
+/// A finished render and what `--stats` and `--exact` report of it
+/// beyond the common lines ([`crate::stats`]).
 struct Rendered<'a> {
     args: &'a RenderArgs,
     volume_spec: &'a str,
-    volume: Volume,
+    volume: &'a Volume,
     view: View,
     scene: Scene,
     sampling: Sampling,
     spectra: &'a SceneSpectra,
     filter: Filter,
-    storage_snr: f64,
     image: Image,
     w: usize,
     h: usize,
     n: usize,
-    t_load: Duration,
-    t_plan: Duration,
-    t_prep: Duration,
-    t_view: Duration,
     adaptive_report: Option<AdaptiveReport<'a>>,
 }
 
 impl Rendered<'_> {
-    /// `--stats`: sizes, memory, filter and timings, one per line.
+    /// `--stats`: memory per view, the preview level and adaptive
+    /// filtering, one per line.
     fn print_human(&self) -> Result<(), Error> {
         let &Rendered {
             args,
-            volume_spec,
-            ref volume,
             ref scene,
             ref sampling,
             spectra,
             filter,
-            storage_snr,
             w,
             h,
             n,
-            t_load,
-            t_plan,
-            t_prep,
-            t_view,
             ref adaptive_report,
             ..
         } = self;
-        let d = volume.dims;
-        say!(
-            "  volume        {}x{}x{} ({})",
-            d[0],
-            d[1],
-            d[2],
-            volume_spec
-        );
-        let [dx, dy, dz] = volume.spacing;
-        say!(
-            "  spacing       {dx} x {dy} x {dz} mm{}",
-            if args.frame.units.ignore_spacing {
-                " (ignored: --ignore-spacing, voxel units)"
-            } else {
-                ""
-            }
-        );
-        say!(
-            "  pixel size    {} {}",
-            sampling.pixel_size(),
-            if args.frame.units.ignore_spacing {
-                "voxel"
-            } else {
-                "mm (values in mm x volume units)"
-            }
-        );
-        say!(
-            "  spectrum      {n}^3 {} = {} bytes ({} bytes/voxel)",
-            args.frame.spectrum.precision,
-            spectra.density.bytes(),
-            args.frame.spectrum.precision.bytes()
-        );
-        match &spectra.gradient {
-            Some(g) => say!(
-                "  |grad f|      {} bytes (second spectrum, for the lights)",
-                g.bytes()
-            ),
-            None => say!("  |grad f|      not built (no light needs it)"),
-        }
         // Plain X-ray views go through the view renderer (any grid side).
         let plain = scene.channels() == 1 && !scene.has_partner_terms();
         let working = match (args.frame.spectrum.precision, plain) {
@@ -429,27 +420,6 @@ impl Rendered<'_> {
             scene.field_count()
         );
         say!("  held          {} bytes in all", spectra.bytes() + working);
-        let f = spectra.density.filter();
-        if f.kind().is_kaiser_bessel() {
-            say!(
-                "  filter        {} (oversample {}, beta {:.3})",
-                f.kind().name(),
-                args.frame.spectrum.oversample.name(),
-                f.beta()
-            );
-        } else {
-            say!(
-                "  filter        {} (oversample {})",
-                f.kind().name(),
-                args.frame.spectrum.oversample.name()
-            );
-        }
-        say!("  storage SNR   {storage_snr:.1} dB (estimate, against the f64 pipeline)");
-        crate::plan::print_human(&args.frame.spectrum);
-        say!("  load          {:.1} ms", t_load.as_secs_f64() * 1e3);
-        say!("  plan          {:.1} ms", t_plan.as_secs_f64() * 1e3);
-        say!("  preprocess    {:.1} ms", t_prep.as_secs_f64() * 1e3);
-        say!("  view          {:.2} ms", t_view.as_secs_f64() * 1e3);
         if args.look.preview_level > 0 {
             say!(
                 "  level         {} ({w}x{h} at pitch {} {}, central 1/{} of the slice)",
@@ -469,57 +439,12 @@ impl Rendered<'_> {
         Ok(())
     }
 
-    /// `--stats-json`: the same as one JSON object.
-    fn print_json(&self) {
-        let &Rendered {
-            args,
-            volume_spec,
-            ref volume,
-            ref sampling,
-            spectra,
-            filter,
-            storage_snr,
-            ref image,
-            w,
-            h,
-            n,
-            t_load,
-            t_plan,
-            t_prep,
-            t_view,
-            ref adaptive_report,
-            ..
-        } = self;
-        let stats = RenderStats {
-            volume: volume_spec,
-            dims: volume.dims,
-            spacing_mm: debug_triple(volume.spacing),
-            pixel_size: sampling.pixel_size(),
-            ignore_spacing: args.frame.units.ignore_spacing,
-            image: [w, h, image.channels],
-            spectrum_side: n,
-            precision: args.frame.spectrum.precision.name(),
-            spectrum_bytes: spectra.density.bytes(),
-            gradient_spectrum_bytes: spectra.gradient.as_ref().map(|g| g.bytes()),
-            filter: filter.kind().name(),
-            oversample: crate::plan::oversample_json(args.frame.spectrum.oversample),
-            storage_snr_db: storage_snr,
-            load_ms: t_load.as_secs_f64() * 1e3,
-            plan_ms: t_plan.as_secs_f64() * 1e3,
-            preprocess_ms: t_prep.as_secs_f64() * 1e3,
-            view_ms: t_view.as_secs_f64() * 1e3,
-            preview_level: args.look.preview_level,
-            accuracy: crate::plan::json(&args.frame.spectrum),
-            adaptive: adaptive_report.as_ref().map(AdaptiveReport::json),
-        };
-        say!("{}", one_line(&stats));
-    }
-
-    /// `--exact`: the SNR against the phantom's exact image, where there is one.
-    fn print_exact(&self) -> Result<(), Error> {
+    /// `--exact`: the SNR against the phantom's exact image, or why there
+    /// is none.
+    fn exact(&self) -> Result<Result<f64, &'static str>, Error> {
         let &Rendered {
             volume_spec,
-            ref volume,
+            volume,
             ref view,
             ref scene,
             ref sampling,
@@ -529,7 +454,7 @@ impl Rendered<'_> {
             ..
         } = self;
         let plain = scene.channels() == 1 && !scene.has_partner_terms();
-        match phantom_by_name(volume_spec) {
+        Ok(match phantom_by_name(volume_spec) {
             Some(Ok(p)) if plain => {
                 let exact = exact_projection_sampled(
                     p.phantom.as_ref(),
@@ -541,7 +466,7 @@ impl Rendered<'_> {
                 )?;
                 let ambient = scene.ambient[0];
                 let exact: Vec<f64> = exact.iter().map(|v| v * ambient).collect();
-                say!("  SNR vs exact  {:.2} dB", snr_db(&exact, &image.data));
+                Ok(snr_db(&exact, &image.data))
             }
             Some(Ok(p)) => match p.phantom.as_gaussian_mixture() {
                 Some(mixture) => {
@@ -554,14 +479,11 @@ impl Rendered<'_> {
                         (w, h),
                         0.05,
                     )?;
-                    say!("  SNR vs exact  {:.2} dB", snr_db(&exact.data, &image.data));
+                    Ok(snr_db(&exact.data, &image.data))
                 }
-                None => {
-                    say!("  SNR vs exact  n/a (cued or shaded references exist for gaussians only)")
-                }
+                None => Err("cued or shaded references exist for gaussians only"),
             },
-            _ => say!("  SNR vs exact  n/a (not a built-in phantom)"),
-        }
-        Ok(())
+            _ => Err("not a built-in phantom"),
+        })
     }
 }
