@@ -35,11 +35,7 @@ const COMMON: [&str; 24] = [
 ];
 
 const RUNS: [(&str, &str, usize); 3] = [
-    (
-        "render",
-        "render sphere@16 --dir 1,0.3,0.2 --out r.png",
-        1,
-    ),
+    ("render", "render sphere@16 --dir 1,0.3,0.2 --out r.png", 1),
     (
         "turntable",
         "turntable sphere@16 --frames 3 --out t.apng",
@@ -64,7 +60,10 @@ fn render_turntable_and_project_print_one_schema_and_only_json() {
                 .unwrap_or_else(|| panic!("{command}: no `{key}` in {stdout}"))
         };
         let places: Vec<usize> = COMMON.iter().map(|k| at(k)).collect();
-        assert!(places.windows(2).all(|p| p[0] < p[1]), "{command}: {stdout}");
+        assert!(
+            places.windows(2).all(|p| p[0] < p[1]),
+            "{command}: {stdout}"
+        );
         assert_eq!(places[0], 1, "{command}: {stdout}");
         assert_eq!(stats["command"], command);
         assert_eq!(stats["volume"], "sphere@16");
@@ -74,7 +73,10 @@ fn render_turntable_and_project_print_one_schema_and_only_json() {
         assert_eq!(stats["views"], views, "{command}");
         let per = stats["ms_per_view"].as_f64().unwrap();
         let all = stats["views_ms"].as_f64().unwrap();
-        assert!((per * views as f64 - all).abs() <= 1e-9 * all.max(1.0), "{stats}");
+        assert!(
+            (per * views as f64 - all).abs() <= 1e-9 * all.max(1.0),
+            "{stats}"
+        );
         assert!(stats["prepare_ms"].as_f64().unwrap() > 0.0, "{stats}");
         assert!(stats["predicted_db"].as_f64().unwrap() >= 50.0, "{stats}");
     }

@@ -76,7 +76,10 @@ fn the_three_light_teapot_turns_in_colour_and_frame_0_is_its_render() {
         &dir,
     ));
     let (_, _, _, one) = frames(&dir.join("one.apng"));
-    assert!(one[0] == render[0], "the one-frame turntable differs from the render");
+    assert!(
+        one[0] == render[0],
+        "the one-frame turntable differs from the render"
+    );
 }
 
 /// A scene's `[[lights]]` and `[shading]` make a shaded turntable, not an

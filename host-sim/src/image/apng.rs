@@ -142,9 +142,7 @@ impl ApngStream {
         } else {
             self.style.encode(frame, self.range)
         };
-        writer
-            .write_image_data(&data)
-            .map_err(|e| fail(&e))?;
+        writer.write_image_data(&data).map_err(|e| fail(&e))?;
         self.left -= 1;
         Ok(())
     }

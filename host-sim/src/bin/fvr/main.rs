@@ -119,9 +119,10 @@ pub(crate) enum Command {
     #[command(after_help = GEOMETRY)]
     Render(Box<RenderArgs>),
     /// Render a turntable animation (APNG): one preprocessing pass, then
-    /// FRAMES X-ray views on a full turn about the up axis.
+    /// FRAMES views on a full turn about the up axis, X-ray, depth-cued or
+    /// lit, with the view options of `render`.
     #[command(after_help = GEOMETRY)]
-    Turntable(TurntableArgs),
+    Turntable(Box<TurntableArgs>),
     /// Render many X-ray views from one preprocessing pass into one float32
     /// stack (NRRD or .npy): views from a CSV or JSON file, or --random N
     /// rotations.
@@ -210,7 +211,7 @@ where
         }
         Some(Command::Turntable(mut args)) => {
             args.frame.spectrum.given = plan::Given::from_flags(&|id| given("turntable", id));
-            merge_scene(&mut args, &|id| given("turntable", id)).and_then(|()| turntable(&args))
+            merge_scene(&mut *args, &|id| given("turntable", id)).and_then(|()| turntable(&args))
         }
         Some(Command::Project(args)) => crate::project::project(&args),
         Some(Command::Compare(args)) => compare(&args),

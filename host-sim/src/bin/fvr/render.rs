@@ -252,10 +252,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         None => None,
     };
     let t_view = view_report.time;
-    check_finite(
-        &image.data,
-        &args.look.overflow_cause(),
-    )?;
+    check_finite(&image.data, &args.look.overflow_cause())?;
     // A cued view keeps the window of its uncued view (look::cue_window).
     let cued = match ext.as_str() {
         "png" => crate::look::cue_window(&renderer, &scene, &view, (w, h), &style.window)?,

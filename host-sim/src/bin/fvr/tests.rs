@@ -138,7 +138,9 @@ fn each_flag_overrides_its_scene_key() {
                     color: [0.0, 0.0, 1.0],
                 }]
         }),
-        (&["--light-ring", "3"], |a| a.look.light_ring == Some((3, 30.0))),
+        (&["--light-ring", "3"], |a| {
+            a.look.light_ring == Some((3, 30.0))
+        }),
         (&["--out", "x.nrrd"], |a| {
             a.out.as_deref() == Some(Path::new("x.nrrd"))
         }),
@@ -159,15 +161,19 @@ fn each_flag_overrides_its_scene_key() {
     // --no-cue-correction is a switch: the scene turns it on, the flag
     // cannot turn it off, and an unset scene key leaves it to the flag.
     let on = "[shading]\ncue_correction = true\n";
-    assert!(merged_render(on, &["--no-cue-correction"]).no_cue_correction);
-    assert!(!merged_render(on, &[]).no_cue_correction);
+    assert!(
+        merged_render(on, &["--no-cue-correction"])
+            .look
+            .no_cue_correction
+    );
+    assert!(!merged_render(on, &[]).look.no_cue_correction);
 }
 
 #[test]
 fn turntable_takes_scene_values_and_flags_win() {
     let run = |flags: &[&str]| {
         merged("turntable", FULL_SCENE, flags, |c| match c {
-            Command::Turntable(args) => Some(args),
+            Command::Turntable(args) => Some(*args),
             _ => None,
         })
     };
@@ -176,6 +182,11 @@ fn turntable_takes_scene_values_and_flags_win() {
     assert_eq!(a.out, PathBuf::from("/s/spin.apng"));
     assert_eq!(a.dir, [1.0, 0.5, -0.25]);
     assert_eq!(a.frame.spectrum.filter, FilterKind::Cubic);
+    // The scene's shading, lights and resampling, as for a render.
+    assert_eq!(a.look.resample, Some(96));
+    assert_eq!(a.look.depth_cue, "linear:1,0.3");
+    assert_eq!(a.look.light_ring, Some((2, 10.0)));
+    assert_eq!(a.look.ambient, Some([0.1; 3]));
     let b = run(&[
         "--frames", "3", "--fps", "30", "--out", "t.apng", "--dir", "0,1,0",
     ]);

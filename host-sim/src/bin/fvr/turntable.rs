@@ -191,9 +191,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     let cue_gain = crate::look::cue_gain(&scene.cue)?;
     let picks = match style.window {
         Window::Range(..) => 0,
-        _ if cue_gain.is_some() || all_bytes > HOLD_FRAMES_BYTES => {
-            SAMPLE_FRAMES.min(views.len())
-        }
+        _ if cue_gain.is_some() || all_bytes > HOLD_FRAMES_BYTES => SAMPLE_FRAMES.min(views.len()),
         _ => 0,
     };
     let bar = progress::count((views.len() + picks) as u64, "frames");
