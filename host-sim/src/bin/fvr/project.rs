@@ -83,18 +83,13 @@ fn declare_job(args: &ProjectArgs, count: usize) {
         None,
         1,
         ("stack and view buffers", move |n, side| {
-            let (w, h) = size.map_or((side, side), |(w, h)| {
-                ((w as u64).min(n), (h as u64).min(n))
-            });
+            let (w, h) = crate::args::planned_image(size, n, side);
             let stack = w
                 .saturating_mul(h)
                 .saturating_mul(4)
                 .saturating_mul(count as u64);
-            // Each thread's view grids at f64, as a turntable's.
-            let grids = n
-                .saturating_mul(n)
-                .saturating_mul(40)
-                .saturating_mul(threads);
+            // Each thread's view grids, as a turntable's.
+            let grids = crate::args::view_grid_bytes(n).saturating_mul(threads);
             stack.saturating_add(grids)
         }),
         "use fewer views, a smaller --size, --precision f16 or --oversample 1",

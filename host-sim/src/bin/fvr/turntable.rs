@@ -87,16 +87,11 @@ fn declare_job(args: &TurntableArgs, scene: &Scene, frames: usize) {
             1
         },
         ("frames and view buffers", move |n, side| {
-            // A size beyond the grid is refused later, by name.
-            let (w, h) = size.map_or((side, side), |(w, h)| {
-                ((w as u64).min(n), (h as u64).min(n))
-            });
+            let (w, h) = crate::args::planned_image(size, n, side);
             let frame = w.saturating_mul(h).saturating_mul(8 * channels);
             let all = frame.saturating_mul(frames as u64);
-            // Per-view grids at f64 (slice, the column walk's sums (2), a
-            // mixed side's transposed grid, output) and the frames kept.
-            let grids = n.saturating_mul(n).saturating_mul(40);
-            grids.saturating_add(if all <= HOLD_FRAMES_BYTES {
+            // One view's grids and the frames kept.
+            crate::args::view_grid_bytes(n).saturating_add(if all <= HOLD_FRAMES_BYTES {
                 all
             } else {
                 frame.saturating_mul(SAMPLE_FRAMES as u64 + 1)
