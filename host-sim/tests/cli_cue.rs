@@ -121,3 +121,24 @@ fn an_explicit_window_is_untouched() {
         assert!((want - p as f64).abs() <= 1.0, "{v} -> {p}, want {want}");
     }
 }
+
+/// A turntable windows a cued view as a render does: a one-frame cued
+/// turntable is the cued render's PNG byte for byte.
+#[test]
+fn a_cued_turntable_takes_the_cue_aware_window() {
+    let dir = temp_dir("cue-turntable");
+    assert_ok(&fvr_line(
+        "render sphere@32 --dir 0,-1,0 --depth-cue linear:1,0.3 --out r.png --quiet",
+        &dir,
+    ));
+    assert_ok(&fvr_line(
+        "turntable sphere@32 --frames 1 --depth-cue linear:1,0.3 --out t.apng --quiet",
+        &dir,
+    ));
+    let (_, render) = grey(&dir.join("r.png"));
+    let (_, frame) = grey(&dir.join("t.apng"));
+    assert!(
+        render == frame,
+        "the cued turntable's frame differs from the render"
+    );
+}
