@@ -199,8 +199,9 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     let kind = crate::stats::kind(channels);
     if !args.stats_json {
         say!(
-            "wrote {} ({frames} frames, {w}x{h} {kind}, {} fps)",
+            "wrote {} ({frames} frame{}, {w}x{h} {kind}, {} fps)",
             args.out.display(),
+            if frames == 1 { "" } else { "s" },
             args.fps
         );
     }
