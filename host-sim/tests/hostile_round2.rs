@@ -251,7 +251,11 @@ fn scene_volumes_are_confined() {
         )
         .unwrap();
     };
-    for path in ["../outside.nrrd", "/proc/self/environ", "data/../../outside.nrrd"] {
+    for path in [
+        "../outside.nrrd",
+        "/proc/self/environ",
+        "data/../../outside.nrrd",
+    ] {
         scene(path);
         refused(
             &dir,
@@ -263,12 +267,20 @@ fn scene_volumes_are_confined() {
     }
     scene("data/inside.nrrd");
     let ok = fvr_line("render --scene scene/s.toml --quiet", &dir);
-    assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
     assert!(dir.join("scene/a.png").is_file());
     // The command line's VOLUME replaces a scene's path; the scene is still
     // checked whole, so a path outside it is refused even then.
     let ok = fvr_line("render outside.nrrd --scene scene/s.toml --quiet", &dir);
-    assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
     std::fs::remove_file(dir.join("scene/a.png")).unwrap();
     scene("/proc/self/environ");
     refused(

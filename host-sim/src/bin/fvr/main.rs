@@ -24,6 +24,7 @@ mod look;
 mod plan;
 mod precision;
 mod prepare;
+mod prepared;
 mod project;
 mod render;
 mod scene;

@@ -211,6 +211,9 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     args.look.check()?;
     view.frame()?;
     let style = args.png.style()?;
+    if crate::prepared::is_prepared(volume_spec) {
+        return crate::prepared::render(args, volume_spec, out, &ext, &view, style);
+    }
     let scene = build_scene(args)?;
     declare_job(args, &scene);
     let t0 = Instant::now();
