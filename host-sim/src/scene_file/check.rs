@@ -257,33 +257,28 @@ impl Checker<'_> {
         Some(v)
     }
 
-    /// An input path: a relative path inside the scene's directory, made
-    /// relative to it, so that a shared scene reads no file elsewhere (as
-    /// [`Self::output_path`] writes none; a volume elsewhere is given on
-    /// the command line, where it replaces the scene's).
+    /// An input path: inside the scene's directory ([`Self::inside`]), so
+    /// that a shared scene reads no file elsewhere; a volume elsewhere is
+    /// given on the command line, where it replaces the scene's.
     fn input_path(&mut self, t: &Table, prefix: &str, key: &str) -> Option<PathBuf> {
-        let s = self.string(t, prefix, key)?;
-        let inside = crate::io::paths::inside(self.base, Path::new(s));
-        if inside.is_none() || s.is_empty() {
-            self.bad(
-                &join(prefix, key),
-                "must be a path inside the scene's directory (give a volume elsewhere as VOLUME on the command line)"
-                    .into(),
-            );
-        }
-        inside.filter(|_| !s.is_empty())
+        self.inside(t, prefix, key, "give a volume elsewhere as VOLUME on the command line")
     }
 
-    /// An output path: like [`Self::path`], but it must stay in the scene's
-    /// directory, so a shared scene cannot write over files elsewhere.
+    /// An output path: inside the scene's directory ([`Self::inside`]), so
+    /// that a shared scene cannot write over files elsewhere.
     fn output_path(&mut self, t: &Table, prefix: &str, key: &str) -> Option<PathBuf> {
+        self.inside(t, prefix, key, "give other outputs with --out")
+    }
+
+    /// A relative path that stays inside the scene's directory, made
+    /// relative to it; otherwise an error that ends with `elsewhere`.
+    fn inside(&mut self, t: &Table, prefix: &str, key: &str, elsewhere: &str) -> Option<PathBuf> {
         let s = self.string(t, prefix, key)?;
         let inside = crate::io::paths::inside(self.base, Path::new(s));
         if inside.is_none() || s.is_empty() {
             self.bad(
                 &join(prefix, key),
-                "must be a path inside the scene's directory (give other outputs with --out)"
-                    .into(),
+                format!("must be a path inside the scene's directory ({elsewhere})"),
             );
         }
         inside.filter(|_| !s.is_empty())
