@@ -126,12 +126,16 @@ def plan_real(plan):
     return np.float32 if plan.dtype == np.complex64 else np.float64
 
 
+FFTW_FLAGS = {"estimate": 64, "measure": 0}  # FFTW_ESTIMATE (FINUFFT's default), FFTW_MEASURE
+FFTW = "estimate"
+
+
 def make_plan(n, eps, upsampfac, threads):
     import finufft
 
     dtype = "complex64" if eps >= 1e-5 else "complex128"
     return finufft.Plan(2, (n, n, n), eps=eps, dtype=dtype, nthreads=threads,
-                        upsampfac=upsampfac)
+                        upsampfac=upsampfac, fftw=FFTW_FLAGS[FFTW])
 
 
 def time_ms(fn, repeats, warm=True):
@@ -218,6 +222,9 @@ def main():
                    help="turntable runs per accuracy (median of their ms/view)")
     p.add_argument("--pads", default="1,1.25",
                    help="slice lattice spacing 1/(pad n): the image's period is pad n pixels")
+    p.add_argument("--fftw", choices=sorted(FFTW_FLAGS), default="estimate",
+                   help="the plan's FFTW flag: estimate (FINUFFT's default) or measure "
+                        "(slow plan, per volume; FFTW keeps its wisdom for later plans)")
     p.add_argument("--margin", type=float, default=1.0,
                    help="stop tightening eps once the worst view is this many dB "
                         "above fvr's best")
@@ -225,6 +232,8 @@ def main():
     p.add_argument("--out", help="also write the Markdown report to this file")
     p.add_argument("--command", default=None, help="the command line to print at the top")
     args = p.parse_args()
+    global FFTW
+    FFTW = args.fftw
     work = pathlib.Path(args.work)
     work.mkdir(parents=True, exist_ok=True)
     import finufft
@@ -259,7 +268,11 @@ def main():
             f"{','.join(map(str, ORBIT_DIR))} --frames {args.frames} --accuracy A --stats-json`, "
             f"`ms_per_view` (all cores, median of {args.fvr_repeats} runs); its dB from "
             "`fvr render --accuracy A` at each of the views above (NRRD).",
-            f"- FINUFFT {finufft.__version__}: per view = setpts + execute (type 2, "
+            f"- FINUFFT {finufft.__version__}, plan option fftw = FFTW_{args.fftw.upper()}"
+            + (" (plan ms includes FFTW's measuring, paid once per grid: later plans of "
+               "the same grid reuse the wisdom)" if args.fftw == "measure" else
+               " (FINUFFT's default)")
+            + ": per view = setpts + execute (type 2, "
             "nthreads = all cores; execute redoes the σ-padded 3D FFT every call) + "
             f"numpy irfft2 + reordering; median over {args.repeats} timed repeats of each view "
             "after the scored render, then median over the views. The slice lattice has spacing "

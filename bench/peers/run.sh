@@ -21,7 +21,8 @@
 # orbit, each with its dB against the closed-form line integrals; it writes
 # docs/performance/finufft.md. Its own options: [--sizes 128,256]
 # [--accuracies 50,60,80] [--eps 1e-2,...,1e-9] [--upsampfacs 2.0,1.25]
-# [--upsampfacs-large 1.25] [--frames 21] [--repeats 2] [--fvr-repeats 3].
+# [--upsampfacs-large 1.25] [--frames 21] [--repeats 2] [--fvr-repeats 3]
+# [--fftw estimate|measure] [--out FILE].
 # This is a manual benchmark: it is not part of scripts/test-all.sh. Run it
 # on an idle machine; the ratios come from one run, the absolute times drift.
 set -euo pipefail
