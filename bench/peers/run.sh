@@ -16,6 +16,13 @@
 # and at 2x padding on the CT head (scripts/fetch-ct-head.sh) and, when
 # FVR_MRI_HEAD is set, the MRI head (scripts/fetch-mri-head.sh); it writes
 # docs/performance/heads.md.
+# --finufft runs bench/peers/finufft_peer.py instead: FINUFFT type 2 (pip
+# finufft) as a slice extractor against fvr --accuracy 50/60/80 on a tilted
+# orbit, each with its dB against the closed-form line integrals; it writes
+# docs/performance/finufft.md. Its own options: [--sizes 128,256]
+# [--accuracies 50,60,80] [--eps 1e-2,...,1e-9] [--upsampfacs 2.0,1.25]
+# [--upsampfacs-large 1.25] [--frames 21] [--repeats 2] [--fvr-repeats 3]
+# [--fftw estimate|measure] [--out FILE].
 # This is a manual benchmark: it is not part of scripts/test-all.sh. Run it
 # on an idle machine; the ratios come from one run, the absolute times drift.
 set -euo pipefail
@@ -30,12 +37,28 @@ if ! "$VENV/bin/python" -c "import itk, scipy; from itk import RTK" 2>/dev/null;
     "$VENV/bin/pip" install --quiet itk-rtk numpy scipy
 fi
 case " $* " in
+    *" --finufft "*)
+        if ! "$VENV/bin/python" -c "import finufft" 2>/dev/null; then
+            "$VENV/bin/pip" install --quiet finufft
+        fi
+        ;;
+esac
+case " $* " in
     *" --rtk-only "*) ;;
     *) cargo build --locked --release -p fvr-host ;;
 esac
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
 mkdir -p docs/performance
 case " $* " in
+    *" --finufft "*)
+        rest=()
+        for arg in "$@"; do
+            [ "$arg" = "--finufft" ] || rest+=("$arg")
+        done
+        exec "$VENV/bin/python" bench/peers/finufft_peer.py --fvr "$TARGET/release/fvr" \
+            --work "$TARGET/peers/work" --out docs/performance/finufft.md \
+            --command "bash bench/peers/run.sh $*" "${rest[@]}"
+        ;;
     *" --heads "*)
         rest=()
         for arg in "$@"; do
