@@ -253,6 +253,17 @@ fn fuzz_regression_implicit_vr_lengths_are_checked_with_the_dictionary_vr() {
     );
 }
 
+/// Found by `cargo fuzz run dicom -s none`: an element of the item group
+/// that is no item or delimiter, (FFFE,FFFF) declaring 0xFDFFFFFF bytes in
+/// a 514-byte file, which the parser reads as a value (4 GB allocated) and
+/// the length walk used to step into as an item.
+#[test]
+fn fuzz_regression_item_group_elements_are_values() {
+    let found = include_bytes!("data/fuzz/dicom-item-group-4gb.dcm");
+    let e = parse_slice(found).unwrap_err().to_string();
+    assert!(e.contains("element (FFFE,FFFF) declares 4261412863 bytes"), "{e}");
+}
+
 /// Found by `cargo fuzz run dicom`: a BitsStored of 0 made
 /// `dicom-pixeldata` panic building its lookup table
 /// (`assertion failed: bits_stored != 0 && bits_stored <= 32`).

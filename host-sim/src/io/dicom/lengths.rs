@@ -129,8 +129,16 @@ impl<'a> Walk<'a> {
             self.pos = at + 8;
             match elem {
                 0xE000 if self.fragments && len != UNDEFINED => self.skip(tag, len)?,
+                // An item of elements: walk into it (its length still has
+                // to fit the file).
+                0xE000 if len != UNDEFINED => self.check(tag, len)?,
+                0xE000 | 0xE00D => {}
                 0xE0DD => self.fragments = false,
-                // An item of elements: walk into it.
+                // Any other element of the group is no item or delimiter:
+                // `dicom-parser` reads its value (as UN), so its length is
+                // checked and skipped like any value's (a (FFFE,FFFF) of
+                // 0xFDFFFFFF bytes in 514 made it allocate 4 GB).
+                _ if len != UNDEFINED => self.skip(tag, len)?,
                 _ => {}
             }
             return Ok(Some((tag, &[])));
