@@ -34,6 +34,7 @@ mod trade;
 mod turntable;
 mod view;
 mod views;
+mod zoom;
 
 use crate::accuracy::accuracy;
 use crate::adaptive_table::adaptive_table;
@@ -272,6 +273,7 @@ fn default_scene() -> Result<(), Error> {
         preview_level: 0,
         exact: false,
         input: InputArgs::default(),
+        zoom: Default::default(),
     };
     let scene = SceneFile::parse(DEFAULT_SCENE, "the default scene", Path::new(""))?;
     apply_scene_to_render(&mut args, &scene, &|_| false);

@@ -154,6 +154,8 @@ pub(crate) struct RenderArgs {
     pub(crate) exact: bool,
     #[command(flatten)]
     pub(crate) input: InputArgs,
+    #[command(flatten)]
+    pub(crate) zoom: crate::zoom::ZoomArgs,
 }
 
 impl RenderArgs {
@@ -180,6 +182,7 @@ impl RenderArgs {
 /// What a render builds from its volume ([`crate::args::plan_job`]).
 fn declare_job(args: &RenderArgs, scene: &Scene) {
     let size = args.frame.size;
+    let zoom = args.zoom.zoom as u64;
     crate::args::plan_job(
         &args.frame.spectrum,
         args.resample,
@@ -196,11 +199,23 @@ fn declare_job(args: &RenderArgs, scene: &Scene) {
             });
             // Per cell at f64: slice, column walk's sums (2), a mixed
             // side's transposed grid and the output.
+            // With --zoom, the padded grid and its transposed copy at f64.
+            let m = n.saturating_mul(zoom);
+            let zoomed = if zoom > 1 {
+                m.saturating_mul(m).saturating_mul(16)
+            } else {
+                0
+            };
             n.saturating_mul(n)
                 .saturating_mul(40)
-                .saturating_add(w.saturating_mul(h).saturating_mul(32))
+                .saturating_add(zoomed)
+                .saturating_add(
+                    w.saturating_mul(h)
+                        .saturating_mul(32)
+                        .saturating_mul(zoom * zoom),
+                )
         }),
-        "use a smaller --resample or --size, --precision f16 or --oversample 1",
+        "use a smaller --resample, --size or --zoom, --precision f16 or --oversample 1",
     );
 }
 
@@ -298,7 +313,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         );
     }
     let (w, h) = renderer.image_size(args.frame.size)?;
-    let (image, view_report) = renderer.render(&view, Some((w, h)))?;
+    let (image, view_report) = renderer.render_zoomed(&view, Some((w, h)), args.zoom.zoom)?;
     let (w, h) = (image.width, image.height);
     let adaptive_report = match &view_report.adaptive {
         Some(a) => Some(AdaptiveReport::new(
@@ -336,7 +351,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         volume,
         view,
         scene,
-        sampling: *renderer.sampling(),
+        sampling: renderer.zoomed_sampling(args.zoom.zoom)?,
         n: renderer.n(),
         filter: renderer.filter(),
         storage_snr: renderer.storage_snr_db(),
@@ -503,8 +518,12 @@ impl Rendered<'_> {
         // Plain X-ray views go through the view renderer (any grid side).
         let plain = scene.channels() == 1 && !scene.has_partner_terms();
         let working = match (args.frame.spectrum.precision, plain) {
-            (Precision::F64, true) => ViewRenderer::<f64>::new(n, filter).bytes(),
-            (_, true) => ViewRenderer::<f32>::new(n, filter).bytes(),
+            (Precision::F64, true) => ViewRenderer::<f64>::new(n, filter)
+                .with_zoom(args.zoom.zoom)?
+                .bytes(),
+            (_, true) => ViewRenderer::<f32>::new(n, filter)
+                .with_zoom(args.zoom.zoom)?
+                .bytes(),
             (Precision::F64, false) => SceneRenderer::<f64>::new(n, filter, scene)?.bytes(),
             (_, false) => SceneRenderer::<f32>::new(n, filter, scene)?.bytes(),
         };
