@@ -32,6 +32,7 @@ pub fn gradient_volume(volume: &Volume) -> Result<Volume, fvr_core::Error> {
         dims: volume.dims,
         data: out.into_iter().map(|v| v as f32).collect(),
         spacing: volume.spacing,
+        orientation: volume.orientation,
     })
 }
 

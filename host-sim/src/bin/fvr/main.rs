@@ -10,6 +10,7 @@ mod stdout;
 mod accuracy;
 mod adaptive_report;
 mod adaptive_table;
+mod anatomy;
 mod args;
 mod checks;
 mod clap_error;
@@ -274,6 +275,7 @@ fn default_scene() -> Result<(), Error> {
         exact: false,
         input: InputArgs::default(),
         zoom: Default::default(),
+        anatomy: Default::default(),
     };
     let scene = SceneFile::parse(DEFAULT_SCENE, "the default scene", Path::new(""))?;
     apply_scene_to_render(&mut args, &scene, &|_| false);

@@ -49,8 +49,9 @@ pub(crate) struct RenderArgs {
     /// command line override the scene's values.
     #[arg(long, value_name = "FILE.toml", long_help = SCENE_HELP)]
     pub(crate) scene: Option<PathBuf>,
-    /// View direction X,Y,Z, from the eye into the scene.
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, required_unless_present = "scene")]
+    /// View direction X,Y,Z in the volume's frame (its i, j, k axes), from
+    /// the eye into the scene. --view names a view in the patient's frame.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, required_unless_present_any = ["scene", "view"])]
     pub(crate) dir: Option<[f64; 3]>,
     /// Up hint X,Y,Z.
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,1")]
@@ -156,6 +157,8 @@ pub(crate) struct RenderArgs {
     pub(crate) input: InputArgs,
     #[command(flatten)]
     pub(crate) zoom: crate::zoom::ZoomArgs,
+    #[command(flatten)]
+    pub(crate) anatomy: crate::anatomy::AnatomyArgs,
 }
 
 impl RenderArgs {
@@ -166,6 +169,11 @@ impl RenderArgs {
     }
 
     pub(crate) fn view(&self) -> Result<View, Error> {
+        if self.anatomy.view.is_some() {
+            // Stands in for the named view until the volume's orientation
+            // is read ([`crate::anatomy`]).
+            return Ok(View::along([1.0, 0.0, 0.0]));
+        }
         let dir = self.dir.ok_or_else(|| {
             "no view direction: give --dir, or `camera.dir` in the scene".to_string()
         })?;
@@ -288,6 +296,10 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
     }
     fvr_host::budget::check_plan(volume.dims)?;
+    let view = match args.anatomy.view {
+        Some(named) => named.view_of(&mut volume, volume_spec),
+        None => view,
+    };
     let t_load = t0.elapsed();
     let settings = settings(args, scene.clone())?;
     settings.check()?;

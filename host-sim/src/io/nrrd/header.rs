@@ -35,6 +35,9 @@ pub(crate) struct Layout {
     /// The `data file` field: the data is in this file, relative to the
     /// header's directory, not after the header.
     pub data_file: Option<String>,
+    /// The axes and origin in the patient (RAS), from a patient `space`,
+    /// three `space directions` vectors and `space origin`.
+    pub orientation: Option<fvr_engine::volume::Orientation>,
 }
 
 impl Layout {
@@ -58,6 +61,7 @@ impl Layout {
             byte_skip: 0,
             spacing: fvr_engine::volume::DEFAULT_SPACING,
             data_file: None,
+            orientation: None,
         }
     }
 }
@@ -76,6 +80,8 @@ struct Fields {
     spacings: Option<String>,
     space_directions: Option<String>,
     kinds: Option<String>,
+    space: Option<String>,
+    space_origin: Option<String>,
 }
 
 impl Fields {
@@ -94,6 +100,8 @@ impl Fields {
             "spacings" => ("spacings", &mut self.spacings),
             "space directions" => ("space directions", &mut self.space_directions),
             "kinds" => ("kinds", &mut self.kinds),
+            "space" => ("space", &mut self.space),
+            "space origin" => ("space origin", &mut self.space_origin),
             _ => return None,
         })
     }
@@ -131,12 +139,22 @@ impl Fields {
         if let Some(kinds) = &self.kinds {
             check_kinds(kinds)?;
         }
+        let mut vectors = Vec::new();
         let spacing = match (self.spacings, self.space_directions) {
             // The format forbids both; `space directions` is the fuller one.
-            (_, Some(d)) => parse_space_directions(&d, dimension)?,
+            (_, Some(d)) => {
+                let (spacing, v) = parse_space_directions(&d, dimension)?;
+                vectors = v;
+                spacing
+            }
             (Some(s), None) => parse_spacings(&s, dimension)?,
             (None, None) => fvr_engine::volume::DEFAULT_SPACING,
         };
+        let orientation = super::space::orientation(
+            self.space.as_deref(),
+            &vectors,
+            self.space_origin.as_deref(),
+        )?;
         let data_file = match self.data_file {
             Some(f) => Some(parse_data_file(&f)?),
             None => None,
@@ -152,6 +170,7 @@ impl Fields {
             byte_skip,
             spacing,
             data_file,
+            orientation,
         })
     }
 }
@@ -218,10 +237,14 @@ fn parse_spacings(value: &str, dimension: usize) -> Result<[f64; 3], IoError> {
 /// The `space directions` field: per axis a vector `(x,y,z)` (or `none`);
 /// the spacing is its length. Only the lengths are kept: rendering happens
 /// in index space, scaled per axis.
-fn parse_space_directions(value: &str, dimension: usize) -> Result<[f64; 3], IoError> {
+fn parse_space_directions(
+    value: &str,
+    dimension: usize,
+) -> Result<([f64; 3], Vec<[f64; 3]>), IoError> {
     let bad = |why: String| field_error("space directions", why);
     let mut spacing = fvr_engine::volume::DEFAULT_SPACING;
     let mut units: Vec<[f64; 3]> = Vec::new();
+    let mut vectors: Vec<[f64; 3]> = Vec::new();
     let mut rest = value.trim();
     let mut axis = 0;
     while !rest.is_empty() {
@@ -234,6 +257,8 @@ fn parse_space_directions(value: &str, dimension: usize) -> Result<[f64; 3], IoE
         if let Some(after) = rest.strip_prefix("none") {
             rest = after.trim_start();
             axis += 1;
+            // An axis without a vector: no orientation.
+            vectors.push([f64::NAN; 3]);
             continue;
         }
         let inner = rest
@@ -266,6 +291,7 @@ fn parse_space_directions(value: &str, dimension: usize) -> Result<[f64; 3], IoE
         spacing[axis] = length;
         if let [x, y, z] = components[..] {
             units.push([x / length, y / length, z / length]);
+            vectors.push([x, y, z]);
         }
         rest = inner.1.trim_start();
         axis += 1;
@@ -281,7 +307,10 @@ fn parse_space_directions(value: &str, dimension: usize) -> Result<[f64; 3], IoE
             "expected {dimension} vectors (or `none`), got {axis}"
         )));
     }
-    Ok(spacing)
+    if vectors.len() != 3 || vectors.iter().flatten().any(|c| !c.is_finite()) {
+        vectors.clear();
+    }
+    Ok((spacing, vectors))
 }
 
 /// The `kinds` field: every axis must be a spatial one (`domain`, `space`,
