@@ -102,15 +102,37 @@ pub fn read_nrrd(path: &Path) -> Result<Volume, IoError> {
 /// [`read_nrrd`], advancing `progress` by the bytes read from the file
 /// that holds the samples (its length is set to that file's size).
 pub fn read_nrrd_with_progress(path: &Path, progress: &ProgressBar) -> Result<Volume, IoError> {
-    read_nrrd_limited(path, crate::budget::limit_bytes(), progress)
+    read_nrrd_limited(path, crate::budget::limit_bytes(), progress, false)
 }
 
-fn read_nrrd_limited(path: &Path, limit: u64, progress: &ProgressBar) -> Result<Volume, IoError> {
+/// [`read_nrrd`] for an image `fvr render` wrote: also a colour image
+/// (`kinds: RGB-color domain domain`, `sizes: 3 W H`), as dims `[3, W, H]`.
+///
+/// # Errors
+/// As [`read_nrrd`].
+pub fn read_nrrd_image(path: &Path) -> Result<Volume, IoError> {
+    read_nrrd_limited(
+        path,
+        crate::budget::limit_bytes(),
+        &ProgressBar::hidden(),
+        true,
+    )
+}
+
+fn read_nrrd_limited(
+    path: &Path,
+    limit: u64,
+    progress: &ProgressBar,
+    image: bool,
+) -> Result<Volume, IoError> {
     let open = || -> Result<Volume, IoError> {
         let file = crate::io::open_file(path)?;
         progress.set_length(file.metadata().map(|m| m.len()).unwrap_or(0));
         let mut reader = BufReader::with_capacity(FILE_BUFFER_BYTES, progress.wrap_read(file));
         let layout = read_header(&mut reader)?;
+        if !image {
+            layout.check_volume()?;
+        }
         check_memory(layout.dims, layout.count, layout.ty, limit)?;
         let Some(name) = &layout.data_file else {
             return read_data(&mut reader, &layout);
@@ -159,6 +181,7 @@ fn parse_nrrd_limited(bytes: &[u8], limit: u64) -> Result<Volume, IoError> {
 /// before reading any data.
 fn read_nrrd_from<R: BufRead>(reader: &mut R, limit: u64) -> Result<Volume, IoError> {
     let layout = read_header(reader)?;
+    layout.check_volume()?;
     check_memory(layout.dims, layout.count, layout.ty, limit)?;
     if let Some(file) = &layout.data_file {
         return Err(IoError::DetachedData {

@@ -353,7 +353,11 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
             image.write_png(out)?;
         }
     } else {
-        image.write_nrrd(out)?;
+        // The image's pixel pitch: the pixel size, over the zoom, times a
+        // preview level's 2^L.
+        let pitch = renderer.zoomed_sampling(args.zoom.zoom)?.pixel_size()
+            * (1u64 << args.preview_level.min(62)) as f64;
+        fvr_host::image::nrrd_image::write_image_nrrd(out, &image, Some(pitch))?;
     }
     let kind = if image.channels == 1 { "grey" } else { "RGB" };
     say!("wrote {} ({w}x{h} {kind})", out.display());

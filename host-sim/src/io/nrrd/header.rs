@@ -38,6 +38,9 @@ pub(crate) struct Layout {
     /// The axes and origin in the patient (RAS), from a patient `space`,
     /// three `space directions` vectors and `space origin`.
     pub orientation: Option<fvr_engine::volume::Orientation>,
+    /// `kinds: RGB-color domain domain` (or `space`): a colour image, which
+    /// only the image reader accepts ([`Layout::check_volume`]).
+    pub colour: bool,
 }
 
 impl Layout {
@@ -62,6 +65,22 @@ impl Layout {
             spacing: fvr_engine::volume::DEFAULT_SPACING,
             data_file: None,
             orientation: None,
+            colour: false,
+        }
+    }
+
+    /// `Ok` unless this is a colour image: a volume's axes must all be
+    /// spatial.
+    ///
+    /// # Errors
+    /// The `kinds` error naming the colour axis.
+    pub(crate) fn check_volume(&self) -> Result<(), IoError> {
+        match self.colour {
+            true => Err(field_error(
+                "kinds",
+                "axis 0 is `RGB-color`: only scalar volumes with spatial axes can be rendered",
+            )),
+            false => Ok(()),
         }
     }
 }
@@ -136,9 +155,10 @@ impl Fields {
         let byte_skip = parse_skip(self.byte_skip.as_deref(), "byte skip")?;
         let line_skip = parse_skip(self.line_skip.as_deref(), "line skip")?;
         let (dims, count, data_bytes) = geometry(&sizes, ty)?;
-        if let Some(kinds) = &self.kinds {
-            check_kinds(kinds)?;
-        }
+        let colour = match &self.kinds {
+            Some(kinds) => check_kinds(kinds)?,
+            None => false,
+        };
         let mut vectors = Vec::new();
         let spacing = match (self.spacings, self.space_directions) {
             // The format forbids both; `space directions` is the fuller one.
@@ -147,7 +167,7 @@ impl Fields {
                 vectors = v;
                 spacing
             }
-            (Some(s), None) => parse_spacings(&s, dimension)?,
+            (Some(s), None) => parse_spacings(&s, dimension, colour)?,
             (None, None) => fvr_engine::volume::DEFAULT_SPACING,
         };
         let orientation = super::space::orientation(
@@ -171,6 +191,7 @@ impl Fields {
             spacing,
             data_file,
             orientation,
+            colour,
         })
     }
 }
@@ -213,7 +234,7 @@ fn parse_sizes(value: &str, dimension: usize) -> Result<Vec<usize>, IoError> {
 }
 
 /// The `spacings` field: one finite positive number per axis.
-fn parse_spacings(value: &str, dimension: usize) -> Result<[f64; 3], IoError> {
+fn parse_spacings(value: &str, dimension: usize, colour: bool) -> Result<[f64; 3], IoError> {
     let words: Vec<&str> = value.split_whitespace().collect();
     if words.len() != dimension {
         return Err(field_error(
@@ -226,7 +247,11 @@ fn parse_spacings(value: &str, dimension: usize) -> Result<[f64; 3], IoError> {
         ));
     }
     let mut spacing = fvr_engine::volume::DEFAULT_SPACING;
-    for (slot, word) in spacing.iter_mut().zip(&words) {
+    for (axis, (slot, word)) in spacing.iter_mut().zip(&words).enumerate() {
+        // A colour axis has no spacing.
+        if colour && axis == 0 && word.eq_ignore_ascii_case("nan") {
+            continue;
+        }
         *slot = word
             .parse::<f64>()
             .map_err(|_| field_error("spacings", format!("`{}` is not a number", excerpt(word))))?;
@@ -316,7 +341,17 @@ fn parse_space_directions(
 /// The `kinds` field: every axis must be a spatial one (`domain`, `space`,
 /// or unknown: `none`, `???`). A colour, vector or list axis would be
 /// rendered as space.
-fn check_kinds(value: &str) -> Result<(), IoError> {
+///
+/// `Ok(true)` for a colour image, `RGB-color` then two spatial axes (which
+/// only the image reader accepts).
+fn check_kinds(value: &str) -> Result<bool, IoError> {
+    let words: Vec<&str> = value.split_whitespace().collect();
+    let spatial = |k: &str| matches!(k, "domain" | "space" | "none" | "???");
+    if let ["RGB-color", a, b] = words[..] {
+        if spatial(a) && spatial(b) {
+            return Ok(true);
+        }
+    }
     for (axis, kind) in value.split_whitespace().enumerate() {
         if !matches!(kind, "domain" | "space" | "none" | "???") {
             return Err(field_error(
@@ -328,7 +363,7 @@ fn check_kinds(value: &str) -> Result<(), IoError> {
             ));
         }
     }
-    Ok(())
+    Ok(false)
 }
 
 /// The `data file` field: a single file name. The multi-file forms
