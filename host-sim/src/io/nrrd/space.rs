@@ -78,7 +78,8 @@ pub(crate) fn orientation(
 /// unit vector times its spacing) and `space origin`.
 pub(crate) fn header_lines(orientation: &Orientation, spacing: [f64; 3]) -> String {
     let d = &orientation.direction;
-    let vector = |v: [f64; 3]| format!("({:?},{:?},{:?})", v[0], v[1], v[2]);
+    // `+ 0.0` writes −0 (from LPS sign flips) as 0.
+    let vector = |v: [f64; 3]| format!("({:?},{:?},{:?})", v[0] + 0.0, v[1] + 0.0, v[2] + 0.0);
     let axes: Vec<String> = (0..3)
         .map(|a| vector(std::array::from_fn(|w| d[w][a] * spacing[a])))
         .collect();
