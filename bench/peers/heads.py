@@ -186,9 +186,9 @@ def head(fvr, name, source, background, views, work):
         method = (f"fvr {label}: {stats['filter']} os{stats['oversample']} "
                   f"{stats['precision']}")
         print(f"{name}: {method}: spectrum {stats['spectrum_bytes'] / MIB:.0f} MiB, "
-              f"plan {stats['plan_ms']:.0f} ms, preprocess {stats['preprocess_ms']:.0f} ms, "
+              f"plan {stats['plan_ms']:.0f} ms, preprocess {stats['prepare_ms']:.0f} ms, "
               f"{stats['ms_per_view']:.2f} ms/view, {snr:.1f} dB", flush=True)
-        rows.append((name, method, stats["spectrum_bytes"], stats["plan_ms"], stats["preprocess_ms"],
+        rows.append((name, method, stats["spectrum_bytes"], stats["plan_ms"], stats["prepare_ms"],
                      stats["ms_per_view"], snr))
     return rows
 

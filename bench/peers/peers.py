@@ -195,7 +195,7 @@ def run_fvr(fvr, path, gaussians, n, filt, precision, views, work):
         check=True, capture_output=True, text=True,
     )
     snr = snr_db(fvr_reference(gaussians, n, d), read_nrrd_image(image_path))
-    return stats["plan_ms"], stats["preprocess_ms"], stats["ms_per_view"], tilted, snr
+    return stats["plan_ms"], stats["prepare_ms"], stats["ms_per_view"], tilted, snr
 
 
 def main():

@@ -94,7 +94,7 @@ fn turntables_and_scene_files_take_mixed_grids() {
     let stats = json_line(&out.stdout);
     assert_eq!(stats["spectrum_side"], 40, "{stats}");
     assert_eq!(stats["oversample"], 1.25, "{stats}");
-    assert_eq!(stats["image"], serde_json::json!([32, 32]), "{stats}");
+    assert_eq!(stats["image"], serde_json::json!([32, 32, 1]), "{stats}");
     std::fs::write(
         dir.join("s.toml"),
         "[volume]\nbuiltin = \"sphere@32\"\n[camera]\ndir = [1, 0, 0]\n\

@@ -116,6 +116,16 @@ fn turntable_options_match_render_options() {
         "up",
         "pixel-size",
         "ignore-spacing",
+        "depth-cue",
+        "cue-harmonics",
+        "ambient",
+        "light",
+        "light-ring",
+        "no-cue-correction",
+        "resample",
+        "preview-level",
+        "stats",
+        "stats-json",
     ];
     for name in shared {
         let r = render.iter().find(|(n, _)| n == name);
@@ -175,7 +185,7 @@ fn the_ct_head_renders_by_name() {
 fn turntable_writes_an_apng_and_reports_views_per_second() {
     let (dir, out) = fvr_in(
         "io-spin",
-        "turntable gaussians@32 --frames 8 --out spin.apng --colormap hot",
+        "turntable gaussians@32 --frames 8 --out spin.apng --colormap hot --stats",
     );
     assert_ok(&out);
     let text = stdout(&out);

@@ -233,7 +233,10 @@ fn fuzz_regression_implicit_vr_lengths_are_checked_with_the_dictionary_vr() {
         ..CtSlice::axial([2, 2], &[1, 2, 3, 4])
     }
     .encode();
-    assert_eq!(parse_slice(&implicit).unwrap().pixels, vec![1.0, 2.0, 3.0, 4.0]);
+    assert_eq!(
+        parse_slice(&implicit).unwrap().pixels,
+        vec![1.0, 2.0, 3.0, 4.0]
+    );
     let mut bytes = implicit.clone();
     // (0028,0010) Rows, implicit: tag, 4-byte length 2; renamed to the
     // group length (0028,0000), a UL, and given 6 bytes (4 of the next
@@ -244,7 +247,10 @@ fn fuzz_regression_implicit_vr_lengths_are_checked_with_the_dictionary_vr() {
         .expect("Rows in implicit VR");
     bytes[at + 2..at + 8].copy_from_slice(&[0, 0, 6, 0, 0, 0]);
     let e = parse_slice(&bytes).unwrap_err().to_string();
-    assert!(e.contains("(0028,0000) of 4-byte values has length 6"), "{e}");
+    assert!(
+        e.contains("(0028,0000) of 4-byte values has length 6"),
+        "{e}"
+    );
 }
 
 /// Found by `cargo fuzz run dicom`: a BitsStored of 0 made

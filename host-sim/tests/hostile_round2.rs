@@ -231,6 +231,67 @@ fn scene_profiles_are_confined_and_never_quoted() {
     );
 }
 
+/// Class 14, the scene's other input: `volume.path` stays in the scene's
+/// directory too (a shared scene cannot read `/proc/self/environ` or a
+/// file beside it); a volume given on the command line replaces it.
+#[test]
+fn scene_volumes_are_confined() {
+    let dir = temp_dir("round2-volume");
+    std::fs::create_dir_all(dir.join("scene/data")).unwrap();
+    let vol = encode_nrrd(&[8, 8, 8], F32, Raw, Little, &[1.0; 512]);
+    std::fs::write(dir.join("outside.nrrd"), &vol).unwrap();
+    std::fs::write(dir.join("scene/data/inside.nrrd"), &vol).unwrap();
+    let scene = |path: &str| {
+        std::fs::write(
+            dir.join("scene/s.toml"),
+            format!(
+                "[volume]\npath = \"{path}\"\n[camera]\ndir = [1, 0, 0]\n\
+                 [output]\npath = \"a.png\"\n"
+            ),
+        )
+        .unwrap();
+    };
+    for path in [
+        "../outside.nrrd",
+        "/proc/self/environ",
+        "data/../../outside.nrrd",
+    ] {
+        scene(path);
+        refused(
+            &dir,
+            "render --scene scene/s.toml",
+            &["volume.path", "inside the scene's directory"],
+            &[],
+            "scene/a.png",
+        );
+    }
+    scene("data/inside.nrrd");
+    let ok = fvr_line("render --scene scene/s.toml --quiet", &dir);
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    assert!(dir.join("scene/a.png").is_file());
+    // The command line's VOLUME replaces a scene's path; the scene is still
+    // checked whole, so a path outside it is refused even then.
+    let ok = fvr_line("render outside.nrrd --scene scene/s.toml --quiet", &dir);
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    std::fs::remove_file(dir.join("scene/a.png")).unwrap();
+    scene("/proc/self/environ");
+    refused(
+        &dir,
+        "render outside.nrrd --scene scene/s.toml",
+        &["volume.path", "inside the scene's directory"],
+        &[],
+        "scene/a.png",
+    );
+}
+
 /// Class 15: DICOM samples keep only their BitsStored low bits (0xF123 with
 /// 12 bits stored is 0x123 = 291), and a raw file longer than `--raw-dims`
 /// is refused like a shorter one.

@@ -221,3 +221,137 @@ fn a_corrupt_file_is_named_in_one_line() {
     let e = FvrsFile::read(&path).err().unwrap();
     assert!(e.contains("truncated"), "{e}");
 }
+
+/// `fvr render X.fvrs` renders the stored spectrum without the volume: the
+/// same image, bit for bit, as `fvr render VOLUME --ignore-spacing` with the
+/// filter, grid and precision the file holds (f16 and f32, two views, NRRD
+/// and PNG); options that need the volume and corrupt files are one line,
+/// exit 2, nothing written.
+#[test]
+fn a_prepared_spectrum_renders_as_the_volume_does() {
+    let dir = tempdir();
+    let d = dir.path();
+    for (precision, filter) in [("f16", "kb4"), ("f32", "kb3")] {
+        let file = format!("s-{precision}.fvrs");
+        let (code, err) = fvr(
+            d,
+            &[
+                "prepare",
+                "sphere@32",
+                "--for",
+                "host",
+                "--precision",
+                precision,
+                "--filter",
+                filter,
+                "--out",
+                &file,
+                "--quiet",
+            ],
+        );
+        assert_eq!(code, 0, "{err}");
+        for (k, view) in ["1,0.3,0.2", "0.2,-1,0.4"].into_iter().enumerate() {
+            for ext in ["nrrd", "png"] {
+                let (a, b) = (format!("a{k}.{ext}"), format!("b{k}.{ext}"));
+                let (code, err) = fvr(d, &["render", &file, "--dir", view, "--out", &a]);
+                assert_eq!(code, 0, "{err}");
+                let (code, err) = fvr(
+                    d,
+                    &[
+                        "render",
+                        "sphere@32",
+                        "--ignore-spacing",
+                        "--filter",
+                        filter,
+                        "--oversample",
+                        "1",
+                        "--precision",
+                        precision,
+                        "--dir",
+                        view,
+                        "--out",
+                        &b,
+                        "--quiet",
+                    ],
+                );
+                assert_eq!(code, 0, "{err}");
+                let (a, b) = (
+                    std::fs::read(d.join(a)).unwrap(),
+                    std::fs::read(d.join(b)).unwrap(),
+                );
+                assert!(a == b, "{precision} {filter} {view} {ext}: images differ");
+            }
+        }
+    }
+    // Only the JSON on stdout, in the stats schema's keys.
+    let out = Command::new(env!("CARGO_BIN_EXE_fvr"))
+        .current_dir(d)
+        .args([
+            "render",
+            "s-f16.fvrs",
+            "--dir",
+            "1,0,0",
+            "--out",
+            "j.png",
+            "--stats-json",
+        ])
+        .output()
+        .unwrap();
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["spectrum_side"], 32);
+    assert_eq!(json["precision"], "f16");
+    assert_eq!(json["filter"], "kb4");
+    assert_eq!(json["image"], serde_json::json!([32, 32, 1]));
+    assert!(json["ms_per_view"].as_f64().unwrap() > 0.0);
+    // Options that need the volume, and a corrupt file.
+    for (args, needle) in [
+        (
+            vec!["--light", "1,0,0:1"],
+            "--light does not apply to a prepared spectrum",
+        ),
+        (vec!["--filter", "kb6"], "--filter does not apply"),
+        (vec!["--accuracy", "60"], "--accuracy does not apply"),
+        (vec!["--adaptive", "40"], "--adaptive does not apply"),
+    ] {
+        let mut line = vec!["render", "s-f16.fvrs", "--dir", "1,0,0", "--out", "x.png"];
+        line.extend(args);
+        let (code, err) = fvr(d, &line);
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains(needle), "{err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(!d.join("x.png").exists());
+    }
+    // The image and the spectrum's copy are budgeted before reading.
+    let (code, err) = fvr(
+        d,
+        &[
+            "--max-memory",
+            "64K",
+            "render",
+            "s-f16.fvrs",
+            "--dir",
+            "1,0,0",
+            "--out",
+            "x.png",
+        ],
+    );
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("s-f16.fvrs") && err.contains("--max-memory"),
+        "{err}"
+    );
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(!d.join("x.png").exists());
+    let mut bytes = std::fs::read(d.join("s-f16.fvrs")).unwrap();
+    let last = bytes.len() - 100;
+    bytes[last] ^= 1;
+    std::fs::write(d.join("bad.fvrs"), bytes).unwrap();
+    let (code, err) = fvr(
+        d,
+        &["render", "bad.fvrs", "--dir", "1,0,0", "--out", "x.png"],
+    );
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("bad.fvrs") && err.contains("CRC"), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(!d.join("x.png").exists());
+}

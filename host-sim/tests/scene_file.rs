@@ -136,8 +136,9 @@ fn turntable_reads_the_scene() {
     .unwrap();
     let out = fvr_line("turntable --scene spin.toml", &dir);
     let stdout = assert_ok(&out);
-    assert!(stdout.contains("(3 frames, 12x12, 5 fps)"), "{stdout}");
-    assert!(String::from_utf8_lossy(&out.stderr).contains("does not use the scene's [shading]"));
+    assert!(stdout.contains("(3 frames, 12x12 grey, 5 fps)"), "{stdout}");
+    // The scene's [shading] applies to the turntable as to a render.
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("does not use"));
     assert!(dir.join("spin.apng").is_file());
 }
 

@@ -56,7 +56,7 @@ pub(crate) fn report<'py>(
     d.set_item("storage_snr_db", r.storage_snr_db())?;
     d.set_item("load_ms", load_ms)?;
     d.set_item("plan_ms", plan.time.as_secs_f64() * 1e3)?;
-    d.set_item("preprocess_ms", r.prepare_time().as_secs_f64() * 1e3)?;
+    d.set_item("prepare_ms", r.prepare_time().as_secs_f64() * 1e3)?;
     d.set_item("preview_level", r.settings().preview_level)?;
     let p = plan.prediction;
     let accuracy = PyDict::new(py);

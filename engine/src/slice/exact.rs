@@ -19,6 +19,11 @@
 //!   whole rows (`cargo bench -p fvr-host --bench view_cpu`); the tiling is
 //!   a tunable ([`Tiling`]).
 //! - **Wide filters** (kb6) sum every plane of a point side by side.
+//! - **Prefetch.** Each point asks for the runs of the point
+//!   [`Tiling::ahead`] columns on ([`crate::slice::prefetch`]): on a plane
+//!   along no axis a point's runs lie plane and line strides apart, which
+//!   the hardware prefetchers do not follow. A hint, so the values are the
+//!   same bits.
 //!
 //! A point's fixed-point position is the row's anchor plus `(k − anchor)`
 //! steps, exactly the integer the core's running sum reaches, so the visit
@@ -34,6 +39,7 @@ use fvr_core::num::{Real, Sample};
 use fvr_core::spectrum::Spectrum;
 use rayon::prelude::*;
 
+use crate::slice::prefetch::prefetch;
 use crate::spectrum::bricks::Bricked;
 
 /// How the host extraction walks the slice: `band` mirror pairs per unit
@@ -46,7 +52,8 @@ pub struct Tiling {
     /// Columns per tile inside a band (≥ 1).
     pub chunk: usize,
     /// Lines of cells the strip and column walks prefetch ahead of the one
-    /// they reduce (0: none; [`crate::slice::prefetch`]).
+    /// they reduce, and columns the exact walk prefetches ahead of the
+    /// point it sums (0: none; [`crate::slice::prefetch`]).
     pub ahead: usize,
 }
 
@@ -166,6 +173,11 @@ trait TapSource<S>: Sync {
     /// `Σ_c wz_c Σ_b wy_b Σ_t wx_t·c[z + c, y + b, x + t]` in the core's
     /// order ([`tap_sum_on`]).
     fn sum<const W: usize, T: Real>(&self, taps: [i32; 3], weights: [&[T; W]; 3]) -> T;
+
+    /// Ask the caches for the runs [`TapSource::sum`] will read at `taps`
+    /// (a hint: nothing is read into the program).
+    #[inline(always)]
+    fn prefetch<const W: usize>(&self, _taps: [i32; 3]) {}
 }
 
 /// The linear layout (x fastest, then y, then z).
@@ -178,6 +190,16 @@ impl<S: Sample + Sync, const POW2: bool> TapSource<S> for Linear<'_, S, POW2> {
     #[inline(always)]
     fn sum<const W: usize, T: Real>(&self, taps: [i32; 3], weights: [&[T; W]; 3]) -> T {
         tap_sum_on(self.data, self.side, taps, weights)
+    }
+
+    #[inline(always)]
+    fn prefetch<const W: usize>(&self, taps: [i32; 3]) {
+        let (lines, planes, x0) = run_starts::<W, POW2>(self.side, taps);
+        for plane in planes {
+            for line in lines {
+                prefetch(self.data, plane + line + x0);
+            }
+        }
     }
 }
 
@@ -313,6 +335,7 @@ fn walk<const W: usize, const POW2: bool, S: Sample, T: Real + Send + Sync, Src:
         phases: &phases,
         raw_gain: T::exp2i(T::raw_exponent::<S>()),
         step: g.right.map(PhaseTable::<T, W>::fixed_step),
+        ahead: g.tiling.ahead,
     };
     let fill = |band: &mut Vec<Pair<'_, T>>| fill_band(&taps, g, band);
     if g.parallel {
@@ -447,6 +470,14 @@ fn fill_pair<const W: usize, const POW2: bool, S: Sample, T: Real, Src: TapSourc
         }
         let steps = (k - pair.anchor) as i64;
         let y: [i64; 3] = core::array::from_fn(|a| pair.base[a] + steps * taps.step[a]);
+        if taps.ahead > 0 {
+            // The point `ahead` columns on: on a plane that runs along no
+            // axis, its runs lie a plane or a line stride from this one's,
+            // where the hardware prefetchers do not look.
+            let ahead = taps.ahead as i64;
+            let y: [i64; 3] = core::array::from_fn(|a| y[a] + ahead * taps.step[a]);
+            taps.prefetch(y, plus, minus);
+        }
         let (value, mirror) = taps.point(y, plus, minus);
         if plus {
             if let Some(g) = pair
@@ -503,6 +534,8 @@ struct Taps<'a, const W: usize, const POW2: bool, S, T, Src> {
     phases: &'a PhaseTable<T, W>,
     raw_gain: T,
     step: [i64; 3],
+    /// Columns ahead whose runs are prefetched ([`Tiling::ahead`]).
+    ahead: usize,
 }
 
 impl<const W: usize, const POW2: bool, S: Sample, T: Real, Src: TapSource<S>>
@@ -533,6 +566,20 @@ impl<const W: usize, const POW2: bool, S: Sample, T: Real, Src: TapSource<S>>
         (value, mirrored)
     }
 
+    /// Prefetch the runs of the point at fixed-point position `y` (when
+    /// `plus`) and of its mirror (when `minus`), as [`Taps::point`] will
+    /// read them.
+    #[inline(always)]
+    fn prefetch(&self, y: [i64; 3], plus: bool, minus: bool) {
+        let j = y.map(|c| self.phases.taps_fixed_point(c).0);
+        if plus {
+            self.source.prefetch::<W>(j);
+        }
+        if minus {
+            self.source.prefetch::<W>(j.map(|j| -j - (W as i32 - 1)));
+        }
+    }
+
     /// [`tap_sum`] on this spectrum.
     #[inline(always)]
     fn value(&self, jx: i32, wx: &[T; W], jy: i32, wy: &[T; W], jz: i32, wz: &[T; W]) -> T {
@@ -552,21 +599,17 @@ pub(crate) fn tap_sum<const W: usize, S: Sample, T: Real>(
     tap_sum_on(data, Side::<true> { n }, taps, weights)
 }
 
-/// `Σ_c wz_c Σ_b wy_b Σ_t wx_t·c[z + c, y + b, x + t]` (indices wrapping
-/// around the cube), summed in the core's order: each x-line from
-/// zero, tap by tap, then lines into planes, planes into the value. The
-/// samples are read raw ([`Real::load_raw`]): `wx` carries `2^e`
-/// ([`Real::raw_exponent`]), which leaves every product as the core's.
+/// The starts of the `W × W` runs of a point's taps at `[jx, jy, jz]`:
+/// the lines' offsets within a plane, the planes' offsets and the run's
+/// first `x` (indices wrapping around the cube of side `side.n`).
 #[inline(always)]
-fn tap_sum_on<const W: usize, const POW2: bool, S: Sample, T: Real>(
-    data: &[S],
+fn run_starts<const W: usize, const POW2: bool>(
     side: Side<POW2>,
     [jx, jy, jz]: [i32; 3],
-    [wx, wy, wz]: [&[T; W]; 3],
-) -> T {
+) -> ([usize; W], [usize; W], usize) {
     let n = side.n;
     let nn = n * n;
-    let (lines, planes, x0): ([usize; W], [usize; W], usize) = if POW2 {
+    if POW2 {
         // `((j + b) mod n)·n` as `(j·n + b·n) mod n²`, in wrapping usize.
         let (y0, z0) = (
             (jy as usize).wrapping_mul(n),
@@ -584,7 +627,23 @@ fn tap_sum_on<const W: usize, const POW2: bool, S: Sample, T: Real>(
             core::array::from_fn(|c| side.step(z0, c) * nn),
             side.wrap(jx as i64),
         )
-    };
+    }
+}
+
+/// `Σ_c wz_c Σ_b wy_b Σ_t wx_t·c[z + c, y + b, x + t]` (indices wrapping
+/// around the cube), summed in the core's order: each x-line from
+/// zero, tap by tap, then lines into planes, planes into the value. The
+/// samples are read raw ([`Real::load_raw`]): `wx` carries `2^e`
+/// ([`Real::raw_exponent`]), which leaves every product as the core's.
+#[inline(always)]
+fn tap_sum_on<const W: usize, const POW2: bool, S: Sample, T: Real>(
+    data: &[S],
+    side: Side<POW2>,
+    [jx, jy, jz]: [i32; 3],
+    [wx, wy, wz]: [&[T; W]; 3],
+) -> T {
+    let (lines, planes, x0) = run_starts::<W, POW2>(side, [jx, jy, jz]);
+    let n = side.n;
     let mut acc = T::ZERO;
     // Up to W = 5 plane by plane: kb5 side by side took 1.03 to 1.5× the
     // CPU time (`FVR_BENCH_FILTERS=kb5 cargo bench -p fvr-host --bench
@@ -609,13 +668,18 @@ fn tap_sum_on<const W: usize, const POW2: bool, S: Sample, T: Real>(
         // each in the core's order: the same operations per plane,
         // interleaved, which the compiler vectorizes (kb6 about 1.1 to
         // 1.5× less CPU time a view; kb4 compiles slower this way).
+        // The runs are borrowed, not copied: a copy into an array on the
+        // stack was written in 8- and 4-byte pieces and read back in 16,
+        // which defeats store forwarding (a stall a run; half the kb6 walk's
+        // samples under `perf record` on a tilted turntable at 256³).
+        let zeros = [S::default(); W];
         let mut acc_y = [T::ZERO; W];
         for b in 0..W {
-            let runs: [[S; W]; W] = core::array::from_fn(|c| {
+            let runs: [&[S; W]; W] = core::array::from_fn(|c| {
                 let start = planes[c] + lines[b] + x0;
                 data.get(start..start + W)
-                    .and_then(|s| <[S; W]>::try_from(s).ok())
-                    .unwrap_or([S::default(); W])
+                    .and_then(|s| <&[S; W]>::try_from(s).ok())
+                    .unwrap_or(&zeros)
             });
             let mut acc_x = [T::ZERO; W];
             for t in 0..W {

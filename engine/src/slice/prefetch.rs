@@ -1,5 +1,6 @@
-//! Software prefetch of spectrum cells for the strip and column walks
-//! ([`crate::slice::strip`], [`crate::slice::column`]).
+//! Software prefetch of spectrum cells for the strip, column and exact
+//! walks ([`crate::slice::strip`], [`crate::slice::column`],
+//! [`crate::slice::exact`]).
 //!
 //! Those walks reduce the cells of one line `w` at a time, a run of a few
 //! to a few dozen cells per plane. On a spectrum larger than the last-level

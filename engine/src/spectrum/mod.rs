@@ -179,6 +179,25 @@ impl<S: Sample> OwnedSpectrum<S> {
         })
     }
 
+    /// An owned copy of a plain core spectrum (one `fvr prepare` stored,
+    /// read in place from its file): the same samples, side, scale, filter
+    /// and dims, so it renders the same views bit for bit. `None` for a
+    /// spectrum with block exponents, which the host walks do not read.
+    pub fn from_view(spec: &Spectrum<'_, S>) -> Option<Self> {
+        if spec.blocks().is_some() {
+            return None;
+        }
+        Some(Self {
+            data: spec.data().to_vec(),
+            n: spec.n(),
+            scale: spec.scale(),
+            filter: *spec.filter(),
+            dims: spec.dims(),
+            energy: None,
+            exchanged: OnceLock::new(),
+        })
+    }
+
     /// Borrow as a core spectrum.
     pub fn view(&self) -> Spectrum<'_, S> {
         Spectrum::from_parts(&self.data, self.n, self.scale, self.filter, self.dims)

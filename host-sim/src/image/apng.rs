@@ -19,6 +19,8 @@ pub struct ApngStream {
     pixels: usize,
     range: (f64, f64),
     style: Style,
+    /// Frames of interleaved R, G, B values, each channel windowed alike.
+    rgb: bool,
     left: usize,
 }
 
@@ -38,6 +40,43 @@ impl ApngStream {
         style: &Style,
         range: (f64, f64),
     ) -> Result<Self, String> {
+        Self::start(path, (width, height), frames, fps, style, range, false)
+    }
+
+    /// Start an 8-bit RGB animation like [`ApngStream::create`]: each frame
+    /// holds `width × height` interleaved R, G, B values, all three mapped
+    /// through the window `range` (one window keeps the lights' colour
+    /// balance, as [`crate::image::ImageFiles::write_png`] does).
+    ///
+    /// # Errors
+    /// As [`ApngStream::create`].
+    pub fn create_rgb(
+        path: &Path,
+        (width, height): (usize, usize),
+        frames: usize,
+        fps: u16,
+        range: (f64, f64),
+    ) -> Result<Self, String> {
+        Self::start(
+            path,
+            (width, height),
+            frames,
+            fps,
+            &Style::default(),
+            range,
+            true,
+        )
+    }
+
+    fn start(
+        path: &Path,
+        (width, height): (usize, usize),
+        frames: usize,
+        fps: u16,
+        style: &Style,
+        range: (f64, f64),
+        rgb: bool,
+    ) -> Result<Self, String> {
         let fail = |e: &dyn std::fmt::Display| apng_error(path, e);
         if frames == 0 {
             return Err(fail(&"no frames to write"));
@@ -53,14 +92,19 @@ impl ApngStream {
             writer: None,
             out: out.clone(),
             path: path.to_path_buf(),
-            pixels: width.saturating_mul(height),
+            pixels: width.saturating_mul(height) * if rgb { 3 } else { 1 },
             range,
             style: *style,
+            rgb,
             left: frames,
         };
         let header = (|| {
-            let mut enc =
-                super::png::encoder(out, width, height, style.png_color(), style.png_depth())?;
+            let (color, depth) = if rgb {
+                (png::ColorType::Rgb, png::BitDepth::Eight)
+            } else {
+                (style.png_color(), style.png_depth())
+            };
+            let mut enc = super::png::encoder(out, width, height, color, depth)?;
             enc.set_animated(count, 0).map_err(|e| e.to_string())?;
             enc.set_frame_delay(1, fps).map_err(|e| e.to_string())?;
             enc.write_header().map_err(|e| e.to_string())
@@ -70,7 +114,8 @@ impl ApngStream {
         Ok(stream)
     }
 
-    /// Encode the next frame (`width × height`, row 0 at the top).
+    /// Encode the next frame (`width × height` values, or interleaved RGB
+    /// triples, row 0 at the top).
     ///
     /// # Errors
     /// A frame of the wrong size, more frames than declared, or an encoding
@@ -92,9 +137,12 @@ impl ApngStream {
             .writer
             .as_mut()
             .ok_or_else(|| fail(&"already failed"))?;
-        writer
-            .write_image_data(&self.style.encode(frame, self.range))
-            .map_err(|e| fail(&e))?;
+        let data = if self.rgb {
+            super::to_gray8(frame, self.range)
+        } else {
+            self.style.encode(frame, self.range)
+        };
+        writer.write_image_data(&data).map_err(|e| fail(&e))?;
         self.left -= 1;
         Ok(())
     }

@@ -46,6 +46,13 @@ pub trait ImageFiles {
     /// # Errors
     /// File or encoding errors, with the path.
     fn write_png(&self, path: &std::path::Path) -> Result<(), String>;
+
+    /// Write as an 8-bit PNG, grey or RGB, every channel through the
+    /// window `range`.
+    ///
+    /// # Errors
+    /// File or encoding errors, with the path.
+    fn write_png_window(&self, path: &std::path::Path, range: (f64, f64)) -> Result<(), String>;
 }
 
 impl ImageFiles for Image {
@@ -61,7 +68,11 @@ impl ImageFiles for Image {
 
     fn write_png(&self, path: &std::path::Path) -> Result<(), String> {
         let (lo, hi) = AUTO_WINDOW_PERCENTILES;
-        let bytes = to_gray8(&self.data, percentile_range(&self.data, lo, hi));
+        self.write_png_window(path, percentile_range(&self.data, lo, hi))
+    }
+
+    fn write_png_window(&self, path: &std::path::Path, range: (f64, f64)) -> Result<(), String> {
+        let bytes = to_gray8(&self.data, range);
         let color = if self.channels == 1 {
             ::png::ColorType::Grayscale
         } else {

@@ -257,14 +257,21 @@ impl Checker<'_> {
         Some(v)
     }
 
-    /// A relative path made relative to the scene's directory.
-    fn path(&mut self, t: &Table, prefix: &str, key: &str) -> Option<PathBuf> {
+    /// An input path: a relative path inside the scene's directory, made
+    /// relative to it, so that a shared scene reads no file elsewhere (as
+    /// [`Self::output_path`] writes none; a volume elsewhere is given on
+    /// the command line, where it replaces the scene's).
+    fn input_path(&mut self, t: &Table, prefix: &str, key: &str) -> Option<PathBuf> {
         let s = self.string(t, prefix, key)?;
-        if s.is_empty() {
-            self.bad(&join(prefix, key), "must not be empty".into());
-            return None;
+        let inside = crate::io::paths::inside(self.base, Path::new(s));
+        if inside.is_none() || s.is_empty() {
+            self.bad(
+                &join(prefix, key),
+                "must be a path inside the scene's directory (give a volume elsewhere as VOLUME on the command line)"
+                    .into(),
+            );
         }
-        Some(self.base.join(s))
+        inside.filter(|_| !s.is_empty())
     }
 
     /// An output path: like [`Self::path`], but it must stay in the scene's
@@ -346,7 +353,7 @@ impl Checker<'_> {
 
     fn volume(&mut self, t: &Table) -> VolumeSection {
         let p = "volume";
-        let path = self.path(t, p, "path");
+        let path = self.input_path(t, p, "path");
         let builtin = self.string(t, p, "builtin").map(str::to_string);
         let spec = match (path, builtin) {
             (Some(_), Some(_)) => {

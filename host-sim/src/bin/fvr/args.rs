@@ -353,3 +353,18 @@ pub(crate) fn volume_help() -> String {
         "Volume: a file ({FORMATS_HELP}), a raw file (with --raw-dims), one of the {DATASETS_HELP}, or one of the {PHANTOM_HELP}"
     )
 }
+
+/// The image a job declares ([`plan_job`]'s `per_grid`): `size`, or the
+/// default `side` square, each side at most the grid's `n` (a size beyond
+/// the grid is refused later, by name).
+pub(crate) fn planned_image(size: Option<(usize, usize)>, n: u64, side: u64) -> (u64, u64) {
+    size.map_or((side, side), |(w, h)| {
+        ((w as u64).min(n), (h as u64).min(n))
+    })
+}
+
+/// One view's grids at f64 on a grid of side `n`: the slice, the column
+/// walk's sums (2), a mixed side's transposed grid and the output.
+pub(crate) fn view_grid_bytes(n: u64) -> u64 {
+    n.saturating_mul(n).saturating_mul(40)
+}

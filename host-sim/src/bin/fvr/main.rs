@@ -21,14 +21,17 @@ mod fuzz;
 mod growth;
 mod http;
 mod json;
+mod look;
 mod plan;
 mod precision;
 mod prepare;
+mod prepared;
 mod project;
 mod render;
 mod scene;
 #[cfg(not(fuzzing))]
 mod signals;
+mod stats;
 #[cfg(test)]
 mod tests;
 mod trade;
@@ -53,7 +56,6 @@ pub(crate) type Error = Box<dyn std::error::Error>;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use fvr_core::geometry::DEFAULT_UP;
-use fvr_engine::render::shaded::DEFAULT_PROFILE_HARMONICS;
 use fvr_host::image::output::{Bits, Colormap};
 use fvr_host::progress;
 use fvr_host::scene_file::SceneFile;
@@ -120,9 +122,10 @@ pub(crate) enum Command {
     #[command(after_help = GEOMETRY)]
     Render(Box<RenderArgs>),
     /// Render a turntable animation (APNG): one preprocessing pass, then
-    /// FRAMES X-ray views on a full turn about the up axis.
+    /// FRAMES views on a full turn about the up axis, X-ray, depth-cued or
+    /// lit, with the view options of `render`.
     #[command(after_help = GEOMETRY)]
-    Turntable(TurntableArgs),
+    Turntable(Box<TurntableArgs>),
     /// Render many X-ray views from one preprocessing pass into one float32
     /// stack (NRRD or .npy): views from a CSV or JSON file, or --random N
     /// rotations.
@@ -211,7 +214,7 @@ where
         }
         Some(Command::Turntable(mut args)) => {
             args.frame.spectrum.given = plan::Given::from_flags(&|id| given("turntable", id));
-            merge_scene(&mut args, &|id| given("turntable", id)).and_then(|()| turntable(&args))
+            merge_scene(&mut *args, &|id| given("turntable", id)).and_then(|()| turntable(&args))
         }
         Some(Command::Project(args)) => crate::project::project(&args),
         Some(Command::Compare(args)) => compare(&args),
@@ -248,12 +251,7 @@ fn default_scene() -> Result<(), Error> {
         dir: None,
         up: DEFAULT_UP,
         frame: FrameArgs::default(),
-        depth_cue: "none".into(),
-        cue_harmonics: DEFAULT_PROFILE_HARMONICS,
-        ambient: None,
-        lights: Vec::new(),
-        light_ring: None,
-        no_cue_correction: false,
+        look: crate::look::LookArgs::default(),
         out: None,
         png: PngArgs {
             bits: Bits::Eight,
@@ -263,7 +261,6 @@ fn default_scene() -> Result<(), Error> {
             colormap: Colormap::Gray,
         },
         stats: true,
-        resample: None,
         stats_json: false,
         adaptive: None,
         adaptive_chain: render::DEFAULT_CHAIN.into(),
@@ -271,7 +268,6 @@ fn default_scene() -> Result<(), Error> {
         adaptive_bound: None,
         adaptive_plain_below: fvr_engine::slice::adaptive::DEFAULT_PLAIN_BELOW,
         adaptive_probes: fvr_engine::slice::adaptive::DEFAULT_PROBES,
-        preview_level: 0,
         exact: false,
         input: InputArgs::default(),
         zoom: Default::default(),

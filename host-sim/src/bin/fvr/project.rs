@@ -12,7 +12,6 @@ use fvr_host::progress;
 use serde::Serialize;
 
 use crate::args::{parse_vec3, prepare_with_progress, volume_help, FrameArgs, InputArgs};
-use crate::json::one_line;
 use crate::views::{random_views, read_views, views_csv, MAX_VIEWS};
 use crate::Error;
 
@@ -67,28 +66,11 @@ pub(crate) struct ProjectArgs {
 /// views over every core, and the progress bar moves between calls.
 const VIEWS_PER_CALL: usize = 32;
 
-/// `--stats-json`.
+/// `fvr project --stats-json`: its members after the common ones.
 #[derive(Serialize)]
-struct ProjectStats<'a> {
-    volume: &'a str,
-    dims: [usize; 3],
-    /// `[W, H, channels]`, as `fvr render` gives it.
-    image: [usize; 3],
-    views: usize,
-    pixel_size: f64,
-    ignore_spacing: bool,
-    spectrum_side: usize,
-    precision: &'static str,
-    spectrum_bytes: usize,
-    filter: &'static str,
-    oversample: serde_json::Value,
-    load_ms: f64,
-    plan_ms: f64,
-    preprocess_ms: f64,
-    views_ms: f64,
-    ms_per_view: f64,
+struct ProjectExtra {
+    /// Writing the stack (and the --save-views file).
     write_ms: f64,
-    accuracy: Option<crate::plan::AccuracyJson>,
 }
 
 /// What the job holds beside the spectrum: the stack, and per-thread view
@@ -101,18 +83,13 @@ fn declare_job(args: &ProjectArgs, count: usize) {
         None,
         1,
         ("stack and view buffers", move |n, side| {
-            let (w, h) = size.map_or((side, side), |(w, h)| {
-                ((w as u64).min(n), (h as u64).min(n))
-            });
+            let (w, h) = crate::args::planned_image(size, n, side);
             let stack = w
                 .saturating_mul(h)
                 .saturating_mul(4)
                 .saturating_mul(count as u64);
-            // Each thread's view grids at f64, as a turntable's.
-            let grids = n
-                .saturating_mul(n)
-                .saturating_mul(40)
-                .saturating_mul(threads);
+            // Each thread's view grids, as a turntable's.
+            let grids = crate::args::view_grid_bytes(n).saturating_mul(threads);
             stack.saturating_add(grids)
         }),
         "use fewer views, a smaller --size, --precision f16 or --oversample 1",
@@ -207,49 +184,32 @@ pub(crate) fn project(args: &ProjectArgs) -> Result<(), Error> {
     let (w, h, c) = (shape.width, shape.height, shape.channels);
     if !args.stats_json {
         say!(
-            "wrote {} ({} views of {w}x{h}{})",
+            "wrote {} ({} views of {w}x{h} {})",
             args.out.display(),
             views.len(),
-            if c == 1 { " grey" } else { " RGB" }
+            crate::stats::kind(c)
         );
     }
+    let job = crate::stats::Job {
+        command: "project",
+        volume_spec: &args.volume,
+        volume: &volume,
+        renderer: &renderer,
+        frame: &args.frame,
+        image: [w, h, c],
+        load: t_load,
+        views: views.len(),
+        views_time: t_views,
+        output: &args.out,
+        zoom: 1,
+    };
     if args.stats_json {
-        let stats = ProjectStats {
-            volume: &args.volume,
-            dims: volume.dims,
-            image: [w, h, c],
-            views: views.len(),
-            pixel_size,
-            ignore_spacing: args.frame.units.ignore_spacing,
-            spectrum_side: renderer.n(),
-            precision: args.frame.spectrum.precision.name(),
-            spectrum_bytes: renderer.spectra().density.bytes(),
-            filter: renderer.filter().kind().name(),
-            oversample: crate::plan::oversample_json(args.frame.spectrum.oversample),
-            load_ms: ms(t_load),
-            plan_ms: ms(renderer.plan().time),
-            preprocess_ms: ms(renderer.prepare_time()),
-            views_ms: ms(t_views),
-            ms_per_view: ms(t_views) / views.len() as f64,
+        job.print_json(&ProjectExtra {
             write_ms: ms(t_write),
-            accuracy: crate::plan::json(&args.frame.spectrum),
-        };
-        say!("{}", one_line(&stats));
+        });
     } else if args.stats {
-        say!(
-            "  load {:.1} ms, plan {:.1} ms, preprocess {:.1} ms ({}^3 {}), {} views in {:.1} ms \
-             = {:.2} ms a view, written in {:.1} ms",
-            ms(t_load),
-            ms(renderer.plan().time),
-            ms(renderer.prepare_time()),
-            renderer.n(),
-            args.frame.spectrum.precision,
-            views.len(),
-            ms(t_views),
-            ms(t_views) / views.len() as f64,
-            ms(t_write)
-        );
-        crate::plan::print_human(&args.frame.spectrum);
+        job.print_human();
+        say!("  write         {:.1} ms", ms(t_write));
     }
     Ok(())
 }

@@ -121,45 +121,13 @@ pub(crate) fn apply_scene_to_render(
     given: &dyn Fn(&str) -> bool,
 ) {
     apply_scene_to_input(&mut args.volume, &mut args.input, scene, given);
-    fill(
-        given,
-        "resample",
-        &mut args.resample,
-        scene.volume.resample.map(Some),
-    );
     let c = &scene.camera;
     fill(given, "dir", &mut args.dir, c.dir.map(Some));
     fill(given, "up", &mut args.up, c.up);
     fill(given, "size", &mut args.frame.size, c.size.map(Some));
     apply_scene_to_units(&mut args.frame.units, scene, given);
     apply_scene_to_spectrum(&mut args.frame.spectrum, scene, given);
-    let sh = &scene.shading;
-    fill(
-        given,
-        "depth_cue",
-        &mut args.depth_cue,
-        sh.depth_cue.clone(),
-    );
-    fill(
-        given,
-        "cue_harmonics",
-        &mut args.cue_harmonics,
-        sh.cue_harmonics,
-    );
-    fill(given, "ambient", &mut args.ambient, sh.ambient.map(Some));
-    fill(
-        given,
-        "no_cue_correction",
-        &mut args.no_cue_correction,
-        sh.cue_correction.map(|on| !on),
-    );
-    fill(given, "lights", &mut args.lights, scene.lights.clone());
-    fill(
-        given,
-        "light_ring",
-        &mut args.light_ring,
-        scene.light_ring.map(Some),
-    );
+    crate::look::apply_scene_to_look(&mut args.look, scene, given);
     fill(
         given,
         "out",
@@ -170,8 +138,9 @@ pub(crate) fn apply_scene_to_render(
 }
 
 /// Fill the turntable settings the command line did not give from the
-/// scene: volume, camera, spectrum, output window and `[turntable]`. Scene
-/// keys a turntable does not use are named on stderr.
+/// scene: volume, camera, spectrum, shading and lights, output window and
+/// `[turntable]`. The scene's `output.path`, which a turntable does not
+/// use, is named on stderr.
 pub(crate) fn apply_scene_to_turntable(
     args: &mut TurntableArgs,
     scene: &SceneFile,
@@ -184,31 +153,16 @@ pub(crate) fn apply_scene_to_turntable(
     fill(given, "size", &mut args.frame.size, c.size.map(Some));
     apply_scene_to_units(&mut args.frame.units, scene, given);
     apply_scene_to_spectrum(&mut args.frame.spectrum, scene, given);
+    crate::look::apply_scene_to_look(&mut args.look, scene, given);
     apply_scene_to_png(&mut args.png, scene, given);
     let t = &scene.turntable;
     fill(given, "frames", &mut args.frames, t.frames);
     fill(given, "fps", &mut args.fps, t.fps);
     fill(given, "out", &mut args.out, t.path.clone());
-    let unused: Vec<&str> = [
-        ("volume.resample", scene.volume.resample.is_some()),
-        (
-            "[shading]",
-            scene.shading != fvr_host::scene_file::ShadingSection::default(),
-        ),
-        (
-            "[[lights]]",
-            scene.lights.as_ref().is_some_and(|l| !l.is_empty()),
-        ),
-        ("[light_ring]", scene.light_ring.is_some()),
-        ("output.path", scene.output.path.is_some()),
-    ]
-    .into_iter()
-    .filter_map(|(name, set)| set.then_some(name))
-    .collect();
-    if !unused.is_empty() {
+    if scene.output.path.is_some() {
         eprintln!(
-            "fvr: note: the turntable renders X-ray views and does not use the scene's {}",
-            unused.join(", ")
+            "fvr: note: the turntable writes `turntable.path` (or --out), not the scene's \
+             output.path"
         );
     }
 }

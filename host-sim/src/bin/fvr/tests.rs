@@ -55,7 +55,7 @@ fn scene_fills_every_render_setting() {
     assert_eq!(a.input.raw_type, SampleType::U16);
     assert_eq!(a.input.raw_endian, Endian::Big);
     assert_eq!(a.input.background, Some(-1024.0));
-    assert_eq!(a.resample, Some(96));
+    assert_eq!(a.look.resample, Some(96));
     assert_eq!(a.dir, Some([1.0, 0.5, -0.25]));
     assert_eq!(a.up, [0.0, 1.0, 0.0]);
     assert_eq!(a.frame.size, Some((64, 32)));
@@ -65,13 +65,13 @@ fn scene_fills_every_render_setting() {
     assert_eq!(a.frame.spectrum.oversample, GridOversampling::X2);
     assert_eq!(a.frame.spectrum.precision, Precision::F32);
     assert_eq!(a.frame.spectrum.kb_design, KbDesign::Sigma(1.5));
-    assert_eq!(a.ambient, Some([0.1; 3]));
-    assert_eq!(a.depth_cue, "linear:1,0.3");
-    assert_eq!(a.cue_harmonics, 6);
-    assert!(a.no_cue_correction);
-    assert_eq!(a.light_ring, Some((2, 10.0)));
+    assert_eq!(a.look.ambient, Some([0.1; 3]));
+    assert_eq!(a.look.depth_cue, "linear:1,0.3");
+    assert_eq!(a.look.cue_harmonics, 6);
+    assert!(a.look.no_cue_correction);
+    assert_eq!(a.look.light_ring, Some((2, 10.0)));
     assert_eq!(
-        a.lights,
+        a.look.lights,
         vec![Light {
             towards: [0.0, 1.0, 0.0],
             color: [1.0, 0.0, 0.0]
@@ -85,8 +85,8 @@ fn scene_fills_every_render_setting() {
     let d = merged_render("", &["v.nrrd", "--dir", "0,1,0", "--out", "o.png"]);
     assert_eq!(d.frame.spectrum.filter, FilterKind::Kb4);
     assert_eq!(d.up, DEFAULT_UP);
-    assert_eq!(d.depth_cue, "none");
-    assert!(!d.no_cue_correction && d.lights.is_empty() && d.light_ring.is_none());
+    assert_eq!(d.look.depth_cue, "none");
+    assert!(!d.look.no_cue_correction && d.look.lights.is_empty() && d.look.light_ring.is_none());
 }
 
 #[test]
@@ -106,7 +106,7 @@ fn each_flag_overrides_its_scene_key() {
             a.input.raw_endian == Endian::Little
         }),
         (&["--background", "0"], |a| a.input.background == Some(0.0)),
-        (&["--resample", "64"], |a| a.resample == Some(64)),
+        (&["--resample", "64"], |a| a.look.resample == Some(64)),
         (&["--dir", "0,0,1"], |a| a.dir == Some([0.0, 0.0, 1.0])),
         (&["--up", "1,0,0"], |a| a.up == [1.0, 0.0, 0.0]),
         (&["--size", "8"], |a| a.frame.size == Some((8, 8))),
@@ -128,17 +128,19 @@ fn each_flag_overrides_its_scene_key() {
         (&["--kb-design", "auto"], |a| {
             a.frame.spectrum.kb_design == KbDesign::Auto
         }),
-        (&["--ambient", "0.5"], |a| a.ambient == Some([0.5; 3])),
-        (&["--depth-cue", "none"], |a| a.depth_cue == "none"),
-        (&["--cue-harmonics", "3"], |a| a.cue_harmonics == 3),
+        (&["--ambient", "0.5"], |a| a.look.ambient == Some([0.5; 3])),
+        (&["--depth-cue", "none"], |a| a.look.depth_cue == "none"),
+        (&["--cue-harmonics", "3"], |a| a.look.cue_harmonics == 3),
         (&["--light", "1,0,0:0,0,1"], |a| {
-            a.lights
+            a.look.lights
                 == [Light {
                     towards: [1.0, 0.0, 0.0],
                     color: [0.0, 0.0, 1.0],
                 }]
         }),
-        (&["--light-ring", "3"], |a| a.light_ring == Some((3, 30.0))),
+        (&["--light-ring", "3"], |a| {
+            a.look.light_ring == Some((3, 30.0))
+        }),
         (&["--out", "x.nrrd"], |a| {
             a.out.as_deref() == Some(Path::new("x.nrrd"))
         }),
@@ -159,15 +161,19 @@ fn each_flag_overrides_its_scene_key() {
     // --no-cue-correction is a switch: the scene turns it on, the flag
     // cannot turn it off, and an unset scene key leaves it to the flag.
     let on = "[shading]\ncue_correction = true\n";
-    assert!(merged_render(on, &["--no-cue-correction"]).no_cue_correction);
-    assert!(!merged_render(on, &[]).no_cue_correction);
+    assert!(
+        merged_render(on, &["--no-cue-correction"])
+            .look
+            .no_cue_correction
+    );
+    assert!(!merged_render(on, &[]).look.no_cue_correction);
 }
 
 #[test]
 fn turntable_takes_scene_values_and_flags_win() {
     let run = |flags: &[&str]| {
         merged("turntable", FULL_SCENE, flags, |c| match c {
-            Command::Turntable(args) => Some(args),
+            Command::Turntable(args) => Some(*args),
             _ => None,
         })
     };
@@ -176,6 +182,11 @@ fn turntable_takes_scene_values_and_flags_win() {
     assert_eq!(a.out, PathBuf::from("/s/spin.apng"));
     assert_eq!(a.dir, [1.0, 0.5, -0.25]);
     assert_eq!(a.frame.spectrum.filter, FilterKind::Cubic);
+    // The scene's shading, lights and resampling, as for a render.
+    assert_eq!(a.look.resample, Some(96));
+    assert_eq!(a.look.depth_cue, "linear:1,0.3");
+    assert_eq!(a.look.light_ring, Some((2, 10.0)));
+    assert_eq!(a.look.ambient, Some([0.1; 3]));
     let b = run(&[
         "--frames", "3", "--fps", "30", "--out", "t.apng", "--dir", "0,1,0",
     ]);

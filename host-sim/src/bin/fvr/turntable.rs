@@ -1,20 +1,22 @@
-//! `fvr turntable`: an APNG of X-ray views on a full turn.
+//! `fvr turntable`: an APNG of views on a full turn, X-ray, depth-cued or
+//! shaded, each frame the view `fvr render` makes with the same options.
 
 use crate::args::{parse_vec3, prepare_with_progress, volume_help, FrameArgs, InputArgs, PngArgs};
-use crate::json::one_line;
+use crate::look::LookArgs;
+use crate::stats::Job;
 use crate::Error;
 
 use crate::scene::SCENE_HELP;
 use serde::Serialize;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::Args;
-use fvr_core::geometry::{Sampling, View};
+use fvr_core::geometry::View;
+use fvr_core::shading::Scene;
 use fvr_engine::render::turntable;
-use fvr_engine::spectrum::AnySpectrum;
-use fvr_engine::{Plan, Settings};
-use fvr_host::image::output::{write_apng, ApngStream, Window};
+use fvr_engine::{Plan, Renderer, Settings};
+use fvr_host::image::output::{ApngStream, Bits, Colormap, Window};
 use fvr_host::progress;
 use indicatif::ProgressBar;
 use std::time::Duration;
@@ -24,8 +26,9 @@ pub(crate) struct TurntableArgs {
     /// A volume file, a raw file with --raw-dims, a data set, or a built-in phantom.
     #[arg(help = volume_help(), required_unless_present = "scene")]
     pub(crate) volume: Option<String>,
-    /// Scene file (TOML): its volume, camera, spectrum, output window and
-    /// [turntable] settings; flags given on the command line override them.
+    /// Scene file (TOML): its volume, camera, spectrum, shading, lights,
+    /// output window and [turntable] settings; flags given on the command
+    /// line override them.
     #[arg(long, value_name = "FILE.toml", long_help = SCENE_HELP)]
     pub(crate) scene: Option<PathBuf>,
     /// Number of frames in the turn.
@@ -42,11 +45,17 @@ pub(crate) struct TurntableArgs {
     pub(crate) up: [f64; 3],
     #[command(flatten)]
     pub(crate) frame: FrameArgs,
-    /// Output file: .apng or .png (an animated PNG either way).
+    #[command(flatten)]
+    pub(crate) look: LookArgs,
+    /// Output file: .apng or .png (an animated PNG either way; RGB, 8-bit,
+    /// for coloured lights).
     #[arg(long, default_value = "spin.apng")]
     pub(crate) out: PathBuf,
-    /// Print the timings (load, preprocess, views, views per second) as one
-    /// JSON object instead of the summary line.
+    /// Print the sizes, choices and timings (load, plan, prepare, views).
+    #[arg(long)]
+    pub(crate) stats: bool,
+    /// Print them as one JSON object on stdout instead, and nothing else
+    /// there.
     #[arg(long)]
     pub(crate) stats_json: bool,
     #[command(flatten)]
@@ -60,206 +69,306 @@ pub(crate) struct TurntableArgs {
 /// rendered first, and every frame is encoded as soon as it is rendered.
 const HOLD_FRAMES_BYTES: u64 = 256 << 20;
 
-/// Frames rendered first to set the window of a streamed animation.
+/// Frames rendered first to set the window of a streamed animation (and
+/// of a depth-cued one, from the uncued views).
 const SAMPLE_FRAMES: usize = 16;
 
 /// What a turntable of `frames` frames builds from its volume
 /// ([`crate::args::plan_job`]).
-fn declare_job(args: &TurntableArgs, frames: usize) {
+fn declare_job(args: &TurntableArgs, scene: &Scene, frames: usize) {
     let size = args.frame.size;
+    let channels = scene.channels() as u64;
     crate::args::plan_job(
         &args.frame.spectrum,
-        None,
-        1,
+        args.look.resample,
+        if scene.needs_gradient_spectrum() {
+            2
+        } else {
+            1
+        },
         ("frames and view buffers", move |n, side| {
-            // A size beyond the grid is refused later, by name.
-            let (w, h) = size.map_or((side, side), |(w, h)| {
-                ((w as u64).min(n), (h as u64).min(n))
-            });
-            let frame = w.saturating_mul(h).saturating_mul(8);
+            let (w, h) = crate::args::planned_image(size, n, side);
+            let frame = w.saturating_mul(h).saturating_mul(8 * channels);
             let all = frame.saturating_mul(frames as u64);
-            // Per-view grids at f64 (slice, the column walk's sums (2), a
-            // mixed side's transposed grid, output) and the frames kept.
-            let grids = n.saturating_mul(n).saturating_mul(40);
-            grids.saturating_add(if all <= HOLD_FRAMES_BYTES {
+            // One view's grids and the frames kept.
+            crate::args::view_grid_bytes(n).saturating_add(if all <= HOLD_FRAMES_BYTES {
                 all
             } else {
                 frame.saturating_mul(SAMPLE_FRAMES as u64 + 1)
             })
         }),
-        "use fewer --frames, a smaller --size, --precision f16 or --oversample 1",
+        "use fewer --frames, a smaller --size or --resample, --precision f16 or --oversample 1",
     );
+}
+
+/// `fvr turntable --stats-json`: its members after the common ones.
+#[derive(Serialize)]
+struct TurntableExtra {
+    frames: usize,
+    fps: u16,
+    /// The spectrum's copy with x and y exchanged, for strip rows along y
+    /// (0 when no frame took it).
+    exchanged_bytes: usize,
+    views_per_second: f64,
+    /// The PNG window `[low, high]` all frames share.
+    window: [f64; 2],
 }
 
 pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     crate::checks::check_direction("--dir (camera.dir in a scene)", args.dir)?;
     crate::checks::check_direction("--up (camera.up in a scene)", args.up)?;
+    args.look.check()?;
     let views = turntable::orbit(args.dir, args.up, args.frames as usize)?;
     let style = args.png.style()?;
-    let t0 = Instant::now();
     let volume_spec = args.volume.as_deref().ok_or_else(|| {
         "no volume: give VOLUME, or `volume.path` or `volume.builtin` in the scene".to_string()
     })?;
-    let scene: Vec<&std::path::Path> = args.scene.iter().map(|p| p.as_path()).collect();
-    crate::checks::check_output(&args.out, &["apng", "png"], volume_spec, &scene)?;
-    declare_job(args, views.len());
-    let volume = args.input.load(volume_spec)?;
+    let mut others: Vec<&Path> = args.scene.iter().map(|p| p.as_path()).collect();
+    if let Some(profile) = args.look.depth_cue.strip_prefix("profile:@") {
+        others.push(Path::new(profile));
+    }
+    crate::checks::check_output(&args.out, &["apng", "png"], volume_spec, &others)?;
+    let scene = args.look.scene(&views[0])?;
+    if scene.channels() > 1 && (args.png.colormap != Colormap::Gray || args.png.bits != Bits::Eight)
+    {
+        return Err(
+            "--colormap and --bits 16 apply to grey frames; coloured lights make RGB frames \
+             (8-bit): leave them out, or give grey light colours"
+                .into(),
+        );
+    }
+    declare_job(args, &scene, views.len());
+    let t0 = Instant::now();
+    let mut volume = args.input.load(volume_spec)?;
     crate::checks::check_not_input(&args.out)?;
-    let _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
+    let mut _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
+    if let Some(largest) = args.look.resample {
+        crate::checks::check_resample(&volume, largest)?;
+        volume = volume.resample_isotropic(largest)?;
+        _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
+    }
     fvr_host::budget::check_plan(volume.dims)?;
     let t_load = t0.elapsed();
     let settings = Settings {
+        scene: scene.clone(),
+        preview_level: args.look.preview_level,
         units: args.frame.units.units(),
         ..crate::plan::settings(&args.frame.spectrum)
     };
+    settings.check()?;
     let plan = Plan::choose(&volume, &settings)?;
-    let t_plan = plan.time;
     let mut planned = args.clone();
     crate::plan::apply(&mut planned.frame.spectrum, &plan);
     let args = &planned;
     // The planner may have changed the spectrum's settings.
-    declare_job(args, views.len());
+    declare_job(args, &scene, views.len());
     fvr_host::budget::check_plan(volume.dims)?;
     let renderer = prepare_with_progress(&volume, settings, plan)?;
     for w in renderer.warnings() {
         eprintln!("fvr: warning: {w}");
     }
-    let t_prep = renderer.prepare_time();
-    let spec = &renderer.spectra().density;
-    let n = renderer.n();
-    let (w, h) = renderer.image_size(args.frame.size)?;
-    let sampling = *renderer.sampling();
-    let all_bytes = (views.len() as u64).saturating_mul((w * h * 8) as u64);
-    let sampled = !matches!(style.window, Window::Range(..)) && all_bytes > HOLD_FRAMES_BYTES;
-    let extra = if sampled {
-        SAMPLE_FRAMES.min(views.len())
-    } else {
-        0
+    crate::look::warn_negative_cue(&volume, &scene, &views[0])?;
+    let size = renderer.image_size(args.frame.size)?;
+    let (w, h) = match args.look.preview_level {
+        0 => size,
+        level => fvr_core::render::preview_size(size.0, size.1, level),
     };
-    let bar = progress::count((views.len() + extra) as u64, "frames");
+    let source = Source {
+        renderer: &renderer,
+        scene: &scene,
+        size,
+        image: (w, h),
+        cause: args.look.overflow_cause(),
+    };
+    let channels = scene.channels();
+    let frame_bytes = (w * h * channels * 8) as u64;
+    let all_bytes = (views.len() as u64).saturating_mul(frame_bytes);
+    let cue_gain = crate::look::cue_gain(&scene.cue)?;
+    let picks = match style.window {
+        Window::Range(..) => 0,
+        _ if cue_gain.is_some() || all_bytes > HOLD_FRAMES_BYTES => SAMPLE_FRAMES.min(views.len()),
+        _ => 0,
+    };
+    let bar = progress::count((views.len() + picks) as u64, "frames");
     let t2 = Instant::now();
-    let result = write_frames(spec, &views, &sampling, (w, h), &bar, args, sampled);
+    let result = write_frames(&source, &views, &bar, args, picks, cue_gain, channels);
     bar.finish_and_clear();
-    let encode = result?;
+    let (encode, range) = result?;
     let t_views = t2.elapsed().saturating_sub(encode);
     let frames = views.len();
-    let secs = t_views.as_secs_f64();
-    say!(
-        "wrote {} ({} frames, {w}x{h}, {} fps)",
-        args.out.display(),
-        frames,
-        args.fps
-    );
-    let views_per_second = frames as f64 / secs.max(1e-9);
+    let kind = crate::stats::kind(channels);
+    if !args.stats_json {
+        say!(
+            "wrote {} ({frames} frame{}, {w}x{h} {kind}, {} fps)",
+            args.out.display(),
+            if frames == 1 { "" } else { "s" },
+            args.fps
+        );
+    }
+    let job = Job {
+        command: "turntable",
+        volume_spec,
+        volume: &volume,
+        renderer: &renderer,
+        frame: &args.frame,
+        image: [w, h, channels],
+        load: t_load,
+        views: frames,
+        views_time: t_views,
+        output: &args.out,
+        zoom: 1,
+    };
+    let views_per_second = frames as f64 / t_views.as_secs_f64().max(1e-9);
     if args.stats_json {
-        let stats = TurntableStats {
-            volume: volume_spec,
-            dims: volume.dims,
-            image: [w, h],
+        job.print_json(&TurntableExtra {
             frames,
             fps: args.fps,
-            spectrum_side: n,
-            precision: args.frame.spectrum.precision.name(),
-            spectrum_bytes: spec.bytes(),
-            exchanged_bytes: spec.exchanged_bytes(),
-            filter: args.frame.spectrum.filter.name(),
-            oversample: crate::plan::oversample_json(args.frame.spectrum.oversample),
-            load_ms: t_load.as_secs_f64() * 1e3,
-            plan_ms: t_plan.as_secs_f64() * 1e3,
-            preprocess_ms: t_prep.as_secs_f64() * 1e3,
-            views_ms: secs * 1e3,
-            ms_per_view: secs * 1e3 / frames.max(1) as f64,
+            exchanged_bytes: renderer.spectra().density.exchanged_bytes(),
             views_per_second,
-            accuracy: crate::plan::json(&args.frame.spectrum),
-        };
-        say!("{}", one_line(&stats));
-    } else {
+            window: [range.0, range.1],
+        });
+    } else if args.stats {
+        job.print_human();
+        say!("  rate          {views_per_second:.1} views/s");
         say!(
-            "  load {:.1} ms, plan {:.1} ms, preprocess {:.1} ms ({n}^3 {}), {} views in {:.1} ms = {:.1} views/s",
-            t_load.as_secs_f64() * 1e3,
-            t_plan.as_secs_f64() * 1e3,
-            t_prep.as_secs_f64() * 1e3,
-            args.frame.spectrum.precision,
-            frames,
-            secs * 1e3,
-            views_per_second
+            "  window        {} to {}{}",
+            range.0,
+            range.1,
+            match cue_gain {
+                Some(g) if !matches!(style.window, Window::Range(..)) =>
+                    format!(" (the uncued views' window times {g}, the cue's largest weight)"),
+                _ => String::new(),
+            }
         );
-        crate::plan::print_human(&args.frame.spectrum);
     }
     Ok(())
 }
 
-/// Render the views and write the animation. With a fixed window, or with
-/// `sampled` (the window from evenly spaced frames rendered first), each
-/// frame is encoded as it comes; otherwise all frames are kept for an exact
-/// percentile window. Returns the time spent encoding.
+/// Where the frames come from: the prepared renderer and its scene.
+struct Source<'a> {
+    renderer: &'a Renderer,
+    scene: &'a Scene,
+    /// The image size asked for (before a preview level shrinks it).
+    size: (usize, usize),
+    /// The frames' size.
+    image: (usize, usize),
+    /// What to blame for non-finite pixels.
+    cause: String,
+}
+
+impl Source<'_> {
+    /// Render `views` in `scene`, handing each frame to `each`. A plain
+    /// X-ray turntable reuses one set of view buffers for every frame.
+    fn each(
+        &self,
+        views: &[View],
+        scene: &Scene,
+        bar: &ProgressBar,
+        mut each: impl FnMut(&[f64]) -> Result<(), Error>,
+    ) -> Result<(), Error> {
+        let r = self.renderer;
+        let check = |frame: &[f64]| crate::checks::check_finite(frame, &self.cause);
+        if *scene == Scene::xray() && r.settings().preview_level == 0 {
+            let spec = &r.spectra().density;
+            return turntable::render_each(
+                spec,
+                views,
+                r.sampling(),
+                self.size,
+                &|| bar.inc(1),
+                |_, frame| {
+                    check(frame)?;
+                    each(frame)
+                },
+            );
+        }
+        for view in views {
+            let data = if scene == self.scene {
+                r.render(view, Some(self.size))?.0.data
+            } else {
+                let (w, h) = self.size;
+                r.spectra()
+                    .render_sampled(scene, view, r.sampling(), w, h)?
+                    .data
+            };
+            check(&data)?;
+            each(&data)?;
+            bar.inc(1);
+        }
+        Ok(())
+    }
+}
+
+/// Render the views and write the animation, every frame through one
+/// window: the one given; for a depth cue, the percentile window of
+/// `picks` evenly spaced uncued views times the cue's largest weight
+/// (`cue_gain`), so that near content stays brighter than far content;
+/// else the percentile window of `picks` evenly spaced frames rendered
+/// first, or with no picks, of all frames (kept until the window is
+/// known). Returns the time spent encoding and the window.
 fn write_frames(
-    spec: &AnySpectrum,
+    source: &Source<'_>,
     views: &[View],
-    sampling: &Sampling,
-    (w, h): (usize, usize),
     bar: &ProgressBar,
     args: &TurntableArgs,
-    sampled: bool,
-) -> Result<Duration, Error> {
-    let style = &args.png.style()?;
+    picks: usize,
+    cue_gain: Option<f64>,
+    channels: usize,
+) -> Result<(Duration, (f64, f64)), Error> {
+    let style = args.png.style()?;
+    let mut kept: Vec<f64> = Vec::new();
     let range = match style.window {
         Window::Range(lo, hi) => Some((lo, hi)),
-        Window::Percentiles(..) if sampled => {
-            let k = SAMPLE_FRAMES.min(views.len());
-            let picks: Vec<View> = (0..k).map(|i| views[i * views.len() / k]).collect();
-            let frames = turntable::render_views(spec, &picks, sampling, w, h, &|| bar.inc(1))?;
-            Some(style.window.resolve(&frames.concat()))
+        Window::Percentiles(..) if picks > 0 => {
+            let chosen: Vec<View> = (0..picks).map(|i| views[i * views.len() / picks]).collect();
+            let sample_scene = match cue_gain {
+                Some(_) => crate::look::uncued(source.scene),
+                None => source.scene.clone(),
+            };
+            let mut pixels = Vec::new();
+            source.each(&chosen, &sample_scene, bar, |f| {
+                pixels.extend_from_slice(f);
+                Ok(())
+            })?;
+            let (lo, hi) = style.window.resolve(&pixels);
+            let g = cue_gain.unwrap_or(1.0);
+            Some((lo * g, hi * g))
         }
-        Window::Percentiles(..) => None,
-    };
-    let Some(range) = range else {
-        let frames = turntable::render_views(spec, views, sampling, w, h, &|| bar.inc(1))?;
-        for frame in &frames {
-            crate::checks::check_finite(
-                frame,
-                &crate::checks::overflow_cause(false, false, false),
-            )?;
+        Window::Percentiles(..) => {
+            source.each(views, source.scene, bar, |f| {
+                kept.extend_from_slice(f);
+                Ok(())
+            })?;
+            None
         }
-        let t = Instant::now();
-        write_apng(&args.out, w, h, &frames, args.fps, style)?;
-        return Ok(t.elapsed());
     };
-    let mut stream = ApngStream::create(&args.out, (w, h), views.len(), args.fps, style, range)?;
+    let range = range.unwrap_or_else(|| style.window.resolve(&kept));
+    let (w, h) = source.image;
+    let create = || -> Result<ApngStream, String> {
+        if channels == 1 {
+            ApngStream::create(&args.out, (w, h), views.len(), args.fps, &style, range)
+        } else {
+            ApngStream::create_rgb(&args.out, (w, h), views.len(), args.fps, range)
+        }
+    };
     let mut encode = Duration::ZERO;
-    turntable::render_each(spec, views, sampling, (w, h), &|| bar.inc(1), |_, frame| {
-        crate::checks::check_finite(frame, &crate::checks::overflow_cause(false, false, false))?;
+    if !kept.is_empty() {
+        let t = Instant::now();
+        let mut stream = create()?;
+        for frame in kept.chunks(w * h * channels) {
+            stream.push(frame)?;
+        }
+        stream.finish()?;
+        return Ok((t.elapsed(), range));
+    }
+    let mut stream = create()?;
+    source.each(views, source.scene, bar, |frame| {
         let t = Instant::now();
         stream.push(frame)?;
         encode += t.elapsed();
-        Ok::<(), Error>(())
+        Ok(())
     })?;
     let t = Instant::now();
     stream.finish()?;
-    Ok(encode + t.elapsed())
-}
-
-/// `fvr turntable --stats-json`, in the order printed.
-#[derive(Serialize)]
-struct TurntableStats<'a> {
-    volume: &'a str,
-    dims: [usize; 3],
-    image: [usize; 2],
-    frames: usize,
-    fps: u16,
-    spectrum_side: usize,
-    precision: &'a str,
-    spectrum_bytes: usize,
-    /// The spectrum's copy with x and y exchanged, for strip rows along y
-    /// (0 when no frame took it).
-    exchanged_bytes: usize,
-    filter: &'a str,
-    oversample: serde_json::Value,
-    load_ms: f64,
-    plan_ms: f64,
-    preprocess_ms: f64,
-    views_ms: f64,
-    ms_per_view: f64,
-    views_per_second: f64,
-    accuracy: Option<crate::plan::AccuracyJson>,
+    Ok((encode + t.elapsed(), range))
 }

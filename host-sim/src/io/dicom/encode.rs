@@ -171,13 +171,11 @@ impl<'a> CtSlice<'a> {
             PrimitiveValue::from(bytes),
         );
         let file = obj
-            .with_meta(
-                FileMetaTableBuilder::new().transfer_syntax(if implicit_vr {
-                    dicom_dictionary_std::uids::IMPLICIT_VR_LITTLE_ENDIAN
-                } else {
-                    dicom_dictionary_std::uids::EXPLICIT_VR_LITTLE_ENDIAN
-                }),
-            )
+            .with_meta(FileMetaTableBuilder::new().transfer_syntax(if implicit_vr {
+                dicom_dictionary_std::uids::IMPLICIT_VR_LITTLE_ENDIAN
+            } else {
+                dicom_dictionary_std::uids::EXPLICIT_VR_LITTLE_ENDIAN
+            }))
             .expect("a complete file meta table");
         let mut out = Vec::new();
         file.write_all(&mut out).expect("writing DICOM into a Vec");

@@ -75,7 +75,8 @@ fn implicit_vr((group, elem): (u16, u16)) -> Option<&'static [u8]> {
     if (group, elem) == (0x7FE0, 0x0010) || (group >> 8 == 0x60 && elem == 0x3000) {
         return Some(b"OW");
     }
-    let entry = dicom_dictionary_std::StandardDataDictionary.by_tag(dicom_core::Tag(group, elem))?;
+    let entry =
+        dicom_dictionary_std::StandardDataDictionary.by_tag(dicom_core::Tag(group, elem))?;
     Some(entry.vr().relaxed().to_string().as_bytes())
 }
 
