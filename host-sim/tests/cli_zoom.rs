@@ -103,6 +103,24 @@ fn zoom_on_the_command_line() {
     );
     assert_error(&out, &["--zoom", "--preview-level"]);
     assert!(!dir.join("bad.png").exists());
+    // A prepared spectrum has no volume: --zoom and --view are refused.
+    assert_ok(&fvr_line(
+        "prepare sphere@16 --for host --out s.fvrs --quiet",
+        &dir,
+    ));
+    for flag in ["--zoom 2", "--view left"] {
+        let dir_flag = if flag.starts_with("--view") {
+            ""
+        } else {
+            "--dir 1,0,0"
+        };
+        let out = fvr_line(
+            &format!("render s.fvrs {dir_flag} {flag} --out bad.png"),
+            &dir,
+        );
+        assert_error(&out, &["fvr: error:", "--zoom and --view need the volume"]);
+        assert!(!dir.join("bad.png").exists());
+    }
 }
 
 /// `--stats-json` reports the zoomed pixel size: the plain one over F.

@@ -235,6 +235,10 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     view.frame()?;
     let style = args.png.style()?;
     if crate::prepared::is_prepared(volume_spec) {
+        if args.zoom.zoom > 1 || args.anatomy.view.is_some() {
+            return Err("--zoom and --view need the volume (its grid and orientation), not a                         prepared .fvrs spectrum: give the volume, or --dir and no --zoom"
+                .into());
+        }
         return crate::prepared::render(args, volume_spec, out, &ext, &view, style);
     }
     let scene = build_scene(args)?;
