@@ -28,7 +28,7 @@ fn lit_and_cued_render_writes_rgb_nrrd_and_reports_memory() {
     assert_ok(&out);
     assert!(stdout.contains("RGB"), "{stdout}");
     assert!(stdout.contains("second spectrum"), "{stdout}");
-    let image = read_nrrd(&dir.join("lit.nrrd")).unwrap();
+    let image = fvr_host::io::nrrd::read_nrrd_image(&dir.join("lit.nrrd")).unwrap();
     assert_eq!(image.dims, [3, 32, 32]);
     assert!(image.data.iter().all(|v| v.is_finite()));
     // Red light from +y, blue from −x: the channels differ.

@@ -79,7 +79,7 @@ fn flags_override_the_scene() {
         &dir,
     ));
     assert!(stdout.contains("wrote over.nrrd (16x16 RGB)"), "{stdout}");
-    let image = fvr_host::io::nrrd::read_nrrd(&dir.join("over.nrrd")).unwrap();
+    let image = fvr_host::io::nrrd::read_nrrd_image(&dir.join("over.nrrd")).unwrap();
     assert_eq!(image.dims, [3, 16, 16]);
     assert!(image.data.chunks(3).all(|p| p[0] == p[1] && p[1] == p[2]));
     assert!(image.data.iter().any(|&v| v > 0.0));

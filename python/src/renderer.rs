@@ -203,6 +203,7 @@ impl PyRenderer {
                 // With the GIL held: no Python thread writes the array meanwhile.
                 data: data.to_vec(),
                 spacing: fvr_engine::volume::DEFAULT_SPACING,
+                orientation: None,
             };
             (volume, "array".to_string())
         };

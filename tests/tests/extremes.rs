@@ -126,6 +126,7 @@ fn constant_volume_projects_to_c_times_n_along_an_axis_up_to_kb4_aliasing_in_f64
         dims: [N; 3],
         data: vec![c; N * N * N],
         spacing: fvr_engine::volume::DEFAULT_SPACING,
+        orientation: None,
     };
     assert_eq!(
         choose_oversampling(&volume, FilterKind::Kb4, KbDesign::Auto),
@@ -313,6 +314,7 @@ fn volume_scaled_by_2_pow_minus_20_is_bit_identical_and_by_1e_minus_6_or_1e_minu
             dims: base.dims,
             data: base.data.iter().map(|v| v * factor).collect(),
             spacing: fvr_engine::volume::DEFAULT_SPACING,
+            orientation: None,
         };
         let mut b = Subject::new("scaled", scaled, None, filter, views.clone());
         let (rb, _) = b.render_format(Format::F64, Arithmetic::PerPass).unwrap();
@@ -461,6 +463,7 @@ fn sizes_1_2_and_4_work_in_every_format() {
                 .map(|_| rng.next_f64() as f32 + 0.5)
                 .collect(),
             spacing: fvr_engine::volume::DEFAULT_SPACING,
+            orientation: None,
         };
         for o in [1u32, 2] {
             let filter = choose_filter(&volume, FilterKind::Kb4, o, KbDesign::Auto).unwrap();

@@ -193,7 +193,7 @@ fn line<T: Real>(data: &mut [T], scratch: &mut [T], inverse: Inverse<'_, T>) {
 /// `job(y, row y, row −y, scratch)` for `y = 0 ..= m/2` on rayon threads,
 /// `row −y` `None` where `y ≡ −y`; `scratch` holds a 1D transform's
 /// scratch ([`mixed_scratch_len`]`(m)`).
-fn for_row_pairs<T: Real>(
+pub(super) fn for_row_pairs<T: Real>(
     data: &mut [T],
     m: usize,
     job: impl Fn(usize, &mut [T], Option<&mut [T]>, &mut [T]) + Sync,
@@ -217,7 +217,7 @@ fn for_row_pairs<T: Real>(
 /// The shift's phase factors per axis: `cos φ`, `sin φ` of
 /// `φ = −2π k·t/m` for every `k`, Nyquist without phase, in `libm` as the
 /// core computes them.
-struct ShiftTables<T> {
+pub(super) struct ShiftTables<T> {
     m: usize,
     cx: Vec<T>,
     sx: Vec<T>,
@@ -227,7 +227,7 @@ struct ShiftTables<T> {
 
 /// The tables for shift `t`, `None` for no shift (the core then leaves the
 /// grid as it is).
-fn shift_tables<T: Real>(m: usize, t: [f64; 2]) -> Option<ShiftTables<T>> {
+pub(super) fn shift_tables<T: Real>(m: usize, t: [f64; 2]) -> Option<ShiftTables<T>> {
     if t == [0.0, 0.0] {
         return None;
     }
@@ -259,7 +259,7 @@ impl<T: Real> ShiftTables<T> {
     /// and `−y` (`mirror`; `None` where they coincide, and the pairs then
     /// lie within the row): the point `(x, y)` of each pair `(x, y)`,
     /// `(−x, −y)` that comes first in the grid carries the phase.
-    fn shift_rows(&self, y: usize, row: &mut [T], mirror: Option<&mut [T]>) {
+    pub(super) fn shift_rows(&self, y: usize, row: &mut [T], mirror: Option<&mut [T]>) {
         let m = self.m;
         let neg = |k: usize| if k == 0 { 0 } else { m - k };
         let (cy, sy) = (self.cy[y], self.sy[y]);

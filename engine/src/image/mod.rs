@@ -1,9 +1,11 @@
 //! The image stage: the 2D inverse transform that turns a slice into a
-//! projection ([`inverse`]), the image type the renderers return, and the
+//! projection ([`inverse`]) and its zero-padded, magnified form
+//! ([`zoom`]), the image type the renderers return, and the
 //! agreement measure.
 
 mod agreement;
 pub mod inverse;
+pub mod zoom;
 
 pub use agreement::{max_abs_error, snr_db};
 

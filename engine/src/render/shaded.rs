@@ -32,6 +32,7 @@ pub fn gradient_volume(volume: &Volume) -> Result<Volume, fvr_core::Error> {
         dims: volume.dims,
         data: out.into_iter().map(|v| v as f32).collect(),
         spacing: volume.spacing,
+        orientation: volume.orientation,
     })
 }
 
@@ -163,15 +164,7 @@ impl SceneSpectra {
         width: usize,
         height: usize,
     ) -> Option<Result<Image, fvr_core::Error>> {
-        if scene.channels() != 1 || scene.has_partner_terms() {
-            return None;
-        }
-        // A cue with equal ends weighs every depth alike.
-        let cue = match scene.cue {
-            DepthCue::Linear { front, .. } | DepthCue::Sine { front, .. } => front,
-            DepthCue::None | DepthCue::Profile { .. } => 1.0,
-        };
-        let grey = scene.ambient[0] * cue;
+        let grey = plain_grey(scene)?;
         Some(
             self.density
                 .render_sampled(view, sampling, width, height)
@@ -429,4 +422,19 @@ fn hue(frac: f64) -> [f64; 3] {
         let d = d.min(3.0 - d);
         (1.0 - d).max(0.0)
     })
+}
+
+/// The factor a plain X-ray scene (grey, no lights, no depth-varying cue)
+/// multiplies the plain projection by: the ambient grey times the cue's
+/// constant weight. `None` for any other scene.
+pub(crate) fn plain_grey(scene: &Scene) -> Option<f64> {
+    if scene.channels() != 1 || scene.has_partner_terms() {
+        return None;
+    }
+    // A cue with equal ends weighs every depth alike.
+    let cue = match scene.cue {
+        DepthCue::Linear { front, .. } | DepthCue::Sine { front, .. } => front,
+        DepthCue::None | DepthCue::Profile { .. } => 1.0,
+    };
+    Some(scene.ambient[0] * cue)
 }

@@ -12,6 +12,7 @@ use fvr_core::slice::extract_slice_rows;
 use fvr_core::spectrum::Spectrum;
 
 use crate::image::inverse::MixedFinish;
+use crate::image::zoom::ZoomFinish;
 use crate::slice::column;
 use crate::slice::exact::{self, Tiling};
 use crate::slice::strip;
@@ -36,6 +37,8 @@ pub struct ViewRenderer<T> {
     walk: Walk,
     /// Strip views with rows along y drawn so far ([`Self::exchanged`]).
     y_rows_views: usize,
+    /// The zero-padded finish of a magnified image ([`Self::with_zoom`]).
+    zoom: Option<ZoomFinish<T>>,
 }
 
 /// How a plain view's slice is summed.
@@ -73,6 +76,7 @@ impl<T: Real> ViewRenderer<T> {
             tiling: Tiling::default(),
             walk: Walk::default(),
             y_rows_views: 0,
+            zoom: None,
         }
     }
 
@@ -145,6 +149,7 @@ impl<T: Real> ViewRenderer<T> {
         (self.tw.len() + self.grid.len() + self.aux.len() + mixed + along)
             * std::mem::size_of::<T>()
             + std::mem::size_of::<KernelTable<T>>()
+            + self.zoom.as_ref().map_or(0, ZoomFinish::bytes)
     }
 
     /// Extract the slice on `threads` threads (0, the default: one per
@@ -167,6 +172,20 @@ impl<T: Real> ViewRenderer<T> {
     pub fn with_tiling(mut self, tiling: Tiling) -> Self {
         self.tiling = tiling;
         self
+    }
+
+    /// Magnify every image `zoom` times ([`crate::image::zoom`]): the same
+    /// field of view, `zoom·width × zoom·height` pixels in `out`. A zoom of
+    /// 1 is the plain image.
+    ///
+    /// # Errors
+    /// A factor [`crate::image::zoom::zoomed_side`] refuses.
+    pub fn with_zoom(mut self, zoom: usize) -> Result<Self, fvr_core::Error> {
+        self.zoom = match zoom {
+            1 => None,
+            _ => Some(ZoomFinish::new(self.n, zoom)?),
+        };
+        Ok(self)
     }
 
     /// Sum plain slices by `walk` ([`Walk`]).
@@ -251,7 +270,19 @@ impl<T: Real> ViewRenderer<T> {
         };
         // Blocks of at least 16 rows: below that a thread costs more than it saves.
         let blocks = threads.min(n / 16).max(1);
-        if blocks == 1 || self.grid.len() != grid_len(n) || self.kernel.filter() != spec.filter() {
+        let own_grid = self.grid.len() == grid_len(n) && self.kernel.filter() == spec.filter();
+        // The core's path below finishes at the slice's side only.
+        if self.zoom.is_some() && self.grid.len() != grid_len(n) {
+            return Err(fvr_core::Error::LengthMismatch {
+                what: "spectrum side for the zoomed finish",
+                expected: self.n,
+                got: n,
+            });
+        }
+        if self.zoom.is_some() && !own_grid {
+            return Err(fvr_core::Error::FilterMismatch);
+        }
+        if (blocks == 1 && self.zoom.is_none()) || !own_grid {
             return render_projection_with(
                 &spec,
                 &self.kernel,
@@ -297,6 +328,13 @@ impl<T: Real> ViewRenderer<T> {
     /// [`MixedFinish`] on the renderer's threads for a mixed-radix
     /// side, else through the core's [`finish_with`] (the same image).
     fn finish(&mut self, n: usize, crop: &Crop, out: &mut [T]) -> Result<(), fvr_core::Error> {
+        if let Some(zoom) = &mut self.zoom {
+            let grid = &mut self.grid;
+            return match &self.pool {
+                Some(pool) => pool.install(|| zoom.finish(grid, crop, out)),
+                None => zoom.finish(grid, crop, out),
+            };
+        }
         // The tables are for the renderer's side; the core checks `n` against it.
         if self.n.is_power_of_two() {
             let tw = Twiddles::from_table(&self.tw, self.n)?;

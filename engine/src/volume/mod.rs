@@ -1,6 +1,9 @@
 //! An owned 3D volume of f32 samples, the host-side input to the core.
 
+mod orientation;
 pub mod phantom;
+
+pub use orientation::Orientation;
 
 use std::fmt;
 
@@ -19,6 +22,10 @@ pub struct Volume {
     /// in millimetres: finite and positive ([`check_spacing`]).
     /// [`DEFAULT_SPACING`] when the source gives none.
     pub spacing: [f64; 3],
+    /// Where the voxel axes point in the patient, when the source says
+    /// (NIfTI sform/qform, NRRD `space directions`, DICOM
+    /// `ImageOrientationPatient`); `None` for phantoms and files without.
+    pub orientation: Option<Orientation>,
 }
 
 /// The most cells a padded cube may have per voxel of the volume before
@@ -70,6 +77,7 @@ impl Volume {
             dims,
             data,
             spacing: DEFAULT_SPACING,
+            orientation: None,
         }
     }
 
@@ -232,6 +240,7 @@ impl Volume {
             dims,
             data,
             spacing: [h; 3],
+            orientation: self.orientation,
         })
     }
 

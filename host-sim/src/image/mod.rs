@@ -3,6 +3,7 @@
 //! ([`plot`]).
 
 mod apng;
+pub mod nrrd_image;
 pub mod output;
 pub mod plot;
 mod png;

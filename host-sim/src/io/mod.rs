@@ -30,6 +30,7 @@ pub mod fvrs;
 pub mod inputs;
 pub mod inv3;
 pub mod nifti;
+mod nifti_encode;
 pub mod nrrd;
 pub mod paths;
 pub mod stack;

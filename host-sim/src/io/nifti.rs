@@ -37,7 +37,7 @@ use indicatif::ProgressBar;
 
 use super::{decode_samples, open_counted, MaybeGzip};
 use crate::io::nrrd::{format_error, Endian, IoError, SampleType};
-use fvr_engine::volume::{check_spacing, Volume};
+use fvr_engine::volume::{check_spacing, Orientation, Volume};
 
 /// Bytes of a NIfTI-1 header.
 pub const HEADER_BYTES: usize = 348;
@@ -49,11 +49,11 @@ const DIM_OFFSET: usize = 40;
 const FORMAT: &str = "NIfTI-1 header";
 
 /// `magic` of a single-file NIfTI-1 (`.nii`).
-const MAGIC_SINGLE: &[u8; 4] = b"n+1\0";
+pub(crate) const MAGIC_SINGLE: &[u8; 4] = b"n+1\0";
 /// `magic` of a header/image pair (`.hdr` + `.img`).
 const MAGIC_PAIR: &[u8; 4] = b"ni1\0";
 /// Offset of `magic`.
-const MAGIC_OFFSET: usize = 344;
+pub(crate) const MAGIC_OFFSET: usize = 344;
 
 /// Whether `head` starts with a NIfTI-1 header: `sizeof_hdr` 348 in either
 /// byte order and the magic `n+1` or `ni1`.
@@ -83,6 +83,9 @@ pub struct NiftiLayout {
     pub pair: bool,
     /// The permutation and flips to the closest RAS order.
     pub to_ras: AxisMap,
+    /// The file's axes and origin in RAS (from the sform, else the qform),
+    /// before that reordering; `None` with both codes 0.
+    pub orientation: Option<Orientation>,
 }
 
 /// A permutation and flips of the three axes: file axis `a` becomes axis
@@ -227,7 +230,7 @@ pub fn parse_header(bytes: &[u8]) -> Result<NiftiLayout, IoError> {
     let scaling = parse_scaling(h.scl_slope, h.scl_inter)?;
     let pair = &h.magic == MAGIC_PAIR;
     let vox_offset = parse_vox_offset(h.vox_offset, pair)?;
-    let to_ras = parse_orientation(&h)?;
+    let (to_ras, orientation) = parse_orientation(&h)?;
     Ok(NiftiLayout {
         dims,
         ty,
@@ -237,11 +240,13 @@ pub fn parse_header(bytes: &[u8]) -> Result<NiftiLayout, IoError> {
         vox_offset,
         pair,
         to_ras,
+        orientation,
     })
 }
 
-/// The axis map from the sform, else the qform, else the identity.
-fn parse_orientation(h: &NiftiHeader) -> Result<AxisMap, IoError> {
+/// The axis map from the sform, else the qform, else the identity, and the
+/// orientation it was read from.
+fn parse_orientation(h: &NiftiHeader) -> Result<(AxisMap, Option<Orientation>), IoError> {
     if h.sform_code > 0 {
         let rows = [h.srow_x, h.srow_y, h.srow_z];
         let m: [[f64; 3]; 3] =
@@ -264,7 +269,9 @@ fn parse_orientation(h: &NiftiHeader) -> Result<AxisMap, IoError> {
                 ),
             ));
         }
-        return AxisMap::closest(m, "sform").ok_or_else(|| {
+        let origin = [h.srow_x[3], h.srow_y[3], h.srow_z[3]].map(|v| v as f64);
+        let orientation = Orientation::from_columns(m, origin);
+        let map = AxisMap::closest(m, "sform").ok_or_else(|| {
             format_error(
                 FORMAT,
                 "srow_x",
@@ -274,7 +281,8 @@ fn parse_orientation(h: &NiftiHeader) -> Result<AxisMap, IoError> {
                     h.sform_code, h.srow_x, h.srow_y, h.srow_z
                 ),
             )
-        });
+        })?;
+        return Ok((map, orientation));
     }
     if h.qform_code > 0 {
         let (b, c, d) = (h.quatern_b as f64, h.quatern_c as f64, h.quatern_d as f64);
@@ -310,9 +318,14 @@ fn parse_orientation(h: &NiftiHeader) -> Result<AxisMap, IoError> {
                 qfac * (a * a + d * d - c * c - b * b),
             ],
         ];
-        return Ok(AxisMap::closest(m, "qform").unwrap_or(AxisMap::IDENTITY));
+        let origin = [h.quatern_x, h.quatern_y, h.quatern_z].map(|v| v as f64);
+        let orientation = Orientation::from_columns(m, origin);
+        return Ok((
+            AxisMap::closest(m, "qform").unwrap_or(AxisMap::IDENTITY),
+            orientation,
+        ));
     }
-    Ok(AxisMap::IDENTITY)
+    Ok((AxisMap::IDENTITY, None))
 }
 
 fn hex(bytes: &[u8]) -> String {
@@ -542,7 +555,12 @@ fn read_samples<R: BufRead>(
     if let Some((slope, inter)) = layout.scaling {
         apply_scaling(&mut volume, slope, inter)?;
     }
+    let (dims, spacing) = (volume.dims, volume.spacing);
     layout.to_ras.apply(&mut volume);
+    volume.orientation = layout.orientation.map(|o| {
+        let map = &layout.to_ras;
+        o.permuted(map.world, map.flip, dims, spacing)
+    });
     Ok(volume)
 }
 
@@ -602,94 +620,4 @@ fn missing_image(hdr: &Path) -> IoError {
     )
 }
 
-/// Encode a single-file NIfTI-1 (`.nii`) of float32 samples in `endian`
-/// order, with `pixdim` spacing in mm and scaling `(scl_slope, scl_inter)`.
-/// A test and fixture helper: it writes the fields this reader uses, the
-/// magic, and no extensions.
-///
-/// # Panics
-/// If `data.len()` is not the product of `dims` or a size exceeds `i16::MAX`.
-pub fn encode_nifti_f32(
-    dims: [usize; 3],
-    spacing: [f64; 3],
-    scaling: (f32, f32),
-    data: &[f32],
-    endian: Endian,
-) -> Vec<u8> {
-    assert_eq!(
-        data.len(),
-        dims.iter().product::<usize>(),
-        "encode_nifti_f32"
-    );
-    let i16b = |v: i16| match endian {
-        Endian::Little => v.to_le_bytes(),
-        Endian::Big => v.to_be_bytes(),
-    };
-    let f32b = |v: f32| match endian {
-        Endian::Little => v.to_le_bytes(),
-        Endian::Big => v.to_be_bytes(),
-    };
-    let mut h = vec![0u8; HEADER_BYTES];
-    let mut put = |off: usize, bytes: &[u8]| h[off..off + bytes.len()].copy_from_slice(bytes);
-    put(
-        0,
-        &match endian {
-            Endian::Little => 348i32.to_le_bytes(),
-            Endian::Big => 348i32.to_be_bytes(),
-        },
-    );
-    put(40, &i16b(3));
-    for (a, &d) in dims.iter().enumerate() {
-        put(
-            42 + 2 * a,
-            &i16b(i16::try_from(d).expect("NIfTI sizes fit in i16")),
-        );
-    }
-    for a in 3..7 {
-        put(42 + 2 * a, &i16b(1));
-    }
-    put(70, &i16b(16)); // datatype float32
-    put(72, &i16b(32)); // bitpix
-    put(76, &f32b(1.0)); // pixdim[0] (qfac)
-    for (a, &s) in spacing.iter().enumerate() {
-        put(80 + 4 * a, &f32b(s as f32));
-    }
-    put(108, &f32b(352.0)); // vox_offset
-    put(112, &f32b(scaling.0));
-    put(116, &f32b(scaling.1));
-    put(123, &[2]); // xyzt_units: mm
-    put(MAGIC_OFFSET, MAGIC_SINGLE);
-    h.extend_from_slice(&[0; 4]); // no extensions
-    for &v in data {
-        h.extend_from_slice(&f32b(v));
-    }
-    h
-}
-
-/// Byte offsets of header fields, for tests that corrupt them.
-pub mod offsets {
-    /// `dim[0..8]`, i16 each.
-    pub const DIM: usize = 40;
-    /// `datatype`, i16.
-    pub const DATATYPE: usize = 70;
-    /// `pixdim[0..8]`, f32 each.
-    pub const PIXDIM: usize = 76;
-    /// `vox_offset`, f32.
-    pub const VOX_OFFSET: usize = 108;
-    /// `scl_slope`, f32.
-    pub const SCL_SLOPE: usize = 112;
-    /// `scl_inter`, f32.
-    pub const SCL_INTER: usize = 116;
-    /// `xyzt_units`, u8.
-    pub const XYZT_UNITS: usize = 123;
-    /// `qform_code`, i16.
-    pub const QFORM_CODE: usize = 252;
-    /// `sform_code`, i16.
-    pub const SFORM_CODE: usize = 254;
-    /// `quatern_b`, `quatern_c`, `quatern_d`, f32 each.
-    pub const QUATERN_B: usize = 256;
-    /// `srow_x`, `srow_y`, `srow_z`, 4 f32 each.
-    pub const SROW_X: usize = 280;
-    /// `magic`, 4 bytes.
-    pub const MAGIC: usize = super::MAGIC_OFFSET;
-}
+pub use super::nifti_encode::{encode_nifti_f32, offsets};

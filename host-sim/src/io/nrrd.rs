@@ -24,7 +24,11 @@
 //!   multi-file forms (`LIST`, format strings) are refused.
 //! - `space directions` of an oblique or sheared grid keep only their
 //!   lengths: the volume is rendered as an axis-aligned grid with those
-//!   spacings.
+//!   spacings. With a patient `space` (`right-anterior-superior`,
+//!   `left-anterior-superior`, `left-posterior-superior` or their
+//!   abbreviations) the vectors and `space origin` also become the volume's
+//!   [`fvr_engine::volume::Orientation`] (in RAS), which `--view` and
+//!   `fvr convert` use.
 //! - Bytes after the expected data are ignored. For gzip, the last member
 //!   read is decompressed to its end (within the margin) so that its CRC is
 //!   verified.
@@ -32,6 +36,7 @@
 use super::error;
 mod header;
 mod samples;
+mod space;
 #[cfg(test)]
 mod tests;
 
@@ -97,15 +102,37 @@ pub fn read_nrrd(path: &Path) -> Result<Volume, IoError> {
 /// [`read_nrrd`], advancing `progress` by the bytes read from the file
 /// that holds the samples (its length is set to that file's size).
 pub fn read_nrrd_with_progress(path: &Path, progress: &ProgressBar) -> Result<Volume, IoError> {
-    read_nrrd_limited(path, crate::budget::limit_bytes(), progress)
+    read_nrrd_limited(path, crate::budget::limit_bytes(), progress, false)
 }
 
-fn read_nrrd_limited(path: &Path, limit: u64, progress: &ProgressBar) -> Result<Volume, IoError> {
+/// [`read_nrrd`] for an image `fvr render` wrote: also a colour image
+/// (`kinds: RGB-color domain domain`, `sizes: 3 W H`), as dims `[3, W, H]`.
+///
+/// # Errors
+/// As [`read_nrrd`].
+pub fn read_nrrd_image(path: &Path) -> Result<Volume, IoError> {
+    read_nrrd_limited(
+        path,
+        crate::budget::limit_bytes(),
+        &ProgressBar::hidden(),
+        true,
+    )
+}
+
+fn read_nrrd_limited(
+    path: &Path,
+    limit: u64,
+    progress: &ProgressBar,
+    image: bool,
+) -> Result<Volume, IoError> {
     let open = || -> Result<Volume, IoError> {
         let file = crate::io::open_file(path)?;
         progress.set_length(file.metadata().map(|m| m.len()).unwrap_or(0));
         let mut reader = BufReader::with_capacity(FILE_BUFFER_BYTES, progress.wrap_read(file));
         let layout = read_header(&mut reader)?;
+        if !image {
+            layout.check_volume()?;
+        }
         check_memory(layout.dims, layout.count, layout.ty, limit)?;
         let Some(name) = &layout.data_file else {
             return read_data(&mut reader, &layout);
@@ -154,6 +181,7 @@ fn parse_nrrd_limited(bytes: &[u8], limit: u64) -> Result<Volume, IoError> {
 /// before reading any data.
 fn read_nrrd_from<R: BufRead>(reader: &mut R, limit: u64) -> Result<Volume, IoError> {
     let layout = read_header(reader)?;
+    layout.check_volume()?;
     check_memory(layout.dims, layout.count, layout.ty, limit)?;
     if let Some(file) = &layout.data_file {
         return Err(IoError::DetachedData {
@@ -174,6 +202,7 @@ fn read_data<R: BufRead>(reader: &mut R, layout: &Layout) -> Result<Volume, IoEr
     };
     let mut volume = Volume::new(layout.dims, data);
     volume.spacing = layout.spacing;
+    volume.orientation = layout.orientation;
     Ok(volume)
 }
 
@@ -497,7 +526,9 @@ pub fn write_nrrd_f32(path: &Path, sizes: &[usize], data: &[f32]) -> Result<(), 
 
 /// Write `volume` as a 3D `float` NRRD file (raw, little endian) with its
 /// voxel spacing as `spacings`, which [`read_nrrd`] reads back exactly (the
-/// numbers are written in Rust's shortest round-trip form). The samples are
+/// numbers are written in Rust's shortest round-trip form); a volume with
+/// an orientation gets `space: right-anterior-superior`, `space
+/// directions` and `space origin` instead (read back to rounding). The samples are
 /// streamed, so no second copy of the volume is held. Errors carry the path.
 pub fn write_volume_nrrd(path: &Path, volume: &Volume) -> Result<(), IoError> {
     use std::io::Write;
@@ -509,7 +540,13 @@ pub fn write_volume_nrrd(path: &Path, volume: &Volume) -> Result<(), IoError> {
         // The header ends with its blank line: the spacing goes before it.
         text.truncate(text.len() - 1);
         let [sx, sy, sz] = volume.spacing;
-        text.push_str(&format!("spacings: {sx} {sy} {sz}\n\n"));
+        match &volume.orientation {
+            // The format forbids `spacings` beside `space directions`,
+            // whose lengths are the spacing.
+            Some(o) => text.push_str(&space::header_lines(o, volume.spacing)),
+            None => text.push_str(&format!("spacings: {sx} {sy} {sz}\n")),
+        }
+        text.push('\n');
         let mut out = super::atomic::Output::create(path)?;
         out.write_all(text.as_bytes())?;
         for chunk in volume.data.chunks(CHUNK_BYTES / 4) {

@@ -284,6 +284,7 @@ pub fn spatial_scene_projection(
         dims,
         data: data.into_iter().map(|v| v as f32).collect(),
         spacing: volume.spacing,
+        orientation: volume.orientation,
     };
     let (partials, magnitude) = if lit {
         let g = spectral_gradient(volume)?;

@@ -44,6 +44,18 @@ pub const CT_HEAD_SPACING: [f64; 3] = [0.957_031_2, 0.957_031_2, 1.5];
 /// Sizes `[x, y, z]` of `brainsmall`.
 pub const BRAINSMALL_DIMS: [usize; 3] = [128, 128, 84];
 
+/// Where `brainsmall`'s axes point in the patient (RAS). The `.den` file
+/// carries no orientation; these are read from its anatomy: `x` runs from
+/// the face to the back of the head (posterior), `y` from the crown to the
+/// neck (inferior), and `z`, across the sagittal slices, is taken to run to
+/// the patient's right so that the frame is right-handed (a head's left
+/// and right look alike, so the anatomy cannot tell).
+pub const BRAINSMALL_ORIENTATION: fvr_engine::volume::Orientation =
+    fvr_engine::volume::Orientation {
+        direction: [[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]],
+        origin: [0.0; 3],
+    };
+
 /// `brainsmall.den`, gzip-compressed.
 pub const BRAINSMALL_DEN_GZ: &[u8] = include_bytes!("../../tests/data/brainsmall.den.gz");
 
@@ -135,7 +147,14 @@ pub fn load_dataset_with_progress(
     progress: &ProgressBar,
 ) -> Option<Result<Volume, String>> {
     match name {
-        "brainsmall" => Some(parse_den(BRAINSMALL_DEN_GZ).map_err(|e| format!("brainsmall: {e}"))),
+        "brainsmall" => Some(
+            parse_den(BRAINSMALL_DEN_GZ)
+                .map(|v| Volume {
+                    orientation: Some(BRAINSMALL_ORIENTATION),
+                    ..v
+                })
+                .map_err(|e| format!("brainsmall: {e}")),
+        ),
         "ct-head" => Some(
             ct_head_path()
                 .and_then(|p| read_volume_with_progress(&p, progress).map_err(|e| e.to_string())),

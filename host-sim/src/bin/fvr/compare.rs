@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use fvr_host::io::nrrd::read_nrrd;
+use fvr_host::io::nrrd::read_nrrd_image as read_nrrd;
 use fvr_host::reference::{max_abs_error, snr_db};
 
 #[derive(Args)]

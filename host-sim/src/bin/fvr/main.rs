@@ -10,6 +10,7 @@ mod stdout;
 mod accuracy;
 mod adaptive_report;
 mod adaptive_table;
+mod anatomy;
 mod args;
 mod checks;
 mod clap_error;
@@ -37,6 +38,7 @@ mod trade;
 mod turntable;
 mod view;
 mod views;
+mod zoom;
 
 use crate::accuracy::accuracy;
 use crate::adaptive_table::adaptive_table;
@@ -268,6 +270,8 @@ fn default_scene() -> Result<(), Error> {
         adaptive_probes: fvr_engine::slice::adaptive::DEFAULT_PROBES,
         exact: false,
         input: InputArgs::default(),
+        zoom: Default::default(),
+        anatomy: Default::default(),
     };
     let scene = SceneFile::parse(DEFAULT_SCENE, "the default scene", Path::new(""))?;
     apply_scene_to_render(&mut args, &scene, &|_| false);

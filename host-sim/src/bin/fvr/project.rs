@@ -201,6 +201,7 @@ pub(crate) fn project(args: &ProjectArgs) -> Result<(), Error> {
         views: views.len(),
         views_time: t_views,
         output: &args.out,
+        zoom: 1,
     };
     if args.stats_json {
         job.print_json(&ProjectExtra {

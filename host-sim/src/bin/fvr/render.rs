@@ -38,8 +38,9 @@ pub(crate) struct RenderArgs {
     /// command line override the scene's values.
     #[arg(long, value_name = "FILE.toml", long_help = SCENE_HELP)]
     pub(crate) scene: Option<PathBuf>,
-    /// View direction X,Y,Z, from the eye into the scene.
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, required_unless_present = "scene")]
+    /// View direction X,Y,Z in the volume's frame (its i, j, k axes), from
+    /// the eye into the scene. --view names a view in the patient's frame.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, required_unless_present_any = ["scene", "view"])]
     pub(crate) dir: Option<[f64; 3]>,
     /// Up hint X,Y,Z.
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,1")]
@@ -107,6 +108,10 @@ pub(crate) struct RenderArgs {
     pub(crate) exact: bool,
     #[command(flatten)]
     pub(crate) input: InputArgs,
+    #[command(flatten)]
+    pub(crate) zoom: crate::zoom::ZoomArgs,
+    #[command(flatten)]
+    pub(crate) anatomy: crate::anatomy::AnatomyArgs,
 }
 
 impl RenderArgs {
@@ -117,6 +122,11 @@ impl RenderArgs {
     }
 
     pub(crate) fn view(&self) -> Result<View, Error> {
+        if self.anatomy.view.is_some() {
+            // Stands in for the named view until the volume's orientation
+            // is read ([`crate::anatomy`]).
+            return Ok(View::along([1.0, 0.0, 0.0]));
+        }
         let dir = self.dir.ok_or_else(|| {
             "no view direction: give --dir, or `camera.dir` in the scene".to_string()
         })?;
@@ -133,6 +143,7 @@ impl RenderArgs {
 /// What a render builds from its volume ([`crate::args::plan_job`]).
 fn declare_job(args: &RenderArgs, scene: &Scene) {
     let size = args.frame.size;
+    let zoom = args.zoom.zoom as u64;
     crate::args::plan_job(
         &args.frame.spectrum,
         args.look.resample,
@@ -149,11 +160,23 @@ fn declare_job(args: &RenderArgs, scene: &Scene) {
             });
             // Per cell at f64: slice, column walk's sums (2), a mixed
             // side's transposed grid and the output.
+            // With --zoom, the padded grid and its transposed copy at f64.
+            let m = n.saturating_mul(zoom);
+            let zoomed = if zoom > 1 {
+                m.saturating_mul(m).saturating_mul(16)
+            } else {
+                0
+            };
             n.saturating_mul(n)
                 .saturating_mul(40)
-                .saturating_add(w.saturating_mul(h).saturating_mul(32))
+                .saturating_add(zoomed)
+                .saturating_add(
+                    w.saturating_mul(h)
+                        .saturating_mul(32)
+                        .saturating_mul(zoom * zoom),
+                )
         }),
-        "use a smaller --resample or --size, --precision f16 or --oversample 1",
+        "use a smaller --resample, --size or --zoom, --precision f16 or --oversample 1",
     );
 }
 
@@ -212,6 +235,10 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     view.frame()?;
     let style = args.png.style()?;
     if crate::prepared::is_prepared(volume_spec) {
+        if args.zoom.zoom > 1 || args.anatomy.view.is_some() {
+            return Err("--zoom and --view need the volume (its grid and orientation), not a                         prepared .fvrs spectrum: give the volume, or --dir and no --zoom"
+                .into());
+        }
         return crate::prepared::render(args, volume_spec, out, &ext, &view, style);
     }
     let scene = build_scene(args)?;
@@ -226,6 +253,10 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
     }
     fvr_host::budget::check_plan(volume.dims)?;
+    let view = match args.anatomy.view {
+        Some(named) => named.view_of(&mut volume, volume_spec),
+        None => view,
+    };
     let t_load = t0.elapsed();
     let settings = settings(args, scene.clone())?;
     settings.check()?;
@@ -242,7 +273,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     }
     crate::look::warn_negative_cue(&volume, &scene, &view)?;
     let (w, h) = renderer.image_size(args.frame.size)?;
-    let (image, view_report) = renderer.render(&view, Some((w, h)))?;
+    let (image, view_report) = renderer.render_zoomed(&view, Some((w, h)), args.zoom.zoom)?;
     let (w, h) = (image.width, image.height);
     let adaptive_report = match &view_report.adaptive {
         Some(a) => Some(AdaptiveReport::new(
@@ -282,7 +313,11 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
             image.write_png_window(out, range)?;
         }
     } else {
-        image.write_nrrd(out)?;
+        // The image's pixel pitch: the pixel size, over the zoom, times a
+        // preview level's 2^L.
+        let pitch = renderer.zoomed_sampling(args.zoom.zoom)?.pixel_size()
+            * (1u64 << args.look.preview_level.min(62)) as f64;
+        fvr_host::image::nrrd_image::write_image_nrrd(out, &image, Some(pitch))?;
     }
     if !args.stats_json {
         let kind = crate::stats::kind(image.channels);
@@ -299,6 +334,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         views: 1,
         views_time: t_view,
         output: out,
+        zoom: args.zoom.zoom,
     };
     let rendered = Rendered {
         args,
@@ -306,7 +342,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         volume: &volume,
         view,
         scene,
-        sampling: *renderer.sampling(),
+        sampling: renderer.zoomed_sampling(args.zoom.zoom)?,
         n: renderer.n(),
         filter: renderer.filter(),
         spectra: renderer.spectra(),
@@ -410,8 +446,12 @@ impl Rendered<'_> {
         // Plain X-ray views go through the view renderer (any grid side).
         let plain = scene.channels() == 1 && !scene.has_partner_terms();
         let working = match (args.frame.spectrum.precision, plain) {
-            (Precision::F64, true) => ViewRenderer::<f64>::new(n, filter).bytes(),
-            (_, true) => ViewRenderer::<f32>::new(n, filter).bytes(),
+            (Precision::F64, true) => ViewRenderer::<f64>::new(n, filter)
+                .with_zoom(args.zoom.zoom)?
+                .bytes(),
+            (_, true) => ViewRenderer::<f32>::new(n, filter)
+                .with_zoom(args.zoom.zoom)?
+                .bytes(),
             (Precision::F64, false) => SceneRenderer::<f64>::new(n, filter, scene)?.bytes(),
             (_, false) => SceneRenderer::<f32>::new(n, filter, scene)?.bytes(),
         };

@@ -82,6 +82,8 @@ pub(crate) struct Job<'a> {
     pub(crate) views: usize,
     pub(crate) views_time: Duration,
     pub(crate) output: &'a Path,
+    /// `fvr render --zoom`: the pixels are the renderer's divided by it.
+    pub(crate) zoom: usize,
 }
 
 fn ms(d: Duration) -> f64 {
@@ -98,7 +100,7 @@ impl Job<'_> {
             volume: self.volume_spec.to_string(),
             dims: self.volume.dims,
             spacing_mm: debug_triple(self.volume.spacing),
-            pixel_size: r.sampling().pixel_size(),
+            pixel_size: r.sampling().pixel_size() / self.zoom as f64,
             ignore_spacing: self.frame.units.ignore_spacing,
             image: self.image,
             kind: kind(self.image[2]),
@@ -166,7 +168,7 @@ impl Job<'_> {
         );
         say!(
             "  pixel size    {} {}",
-            r.sampling().pixel_size(),
+            r.sampling().pixel_size() / self.zoom as f64,
             if ignore {
                 "voxel"
             } else {

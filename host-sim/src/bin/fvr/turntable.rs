@@ -216,6 +216,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
         views: frames,
         views_time: t_views,
         output: &args.out,
+        zoom: 1,
     };
     let views_per_second = frames as f64 / t_views.as_secs_f64().max(1e-9);
     if args.stats_json {

@@ -15,6 +15,10 @@
 //!   `PixelSpacing` and orientation, and be evenly spaced (within 1 %):
 //!   missing slices or variable spacing are refused rather than rendered
 //!   distorted.
+//! - `ImageOrientationPatient` (row, column directions; the slice normal
+//!   their cross product) and the first slice's `ImagePositionPatient`,
+//!   from LPS to RAS, are the volume's orientation (none when the
+//!   attribute is absent).
 //! - Voxel `(i, j, k)` is column `i`, row `j` of slice `k`. The spacing is
 //!   `[column spacing, row spacing, slice step]` in mm (`PixelSpacing` is
 //!   row spacing first). A lone slice gets `SliceThickness` (or 1 mm).
@@ -79,8 +83,11 @@ pub struct Slice {
     pub pixel_spacing: [f64; 2],
     /// `ImagePositionPatient`, mm (zero when absent).
     pub position: [f64; 3],
-    /// `ImageOrientationPatient`: row direction, then column direction.
+    /// `ImageOrientationPatient`: row direction, then column direction
+    /// (rows along x, columns along y when absent).
     pub orientation: [f64; 6],
+    /// Whether `ImageOrientationPatient` was given.
+    pub oriented: bool,
     /// `SliceThickness` in mm, if given.
     pub thickness: Option<f64>,
     /// Modality values, column fastest.
@@ -131,8 +138,9 @@ fn slice_from(obj: &DefaultDicomObject) -> Result<Slice, IoError> {
         tags::IMAGE_ORIENTATION_PATIENT,
         "ImageOrientationPatient",
         6,
-    )?
-    .unwrap_or(vec![1.0, 0.0, 0.0, 0.0, 1.0, 0.0]);
+    )?;
+    let oriented = orientation.is_some();
+    let orientation = orientation.unwrap_or(vec![1.0, 0.0, 0.0, 0.0, 1.0, 0.0]);
     let thickness = floats(obj, tags::SLICE_THICKNESS, "SliceThickness", 1)?.map(|v| v[0]);
     let slope = floats(obj, tags::RESCALE_SLOPE, "RescaleSlope", 1)?.map_or(1.0, |v| v[0]);
     let intercept =
@@ -204,6 +212,7 @@ fn slice_from(obj: &DefaultDicomObject) -> Result<Slice, IoError> {
         pixel_spacing: [ps[0], ps[1]],
         position: [position[0], position[1], position[2]],
         orientation: [0, 1, 2, 3, 4, 5].map(|i| orientation[i]),
+        oriented,
         thickness,
         pixels,
     })
@@ -507,12 +516,22 @@ pub fn assemble(mut slices: Vec<Slice>) -> Result<Volume, IoError> {
     let spacing = check_spacing([first.pixel_spacing[1], first.pixel_spacing[0], step])
         .map_err(|e| format_error(SERIES, "PixelSpacing", e.to_string()))?;
     let dims = [first.size[0], first.size[1], slices.len()];
+    // Patient LPS to RAS; voxel k runs along the normal (slices sorted so).
+    let ras = fvr_engine::volume::Orientation::flip_lps;
+    let orientation = match first.oriented {
+        true => fvr_engine::volume::Orientation::from_columns(
+            std::array::from_fn(|w| [ras(row)[w], ras(col)[w], ras(normal)[w]]),
+            ras(slices[0].position),
+        ),
+        false => None,
+    };
     let mut data = Vec::with_capacity(dims.iter().product());
     for s in slices {
         data.extend(s.pixels);
     }
     let mut volume = Volume::new(dims, data);
     volume.spacing = spacing;
+    volume.orientation = orientation;
     Ok(volume)
 }
 

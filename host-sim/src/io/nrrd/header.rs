@@ -35,6 +35,12 @@ pub(crate) struct Layout {
     /// The `data file` field: the data is in this file, relative to the
     /// header's directory, not after the header.
     pub data_file: Option<String>,
+    /// The axes and origin in the patient (RAS), from a patient `space`,
+    /// three `space directions` vectors and `space origin`.
+    pub orientation: Option<fvr_engine::volume::Orientation>,
+    /// `kinds: RGB-color domain domain` (or `space`): a colour image, which
+    /// only the image reader accepts ([`Layout::check_volume`]).
+    pub colour: bool,
 }
 
 impl Layout {
@@ -58,6 +64,23 @@ impl Layout {
             byte_skip: 0,
             spacing: fvr_engine::volume::DEFAULT_SPACING,
             data_file: None,
+            orientation: None,
+            colour: false,
+        }
+    }
+
+    /// `Ok` unless this is a colour image: a volume's axes must all be
+    /// spatial.
+    ///
+    /// # Errors
+    /// The `kinds` error naming the colour axis.
+    pub(crate) fn check_volume(&self) -> Result<(), IoError> {
+        match self.colour {
+            true => Err(field_error(
+                "kinds",
+                "axis 0 is `RGB-color`: only scalar volumes with spatial axes can be rendered",
+            )),
+            false => Ok(()),
         }
     }
 }
@@ -76,6 +99,8 @@ struct Fields {
     spacings: Option<String>,
     space_directions: Option<String>,
     kinds: Option<String>,
+    space: Option<String>,
+    space_origin: Option<String>,
 }
 
 impl Fields {
@@ -94,6 +119,8 @@ impl Fields {
             "spacings" => ("spacings", &mut self.spacings),
             "space directions" => ("space directions", &mut self.space_directions),
             "kinds" => ("kinds", &mut self.kinds),
+            "space" => ("space", &mut self.space),
+            "space origin" => ("space origin", &mut self.space_origin),
             _ => return None,
         })
     }
@@ -128,15 +155,26 @@ impl Fields {
         let byte_skip = parse_skip(self.byte_skip.as_deref(), "byte skip")?;
         let line_skip = parse_skip(self.line_skip.as_deref(), "line skip")?;
         let (dims, count, data_bytes) = geometry(&sizes, ty)?;
-        if let Some(kinds) = &self.kinds {
-            check_kinds(kinds)?;
-        }
+        let colour = match &self.kinds {
+            Some(kinds) => check_kinds(kinds)?,
+            None => false,
+        };
+        let mut vectors = Vec::new();
         let spacing = match (self.spacings, self.space_directions) {
             // The format forbids both; `space directions` is the fuller one.
-            (_, Some(d)) => parse_space_directions(&d, dimension)?,
-            (Some(s), None) => parse_spacings(&s, dimension)?,
+            (_, Some(d)) => {
+                let (spacing, v) = parse_space_directions(&d, dimension)?;
+                vectors = v;
+                spacing
+            }
+            (Some(s), None) => parse_spacings(&s, dimension, colour)?,
             (None, None) => fvr_engine::volume::DEFAULT_SPACING,
         };
+        let orientation = super::space::orientation(
+            self.space.as_deref(),
+            &vectors,
+            self.space_origin.as_deref(),
+        )?;
         let data_file = match self.data_file {
             Some(f) => Some(parse_data_file(&f)?),
             None => None,
@@ -152,6 +190,8 @@ impl Fields {
             byte_skip,
             spacing,
             data_file,
+            orientation,
+            colour,
         })
     }
 }
@@ -194,7 +234,7 @@ fn parse_sizes(value: &str, dimension: usize) -> Result<Vec<usize>, IoError> {
 }
 
 /// The `spacings` field: one finite positive number per axis.
-fn parse_spacings(value: &str, dimension: usize) -> Result<[f64; 3], IoError> {
+fn parse_spacings(value: &str, dimension: usize, colour: bool) -> Result<[f64; 3], IoError> {
     let words: Vec<&str> = value.split_whitespace().collect();
     if words.len() != dimension {
         return Err(field_error(
@@ -207,7 +247,11 @@ fn parse_spacings(value: &str, dimension: usize) -> Result<[f64; 3], IoError> {
         ));
     }
     let mut spacing = fvr_engine::volume::DEFAULT_SPACING;
-    for (slot, word) in spacing.iter_mut().zip(&words) {
+    for (axis, (slot, word)) in spacing.iter_mut().zip(&words).enumerate() {
+        // A colour axis has no spacing.
+        if colour && axis == 0 && word.eq_ignore_ascii_case("nan") {
+            continue;
+        }
         *slot = word
             .parse::<f64>()
             .map_err(|_| field_error("spacings", format!("`{}` is not a number", excerpt(word))))?;
@@ -218,10 +262,14 @@ fn parse_spacings(value: &str, dimension: usize) -> Result<[f64; 3], IoError> {
 /// The `space directions` field: per axis a vector `(x,y,z)` (or `none`);
 /// the spacing is its length. Only the lengths are kept: rendering happens
 /// in index space, scaled per axis.
-fn parse_space_directions(value: &str, dimension: usize) -> Result<[f64; 3], IoError> {
+fn parse_space_directions(
+    value: &str,
+    dimension: usize,
+) -> Result<([f64; 3], Vec<[f64; 3]>), IoError> {
     let bad = |why: String| field_error("space directions", why);
     let mut spacing = fvr_engine::volume::DEFAULT_SPACING;
     let mut units: Vec<[f64; 3]> = Vec::new();
+    let mut vectors: Vec<[f64; 3]> = Vec::new();
     let mut rest = value.trim();
     let mut axis = 0;
     while !rest.is_empty() {
@@ -234,6 +282,8 @@ fn parse_space_directions(value: &str, dimension: usize) -> Result<[f64; 3], IoE
         if let Some(after) = rest.strip_prefix("none") {
             rest = after.trim_start();
             axis += 1;
+            // An axis without a vector: no orientation.
+            vectors.push([f64::NAN; 3]);
             continue;
         }
         let inner = rest
@@ -266,6 +316,7 @@ fn parse_space_directions(value: &str, dimension: usize) -> Result<[f64; 3], IoE
         spacing[axis] = length;
         if let [x, y, z] = components[..] {
             units.push([x / length, y / length, z / length]);
+            vectors.push([x, y, z]);
         }
         rest = inner.1.trim_start();
         axis += 1;
@@ -281,13 +332,26 @@ fn parse_space_directions(value: &str, dimension: usize) -> Result<[f64; 3], IoE
             "expected {dimension} vectors (or `none`), got {axis}"
         )));
     }
-    Ok(spacing)
+    if vectors.len() != 3 || vectors.iter().flatten().any(|c| !c.is_finite()) {
+        vectors.clear();
+    }
+    Ok((spacing, vectors))
 }
 
 /// The `kinds` field: every axis must be a spatial one (`domain`, `space`,
 /// or unknown: `none`, `???`). A colour, vector or list axis would be
 /// rendered as space.
-fn check_kinds(value: &str) -> Result<(), IoError> {
+///
+/// `Ok(true)` for a colour image, `RGB-color` then two spatial axes (which
+/// only the image reader accepts).
+fn check_kinds(value: &str) -> Result<bool, IoError> {
+    let words: Vec<&str> = value.split_whitespace().collect();
+    let spatial = |k: &str| matches!(k, "domain" | "space" | "none" | "???");
+    if let ["RGB-color", a, b] = words[..] {
+        if spatial(a) && spatial(b) {
+            return Ok(true);
+        }
+    }
     for (axis, kind) in value.split_whitespace().enumerate() {
         if !matches!(kind, "domain" | "space" | "none" | "???") {
             return Err(field_error(
@@ -299,7 +363,7 @@ fn check_kinds(value: &str) -> Result<(), IoError> {
             ));
         }
     }
-    Ok(())
+    Ok(false)
 }
 
 /// The `data file` field: a single file name. The multi-file forms

@@ -881,6 +881,7 @@ fn volume_write_keeps_samples_and_spacing() {
         dims: [5, 4, 3],
         data: (0..60).map(|n| (n as f32 - 17.0) / 3.0).collect(),
         spacing: [0.957_031_25, 0.1 + 0.2, 1.5],
+        orientation: None,
     };
     write_volume_nrrd(&file.0, &volume).expect("write");
     let back = read_nrrd(&file.0).expect("read");
@@ -889,6 +890,7 @@ fn volume_write_keeps_samples_and_spacing() {
     assert_eq!(back.spacing, volume.spacing);
     let bad = Volume {
         spacing: [1.0, 0.0, 1.0],
+        orientation: None,
         ..volume
     };
     let err = write_volume_nrrd(&file.0, &bad).expect_err("zero spacing");
