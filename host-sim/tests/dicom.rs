@@ -261,7 +261,10 @@ fn fuzz_regression_implicit_vr_lengths_are_checked_with_the_dictionary_vr() {
 fn fuzz_regression_item_group_elements_are_values() {
     let found = include_bytes!("data/fuzz/dicom-item-group-4gb.dcm");
     let e = parse_slice(found).unwrap_err().to_string();
-    assert!(e.contains("element (FFFE,FFFF) declares 4261412863 bytes"), "{e}");
+    assert!(
+        e.contains("element (FFFE,FFFF) declares 4261412863 bytes"),
+        "{e}"
+    );
 }
 
 /// Found by `cargo fuzz run dicom`: a BitsStored of 0 made

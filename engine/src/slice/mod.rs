@@ -9,3 +9,4 @@ pub mod exact;
 mod prefetch;
 mod runs;
 pub mod strip;
+mod taps;

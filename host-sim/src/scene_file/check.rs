@@ -261,7 +261,12 @@ impl Checker<'_> {
     /// that a shared scene reads no file elsewhere; a volume elsewhere is
     /// given on the command line, where it replaces the scene's.
     fn input_path(&mut self, t: &Table, prefix: &str, key: &str) -> Option<PathBuf> {
-        self.inside(t, prefix, key, "give a volume elsewhere as VOLUME on the command line")
+        self.inside(
+            t,
+            prefix,
+            key,
+            "give a volume elsewhere as VOLUME on the command line",
+        )
     }
 
     /// An output path: inside the scene's directory ([`Self::inside`]), so

@@ -15,7 +15,7 @@ use fvr_core::fvrs::Precision as Stored;
 use fvr_core::geometry::{Sampling, View};
 use fvr_engine::spectrum::{AnySpectrum, OwnedSpectrum};
 use fvr_host::image::output::{write_png, Style, Window};
-use fvr_host::image::{Image, ImageFiles};
+use fvr_host::image::Image;
 use serde::Serialize;
 
 use crate::render::RenderArgs;
@@ -113,7 +113,8 @@ pub(crate) fn render(
             channels: 1,
             data,
         };
-        image.write_nrrd(out)?;
+        // One voxel a pixel: the spacing the render in voxel units writes.
+        fvr_host::image::nrrd_image::write_image_nrrd(out, &image, Some(1.0))?;
     }
     let filter = spectrum.filter();
     let stats = PreparedStats {
