@@ -4,21 +4,7 @@
 //! differs from the X-ray one; an explicit window applies as given.
 
 mod common;
-use common::{assert_ok, fvr_line, temp_dir};
-use std::path::Path;
-
-/// The grey bytes of an 8-bit PNG and its width.
-fn grey(path: &Path) -> (usize, Vec<u8>) {
-    let file = std::fs::File::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut reader = png::Decoder::new(std::io::BufReader::new(file))
-        .read_info()
-        .unwrap();
-    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
-    let frame = reader.next_frame(&mut buf).unwrap();
-    assert_eq!(frame.color_type, png::ColorType::Grayscale);
-    buf.truncate(frame.buffer_size());
-    (frame.width as usize, buf)
-}
+use common::{assert_ok, fvr_line, grey_png as grey, temp_dir};
 
 fn mean_abs_diff(a: &[u8], b: &[u8]) -> f64 {
     assert_eq!(a.len(), b.len());

@@ -3,6 +3,7 @@
 //! ([`plot`]).
 
 mod apng;
+pub mod film;
 pub mod nrrd_image;
 pub mod output;
 pub mod plot;

@@ -57,3 +57,17 @@ pub fn fvr_in(name: &str, command: &str) -> (PathBuf, Output) {
 pub fn read(dir: &Path, name: &str) -> String {
     std::fs::read_to_string(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
+
+/// The grey bytes of an 8-bit PNG and its width.
+#[allow(dead_code)]
+pub fn grey_png(path: &Path) -> (usize, Vec<u8>) {
+    let file = std::fs::File::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut reader = png::Decoder::new(std::io::BufReader::new(file))
+        .read_info()
+        .unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let frame = reader.next_frame(&mut buf).unwrap();
+    assert_eq!(frame.color_type, png::ColorType::Grayscale);
+    buf.truncate(frame.buffer_size());
+    (frame.width as usize, buf)
+}

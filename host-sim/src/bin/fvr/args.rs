@@ -35,6 +35,14 @@ pub(crate) struct PngArgs {
     /// tabulated in matplotlib).
     #[arg(long, default_value = "gray")]
     pub(crate) colormap: Colormap,
+    /// How an X-ray PNG shows the line integrals p: `linear` (windowed as
+    /// they are) or `film[:K]`, a radiograph's attenuation look, 1 − exp(−K·p),
+    /// bright where matter attenuates; K (per mm × volume unit) defaults to
+    /// 3 / (the 99th percentile of p), which shows the longest paths near
+    /// white. Shown on [0, 1] unless --window or --percentiles is given.
+    /// NRRD outputs keep the line integrals. Grey X-ray renders only.
+    #[arg(long, default_value = "linear")]
+    pub(crate) display: fvr_host::image::film::Display,
 }
 
 impl PngArgs {

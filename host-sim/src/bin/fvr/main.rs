@@ -16,6 +16,7 @@ mod checks;
 mod clap_error;
 mod compare;
 mod convert;
+mod film;
 #[cfg(fuzzing)]
 mod fuzz;
 mod growth;
@@ -259,6 +260,7 @@ fn default_scene() -> Result<(), Error> {
             level: None,
             percentiles: fvr_host::image::AUTO_WINDOW_PERCENTILES,
             colormap: Colormap::Gray,
+            display: fvr_host::image::film::Display::Linear,
         },
         stats: true,
         stats_json: false,

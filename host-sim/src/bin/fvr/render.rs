@@ -293,7 +293,18 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         _ => None,
     };
     let mut window = None;
-    if ext == "png" {
+    let film = match ext.as_str() {
+        "png" => crate::film::film_png(&args.png, &image.data, image.channels)?,
+        _ => None,
+    };
+    if let Some((shown, range)) = &film {
+        window = Some(*range);
+        let style = fvr_host::image::output::Style {
+            window: fvr_host::image::output::Window::Range(range.0, range.1),
+            ..style
+        };
+        write_png(out, w, h, shown, &style)?;
+    } else if ext == "png" {
         let range = match cued {
             Some(range) => range,
             None if image.channels == 1 => style.window.resolve(&image.data),

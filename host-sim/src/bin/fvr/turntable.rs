@@ -119,6 +119,12 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     crate::checks::check_direction("--up (camera.up in a scene)", args.up)?;
     args.look.check()?;
     let views = turntable::orbit(args.dir, args.up, args.frames as usize)?;
+    if args.png.display != fvr_host::image::film::Display::Linear {
+        return Err(
+            "--display film is for fvr render: a turntable shows the line integrals linearly"
+                .into(),
+        );
+    }
     let style = args.png.style()?;
     let volume_spec = args.volume.as_deref().ok_or_else(|| {
         "no volume: give VOLUME, or `volume.path` or `volume.builtin` in the scene".to_string()
