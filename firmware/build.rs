@@ -1,12 +1,12 @@
 //! Build script of the firmware:
-//! 1. for the thumb targets, copies `memory.x` (`memory-m3.x` for the
-//!    Cortex-M3 target `thumbv7m-none-eabi`) and `memory-m7.x` to
-//!    directories of `OUT_DIR` as `memory.x`, gives each program the one of
-//!    its part as a link path (`memory-m7.x` to the programs named `*-m7`,
-//!    so that one cargo call builds them all on one library) and links
-//!    with `link.x` and `defmt.x`. (No `memory.x` may sit in the workspace
-//!    root: the linker runs there and would take it before the one in
-//!    `OUT_DIR`.)
+//! 1. for the thumb targets, links each program with a complete linker
+//!    script of its part written to `OUT_DIR` (`link_script.rs`, which says
+//!    why): the Cortex-M4F's layout is `memory.x` in the workspace root, the
+//!    Cortex-M3's (target `thumbv7m-none-eabi`) `memory-m3.x`, and the
+//!    Cortex-M7's (the programs named `*-m7`, on the M4F's target, so that
+//!    one cargo call builds them all on one library) `memory-m7.x`; each
+//!    script is that layout followed by `cortex-m-rt`'s `link.x` without its
+//!    `INCLUDE memory.x`, and goes with `defmt.x`;
 //! 2. runs the core **on the host** to make the flash tables: it samples the
 //!    scene's phantom (`src/scene.rs`), computes its gradient magnitude
 //!    `|∇f|` if a stored spectrum needs it, prepares the f16 spectra listed
@@ -15,8 +15,9 @@
 //!    `OUT_DIR` (the spectra as little-endian f16 files, the rest as Rust).
 //!    For the device-preparation programs it writes u8 volumes, the filters
 //!    fitted to them and their kernel tables (`make_prep_tables`);
-//! 3. refuses a scene whose tables do not fit the flash in `memory.x`, saying
-//!    by how many bytes it is over.
+//! 3. refuses a scene whose tables do not fit the flash of its target's
+//!    layout (the root `memory.x`, or `memory-m3.x`), saying by how many
+//!    bytes it is over.
 //!
 //! Nothing binary is kept in git: the tables are made here on every build.
 
@@ -47,6 +48,12 @@ mod fixed_input;
 #[path = "src/prep_volume.rs"]
 mod prep_volume;
 
+#[allow(dead_code)]
+#[path = "link_script.rs"]
+mod link_script;
+
+use link_script::{read_layout, write_link_script, Part};
+
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
     let manifest = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets it"));
@@ -55,13 +62,13 @@ fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=src/scene.rs");
     println!("cargo:rerun-if-changed=src/fixed_input.rs");
-    let memory = manifest.join(memory_layout(&target));
+    println!("cargo:rerun-if-changed=link_script.rs");
+    let memory = Part::of_target(&target).layout(&manifest);
     let layout = read_layout(&memory);
     if target.starts_with("thumb") {
         println!("cargo:rustc-link-arg-bins=--nmagic");
-        println!("cargo:rustc-link-arg-bins=-Tlink.x");
+        link_scripts(&out, &manifest, &target);
         println!("cargo:rustc-link-arg-bins=-Tdefmt.x");
-        link_layouts(&out, &manifest, &layout);
     }
 
     let tables = make_tables(&out);
@@ -71,53 +78,29 @@ fn main() {
     check_flash_budget(&layout, &memory, &tables);
 }
 
-/// The memory layout for `target`, in the manifest's directory: the
-/// Cortex-M3 (no FPU, QEMU mps2-an385) has its own.
-fn memory_layout(target: &str) -> &'static str {
-    if target.starts_with("thumbv7m-") {
-        "memory-m3.x"
-    } else {
-        "memory.x"
-    }
-}
-
-/// The programs whose name ends in `-m7` run on the Cortex-M7 part with
-/// 1 MiB of RAM (QEMU mps2-an500), which shares the M4F's target triple.
-const M7_SUFFIX: &str = "-m7";
-
-fn read_layout(path: &Path) -> String {
-    println!("cargo:rerun-if-changed={}", path.display());
-    fs::read_to_string(path)
-        .unwrap_or_else(|e| panic!("cannot read the memory layout {}: {e}", path.display()))
-}
-
-/// Puts `layout` in `OUT_DIR/target/memory.x` and
-/// `memory-m7.x` in `OUT_DIR/m7/memory.x`, and hands each program the
-/// directory of its own as a link search path (`link.x` includes
-/// `memory.x`): every program of one build links in the same cargo call,
-/// with one build of the library. The programs are the `[[bin]]` names of
-/// `Cargo.toml`.
-fn link_layouts(out: &Path, manifest: &Path, layout: &str) {
-    let m7 = read_layout(&manifest.join("memory-m7.x"));
-    for (dir, text) in [("target", layout), ("m7", m7.as_str())] {
-        fs::create_dir_all(out.join(dir)).expect("a layout directory in OUT_DIR");
-        fs::write(out.join(dir).join("memory.x"), text).expect("write memory.x to OUT_DIR");
-    }
+/// Writes the linker script of each part the programs of `target` run on
+/// (`link_script::write_link_script`) and hands each program the one of
+/// its part with `-T`: every program of one build links in the same cargo
+/// call, with one build of the library. The programs are the `[[bin]]`
+/// names of `Cargo.toml`.
+fn link_scripts(out: &Path, manifest: &Path, target: &str) {
     let cargo_toml = manifest.join("Cargo.toml");
     println!("cargo:rerun-if-changed={}", cargo_toml.display());
     let manifest_text = fs::read_to_string(&cargo_toml).expect("read Cargo.toml");
     let bins = bin_names(&manifest_text);
     assert!(!bins.is_empty(), "no [[bin]] in {}", cargo_toml.display());
+    let mut scripts: Vec<(Part, PathBuf)> = Vec::new();
     for bin in bins {
-        let dir = if bin.ends_with(M7_SUFFIX) {
-            "m7"
-        } else {
-            "target"
+        let part = Part::of(target, &bin);
+        let script = match scripts.iter().find(|(p, _)| *p == part) {
+            Some((_, script)) => script.clone(),
+            None => {
+                let script = write_link_script(out, manifest, part);
+                scripts.push((part, script.clone()));
+                script
+            }
         };
-        println!(
-            "cargo:rustc-link-arg-bin={bin}=-L{}",
-            out.join(dir).display()
-        );
+        println!("cargo:rustc-link-arg-bin={bin}=-T{}", script.display());
     }
 }
 

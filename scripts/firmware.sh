@@ -5,15 +5,18 @@
 #     defmt-print), and fails loudly if it cannot;
 #  2. lints and builds every program in four cargo calls (the Cortex-M3
 #     and M4F libraries side by side in one; the M7 programs share the
-#     M4F's target and library, build.rs giving them memory-m7.x):
+#     M4F's target and library, build.rs linking them with memory-m7.x):
 #     fvr-scene (plain, depth-cued, shaded and both) and fvr-filter-bench
 #     (M4F), fvr-fixed-bench (M3), fvr-prepare (M4F) and fvr-prepare-m7
 #     (M7), fvr-prepare-q15 (M4F 32^3, M3 64^3) and fvr-prepare-q15-m7 (M7
 #     64^3), and fvr-trig-bench (M4F, M3; the package firmware/trig);
-#  3. runs each in QEMU with -icount shift=0 under a timeout (a HardFault
+#  3. checks that each program linked with its own part's memory layout
+#     (the end of RAM, _stack_start, against memory.x, memory-m3.x or
+#     memory-m7.x);
+#  4. runs each in QEMU with -icount shift=0 under a timeout (a HardFault
 #     would otherwise spin forever), two at a time, decodes its defmt log
 #     and requires exit 0 and the SysTick calibration;
-#  4. checks the QEMU outputs against the host in one cargo call: every
+#  5. checks the QEMU outputs against the host in one cargo call: every
 #     M4F image bit for bit, and the display bytes against the host image
 #     (firmware/tests/qemu_agreement.rs); the M3's integer transforms and
 #     whole plain kb3 view, integer and soft-float f32
@@ -22,9 +25,9 @@
 #     (firmware/tests/qemu_prepare_q15.rs), bit for bit and in dB; then
 #     what the transcendental functions of libm and micromath cost the
 #     image (firmware/trig/tests/trig.rs);
-#  5. prints the instruction counts, the flash/RAM footprint, and RAM
+#  6. prints the instruction counts, the flash/RAM footprint, and RAM
 #     beyond the spectrum of the device preparations;
-#  6. checks that a scene over the flash budget fails to build, naming the
+#  7. checks that a scene over the flash budget fails to build, naming the
 #     excess (build.rs for the tables alone, the linker for tables + code).
 # Usage: bash scripts/firmware.sh
 set -euo pipefail
@@ -97,6 +100,48 @@ echo "== firmware: build ($TARGET and $M3_TARGET, release)"
 cargo build --locked "${PACKAGES[@]}" --target "$TARGET" --target "$M3_TARGET" --release \
     "${BOTH_CORES[@]}"
 cargo build --locked -p fvr-firmware --target "$TARGET" --release --bins
+
+echo "== firmware: each program's memory layout (end of RAM = _stack_start)"
+# The memory layouts: the Cortex-M4F's in the workspace root, the M3's and
+# M7's in firmware/ (firmware/link_script.rs links each program with its
+# part's). A program linked with another part's layout has another end of
+# RAM, so this fails.
+M4F_LAYOUT=memory.x
+M3_LAYOUT=firmware/memory-m3.x
+M7_LAYOUT=firmware/memory-m7.x
+ram_end() { # layout: ORIGIN + LENGTH of its RAM region, in decimal
+    python3 - "$1" <<'PY'
+import re, sys
+text = re.sub(r"/\*.*?\*/", "", open(sys.argv[1]).read(), flags=re.S)
+m = re.search(r"^\s*RAM\s*:\s*ORIGIN\s*=\s*(\w+)\s*,\s*LENGTH\s*=\s*(\w+?)([KM]?)\s*$", text, re.M)
+if not m:
+    sys.exit(f"{sys.argv[1]}: no `RAM : ORIGIN = ..., LENGTH = ...` line")
+unit = {"": 1, "K": 1024, "M": 1024 * 1024}[m.group(3)]
+print(int(m.group(1), 0) + int(m.group(2), 0) * unit)
+PY
+}
+m4f_ram_end=$(ram_end "$M4F_LAYOUT")
+m3_ram_end=$(ram_end "$M3_LAYOUT")
+m7_ram_end=$(ram_end "$M7_LAYOUT")
+[ "$m4f_ram_end" != "$m3_ram_end" ] && [ "$m4f_ram_end" != "$m7_ram_end" ] && [ "$m3_ram_end" != "$m7_ram_end" ] \
+    || fail "two memory layouts end their RAM at the same address: this check cannot tell them apart"
+check_layout() { # elf layout ram-end
+    local hex
+    hex=$(readelf -sW "$1" | awk '$8 == "_stack_start" { print $2 }')
+    [ -n "$hex" ] || fail "$1: no _stack_start symbol"
+    [ $((16#$hex)) -eq "$3" ] \
+        || fail "$(basename "$1") ($1): _stack_start is 0x$hex, but $2 ends RAM at $(printf '0x%08x' "$3"): it linked with another part's memory layout"
+    printf '%-40s _stack_start 0x%s  %s\n' "${1#"$target_dir"/}" "$hex" "$2"
+}
+for program in fvr-scene fvr-filter-bench fvr-prepare fvr-prepare-q15 fvr-trig-bench; do
+    check_layout "$bin_dir/$program" "$M4F_LAYOUT" "$m4f_ram_end"
+done
+for program in fvr-prepare-m7 fvr-prepare-q15-m7; do
+    check_layout "$bin_dir/$program" "$M7_LAYOUT" "$m7_ram_end"
+done
+for program in "$M3_PROGRAM" fvr-prepare-q15 fvr-trig-bench; do
+    check_layout "$m3_dir/$program" "$M3_LAYOUT" "$m3_ram_end"
+done
 
 # Every QEMU run: name (of its log and outputs), machine, cpu, elf.
 QEMU_RUNS=(
@@ -273,7 +318,7 @@ grep -h '^trig ' "$run_dir/fvr-trig-bench-m4f.log" "$run_dir/fvr-trig-bench-m3.l
     || fail "fvr-trig-bench: no counts in its logs"
 
 echo "== firmware: a scene over the flash budget fails to build, naming the excess"
-# In a copy of the workspace whose firmware/memory.x is smaller, building
+# In a copy of the workspace whose memory.x is smaller, building
 # the program whose tables are largest (fvr-filter-bench) in the same
 # target directory: the registry crates are reused. Cargo names a
 # workspace crate's build by its path within the workspace, so the copy's
@@ -293,8 +338,8 @@ cargo fetch --locked --quiet || fail "cargo fetch failed: the copy's lock cannot
 (cd "$budget_ws" && cargo metadata --offline --format-version 1 >/dev/null) \
     || fail "could not update the copy's Cargo.lock offline"
 expect_build_failure() { # flash-length pattern what
-    sed -i "s/^\( *FLASH *: *ORIGIN = 0x00000000, LENGTH = \).*/\1$1/" "$budget_ws/firmware/memory.x"
-    grep -q "LENGTH = $1\$" "$budget_ws/firmware/memory.x" || fail "could not set FLASH to $1 in the copy of firmware/memory.x"
+    sed -i "s/^\( *FLASH *: *ORIGIN = 0x00000000, LENGTH = \).*/\1$1/" "$budget_ws/memory.x"
+    grep -q "LENGTH = $1\$" "$budget_ws/memory.x" || fail "could not set FLASH to $1 in the copy of memory.x"
     set +e
     (cd "$budget_ws" && CARGO_TARGET_DIR="$target_dir" \
         cargo build --locked -p fvr-firmware --target "$TARGET" --release --bin fvr-filter-bench) \

@@ -1,5 +1,6 @@
 //! The parts `fvr prepare --for` budgets a prepared spectrum against: their
-//! flash and RAM (the firmware's memory layouts, `firmware/memory*.x`), and
+//! flash and RAM (the firmware's memory layouts: `memory.x` for the M4F,
+//! `firmware/memory-m3.x` and `firmware/memory-m7.x`), and
 //! what a `.fvrs` image and one view at full size need of each.
 
 use fvr_core::filter::KernelTable;
@@ -26,7 +27,7 @@ pub fn memory(part: Part) -> Option<Memory> {
         Part::M4f => Some(Memory {
             flash: 2048 * K,
             ram: 512 * K,
-            layout: "firmware/memory.x",
+            layout: "memory.x",
         }),
         Part::M3 => Some(Memory {
             flash: 4096 * K,

@@ -53,7 +53,7 @@ impl Precision {
 pub enum Part {
     /// A host computer: no memory budget.
     Host,
-    /// Cortex-M4F (`firmware/memory.x`).
+    /// Cortex-M4F (`memory.x` in the workspace root).
     M4f,
     /// Cortex-M3, no FPU (`firmware/memory-m3.x`).
     M3,
