@@ -73,7 +73,9 @@ mod tests {
         assert_eq!("linear".parse(), Ok(Display::Linear));
         assert_eq!("film".parse(), Ok(Display::Film(None)));
         assert_eq!("film:0.02".parse(), Ok(Display::Film(Some(0.02))));
-        for bad in ["film:0", "film:-1", "film:inf", "film:x", "fil", "linear:2", ""] {
+        for bad in [
+            "film:0", "film:-1", "film:inf", "film:x", "fil", "linear:2", "",
+        ] {
             assert!(bad.parse::<Display>().is_err(), "{bad}");
         }
     }
