@@ -267,6 +267,20 @@ fn fuzz_regression_item_group_elements_are_values() {
     );
 }
 
+/// Found by `cargo fuzz run dicom -s none`: pixel data as OW of odd length
+/// (79 bytes), which the parser reads as 16-bit words, leaving it a byte
+/// out of step with the element boundaries; it then read a 3.4 GB length
+/// from the bytes that followed (`fvr convert` peaked at 3.3 GB resident).
+#[test]
+fn fuzz_regression_odd_ow_lengths_are_refused() {
+    let found = include_bytes!("data/fuzz/dicom-odd-ow-3gb.dcm");
+    let e = parse_slice(found).unwrap_err().to_string();
+    assert!(
+        e.contains("element (7FE0,0010) of 2-byte values has length 79, not a multiple of 2"),
+        "{e}"
+    );
+}
+
 /// Found by `cargo fuzz run dicom`: a BitsStored of 0 made
 /// `dicom-pixeldata` panic building its lookup table
 /// (`assertion failed: bits_stored != 0 && bits_stored <= 32`).

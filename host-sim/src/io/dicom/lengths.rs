@@ -213,7 +213,7 @@ impl<'a> Walk<'a> {
         // takes two bytes of value as the next header (a corrupt file made
         // it allocate 4 GB that way).
         let size = match vr {
-            Some(b"SS" | b"US") => 2,
+            Some(b"SS" | b"US" | b"OW") => 2,
             Some(b"FL" | b"SL" | b"UL" | b"AT" | b"OF" | b"OL") => 4,
             Some(b"FD" | b"SV" | b"UV" | b"OD" | b"OV") => 8,
             _ => 1,
