@@ -130,7 +130,7 @@ fn extreme_light_directions_light_the_volume() {
             &dir,
         );
         assert_ok(&out);
-        let img = fvr_host::io::nrrd::read_nrrd(&dir.join("x.nrrd")).unwrap();
+        let img = fvr_host::io::nrrd::read_nrrd_image(&dir.join("x.nrrd")).unwrap();
         assert!(img.data.iter().all(|v| v.is_finite()), "{light}");
         assert!(img.data.iter().any(|&v| v > 0.0), "{light}: a dark image");
     }
