@@ -7,7 +7,7 @@ mod common;
 use common::{assert_ok, fvr_line, temp_dir};
 
 /// The keys every renderer's `--stats-json` starts with, in order.
-const COMMON: [&str; 24] = [
+const COMMON: [&str; 25] = [
     "command",
     "volume",
     "dims",
@@ -32,6 +32,7 @@ const COMMON: [&str; 24] = [
     "ms_per_view",
     "output",
     "accuracy",
+    "taper",
 ];
 
 const RUNS: [(&str, &str, usize); 3] = [

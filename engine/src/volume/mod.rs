@@ -2,6 +2,7 @@
 
 mod orientation;
 pub mod phantom;
+pub mod taper;
 
 pub use orientation::Orientation;
 

@@ -385,6 +385,7 @@ impl Checker<'_> {
             raw_endian: self.parsed(t, p, "raw_endian", parse_endian),
             background: self.number(t, p, "background"),
             resample: self.integer(t, p, "resample", 2, 4096).map(|v| v as usize),
+            taper: self.integer(t, p, "taper", 1, 4096).map(|v| v as usize),
             ignore_spacing: self.boolean(t, p, "ignore_spacing"),
         }
     }

@@ -99,6 +99,8 @@ pub struct VolumeSection {
     pub background: Option<f64>,
     /// Resample to cubic voxels with this many along the longest side.
     pub resample: Option<usize>,
+    /// Fade content cut by the box over this many voxels (`--taper`).
+    pub taper: Option<usize>,
     /// Render in voxel units, ignoring the volume's spacing.
     pub ignore_spacing: Option<bool>,
 }
@@ -212,6 +214,7 @@ pub(crate) const VOLUME_KEYS: &[&str] = &[
     "raw_endian",
     "background",
     "resample",
+    "taper",
     "ignore_spacing",
 ];
 pub(crate) const CAMERA_KEYS: &[&str] = &["dir", "up", "size", "pixel_size"];

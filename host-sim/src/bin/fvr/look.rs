@@ -13,6 +13,7 @@ use fvr_host::options::{
 use fvr_host::scene_file::SceneFile;
 
 use crate::scene::fill;
+use crate::taper::TaperArgs;
 use crate::Error;
 
 /// Depth cue, ambient, lights, resampling and preview level (render and
@@ -55,6 +56,8 @@ pub(crate) struct LookArgs {
     /// and lights need it.
     #[arg(long, value_name = "N")]
     pub(crate) resample: Option<usize>,
+    #[command(flatten)]
+    pub(crate) taper: TaperArgs,
     /// Progressive preview level: 0 full resolution; L renders the image at
     /// 1/2^L of the size from the central 1/4^L of the slice (4^L times fewer
     /// interpolations). Plain X-ray views only. (`--level` is the PNG
@@ -73,6 +76,7 @@ impl Default for LookArgs {
             light_ring: None,
             no_cue_correction: false,
             resample: None,
+            taper: TaperArgs::default(),
             preview_level: 0,
         }
     }
@@ -82,6 +86,7 @@ impl LookArgs {
     /// Refuse bad light directions and resample counts before any work.
     pub(crate) fn check(&self) -> Result<(), Error> {
         crate::checks::check_resample_count(self.resample)?;
+        self.taper.check()?;
         for light in &self.lights {
             crate::checks::check_direction("--light (a scene light's direction)", light.towards)?;
         }
@@ -137,6 +142,12 @@ pub(crate) fn apply_scene_to_look(
         "resample",
         &mut look.resample,
         scene.volume.resample.map(Some),
+    );
+    fill(
+        given,
+        "taper",
+        &mut look.taper.taper,
+        scene.volume.taper.map(Some),
     );
     let sh = &scene.shading;
     fill(

@@ -33,6 +33,7 @@ mod scene;
 #[cfg(not(fuzzing))]
 mod signals;
 mod stats;
+mod taper;
 #[cfg(test)]
 mod tests;
 mod trade;

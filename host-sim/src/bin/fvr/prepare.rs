@@ -3,6 +3,7 @@
 //! flash and RAM before anything is prepared or written; as the file, a
 //! raw image for loading at run time, or a C `.c`/`.h` pair for flash.
 
+use crate::taper::TaperArgs;
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
@@ -75,6 +76,8 @@ pub(crate) struct PrepareArgs {
     /// stderr); with it, a size that does not fit is refused.
     #[arg(long, value_name = "N")]
     pub(crate) resample: Option<usize>,
+    #[command(flatten)]
+    pub(crate) taper: TaperArgs,
     #[command(flatten)]
     pub(crate) input: InputArgs,
 }
@@ -220,11 +223,13 @@ pub(crate) fn prepare(args: &PrepareArgs) -> Result<(), Error> {
             )
         }
     };
+    args.taper.check()?;
     let files = outputs(args)?;
-    let volume = args.input.load(&args.volume)?;
+    let mut volume = args.input.load(&args.volume)?;
     for f in &files {
         crate::checks::check_not_input(f)?;
     }
+    args.taper.apply(&mut volume)?;
     let volume = fit(volume, args, precision)?;
     let settings = Settings {
         accuracy_db: args.accuracy,

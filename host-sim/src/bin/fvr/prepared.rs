@@ -42,6 +42,7 @@ fn refused_option(args: &RenderArgs) -> Option<&'static str> {
         (!look.lights.is_empty(), "--light"),
         (look.light_ring.is_some(), "--light-ring"),
         (look.resample.is_some(), "--resample"),
+        (look.taper.taper.is_some(), "--taper"),
         (look.preview_level > 0, "--preview-level"),
         (args.adaptive.is_some(), "--adaptive"),
         (args.exact, "--exact"),
@@ -141,6 +142,8 @@ pub(crate) fn render(
         views_ms: t_view.as_secs_f64() * 1e3,
         ms_per_view: t_view.as_secs_f64() * 1e3,
         output: out.display().to_string(),
+        accuracy: None,
+        taper: None,
         window,
     };
     if args.stats_json {
@@ -209,5 +212,7 @@ struct PreparedStats {
     views_ms: f64,
     ms_per_view: f64,
     output: String,
+    accuracy: Option<()>,
+    taper: Option<()>,
     window: Option<[f64; 2]>,
 }

@@ -2,6 +2,7 @@
 //! one float32 stack (NRRD or `.npy`), for projection sets (digitally
 //! reconstructed radiographs, training data, registration).
 
+use crate::taper::TaperArgs;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -59,6 +60,8 @@ pub(crate) struct ProjectArgs {
     #[arg(long)]
     pub(crate) stats_json: bool,
     #[command(flatten)]
+    pub(crate) taper: TaperArgs,
+    #[command(flatten)]
     pub(crate) input: InputArgs,
 }
 
@@ -108,6 +111,7 @@ pub(crate) fn project(args: &ProjectArgs) -> Result<(), Error> {
         }
     }
     crate::checks::check_direction("--up", args.up)?;
+    args.taper.check()?;
     let views = match (&args.views, args.random) {
         (Some(file), _) => read_views(file, args.up)?,
         (None, Some(n)) => random_views(n as usize, args.seed),
@@ -121,12 +125,13 @@ pub(crate) fn project(args: &ProjectArgs) -> Result<(), Error> {
     }
     declare_job(args, views.len());
     let t0 = Instant::now();
-    let volume = args.input.load(&args.volume)?;
+    let mut volume = args.input.load(&args.volume)?;
     crate::checks::check_not_input(&args.out)?;
     if let Some(csv) = &args.save_views {
         crate::checks::check_not_input(csv)?;
     }
     let _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
+    let taper = args.taper.apply(&mut volume)?;
     fvr_host::budget::check_plan(volume.dims)?;
     let t_load = t0.elapsed();
     let settings = Settings {
@@ -202,6 +207,7 @@ pub(crate) fn project(args: &ProjectArgs) -> Result<(), Error> {
         views_time: t_views,
         output: &args.out,
         zoom: 1,
+        taper,
     };
     if args.stats_json {
         job.print_json(&ProjectExtra {

@@ -247,6 +247,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     let mut volume = args.input.load(volume_spec)?;
     crate::checks::check_not_input(out)?;
     let mut _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
+    let taper = args.look.taper.apply(&mut volume)?;
     if let Some(largest) = args.look.resample {
         check_resample(&volume, largest)?;
         volume = volume.resample_isotropic(largest)?;
@@ -346,6 +347,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         views_time: t_view,
         output: out,
         zoom: args.zoom.zoom,
+        taper,
     };
     let rendered = Rendered {
         args,

@@ -16,6 +16,7 @@ use serde_json::value::RawValue;
 
 use crate::args::FrameArgs;
 use crate::json::{debug_triple, one_line};
+use crate::taper::TaperJson;
 
 /// `grey` for one channel, `RGB` for three.
 pub(crate) fn kind(channels: usize) -> &'static str {
@@ -67,6 +68,8 @@ pub(crate) struct Stats {
     /// The file written.
     pub(crate) output: String,
     pub(crate) accuracy: Option<crate::plan::AccuracyJson>,
+    /// `--taper`: the voxels and the faces tapered (null without it).
+    pub(crate) taper: Option<TaperJson>,
 }
 
 /// What a finished job reports, from its prepared renderer.
@@ -84,6 +87,8 @@ pub(crate) struct Job<'a> {
     pub(crate) output: &'a Path,
     /// `fvr render --zoom`: the pixels are the renderer's divided by it.
     pub(crate) zoom: usize,
+    /// What `--taper` did.
+    pub(crate) taper: Option<TaperJson>,
 }
 
 fn ms(d: Duration) -> f64 {
@@ -123,6 +128,7 @@ impl Job<'_> {
             ms_per_view: ms(self.views_time) / self.views.max(1) as f64,
             output: self.output.display().to_string(),
             accuracy: crate::plan::json(spectrum),
+            taper: self.taper.clone(),
         }
     }
 

@@ -148,6 +148,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     let mut volume = args.input.load(volume_spec)?;
     crate::checks::check_not_input(&args.out)?;
     let mut _volume = fvr_host::budget::hold(volume.data.len() as u64 * 4);
+    let taper = args.look.taper.apply(&mut volume)?;
     if let Some(largest) = args.look.resample {
         crate::checks::check_resample(&volume, largest)?;
         volume = volume.resample_isotropic(largest)?;
@@ -223,6 +224,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
         views_time: t_views,
         output: &args.out,
         zoom: 1,
+        taper,
     };
     let views_per_second = frames as f64 / t_views.as_secs_f64().max(1e-9);
     if args.stats_json {
