@@ -146,3 +146,42 @@ fn turntable_takes_the_render_options_and_refuses_what_cannot_be_done() {
         assert!(!dir.join("bad.apng").exists(), "{line}");
     }
 }
+
+/// `--zoom F` magnifies every frame as it magnifies a render: a one-frame
+/// zoomed turntable is the zoomed render's PNG, pixel for pixel, and a
+/// longer turn has frames F times as wide. Lights, depth cues and previews
+/// are refused with it, before any work.
+#[test]
+fn zoomed_turntable_frames_are_zoomed_renders() {
+    let dir = temp_dir("turntable-zoom");
+    assert_ok(&fvr_line(
+        "render sphere@24 --dir 0,-1,0 --zoom 2 --out r.png --quiet",
+        &dir,
+    ));
+    assert_ok(&fvr_line(
+        "turntable sphere@24 --frames 1 --zoom 2 --out one.apng --quiet",
+        &dir,
+    ));
+    let (w, rendered) = common::grey_png(&dir.join("r.png"));
+    let (tw, th, _, one) = frames(&dir.join("one.apng"));
+    assert_eq!((tw as usize, th as usize), (w, w));
+    assert_eq!(one[0], rendered, "frame 0 is the zoomed render");
+    let stdout = assert_ok(&fvr_line(
+        "turntable sphere@24 --frames 3 --zoom 3 --out three.apng --stats-json",
+        &dir,
+    ));
+    let stats: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    let (tw, _, _, turn) = frames(&dir.join("three.apng"));
+    assert_eq!(turn.len(), 3);
+    assert_eq!(tw as usize, 3 * w / 2, "{stats}");
+    assert_eq!(stats["image"][0], 3 * w / 2, "{stats}");
+    for line in [
+        "turntable sphere@24 --frames 2 --zoom 2 --light-ring 3 --out bad.apng",
+        "turntable sphere@24 --frames 2 --zoom 2 --depth-cue linear:1,0.2 --out bad.apng",
+        "turntable sphere@24 --frames 2 --zoom 2 --preview-level 1 --out bad.apng",
+    ] {
+        let out = fvr_line(line, &dir);
+        assert_error(&out, &["--zoom 2 magnifies plain X-ray turntables"]);
+        assert!(!dir.join("bad.apng").exists(), "{line}");
+    }
+}

@@ -69,10 +69,18 @@ pub fn render_views(
     progress: &(dyn Fn() + Sync),
 ) -> Result<Vec<Vec<f64>>, fvr_core::Error> {
     let mut frames = Vec::with_capacity(views.len());
-    render_each(spec, views, sampling, (width, height), progress, |_, f| {
-        frames.push(f.to_vec());
-        Ok::<(), fvr_core::Error>(())
-    })?;
+    render_each(
+        spec,
+        views,
+        sampling,
+        (width, height),
+        1,
+        progress,
+        |_, f| {
+            frames.push(f.to_vec());
+            Ok::<(), fvr_core::Error>(())
+        },
+    )?;
     Ok(frames)
 }
 
@@ -80,29 +88,37 @@ pub fn render_views(
 pub type FrameSink<'a, E> = dyn FnMut(usize, &[f64]) -> Result<(), E> + 'a;
 
 /// Render the views one by one like [`render_views`], handing each frame to
-/// `each(index, pixels)` instead of keeping it: memory is one frame.
+/// `each(index, pixels)` instead of keeping it: memory is one frame. With
+/// `zoom` above 1 each frame is magnified as
+/// [`AnySpectrum::render_zoomed`] magnifies a view: `zoom` times as many
+/// pixels per side of the field of view of `size`.
 ///
 /// # Errors
-/// As [`render_views`], or the first error of `each`.
+/// As [`render_views`], a zoom [`crate::image::zoom::zoomed_side`]
+/// refuses, or the first error of `each`.
 pub fn render_each<E: From<fvr_core::Error>>(
     spec: &AnySpectrum,
     views: &[View],
     sampling: &Sampling,
     size: (usize, usize),
+    zoom: usize,
     progress: &(dyn Fn() + Sync),
     mut each: impl FnMut(usize, &[f64]) -> Result<(), E>,
 ) -> Result<(), E> {
+    #[allow(clippy::too_many_arguments)]
     fn go<S: Sample, T: Real, E: From<fvr_core::Error>>(
         s: &OwnedSpectrum<S>,
         views: &[View],
         sampling: &Sampling,
         (w, h): (usize, usize),
+        zoom: usize,
         progress: &(dyn Fn() + Sync),
         each: &mut FrameSink<'_, E>,
     ) -> Result<(), E> {
-        let mut renderer = ViewRenderer::<T>::new(s.n(), s.filter());
-        let mut out = vec![T::ZERO; w * h];
-        let mut frame = vec![0.0f64; w * h];
+        let mut renderer = ViewRenderer::<T>::new(s.n(), s.filter()).with_zoom(zoom)?;
+        let pixels = (w * zoom).saturating_mul(h * zoom);
+        let mut out = vec![T::ZERO; pixels];
+        let mut frame = vec![0.0f64; pixels];
         for (i, view) in views.iter().enumerate() {
             renderer.render_sampled_into(s, view, sampling, w, h, &mut out)?;
             for (f, v) in frame.iter_mut().zip(&out) {
@@ -114,8 +130,8 @@ pub fn render_each<E: From<fvr_core::Error>>(
         Ok(())
     }
     match spec {
-        AnySpectrum::F16(s) => go::<_, f32, E>(s, views, sampling, size, progress, &mut each),
-        AnySpectrum::F32(s) => go::<_, f32, E>(s, views, sampling, size, progress, &mut each),
-        AnySpectrum::F64(s) => go::<_, f64, E>(s, views, sampling, size, progress, &mut each),
+        AnySpectrum::F16(s) => go::<_, f32, E>(s, views, sampling, size, zoom, progress, &mut each),
+        AnySpectrum::F32(s) => go::<_, f32, E>(s, views, sampling, size, zoom, progress, &mut each),
+        AnySpectrum::F64(s) => go::<_, f64, E>(s, views, sampling, size, zoom, progress, &mut each),
     }
 }

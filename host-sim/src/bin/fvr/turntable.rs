@@ -47,6 +47,8 @@ pub(crate) struct TurntableArgs {
     pub(crate) frame: FrameArgs,
     #[command(flatten)]
     pub(crate) look: LookArgs,
+    #[command(flatten)]
+    pub(crate) zoom: crate::zoom::ZoomArgs,
     /// Output file: .apng or .png (an animated PNG either way; RGB, 8-bit,
     /// for coloured lights).
     #[arg(long, default_value = "spin.apng")]
@@ -78,6 +80,7 @@ const SAMPLE_FRAMES: usize = 16;
 fn declare_job(args: &TurntableArgs, scene: &Scene, frames: usize) {
     let size = args.frame.size;
     let channels = scene.channels() as u64;
+    let zoom = args.zoom.zoom as u64;
     crate::args::plan_job(
         &args.frame.spectrum,
         args.look.resample,
@@ -88,16 +91,27 @@ fn declare_job(args: &TurntableArgs, scene: &Scene, frames: usize) {
         },
         ("frames and view buffers", move |n, side| {
             let (w, h) = crate::args::planned_image(size, n, side);
-            let frame = w.saturating_mul(h).saturating_mul(8 * channels);
+            let frame = w
+                .saturating_mul(h)
+                .saturating_mul(8 * channels)
+                .saturating_mul(zoom * zoom);
             let all = frame.saturating_mul(frames as u64);
+            // With --zoom, the padded grid and its transposed copy at f64.
+            let m = n.saturating_mul(zoom);
+            let zoomed = if zoom > 1 {
+                m.saturating_mul(m).saturating_mul(16)
+            } else {
+                0
+            };
             // One view's grids and the frames kept.
-            crate::args::view_grid_bytes(n).saturating_add(if all <= HOLD_FRAMES_BYTES {
+            let grids = crate::args::view_grid_bytes(n).saturating_add(zoomed);
+            grids.saturating_add(if all <= HOLD_FRAMES_BYTES {
                 all
             } else {
                 frame.saturating_mul(SAMPLE_FRAMES as u64 + 1)
             })
         }),
-        "use fewer --frames, a smaller --size or --resample, --precision f16 or --oversample 1",
+        "use fewer --frames, a smaller --size, --zoom or --resample, --precision f16 or --oversample 1",
     );
 }
 
@@ -135,6 +149,14 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     }
     crate::checks::check_output(&args.out, &["apng", "png"], volume_spec, &others)?;
     let scene = args.look.scene(&views[0])?;
+    if args.zoom.zoom > 1 && (scene != Scene::xray() || args.look.preview_level > 0) {
+        return Err(format!(
+            "--zoom {} magnifies plain X-ray turntables: leave out --zoom, or the lights, \
+             depth cue, --ambient and --preview-level",
+            args.zoom.zoom
+        )
+        .into());
+    }
     if scene.channels() > 1 && (args.png.colormap != Colormap::Gray || args.png.bits != Bits::Eight)
     {
         return Err(
@@ -176,14 +198,16 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     }
     crate::look::warn_negative_cue(&volume, &scene, &views[0])?;
     let size = renderer.image_size(args.frame.size)?;
+    let zoom = args.zoom.zoom;
     let (w, h) = match args.look.preview_level {
-        0 => size,
+        0 => (size.0 * zoom, size.1 * zoom),
         level => fvr_core::render::preview_size(size.0, size.1, level),
     };
     let source = Source {
         renderer: &renderer,
         scene: &scene,
         size,
+        zoom,
         image: (w, h),
         cause: args.look.overflow_cause(),
     };
@@ -223,7 +247,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
         views: frames,
         views_time: t_views,
         output: &args.out,
-        zoom: 1,
+        zoom,
         taper,
     };
     let views_per_second = frames as f64 / t_views.as_secs_f64().max(1e-9);
@@ -256,8 +280,11 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
 struct Source<'a> {
     renderer: &'a Renderer,
     scene: &'a Scene,
-    /// The image size asked for (before a preview level shrinks it).
+    /// The image size asked for (before a preview level shrinks it or a
+    /// zoom magnifies it).
     size: (usize, usize),
+    /// `--zoom`: each side magnified this many times (plain X-ray views).
+    zoom: usize,
     /// The frames' size.
     image: (usize, usize),
     /// What to blame for non-finite pixels.
@@ -283,6 +310,7 @@ impl Source<'_> {
                 views,
                 r.sampling(),
                 self.size,
+                self.zoom,
                 &|| bar.inc(1),
                 |_, frame| {
                     check(frame)?;
