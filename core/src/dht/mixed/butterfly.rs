@@ -16,6 +16,9 @@ pub struct C<T> {
     pub im: T,
 }
 
+// Plain methods rather than the operator traits: the butterflies read as
+// the formulas, and no caller needs `+` on complex values.
+#[allow(clippy::should_implement_trait)]
 impl<T: Real> C<T> {
     /// `self + o`.
     #[inline(always)]
