@@ -142,13 +142,9 @@ fn make_fixed_tables(out: &Path) {
     fs::write(out.join("fixed_tables.rs"), src).expect("write fixed_tables.rs");
 }
 
-/// The kb3 density spectrum of the scene's phantom in Q15 with one block
-/// exponent per x-line, for the Cortex-M3's integer view
-/// (`src/stored_q15.rs`): prepared in f64 by the core
-/// (`Spectrum::prepare`) and rounded once (`encode_blocks`), written as
-/// little-endian mantissas and exponents beside a Rust description.
-fn make_q15_view_tables(out: &Path) {
-    use fvr_core::num::{encode_blocks, BlockLayout, Q15};
+/// The phantom, sampled at voxel centres (i, j, k), rounded to f32 as the
+/// host's phantom sampler does.
+fn phantom_voxels() -> Vec<f32> {
     let [nx, ny, nz] = DIMS;
     let mut voxels = Vec::with_capacity(nx * ny * nz);
     for k in 0..nz {
@@ -158,6 +154,17 @@ fn make_q15_view_tables(out: &Path) {
             }
         }
     }
+    voxels
+}
+
+/// The kb3 density spectrum of the scene's phantom in Q15 with one block
+/// exponent per x-line, for the Cortex-M3's integer view
+/// (`src/stored_q15.rs`): prepared in f64 by the core
+/// (`Spectrum::prepare`) and rounded once (`encode_blocks`), written as
+/// little-endian mantissas and exponents beside a Rust description.
+fn make_q15_view_tables(out: &Path) {
+    use fvr_core::num::{encode_blocks, BlockLayout, Q15};
+    let voxels = phantom_voxels();
     let volume = DenseVolume::new(DIMS, &voxels).expect("phantom shape");
     let n = padded_size(DIMS, OVERSAMPLE).expect("phantom size");
     let (filter, _) =
@@ -226,17 +233,7 @@ struct Made {
 }
 
 fn make_tables(out: &Path) -> Vec<Made> {
-    // The phantom, sampled at voxel centres (i, j, k), rounded to f32 as the
-    // host's phantom sampler does.
-    let [nx, ny, nz] = DIMS;
-    let mut voxels = Vec::with_capacity(nx * ny * nz);
-    for k in 0..nz {
-        for j in 0..ny {
-            for i in 0..nx {
-                voxels.push(scene::density([i as f64, j as f64, k as f64]) as f32);
-            }
-        }
-    }
+    let voxels = phantom_voxels();
     let volume = DenseVolume::new(DIMS, &voxels).expect("phantom shape");
     let n = padded_size(DIMS, OVERSAMPLE).expect("phantom size");
 

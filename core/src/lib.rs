@@ -31,6 +31,9 @@ pub mod slice;
 pub mod spectrum;
 pub mod volume;
 
+#[cfg(test)]
+mod test_support;
+
 pub use error::{Error, Result};
 pub use half::f16;
 pub use render::{render, Buffers, Request, Source};

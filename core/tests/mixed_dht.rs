@@ -303,6 +303,20 @@ fn tables<T: Real>(dims: &[usize]) -> Vec<Vec<T>> {
         .collect()
 }
 
+/// `dht_3d_mixed` of `data` (storage `S`) in arithmetic `T`, with a plan
+/// per axis.
+fn mixed_3d<S: Sample, T: Real>(data: &mut [S], dims: [usize; 3]) {
+    let mut tabs = tables::<T>(&dims);
+    let [tx, ty, tz] = &mut tabs[..] else {
+        unreachable!()
+    };
+    let px = MixedPlan::new(tx, dims[0]).unwrap();
+    let py = MixedPlan::new(ty, dims[1]).unwrap();
+    let pz = MixedPlan::new(tz, dims[2]).unwrap();
+    let mut scratch = vec![T::ZERO; dht_3d_mixed_scratch_len(dims)];
+    dht_3d_mixed(data, dims, &mut scratch, [&px, &py, &pz]).unwrap();
+}
+
 fn check_2d<T: Real>(nx: usize, ny: usize, c: f64) -> f64 {
     let input = signal(nx * ny, (nx * 31 + ny) as u64);
     let mut data: Vec<T> = input.iter().map(|&v| T::from_f64(v)).collect();
@@ -344,15 +358,7 @@ fn check_3d<T: Real + Sample>(dims: [usize; 3], c: f64) -> f64 {
     let input = signal(n, (dims[0] * 1000 + dims[1] * 10 + dims[2]) as u64);
     let mut data: Vec<T> = input.iter().map(|&v| <T as Real>::from_f64(v)).collect();
     let exact: Vec<f64> = data.iter().map(|v| Real::to_f64(*v)).collect();
-    let mut tabs = tables::<T>(&dims);
-    let [tx, ty, tz] = &mut tabs[..] else {
-        unreachable!()
-    };
-    let px = MixedPlan::new(tx, dims[0]).unwrap();
-    let py = MixedPlan::new(ty, dims[1]).unwrap();
-    let pz = MixedPlan::new(tz, dims[2]).unwrap();
-    let mut scratch = vec![T::ZERO; dht_3d_mixed_scratch_len(dims)];
-    dht_3d_mixed(&mut data, dims, &mut scratch, [&px, &py, &pz]).unwrap();
+    mixed_3d::<_, T>(&mut data, dims);
     let r = ratio::<T>(rel_rms(&data, &naive_dht(&exact, dims)), n);
     assert!(r <= c, "{dims:?}: {r:.3}");
     r
@@ -390,16 +396,8 @@ fn true_3d_agrees_with_radix_2() {
         let mut s2 = vec![0.0f64; dht_3d_scratch_len(dims)];
         dht_3d(&mut radix2, dims, &mut s2, &tw).unwrap();
 
-        let mut tabs = tables::<f64>(&dims);
-        let [tx, ty, tz] = &mut tabs[..] else {
-            unreachable!()
-        };
-        let px = MixedPlan::new(tx, dims[0]).unwrap();
-        let py = MixedPlan::new(ty, dims[1]).unwrap();
-        let pz = MixedPlan::new(tz, dims[2]).unwrap();
         let mut mixed = input.clone();
-        let mut sm = vec![0.0f64; dht_3d_mixed_scratch_len(dims)];
-        dht_3d_mixed(&mut mixed, dims, &mut sm, [&px, &py, &pz]).unwrap();
+        mixed_3d::<_, f64>(&mut mixed, dims);
         let r = ratio::<f64>(rel_rms(&mixed, &radix2), n);
         assert!(r <= 4.0, "{dims:?}: {r:.3}");
         println!("3D {dims:?} mixed vs radix 2: {r:.3}·ε·log₂N");
@@ -431,15 +429,7 @@ fn f16_storage_rounds_once_per_pass() {
     let input = signal(n, 11);
     let mut data: Vec<f16> = input.iter().map(|&v| f16::from_f64(v)).collect();
     let exact: Vec<f64> = data.iter().map(|v| v.to_f64()).collect();
-    let mut tabs = tables::<f32>(&dims);
-    let [tx, ty, tz] = &mut tabs[..] else {
-        unreachable!()
-    };
-    let px = MixedPlan::new(tx, dims[0]).unwrap();
-    let py = MixedPlan::new(ty, dims[1]).unwrap();
-    let pz = MixedPlan::new(tz, dims[2]).unwrap();
-    let mut scratch = vec![0.0f32; dht_3d_mixed_scratch_len(dims)];
-    dht_3d_mixed(&mut data, dims, &mut scratch, [&px, &py, &pz]).unwrap();
+    mixed_3d::<_, f32>(&mut data, dims);
     let got: Vec<f64> = data.iter().map(|v| v.to_f64()).collect();
     let err = rel_rms(&got, &naive_dht(&exact, dims));
     let u = 2f64.powi(-11);

@@ -10,12 +10,16 @@
 //! (peak / RMS) of the premultiplied volume and of its spectrum, the
 //! largest a stage meets.
 
+#[path = "../src/test_support.rs"]
+mod test_support;
+
 use fvr_core::dht::fixed::FixedTwiddles;
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::num::{BlockLayout, Q15};
 use fvr_core::spectrum::{prepare_scratch_len, Q15Storage, Spectrum};
 use fvr_core::volume::{padded_size, DenseVolume};
+use test_support::snr_db;
 
 /// A smooth blob with fixed-seed noise, `side³` u8 voxels, `i` fastest.
 fn volume_u8(side: usize, seed: u32) -> Vec<u8> {
@@ -38,16 +42,6 @@ fn volume_u8(side: usize, seed: u32) -> Vec<u8> {
         }
     }
     out
-}
-
-fn snr_db(reference: &[f64], got: &[f64]) -> f64 {
-    let signal: f64 = reference.iter().map(|r| r * r).sum();
-    let noise: f64 = reference
-        .iter()
-        .zip(got)
-        .map(|(r, g)| (r - g) * (r - g))
-        .sum();
-    10.0 * (signal / noise).log10()
 }
 
 fn crest(v: &[f64]) -> f64 {

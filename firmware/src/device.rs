@@ -459,6 +459,19 @@ pub mod unsafe_parts {
     }
 }
 
+/// The HardFault handler of a firmware program: [`hard_fault`], which
+/// ends QEMU with status 102.
+#[macro_export]
+macro_rules! hard_fault_handler {
+    () => {
+        #[allow(unsafe_code)]
+        #[cortex_m_rt::exception]
+        unsafe fn HardFault(_frame: &cortex_m_rt::ExceptionFrame) -> ! {
+            $crate::device::hard_fault()
+        }
+    };
+}
+
 /// The entry point, SysTick-free exception handlers, the frame buffers (in
 /// `.bss`, sized for the program's frames by
 /// [`buffer_sizes`](crate::scene::buffer_sizes)) and the call to [`run`]
@@ -493,10 +506,6 @@ macro_rules! firmware_main {
             $crate::device::run($program, &$frames, &[$($spectrum),+], &[$($derivative),*], bufs)
         }
 
-        #[allow(unsafe_code)]
-        #[cortex_m_rt::exception]
-        unsafe fn HardFault(_frame: &cortex_m_rt::ExceptionFrame) -> ! {
-            $crate::device::hard_fault()
-        }
+        $crate::hard_fault_handler!();
     };
 }

@@ -127,10 +127,6 @@ macro_rules! prepare_main {
             })
         }
 
-        #[allow(unsafe_code)]
-        #[cortex_m_rt::exception]
-        unsafe fn HardFault(_frame: &cortex_m_rt::ExceptionFrame) -> ! {
-            $crate::device::hard_fault()
-        }
+        $crate::hard_fault_handler!();
     };
 }

@@ -26,7 +26,7 @@
 
 use fvr_core::filter::FilterKind;
 use fvr_core::geometry::View;
-use fvr_core::shading::{DepthCue, Light, Scene};
+use fvr_core::shading::{field_count_of, DepthCue, Light, Scene};
 
 /// Side of the phantom's cube (voxels); also the padded spectrum side at
 /// oversampling 1.
@@ -228,20 +228,12 @@ impl SceneSpec {
     /// `Scene::field_count`, as a constant (the slice-sized scratch grids
     /// `render_scene` needs; the field buffer is sized by it).
     pub const fn field_count(&self) -> usize {
-        // A depth-varying cue has terms at the partner point −k.
-        let pair = if self.needs_kernel_derivative() { 2 } else { 1 };
-        if self.channels() == 1 {
-            return pair;
-        }
-        let mut count = pair + 1;
-        if self.needs_gradient_spectrum() {
-            count += pair;
-            // The eq. 14 correction (on in `Scene::xray()`).
-            if pair == 2 {
-                count += pair;
-            }
-        }
-        count
+        // A depth-varying cue has terms at the partner point −k; the eq. 14
+        // correction (on in `Scene::xray()`) adds the cue-derivative fields
+        // where there are both.
+        let partner = self.needs_kernel_derivative();
+        let gradient = self.needs_gradient_spectrum();
+        field_count_of(partner, self.channels(), gradient, gradient && partner)
     }
 }
 

@@ -43,6 +43,17 @@ fn picture(pixels: &[f32], width: usize, channels: usize) -> Image<'_> {
     }
 }
 
+/// What `DcsPanel` sends to draw `picture` at `origin` through `window`,
+/// with a row buffer of `row_len` bytes, as recorded by a capture bus.
+fn recording(origin: (u16, u16), picture: Image<'_>, window: &Window, row_len: usize) -> Vec<u8> {
+    let bus = CaptureBus::new(Memory::default());
+    let mut panel = DcsPanel::new(bus.spi(), bus.dc());
+    let mut row = vec![0u8; row_len];
+    panel.draw(origin, picture, window, &mut row).unwrap();
+    let _ = panel.release();
+    bus.into_inner().0
+}
+
 #[test]
 fn a_frame_is_caset_raset_ramwr_then_rgb565_rows_with_dc_levels() {
     // 3 × 2 image at (10, 300): values 0..5, window 0..5 → gray 0, 51, …, 255.
@@ -55,14 +66,7 @@ fn a_frame_is_caset_raset_ramwr_then_rgb565_rows_with_dc_levels() {
             gain: 51.0
         }
     );
-    let bus = CaptureBus::new(Memory::default());
-    let mut panel = DcsPanel::new(bus.spi(), bus.dc());
-    let mut row = [0u8; 6];
-    panel
-        .draw((10, 300), picture(&image, 3, 1), &window, &mut row)
-        .unwrap();
-    let _ = panel.release();
-    let rec = records(&bus.into_inner().0);
+    let rec = records(&recording((10, 300), picture(&image, 3, 1), &window, 6));
     let px = |g: u8| rgb565_gray(g).to_be_bytes();
     let row0: Vec<u8> = [0u8, 51, 102].iter().flat_map(|&g| px(g)).collect();
     let row1: Vec<u8> = [153u8, 204, 255].iter().flat_map(|&g| px(g)).collect();
@@ -91,14 +95,7 @@ fn a_recording_decodes_to_the_window_and_the_quantized_image() {
         .map(|i| ((i % w) as f32 * 0.37 - (i / w) as f32 * 0.11).sin() * 3.0 + 1.0)
         .collect();
     let window = Window::fit(&image);
-    let bus = CaptureBus::new(Memory::default());
-    let mut panel = DcsPanel::new(bus.spi(), bus.dc());
-    let mut row = vec![0u8; 2 * w];
-    panel
-        .draw((5, 7), picture(&image, w, 1), &window, &mut row)
-        .unwrap();
-    let _ = panel.release();
-    let rec = bus.into_inner().0;
+    let rec = recording((5, 7), picture(&image, w, 1), &window, 2 * w);
     let mut pixels = vec![0u16; w * h];
     let frame = decode_frame(&rec, &mut pixels).unwrap();
     assert_eq!(frame.columns, (5, 5 + w as u16 - 1));
@@ -115,14 +112,7 @@ fn an_rgb_frame_sends_one_rgb565_pixel_per_three_values_through_one_window() {
     // 2 × 2 RGB image: one window over all 12 values, 0..=11 → gain 255/11.
     let image: Vec<f32> = (0..12).map(|v| v as f32).collect();
     let window = Window::fit(&image);
-    let bus = CaptureBus::new(Memory::default());
-    let mut panel = DcsPanel::new(bus.spi(), bus.dc());
-    let mut row = [0u8; 4];
-    panel
-        .draw((3, 4), picture(&image, 2, 3), &window, &mut row)
-        .unwrap();
-    let _ = panel.release();
-    let rec = bus.into_inner().0;
+    let rec = recording((3, 4), picture(&image, 2, 3), &window, 4);
     let mut pixels = vec![0u16; 4];
     let frame = decode_frame(&rec, &mut pixels).unwrap();
     assert_eq!((frame.columns, frame.rows), ((3, 4), (4, 5)));

@@ -3,8 +3,9 @@
 
 mod common;
 
-use common::fixed::{f64_view, integer_floor_db, integer_view, snr, values};
+use common::fixed::{f64_view, integer_floor_db, integer_view, values};
 use common::{exact_image, floor_db, host_image};
+use fvr_engine::image::snr_db;
 use fvr_firmware::scene::SCENE_FRAMES;
 
 /// Against the f64 pipeline: at least the floor of the Q15 error model
@@ -20,14 +21,14 @@ fn integer_view_meets_the_q15_floor_against_f64() {
     let exact = exact_image(plain);
     let f32_image: Vec<f64> = host_image(plain).iter().map(|&v| v as f64).collect();
     let floor = integer_floor_db(&f64_slice, &f64_image);
-    let (against_f64, against_exact) = (snr(&f64_image, &integer), snr(&exact, &integer));
+    let (against_f64, against_exact) = (snr_db(&f64_image, &integer), snr_db(&exact, &integer));
     println!(
         "integer view: {against_f64:.1} dB against the f64 pipeline (floor {floor:.1} dB), \
          {against_exact:.1} dB against exact line integrals; f32 from f16: {:.1} and {:.1} dB; \
          f64 pipeline against exact: {:.1} dB",
-        snr(&f64_image, &f32_image),
-        snr(&exact, &f32_image),
-        snr(&exact, &f64_image),
+        snr_db(&f64_image, &f32_image),
+        snr_db(&exact, &f32_image),
+        snr_db(&exact, &f64_image),
     );
     assert!(
         against_f64 >= floor,

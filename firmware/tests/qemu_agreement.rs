@@ -10,9 +10,7 @@
 
 mod common;
 
-use std::path::PathBuf;
-
-use common::{exact_image, host_image, snr_db};
+use common::{count_differing, exact_image, host_image, qemu_out_dir, snr_db};
 use fvr_firmware::capture::decode_frame;
 use fvr_firmware::display::{rgb565, rgb565_gray, Window};
 use fvr_firmware::scene::{IMAGE_SIDE, PROGRAMS};
@@ -21,10 +19,7 @@ use fvr_host::io::nrrd::parse_nrrd;
 #[test]
 #[ignore = "needs the firmware's QEMU outputs: bash scripts/firmware.sh"]
 fn qemu_images_equal_host_images_bit_for_bit() {
-    let dir = PathBuf::from(
-        std::env::var_os("FVR_QEMU_OUT")
-            .expect("FVR_QEMU_OUT must name the directory QEMU wrote the firmware's files to"),
-    );
+    let dir = qemu_out_dir();
     let mut failures = Vec::new();
     for (program, frames) in PROGRAMS {
         for spec in frames {
@@ -41,11 +36,7 @@ fn qemu_images_equal_host_images_bit_for_bit() {
             };
             assert_eq!(device.dims, dims, "{}", path.display());
             assert_eq!(host.len(), device.data.len(), "{}", path.display());
-            let differing = host
-                .iter()
-                .zip(&device.data)
-                .filter(|(a, b)| a.to_bits() != b.to_bits())
-                .count();
+            let differing = count_differing(&host, &device.data, f32::to_bits);
             let exact = exact_image(spec);
             let host_f64: Vec<f64> = host.iter().map(|&v| v as f64).collect();
             println!(

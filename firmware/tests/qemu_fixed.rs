@@ -22,13 +22,14 @@ mod common;
 #[path = "../src/fixed_input.rs"]
 mod fixed_input;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use common::fixed::{f64_view, integer_floor_db, integer_view, snr, values};
-use common::{exact_image, host_image};
+use common::fixed::{f64_view, integer_floor_db, integer_view, values};
+use common::{count_differing, exact_image, host_image, le_f32s, qemu_out_dir, read_output};
 use fixed_input::{f32_from_q15, q15_block, q31_from_q15, LEN, SIDE};
 use fvr_core::dht::fixed::{self, FixedSample, FixedTwiddles};
 use fvr_core::dht::{self, Twiddles};
+use fvr_engine::image::snr_db;
 use fvr_firmware::scene::SCENE_FRAMES;
 
 /// The input block, as Q15 mantissas.
@@ -46,17 +47,6 @@ fn reference(input: &[i16]) -> Vec<f64> {
     let mut column = vec![0.0f64; SIDE];
     dht::idht_2d(&mut data, SIDE, SIDE, &mut column, &tw).unwrap();
     data
-}
-
-/// `10·log10(Σ r² / Σ (g − r)²)`.
-fn snr_db(got: &[f64], reference: &[f64]) -> f64 {
-    let signal: f64 = reference.iter().map(|r| r * r).sum();
-    let noise: f64 = got
-        .iter()
-        .zip(reference)
-        .map(|(g, r)| (g - r) * (g - r))
-        .sum();
-    10.0 * (signal / noise).log10()
 }
 
 /// Peak over RMS of the nonzero values.
@@ -101,12 +91,6 @@ fn floor_db(frac: u32, crest: f64) -> f64 {
         - 20.0 * crest.log10()
 }
 
-fn read(dir: &Path, name: &str) -> Vec<u8> {
-    let path = dir.join(name);
-    std::fs::read(&path)
-        .unwrap_or_else(|e| panic!("{}: {e} (did the firmware run?)", path.display()))
-}
-
 /// The QEMU result `[exponent i32][mantissas]` of `name`, against the host's
 /// `fixed::idht_2d` of `block`: bit-identical, and its SNR against
 /// `reference` at least the model's floor.
@@ -121,7 +105,7 @@ fn check_fixed<S: FixedSample>(
     let mut buf = vec![S::default(); FixedTwiddles::<S>::buffer_len(SIDE)];
     let tw = FixedTwiddles::new(&mut buf, SIDE).unwrap();
     let exp = fixed::idht_2d(&mut block, SIDE, SIDE, &tw).unwrap();
-    let bytes = read(dir, name);
+    let bytes = read_output(dir, name);
     let width = std::mem::size_of::<S>();
     assert_eq!(bytes.len(), 4 + width * LEN, "{name}");
     let device_exp = i32::from_le_bytes(bytes[..4].try_into().unwrap());
@@ -132,7 +116,7 @@ fn check_fixed<S: FixedSample>(
         .iter()
         .map(|m| m.to_i64() as f64 * scale.exp2())
         .collect();
-    let snr = snr_db(&values, reference);
+    let snr = snr_db(reference, &values);
     let floor = floor_db(S::FRAC_BITS, crest);
     println!(
         "{name}: exponent {device_exp} (host {exp}), {differing} of {LEN} mantissas differ from the \
@@ -152,10 +136,7 @@ fn check_fixed<S: FixedSample>(
 #[test]
 #[ignore = "needs the firmware's QEMU outputs: bash scripts/firmware.sh"]
 fn qemu_fixed_transforms_equal_host_bit_for_bit() {
-    let dir = PathBuf::from(
-        std::env::var_os("FVR_QEMU_OUT")
-            .expect("FVR_QEMU_OUT must name the directory QEMU wrote the firmware's files to"),
-    );
+    let dir = qemu_out_dir();
     let input = input();
     let reference = reference(&input);
     let crest = worst_crest(&input, &reference);
@@ -185,22 +166,15 @@ fn qemu_fixed_transforms_equal_host_bit_for_bit() {
     let tw = Twiddles::new(&mut buf, SIDE).unwrap();
     let mut column = vec![0.0f32; SIDE];
     dht::idht_2d(&mut host, SIDE, SIDE, &mut column, &tw).unwrap();
-    let bytes = read(&dir, "fvr-fixed-bench-f32.bin");
+    let bytes = read_output(&dir, "fvr-fixed-bench-f32.bin");
     assert_eq!(bytes.len(), 4 * LEN);
-    let device: Vec<f32> = bytes
-        .chunks_exact(4)
-        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-        .collect();
-    let differing = host
-        .iter()
-        .zip(&device)
-        .filter(|(a, b)| a.to_bits() != b.to_bits())
-        .count();
+    let device = le_f32s(&bytes);
+    let differing = count_differing(&host, &device, f32::to_bits);
     let values: Vec<f64> = device.iter().map(|&v| v as f64).collect();
     println!(
         "fvr-fixed-bench-f32.bin: {differing} of {LEN} values differ from the host; \
          {:.1} dB against f64 (soft float)",
-        snr_db(&values, &reference)
+        snr_db(&reference, &values)
     );
     if differing != 0 {
         failures.push("f32: not bit-identical to the host".to_string());
@@ -215,7 +189,7 @@ fn check_views(dir: &Path) -> Result<(), String> {
     let exact = exact_image(&SCENE_FRAMES[0]);
 
     let (exp, host) = integer_view();
-    let bytes = read(dir, "fvr-fixed-bench-view-q15.bin");
+    let bytes = read_output(dir, "fvr-fixed-bench-view-q15.bin");
     assert_eq!(bytes.len(), 4 + 2 * host.len(), "view-q15");
     let device_exp = i32::from_le_bytes(bytes[..4].try_into().unwrap());
     let device: Vec<i16> = bytes[4..]
@@ -225,7 +199,7 @@ fn check_views(dir: &Path) -> Result<(), String> {
     let differing = host.iter().zip(&device).filter(|(a, b)| a != b).count();
     let image = values(device_exp, &device);
     let (against_f64, floor) = (
-        snr(&f64_image, &image),
+        snr_db(&f64_image, &image),
         integer_floor_db(&f64_slice, &f64_image),
     );
     println!(
@@ -233,29 +207,22 @@ fn check_views(dir: &Path) -> Result<(), String> {
          pixels differ from the host; {against_f64:.1} dB against the f64 pipeline (floor \
          {floor:.1} dB), {:.1} dB against exact line integrals",
         host.len(),
-        snr(&exact, &image)
+        snr_db(&exact, &image)
     );
 
     let host32 = host_image(&SCENE_FRAMES[0]);
-    let bytes = read(dir, "fvr-fixed-bench-view-f32.bin");
+    let bytes = read_output(dir, "fvr-fixed-bench-view-f32.bin");
     assert_eq!(bytes.len(), 4 * host32.len(), "view-f32");
-    let device32: Vec<f32> = bytes
-        .chunks_exact(4)
-        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-        .collect();
-    let differing32 = host32
-        .iter()
-        .zip(&device32)
-        .filter(|(a, b)| a.to_bits() != b.to_bits())
-        .count();
+    let device32 = le_f32s(&bytes);
+    let differing32 = count_differing(&host32, &device32, f32::to_bits);
     let image32: Vec<f64> = device32.iter().map(|&v| v as f64).collect();
     println!(
         "fvr-fixed-bench-view-f32.bin: {differing32} of {} pixels differ from the host; \
          {:.1} dB against the f64 pipeline, {:.1} dB against exact line integrals (soft float, \
          f16 spectrum)",
         host32.len(),
-        snr(&f64_image, &image32),
-        snr(&exact, &image32)
+        snr_db(&f64_image, &image32),
+        snr_db(&exact, &image32)
     );
     if differing != 0 || device_exp != exp {
         return Err("view-q15: not bit-identical to the host".to_string());

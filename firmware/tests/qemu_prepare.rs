@@ -11,12 +11,14 @@
 //! `cargo test` and run by `scripts/firmware.sh` as
 //! `FVR_QEMU_OUT=<dir> cargo test -p fvr-firmware --test qemu_prepare -- --ignored`.
 
+mod common;
+
 use std::path::Path;
 
+use common::{below_floors, count_differing, qemu_out_dir, read_output, NoClock};
 use fvr_core::f16;
 use fvr_engine::spectrum::{AnySpectrum, OwnedSpectrum};
 use fvr_engine::volume::Volume;
-use fvr_firmware::frame::InstructionClock;
 use fvr_firmware::prepare::{
     fnv1a_f16, prepare_and_render, scratch_len, spectrum_len, view_lens, PrepBuffers, PrepInput,
     PREP_32, PREP_64,
@@ -46,14 +48,6 @@ fn per_pass_floor_db() -> f64 {
 /// roundings' energy, less 1 dB.
 fn against_fast_floor_db() -> f64 {
     one_rounding_db() - 10.0 * 4f64.log10() - 1.0
-}
-
-struct NoClock;
-
-impl InstructionClock for NoClock {
-    fn now(&self) -> u64 {
-        0
-    }
 }
 
 /// The device program on the host: the spectrum (side `N`) and the image.
@@ -148,14 +142,7 @@ fn check_db(
             against_fast_floor_db(),
         ),
     ];
-    let mut failures = Vec::new();
-    for (name, db, floor) in figures {
-        println!("{what}: {name} {db:.1} dB (floor {floor:.1})");
-        if db.is_nan() || db < floor {
-            failures.push(format!("{what}: {name} {db:.1} dB < {floor:.1}"));
-        }
-    }
-    failures
+    below_floors(what, &figures)
 }
 
 /// The host's in-place preparation of the same u8 volume equals the device
@@ -166,11 +153,7 @@ fn in_place_wrapper_agrees<const N: usize>(input: &PrepInput) {
         OwnedSpectrum::<f16>::prepare_in_place::<f32>(&host_volume(input), input.filter().unwrap())
             .unwrap();
     assert_eq!(wrapper.scale(), scale);
-    let differing = spectrum
-        .iter()
-        .zip(wrapper.data())
-        .filter(|(a, b)| a.to_bits() != b.to_bits())
-        .count();
+    let differing = count_differing(&spectrum, wrapper.data(), f16::to_bits);
     assert_eq!(differing, 0, "side {N}: {differing} coefficients differ");
 }
 
@@ -197,19 +180,14 @@ fn compare_program<const N: usize>(dir: &Path, program: &str, input: &PrepInput)
     let (host_spectrum, host_image, scale) = host_run::<N>(input);
     let mut failures = Vec::new();
 
-    let path = dir.join(format!("{program}-spectrum.f16"));
-    let bytes = std::fs::read(&path)
-        .unwrap_or_else(|e| panic!("{}: {e} (did the firmware run?)", path.display()));
-    assert_eq!(bytes.len(), 2 * spectrum_len(N), "{}", path.display());
+    let name = format!("{program}-spectrum.f16");
+    let bytes = read_output(dir, &name);
+    assert_eq!(bytes.len(), 2 * spectrum_len(N), "{name}");
     let device_spectrum: Vec<f16> = bytes
         .chunks_exact(2)
         .map(|b| f16::from_bits(u16::from_le_bytes([b[0], b[1]])))
         .collect();
-    let differing = device_spectrum
-        .iter()
-        .zip(&host_spectrum)
-        .filter(|(a, b)| a.to_bits() != b.to_bits())
-        .count();
+    let differing = count_differing(&device_spectrum, &host_spectrum, f16::to_bits);
     println!(
         "{program}: side {N}, spectrum fnv1a {:#010x}, {differing} of {} coefficients differ from the host core",
         fnv1a_f16(&device_spectrum),
@@ -225,12 +203,7 @@ fn compare_program<const N: usize>(dir: &Path, program: &str, input: &PrepInput)
     let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let device = parse_nrrd(&bytes).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     assert_eq!(device.dims, [N, N, 1], "{}", path.display());
-    let differing = device
-        .data
-        .iter()
-        .zip(&host_image)
-        .filter(|(a, b)| a.to_bits() != b.to_bits())
-        .count();
+    let differing = count_differing(&device.data, &host_image, f32::to_bits);
     println!(
         "{program}: {differing} of {} pixels differ from the host core",
         N * N
@@ -251,9 +224,8 @@ fn compare_program<const N: usize>(dir: &Path, program: &str, input: &PrepInput)
 #[test]
 #[ignore = "needs the firmware's QEMU outputs: bash scripts/firmware.sh"]
 fn qemu_prepared_spectra_equal_host_bit_for_bit() {
-    let dir = std::env::var_os("FVR_QEMU_OUT")
-        .expect("FVR_QEMU_OUT must name the directory QEMU wrote the firmware's files to");
-    let dir = Path::new(&dir);
+    let dir = qemu_out_dir();
+    let dir = dir.as_path();
     let mut failures = compare_program::<32>(dir, "fvr-prepare", &PREP_32);
     failures.extend(compare_program::<64>(dir, "fvr-prepare-m7", &PREP_64));
     assert!(failures.is_empty(), "{failures:#?}");

@@ -23,14 +23,16 @@
 //! `cargo test` and run by `scripts/firmware.sh` as
 //! `FVR_QEMU_OUT=<dir> cargo test -p fvr-firmware --test qemu_prepare_q15 -- --ignored`.
 
+mod common;
+
 use std::path::Path;
 
+use common::{below_floors, qemu_out_dir, read_output, NoClock};
 use fvr_core::f16;
 use fvr_core::num::Q15;
 use fvr_core::slice::fixed::FixedPhases;
 use fvr_engine::spectrum::{AnySpectrum, OwnedSpectrum};
 use fvr_engine::volume::Volume;
-use fvr_firmware::frame::InstructionClock;
 use fvr_firmware::prepare::{PrepInput, PREP_32, PREP_64};
 use fvr_firmware::prepare_q15::{
     fnv1a_q15, prepare_and_render_q15, q15_lens, twiddles_i16, twiddles_q15, Q15Buffers,
@@ -46,14 +48,6 @@ const VIEW_GOAL_DB: f64 = 40.0;
 /// preparation), `10·log10(3/u²)` for `u = 2^−11`, less 1 dB.
 fn f16_path_db() -> f64 {
     10.0 * (3.0 * 2048.0 * 2048.0f64).log10() - 1.0
-}
-
-struct NoClock;
-
-impl InstructionClock for NoClock {
-    fn now(&self) -> u64 {
-        0
-    }
 }
 
 /// A Q15 spectrum and image, from the host or the device.
@@ -180,14 +174,7 @@ fn check_db(what: &str, run: &Q15Run, n: usize, scale: f64, r: &References) -> V
             against_f16_floor,
         ),
     ];
-    let mut failures = Vec::new();
-    for (name, db, floor) in figures {
-        println!("{what}: {name} {db:.1} dB (floor {floor:.1})");
-        if db.is_nan() || db < floor {
-            failures.push(format!("{what}: {name} {db:.1} dB < {floor:.1}"));
-        }
-    }
-    failures
+    below_floors(what, &figures)
 }
 
 #[test]
@@ -197,19 +184,13 @@ fn device_program_on_the_host_meets_the_floors() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
-fn read(dir: &Path, name: &str) -> Vec<u8> {
-    let path = dir.join(name);
-    std::fs::read(&path)
-        .unwrap_or_else(|e| panic!("{}: {e} (did the firmware run?)", path.display()))
-}
-
 /// One program's outputs against the host: bit for bit, then in dB.
 fn compare_program<const N: usize>(dir: &Path, program: &str, input: &PrepInput) -> Vec<String> {
     let (host, scale) = host_run::<N>(input);
-    let bytes = read(dir, &format!("{program}-spectrum.q15"));
+    let bytes = read_output(dir, &format!("{program}-spectrum.q15"));
     assert_eq!(bytes.len(), N * N + 2 * N * N * N, "{program}-spectrum.q15");
     let (exps, mants) = bytes.split_at(N * N);
-    let image_bytes = read(dir, &format!("{program}-image.q15"));
+    let image_bytes = read_output(dir, &format!("{program}-image.q15"));
     assert_eq!(image_bytes.len(), 4 + 2 * N * N, "{program}-image.q15");
     let le16 = |b: &[u8]| -> Vec<i16> {
         b.chunks_exact(2)
@@ -256,9 +237,8 @@ fn compare_program<const N: usize>(dir: &Path, program: &str, input: &PrepInput)
 #[test]
 #[ignore = "needs the firmware's QEMU outputs: bash scripts/firmware.sh"]
 fn qemu_q15_spectra_equal_host_bit_for_bit() {
-    let dir = std::env::var_os("FVR_QEMU_OUT")
-        .expect("FVR_QEMU_OUT must name the directory QEMU wrote the firmware's files to");
-    let dir = Path::new(&dir);
+    let dir = qemu_out_dir();
+    let dir = dir.as_path();
     let mut failures = compare_program::<32>(dir, "fvr-prepare-q15", &PREP_32);
     failures.extend(compare_program::<64>(dir, "fvr-prepare-q15-m7", &PREP_64));
     failures.extend(compare_program::<64>(dir, "fvr-prepare-q15-m3", &PREP_64));

@@ -40,10 +40,7 @@ pub fn dht_2d<T: Real>(
     column: &mut [T],
     tw: &Twiddles<'_, T>,
 ) -> Result<()> {
-    tw.check(nx)?;
-    tw.check(ny)?;
-    check_len("2D array", nx * ny, data.len())?;
-    require_len("column scratch", ny, column.len())?;
+    check_2d(data, nx, ny, column, tw)?;
     if nx == ny && (4..TILED_TRANSPOSE_FROM).contains(&nx) {
         dht_2d_square(data, nx, tw);
     } else {
@@ -96,10 +93,7 @@ pub fn dht_2d_lines<T: Real>(
     column: &mut [T],
     tw: &Twiddles<'_, T>,
 ) -> Result<()> {
-    tw.check(nx)?;
-    tw.check(ny)?;
-    check_len("2D array", nx * ny, data.len())?;
-    require_len("column scratch", ny, column.len())?;
+    check_2d(data, nx, ny, column, tw)?;
     for row in data.chunks_exact_mut(nx) {
         dht_unchecked(row, tw);
     }
@@ -115,6 +109,21 @@ pub fn dht_2d_lines<T: Real>(
     }
     hao_bracewell_2d(data, nx, ny);
     Ok(())
+}
+
+/// The checks of [`dht_2d`] and [`dht_2d_lines`].
+#[inline(always)]
+fn check_2d<T: Real>(
+    data: &[T],
+    nx: usize,
+    ny: usize,
+    column: &[T],
+    tw: &Twiddles<'_, T>,
+) -> Result<()> {
+    tw.check(nx)?;
+    tw.check(ny)?;
+    check_len("2D array", nx * ny, data.len())?;
+    require_len("column scratch", ny, column.len())
 }
 
 /// `H(u,v) = ½[T(u,v) + T(−u,v) + T(u,−v) − T(−u,−v)]` in place.

@@ -33,22 +33,15 @@ impl<'a, T: Real> Twiddles<'a, T> {
     /// `len` not a power of two, or `buf` shorter than
     /// [`Twiddles::buffer_len`]`(len)`.
     pub fn new(buf: &'a mut [T], len: usize) -> Result<Self> {
-        require_pow2("twiddle table length", len)?;
-        let entries = Self::buffer_len(len);
-        require_len("twiddle buffer", entries, buf.len())?;
-        let step = 2.0 * core::f64::consts::PI / len as f64;
-        for (k, slot) in buf[..entries].iter_mut().enumerate() {
+        fill_quarter(buf, len, |k, angle| {
             // Exact symmetric values where the quarter-wave table is tight.
-            *slot = if 4 * k == len {
+            if 4 * k == len {
                 T::ONE
             } else {
-                T::from_f64(libm::sin(step * k as f64))
-            };
-        }
-        Ok(Self {
-            len,
-            quarter: &buf[..entries],
-        })
+                T::from_f64(libm::sin(angle))
+            }
+        })?;
+        Self::from_table(buf, len)
     }
 
     /// Wrap a table filled earlier by [`Twiddles::new`] (or stored, e.g. in
@@ -58,13 +51,8 @@ impl<'a, T: Real> Twiddles<'a, T> {
     /// `len` not a power of two, or `table` shorter than
     /// [`Twiddles::buffer_len`]`(len)`.
     pub fn from_table(table: &'a [T], len: usize) -> Result<Self> {
-        require_pow2("twiddle table length", len)?;
-        let entries = Self::buffer_len(len);
-        require_len("twiddle table", entries, table.len())?;
-        Ok(Self {
-            len,
-            quarter: &table[..entries],
-        })
+        let quarter = quarter_of(table, len)?;
+        Ok(Self { len, quarter })
     }
 
     /// Largest transform length this table serves.
@@ -89,13 +77,53 @@ impl<'a, T: Real> Twiddles<'a, T> {
     }
 
     pub(crate) fn check(&self, n: usize) -> Result<()> {
-        require_pow2("transform length", n)?;
-        if n > self.len {
-            return Err(Error::TwiddlesTooShort {
-                table_len: self.len,
-                needed: n,
-            });
-        }
-        Ok(())
+        check_serves(self.len, n)
     }
+}
+
+/// Fill the first `len/4 + 1` entries of `buf`, a quarter-wave table for
+/// lengths up to `len`, with `value(k, 2πk/len)`.
+///
+/// # Errors
+/// `len` not a power of two, or `buf` too short.
+pub(super) fn fill_quarter<E>(
+    buf: &mut [E],
+    len: usize,
+    value: impl Fn(usize, f64) -> E,
+) -> Result<()> {
+    require_pow2("twiddle table length", len)?;
+    let entries = len / 4 + 1;
+    require_len("twiddle buffer", entries, buf.len())?;
+    let step = 2.0 * core::f64::consts::PI / len as f64;
+    for (k, slot) in buf[..entries].iter_mut().enumerate() {
+        *slot = value(k, step * k as f64);
+    }
+    Ok(())
+}
+
+/// The `len/4 + 1` entries of a quarter-wave `table` for lengths up to
+/// `len`.
+///
+/// # Errors
+/// `len` not a power of two, or `table` too short.
+pub(super) fn quarter_of<E>(table: &[E], len: usize) -> Result<&[E]> {
+    require_pow2("twiddle table length", len)?;
+    let entries = len / 4 + 1;
+    require_len("twiddle table", entries, table.len())?;
+    Ok(&table[..entries])
+}
+
+/// A table for lengths up to `table_len` serves a transform of length `n`.
+///
+/// # Errors
+/// `n` not a power of two, or longer than `table_len`.
+pub(super) fn check_serves(table_len: usize, n: usize) -> Result<()> {
+    require_pow2("transform length", n)?;
+    if n > table_len {
+        return Err(Error::TwiddlesTooShort {
+            table_len,
+            needed: n,
+        });
+    }
+    Ok(())
 }

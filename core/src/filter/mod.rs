@@ -18,4 +18,4 @@ pub use special::{bessel_i0, bessel_i1_over_x};
 pub use table::{DerivativeTable, KernelTable, PhaseTable, TABLE_RESOLUTION};
 
 pub(crate) use special::gauss_legendre_16;
-pub(crate) use table::phase_entry;
+pub(crate) use table::{fill_rows, phase_entry};

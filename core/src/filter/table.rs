@@ -248,16 +248,7 @@ impl<T: Real, const W: usize> PhaseTable<T, W> {
                 v
             }
         };
-        // Each entry is read once: row `i + 1`'s weight is row `i`'s next.
-        for m in 0..W {
-            let mut w0 = entry(0, m);
-            for (i, [weights, differences]) in self.rows.iter_mut().enumerate() {
-                let w1 = entry(i + 1, m);
-                weights[m] = w0;
-                differences[m] = w1 - w0;
-                w0 = w1;
-            }
-        }
+        fill_rows(&mut self.rows, entry);
     }
 
     /// The position `Y = 1024·q − 512·W` of a sample at `q` in 32.32 fixed
@@ -310,6 +301,26 @@ impl<T: Real, const W: usize> PhaseTable<T, W> {
 pub(crate) const fn phase_entry<const W: usize>(i: usize, m: usize) -> i64 {
     let centre = (W as i64 - 2) * (TABLE_RESOLUTION as i64 / 2);
     i as i64 + centre - (m * TABLE_RESOLUTION) as i64
+}
+
+/// The rows of a width-`W` phase table, float or fixed point: row `i`
+/// holds the weights `entry(i, m)` and the differences
+/// `entry(i + 1, m) − entry(i, m)`. Each entry is read once: row `i + 1`'s
+/// weight is row `i`'s next.
+#[inline]
+pub(crate) fn fill_rows<E: Copy + core::ops::Sub<Output = E>, const W: usize>(
+    rows: &mut [[[E; W]; 2]],
+    entry: impl Fn(usize, usize) -> E,
+) {
+    for m in 0..W {
+        let mut w0 = entry(0, m);
+        for (i, [weights, differences]) in rows.iter_mut().enumerate() {
+            let w1 = entry(i + 1, m);
+            weights[m] = w0;
+            differences[m] = w1 - w0;
+            w0 = w1;
+        }
+    }
 }
 
 /// One in the 32.32 fixed point of [`PhaseTable::fixed_position`].

@@ -17,6 +17,7 @@ use super::*;
 use crate::dht::fixed::FixedTwiddles;
 use crate::dht::Twiddles;
 use crate::image::{finish, Crop};
+use crate::test_support::snr_db;
 
 const M: usize = 32;
 
@@ -28,28 +29,34 @@ fn floor_db() -> f64 {
         - 20.0 * libm::log10(crest)
 }
 
+/// [`finish_fixed`] of a copy of `grid` (`M × M`) at `exponent` into fresh
+/// buffers: the image's exponent and mantissas.
+fn finish_fixed_owned(
+    grid: &[i32],
+    exponent: i32,
+    place: &Placement,
+    size: (usize, usize),
+    tw16: &FixedTwiddles<'_, i16>,
+) -> (i32, Vec<i16>) {
+    let mut grid = grid.to_vec();
+    let mut aux = vec![0i32; fixed_aux_len(M)];
+    let mut block = vec![0i16; M * M];
+    let mut out = vec![0i16; size.0 * size.1];
+    let buffers = FixedBuffers {
+        grid: &mut grid,
+        aux: &mut aux,
+        block: &mut block,
+        out: &mut out,
+    };
+    let exponent = finish_fixed(buffers, exponent, M, place, size, tw16).unwrap();
+    (exponent, out)
+}
+
 /// The image of `grid` by both finishes, the fixed one in f64.
 fn both(grid: &[i32], place: Placement, size: (usize, usize)) -> (Vec<f64>, Vec<f64>) {
     let mut tw16 = vec![0i16; FixedTwiddles::<i16>::buffer_len(M)];
     let tw16 = FixedTwiddles::new(&mut tw16, M).unwrap();
-    let mut fixed_grid = grid.to_vec();
-    let mut aux = vec![0i32; fixed_aux_len(M)];
-    let mut block = vec![0i16; M * M];
-    let mut out = vec![0i16; size.0 * size.1];
-    let exponent = finish_fixed(
-        FixedBuffers {
-            grid: &mut fixed_grid,
-            aux: &mut aux,
-            block: &mut block,
-            out: &mut out,
-        },
-        0,
-        M,
-        &place,
-        size,
-        &tw16,
-    )
-    .unwrap();
+    let (exponent, out) = finish_fixed_owned(grid, 0, &place, size, &tw16);
     let fixed = out
         .iter()
         .map(|&v| v as f64 * (exponent as f64).exp2())
@@ -69,16 +76,6 @@ fn both(grid: &[i32], place: Placement, size: (usize, usize)) -> (Vec<f64>, Vec<
     )
     .unwrap();
     (fixed, reference)
-}
-
-fn snr_db(got: &[f64], reference: &[f64]) -> f64 {
-    let signal: f64 = reference.iter().map(|r| r * r).sum();
-    let noise: f64 = got
-        .iter()
-        .zip(reference)
-        .map(|(g, r)| (g - r) * (g - r))
-        .sum();
-    10.0 * libm::log10(signal / noise)
 }
 
 #[test]
@@ -101,7 +98,7 @@ fn random_slices_meet_the_q15_floor_with_and_without_a_shift() {
             shift,
         };
         let (fixed, reference) = both(&grid, place, size);
-        let snr = snr_db(&fixed, &reference);
+        let snr = snr_db(&reference, &fixed);
         assert!(
             snr >= floor_db(),
             "shift {shift:?}: {snr:.1} dB below the floor {:.1} dB",
@@ -133,7 +130,7 @@ fn zero_and_extreme_slices() {
         let grid: Vec<i32> = (0..M * M).map(p).collect();
         let (fixed, reference) = both(&grid, place, (M, M));
         assert!(fixed.iter().all(|v| v.is_finite()));
-        let snr = snr_db(&fixed, &reference);
+        let snr = snr_db(&reference, &fixed);
         // A constant slice is an impulse in the image (κ up to M): the
         // floor for that crest factor.
         let floor = floor_db() + 20.0 * libm::log10(5.0 / M as f64);
@@ -196,23 +193,7 @@ fn the_image_cut_into_the_block_is_the_image() {
         (0, 0, [0.0, 0.0], (1, 1)),
     ] {
         let place = Placement { col0, row0, shift };
-        let (mut g, mut aux) = (grid.clone(), vec![0i32; fixed_aux_len(M)]);
-        let mut block = vec![0i16; M * M];
-        let mut out = vec![0i16; size.0 * size.1];
-        let e_out = finish_fixed(
-            FixedBuffers {
-                grid: &mut g,
-                aux: &mut aux,
-                block: &mut block,
-                out: &mut out,
-            },
-            3,
-            M,
-            &place,
-            size,
-            &tw16,
-        )
-        .unwrap();
+        let (e_out, out) = finish_fixed_owned(&grid, 3, &place, size, &tw16);
         let (mut g, mut aux) = (grid.clone(), vec![0i32; fixed_aux_len(M)]);
         let mut block = vec![0i16; M * M];
         let e_block =

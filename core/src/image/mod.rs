@@ -249,6 +249,64 @@ fn crop_any<T: Real>(grid: &[T], m: usize, crop: &Crop, g: T, out: &mut [T]) {
 ///
 /// `POW2`: `m` is a power of two (`−k mod m` by a mask).
 fn apply_shift<const POW2: bool, T: Real>(grid: &mut [T], m: usize, t: [f64; 2], aux: &mut [T]) {
+    if t == [0.0, 0.0] {
+        return;
+    }
+    shift_phasors(m, t, aux, |ph| {
+        (T::from_f64(libm::cos(ph)), T::from_f64(libm::sin(ph)))
+    });
+    apply_phasors_by::<POW2, T>(grid, m, aux);
+}
+
+/// The phase factors of the shift by `t` into `table`, as
+/// `[cx | sx | cy | sy]` (`m` each): `(cos φ, sin φ) = phasor(φ)` of
+/// `φ = −2π k·t/m` on each axis for every index `k`, Nyquist (`2k = m`)
+/// with phase 0.
+///
+/// # Panics
+/// If `table` is shorter than `4·m`.
+#[inline]
+pub fn shift_phasors<T>(m: usize, t: [f64; 2], table: &mut [T], phasor: impl Fn(f64) -> (T, T)) {
+    let (cx, rest) = table.split_at_mut(m);
+    let (sx, rest) = rest.split_at_mut(m);
+    let (cy, sy) = rest.split_at_mut(m);
+    let tau = -2.0 * core::f64::consts::PI / m as f64;
+    for k in 0..m {
+        let ks = signed_index(k, m) as f64;
+        let (phx, phy) = if 2 * k == m {
+            (0.0, 0.0)
+        } else {
+            (tau * ks * t[0], tau * ks * t[1])
+        };
+        (cx[k], sx[k]) = phasor(phx);
+        (cy[k], sy[k]) = phasor(phy);
+    }
+}
+
+/// The shift of one pair of points `k`, `−k`: with the phase factors
+/// `(cos, sin)` of `k`'s two axes, `(H'(k), H'(−k))` from `(H(k), H(−k))`.
+#[inline(always)]
+pub fn shift_pair<T: Real>([cx, sx]: [T; 2], [cy, sy]: [T; 2], (h, hm): (T, T)) -> (T, T) {
+    let c = cx * cy - sx * sy;
+    let s = sx * cy + cx * sy;
+    (c * h + s * hm, c * hm - s * h)
+}
+
+/// Shift the Hartley slice `grid` (`m × m`, a power of two) by the phase
+/// factors `table` of [`shift_phasors`].
+///
+/// # Panics
+/// If `grid` is shorter than `m²` or `table` than `4·m`.
+#[inline]
+pub fn apply_phasors<T: Real>(grid: &mut [T], m: usize, table: &[T]) {
+    apply_phasors_by::<true, T>(grid, m, table);
+}
+
+/// [`apply_phasors`] for any `m` (`POW2`: `m` is a power of two, `−k mod m`
+/// by a mask): the point of each pair that comes first in `grid` carries
+/// the phase.
+#[inline(always)]
+fn apply_phasors_by<const POW2: bool, T: Real>(grid: &mut [T], m: usize, table: &[T]) {
     let neg = |k: usize| {
         if POW2 {
             neg_mod(k, m)
@@ -258,26 +316,9 @@ fn apply_shift<const POW2: bool, T: Real>(grid: &mut [T], m: usize, t: [f64; 2],
             m - k
         }
     };
-    if t == [0.0, 0.0] {
-        return;
-    }
-    let (cx, rest) = aux.split_at_mut(m);
-    let (sx, rest) = rest.split_at_mut(m);
-    let (cy, sy) = rest.split_at_mut(m);
-    let tau = -2.0 * core::f64::consts::PI / m as f64;
-    for k in 0..m {
-        let nyq = 2 * k == m;
-        let ks = signed_index(k, m) as f64;
-        let (phx, phy) = if nyq {
-            (0.0, 0.0)
-        } else {
-            (tau * ks * t[0], tau * ks * t[1])
-        };
-        cx[k] = T::from_f64(libm::cos(phx));
-        sx[k] = T::from_f64(libm::sin(phx));
-        cy[k] = T::from_f64(libm::cos(phy));
-        sy[k] = T::from_f64(libm::sin(phy));
-    }
+    let (cx, rest) = table.split_at(m);
+    let (sx, rest) = rest.split_at(m);
+    let (cy, sy) = rest.split_at(m);
     for iy in 0..m {
         let my = neg(iy);
         for ix in 0..m {
@@ -285,11 +326,7 @@ fn apply_shift<const POW2: bool, T: Real>(grid: &mut [T], m: usize, t: [f64; 2],
             if a >= b {
                 continue;
             }
-            let c = cx[ix] * cy[iy] - sx[ix] * sy[iy];
-            let s = sx[ix] * cy[iy] + cx[ix] * sy[iy];
-            let (h, hm) = (grid[a], grid[b]);
-            grid[a] = c * h + s * hm;
-            grid[b] = c * hm - s * h;
+            (grid[a], grid[b]) = shift_pair([cx[ix], sx[ix]], [cy[iy], sy[iy]], (grid[a], grid[b]));
         }
     }
 }

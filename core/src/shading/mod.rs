@@ -79,8 +79,8 @@ mod passes;
 mod scene;
 
 pub use scene::{
-    ChannelPlan, CueTerms, DepthCue, Light, Scene, ViewPlan, Wave, MAX_HARMONICS, MAX_LIGHTS,
-    MAX_PROFILE_POINTS,
+    field_count_of, ChannelPlan, CueTerms, DepthCue, Light, Scene, ViewPlan, Wave, MAX_HARMONICS,
+    MAX_LIGHTS, MAX_PROFILE_POINTS,
 };
 
 pub(crate) use passes::{accumulate_cue, fold_partner, Accumulators, CueView, Tables};

@@ -196,18 +196,12 @@ impl Scene {
     /// [`crate::shading::fields_len`]): 1 for a plain or cued grey
     /// image; otherwise one accumulator per spectrum term plus one output.
     pub fn field_count(&self) -> usize {
-        let pair = if self.has_partner_terms() { 2 } else { 1 };
-        if self.channels() == 1 {
-            return pair;
-        }
-        let mut count = pair + 1;
-        if self.needs_gradient_spectrum() {
-            count += pair;
-        }
-        if self.needs_cue_derivative_fields() {
-            count += pair;
-        }
-        count
+        field_count_of(
+            self.has_partner_terms(),
+            self.channels(),
+            self.needs_gradient_spectrum(),
+            self.needs_cue_derivative_fields(),
+        )
     }
 }
 
@@ -455,4 +449,28 @@ fn cosine_coefficient(weights: &[f64], m: usize) -> f64 {
     } else {
         2.0 * sum
     }
+}
+
+/// [`Scene::field_count`] from what the scene needs: terms at the partner
+/// point `−k` (a depth-varying cue), its channels, the gradient spectrum
+/// and the cue-derivative fields. A `const fn`, so that a device sizes its
+/// buffers at compile time.
+pub const fn field_count_of(
+    partner_terms: bool,
+    channels: usize,
+    gradient: bool,
+    cue_derivative: bool,
+) -> usize {
+    let pair = if partner_terms { 2 } else { 1 };
+    if channels == 1 {
+        return pair;
+    }
+    let mut count = pair + 1;
+    if gradient {
+        count += pair;
+    }
+    if cue_derivative {
+        count += pair;
+    }
+    count
 }

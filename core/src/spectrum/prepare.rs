@@ -142,7 +142,7 @@ pub struct LineBlockStorage<'a, 's, S> {
 
 /// The volume's dims, the padded side `n` and the cube's length `n³`,
 /// checking that `storage` elements hold the cube.
-fn cube_for<V: VoxelSource>(
+pub(super) fn cube_for<V: VoxelSource>(
     volume: &V,
     filter: &Filter,
     storage: usize,

@@ -3,13 +3,13 @@
 //! ([`crate::dht::fixed::dht_3d_lines`]) in place, ending in the Q15 format with
 //! one exponent per x-line that the integer view reads.
 
-use super::prepare::premultiplier;
+use super::prepare::{cube_for, premultiplier};
 use super::Spectrum;
 use crate::dht::fixed::{dht_3d_lines, FixedTwiddles};
 use crate::error::{require_len, Error, Result};
 use crate::filter::Filter;
 use crate::num::{BlockExponents, BlockLayout, Q15};
-use crate::volume::{padded_size, DenseVolume, VoxelSource};
+use crate::volume::DenseVolume;
 
 /// Largest magnitude of a fixed-point premultiplier (and of a Q15
 /// mantissa).
@@ -28,9 +28,9 @@ pub struct Q15Storage<'a, 's> {
 
 impl<'a> Spectrum<'a, Q15> {
     /// Premultiply `volume` for `filter`, zero-pad it into the cube of side
-    /// [`padded_size`]`(dims, filter.oversample())` (circularly shifted as
-    /// in [`Spectrum::prepare`]) and take its Q15 3D DHT in place, all in
-    /// integers but for the `n` premultipliers.
+    /// [`padded_size`](crate::volume::padded_size)`(dims, filter.oversample())`
+    /// (circularly shifted as in [`Spectrum::prepare`]) and take its Q15 3D
+    /// DHT in place, all in integers but for the `n` premultipliers.
     ///
     /// # Arithmetic
     /// - *Premultipliers*: `1/ĥ(x/n)` for the `n` signed positions, in f64
@@ -70,13 +70,7 @@ impl<'a> Spectrum<'a, Q15> {
             exponents,
             premul,
         } = storage;
-        let dims = volume.dims();
-        let n = padded_size(dims, filter.oversample())?;
-        let cube = n
-            .checked_mul(n)
-            .and_then(|v| v.checked_mul(n))
-            .ok_or(Error::VolumeTooLarge { dims, grid: n })?;
-        require_len("spectrum storage", cube, mantissas.len())?;
+        let (dims, n, cube) = cube_for(volume, &filter, mantissas.len())?;
         require_len("block exponents", n * n, exponents.len())?;
         require_len("premultiplier table", n, premul.len())?;
         let (mantissas, exponents, premul) = (

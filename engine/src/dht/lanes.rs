@@ -10,56 +10,11 @@
 //! table, then the pass that splits the even and odd spectra and forms
 //! `H = Re X ∓ Im X` (`core/src/dht/mixed/`).
 
+use fvr_core::dht::mixed::butterfly::{even_split, radix2, radix3, radix4, radix5, twiddle, C};
 use fvr_core::num::Real;
 
 /// Lines transformed together.
 pub const LANES: usize = 16;
-
-/// A complex value as the core's stages compute it.
-#[derive(Clone, Copy)]
-struct C<T> {
-    re: T,
-    im: T,
-}
-
-impl<T: Real> C<T> {
-    #[inline(always)]
-    fn add(self, o: Self) -> Self {
-        C {
-            re: self.re + o.re,
-            im: self.im + o.im,
-        }
-    }
-    #[inline(always)]
-    fn sub(self, o: Self) -> Self {
-        C {
-            re: self.re - o.re,
-            im: self.im - o.im,
-        }
-    }
-    #[inline(always)]
-    fn mul(self, o: Self) -> Self {
-        C {
-            re: self.re * o.re - self.im * o.im,
-            im: self.re * o.im + self.im * o.re,
-        }
-    }
-    #[inline(always)]
-    fn scale(self, a: T) -> Self {
-        C {
-            re: self.re * a,
-            im: self.im * a,
-        }
-    }
-    /// `self · (−i)`.
-    #[inline(always)]
-    fn mul_neg_i(self) -> Self {
-        C {
-            re: self.im,
-            im: -self.re,
-        }
-    }
-}
 
 /// The radices of the complex FFT of a plan of length `n` (of `n/2` for
 /// even `n`), in the core's order: fours, a two, threes, fives.
@@ -185,25 +140,15 @@ fn split<T: Real>([zr, zi]: [&[T]; 2], out: &mut [Vec<T>; 2], table: &[T], n: us
         let (ar, ai, br, bi) = (lanes(zr, a), lanes(zi, a), lanes(zr, b), lanes(zi, b));
         let (lo, hi) = (lanes_mut(low, a), lanes_mut(high, b));
         for l in 0..LANES {
-            let e = C {
-                re: ar[l] + br[l],
-                im: ai[l] - bi[l],
+            let a = C {
+                re: ar[l],
+                im: ai[l],
             };
-            let d = C {
-                re: ar[l] - br[l],
-                im: ai[l] + bi[l],
+            let b = C {
+                re: br[l],
+                im: bi[l],
             };
-            let o = C {
-                re: d.im,
-                im: -d.re,
-            };
-            let wo = C {
-                re: w.re * o.re - w.im * o.im,
-                im: w.re * o.im + w.im * o.re,
-            };
-            let (xr, xi) = (T::HALF * (e.re + wo.re), T::HALF * (e.im + wo.im));
-            lo[l] = xr - xi;
-            hi[l] = xr + xi;
+            (lo[l], hi[l]) = even_split(a, b, w);
         }
     }
 }
@@ -285,55 +230,6 @@ impl<T: Real> Stage<'_, T> {
     /// `ω_ℓ^e`, `e < ℓ`.
     #[inline(always)]
     fn twiddle(&self, e: usize) -> C<T> {
-        let i = 2 * e * self.step;
-        match self.table.get(i..i + 2) {
-            Some(t) => C { re: t[0], im: t[1] },
-            None => C {
-                re: T::ONE,
-                im: T::ZERO,
-            },
-        }
+        twiddle(self.table, self.step, e)
     }
-}
-
-#[inline(always)]
-fn radix2<T: Real>([a0, a1]: [C<T>; 2]) -> [C<T>; 2] {
-    [a0.add(a1), a0.sub(a1)]
-}
-
-#[inline(always)]
-fn radix3<T: Real>([a0, a1, a2]: [C<T>; 3]) -> [C<T>; 3] {
-    let s3 = T::from_f64(0.866_025_403_784_438_6);
-    let t = a1.add(a2);
-    let d = a1.sub(a2).scale(s3).mul_neg_i();
-    let base = a0.sub(t.scale(T::HALF));
-    [a0.add(t), base.add(d), base.sub(d)]
-}
-
-#[inline(always)]
-fn radix4<T: Real>([a0, a1, a2, a3]: [C<T>; 4]) -> [C<T>; 4] {
-    let (t0, t1) = (a0.add(a2), a0.sub(a2));
-    let (t2, t3) = (a1.add(a3), a1.sub(a3).mul_neg_i());
-    [t0.add(t2), t1.add(t3), t0.sub(t2), t1.sub(t3)]
-}
-
-#[inline(always)]
-fn radix5<T: Real>([a0, a1, a2, a3, a4]: [C<T>; 5]) -> [C<T>; 5] {
-    let c1 = T::from_f64(0.309_016_994_374_947_45);
-    let c2 = T::from_f64(-0.809_016_994_374_947_5);
-    let s1 = T::from_f64(0.951_056_516_295_153_5);
-    let s2 = T::from_f64(0.587_785_252_292_473_1);
-    let (t1, d1) = (a1.add(a4), a1.sub(a4));
-    let (t2, d2) = (a2.add(a3), a2.sub(a3));
-    let e1 = a0.add(t1.scale(c1)).add(t2.scale(c2));
-    let e2 = a0.add(t1.scale(c2)).add(t2.scale(c1));
-    let o1 = d1.scale(s1).add(d2.scale(s2)).mul_neg_i();
-    let o2 = d1.scale(s2).sub(d2.scale(s1)).mul_neg_i();
-    [
-        a0.add(t1).add(t2),
-        e1.add(o1),
-        e2.add(o2),
-        e2.sub(o2),
-        e1.sub(o1),
-    ]
 }

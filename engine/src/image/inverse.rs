@@ -22,9 +22,9 @@
 //!
 //! [`finish_with`]: fvr_core::image::finish_with
 
-use fvr_core::dht::{dht, dht_mixed, mixed_scratch_len, mixed_table_len, signed_index, MixedPlan};
+use fvr_core::dht::{dht, dht_mixed, mixed_scratch_len, mixed_table_len, MixedPlan};
 use fvr_core::error::{Error, Result};
-use fvr_core::image::{check_image, grid_len, Crop, Inverse};
+use fvr_core::image::{check_image, grid_len, shift_pair, shift_phasors, Crop, Inverse};
 use fvr_core::num::Real;
 use rayon::prelude::*;
 
@@ -219,10 +219,8 @@ pub(super) fn for_row_pairs<T: Real>(
 /// core computes them.
 pub(super) struct ShiftTables<T> {
     m: usize,
-    cx: Vec<T>,
-    sx: Vec<T>,
-    cy: Vec<T>,
-    sy: Vec<T>,
+    /// `[cx | sx | cy | sy]`, `m` each (`fvr_core::image::shift_phasors`).
+    table: Vec<T>,
 }
 
 /// The tables for shift `t`, `None` for no shift (the core then leaves the
@@ -231,27 +229,11 @@ pub(super) fn shift_tables<T: Real>(m: usize, t: [f64; 2]) -> Option<ShiftTables
     if t == [0.0, 0.0] {
         return None;
     }
-    let tau = -2.0 * core::f64::consts::PI / m as f64;
-    let mut tables = ShiftTables {
-        m,
-        cx: Vec::with_capacity(m),
-        sx: Vec::with_capacity(m),
-        cy: Vec::with_capacity(m),
-        sy: Vec::with_capacity(m),
-    };
-    for k in 0..m {
-        let ks = signed_index(k, m) as f64;
-        let (phx, phy) = if 2 * k == m {
-            (0.0, 0.0)
-        } else {
-            (tau * ks * t[0], tau * ks * t[1])
-        };
-        tables.cx.push(T::from_f64(libm::cos(phx)));
-        tables.sx.push(T::from_f64(libm::sin(phx)));
-        tables.cy.push(T::from_f64(libm::cos(phy)));
-        tables.sy.push(T::from_f64(libm::sin(phy)));
-    }
-    Some(tables)
+    let mut table = vec![T::ZERO; 4 * m];
+    shift_phasors(m, t, &mut table, |ph| {
+        (T::from_f64(libm::cos(ph)), T::from_f64(libm::sin(ph)))
+    });
+    Some(ShiftTables { m, table })
 }
 
 impl<T: Real> ShiftTables<T> {
@@ -262,13 +244,12 @@ impl<T: Real> ShiftTables<T> {
     pub(super) fn shift_rows(&self, y: usize, row: &mut [T], mirror: Option<&mut [T]>) {
         let m = self.m;
         let neg = |k: usize| if k == 0 { 0 } else { m - k };
-        let (cy, sy) = (self.cy[y], self.sy[y]);
+        let (cx, rest) = self.table.split_at(m);
+        let (sx, rest) = rest.split_at(m);
+        let (cy, sy) = rest.split_at(m);
+        let y_phase = [cy[y], sy[y]];
         let rotate = |x: usize, h: &mut T, hm: &mut T| {
-            let c = self.cx[x] * cy - self.sx[x] * sy;
-            let s = self.sx[x] * cy + self.cx[x] * sy;
-            let (a, b) = (*h, *hm);
-            *h = c * a + s * b;
-            *hm = c * b - s * a;
+            (*h, *hm) = shift_pair([cx[x], sx[x]], y_phase, (*h, *hm));
         };
         match mirror {
             // y < −y: every point of row y comes first.

@@ -125,30 +125,26 @@ impl SceneSpectra {
         width: usize,
         height: usize,
     ) -> Result<Image, String> {
-        if *sampling == Sampling::UNIT {
-            return self
-                .render(scene, view, width, height)
-                .map_err(|e| e.to_string());
-        }
-        if let Some(pitch) = sampling.uniform_pitch() {
+        let image = if *sampling == Sampling::UNIT {
+            self.render(scene, view, width, height)
+        } else if let Some(pitch) = sampling.uniform_pitch() {
             let scaled = Scene {
                 ambient: scene.ambient.map(|a| a * pitch),
                 ..scene.clone()
             };
-            return self
-                .render(&scaled, view, width, height)
-                .map_err(|e| e.to_string());
-        }
-        if let Some(image) = self.plain_xray(scene, view, sampling, width, height) {
-            return image.map_err(|e| e.to_string());
-        }
-        let [x, y, z] = sampling.spacing();
-        Err(format!(
-            "depth cueing and shading need cubic voxels imaged at their own size, but the voxels \
-             are {x} x {y} x {z} mm and the pixels {} mm: use --resample N (cubic voxels) or \
-             --ignore-spacing (voxel units), or render an X-ray view",
-            sampling.pixel_size()
-        ))
+            self.render(&scaled, view, width, height)
+        } else if let Some(image) = self.plain_xray(scene, view, sampling, width, height) {
+            image
+        } else {
+            let [x, y, z] = sampling.spacing();
+            return Err(format!(
+                "depth cueing and shading need cubic voxels imaged at their own size, but the \
+                 voxels are {x} x {y} x {z} mm and the pixels {} mm: use --resample N (cubic \
+                 voxels) or --ignore-spacing (voxel units), or render an X-ray view",
+                sampling.pixel_size()
+            ));
+        };
+        image.map_err(|e| e.to_string())
     }
 
     /// A plain X-ray scene (grey, no lights, no depth-varying cue) through

@@ -407,25 +407,21 @@ impl AnySpectrum {
         precision: Precision,
         how: Preparation,
     ) -> Result<Self, PipelineError> {
-        Ok(match (precision, how) {
-            (Precision::F16, Preparation::Fast) => {
-                AnySpectrum::F16(OwnedSpectrum::prepare::<f32>(volume, filter)?)
+        /// One spectrum of storage `S` in arithmetic `T` by the path `how`.
+        fn by<S: StoreFormat, T: FftReal>(
+            volume: &Volume,
+            filter: Filter,
+            how: Preparation,
+        ) -> Result<OwnedSpectrum<S>, PipelineError> {
+            match how {
+                Preparation::Fast => OwnedSpectrum::prepare::<T>(volume, filter),
+                Preparation::InPlace => OwnedSpectrum::prepare_in_place::<T>(volume, filter),
             }
-            (Precision::F32, Preparation::Fast) => {
-                AnySpectrum::F32(OwnedSpectrum::prepare::<f32>(volume, filter)?)
-            }
-            (Precision::F64, Preparation::Fast) => {
-                AnySpectrum::F64(OwnedSpectrum::prepare::<f64>(volume, filter)?)
-            }
-            (Precision::F16, Preparation::InPlace) => {
-                AnySpectrum::F16(OwnedSpectrum::prepare_in_place::<f32>(volume, filter)?)
-            }
-            (Precision::F32, Preparation::InPlace) => {
-                AnySpectrum::F32(OwnedSpectrum::prepare_in_place::<f32>(volume, filter)?)
-            }
-            (Precision::F64, Preparation::InPlace) => {
-                AnySpectrum::F64(OwnedSpectrum::prepare_in_place::<f64>(volume, filter)?)
-            }
+        }
+        Ok(match precision {
+            Precision::F16 => AnySpectrum::F16(by::<f16, f32>(volume, filter, how)?),
+            Precision::F32 => AnySpectrum::F32(by::<f32, f32>(volume, filter, how)?),
+            Precision::F64 => AnySpectrum::F64(by::<f64, f64>(volume, filter, how)?),
         })
     }
 

@@ -24,7 +24,7 @@ mod device {
     use fvr_core::dht::{self, Twiddles};
     use fvr_core::slice::fixed::FixedPhases;
     use fvr_firmware::capture::ByteSink;
-    use fvr_firmware::device::{HostFile, RunError, SysTickClock};
+    use fvr_firmware::device::{calibrated_clock, exit_with, HostFile, RunError, SysTickClock};
     use fvr_firmware::fixed_view::{render_view, ViewBuffers, ViewError, WIDTH};
     use fvr_firmware::frame::{
         render_frame, tables_for, FrameBuffers, FrameError, InstructionClock,
@@ -65,14 +65,7 @@ mod device {
     pub const FLOAT_AUX: usize = fvr_firmware::frame::AUX_LEN;
 
     pub fn run(blocks: Blocks, views: Views) -> ! {
-        let status = match measure(blocks, views) {
-            Ok(()) => 0,
-            Err(e) => {
-                defmt::error!("{=str}: {}", PROGRAM, defmt::Debug2Format(&e));
-                1
-            }
-        };
-        semihosting::process::exit(status)
+        exit_with(PROGRAM, measure(blocks, views))
     }
 
     fn core_error(e: fvr_core::Error) -> RunError {
@@ -102,14 +95,7 @@ mod device {
     }
 
     fn measure(blocks: Blocks, views: Views) -> Result<(), RunError> {
-        let peripherals =
-            cortex_m::Peripherals::take().ok_or(RunError::Host("peripherals taken"))?;
-        let mut clock = SysTickClock::start(peripherals.SYST);
-        let (calibration, ()) = count(&clock, || cortex_m::asm::delay(1_000_000));
-        defmt::println!(
-            "calibration: delay loop of 2000002 instructions counted as {=u64}",
-            calibration
-        );
+        let mut clock = calibrated_clock()?;
 
         // (d) The Q15 twiddles: made here in soft float, or checked in flash.
         let mut made = [0i16; TWIDDLES_LEN];
@@ -280,61 +266,29 @@ fn main() -> ! {
     use device::{AUX, FLOAT_AUX};
     use fvr_core::slice::fixed::FixedPhases;
     use fvr_firmware::fixed_view::WIDTH;
-    let phases = cortex_m::singleton!(PHASES: FixedPhases<WIDTH> = FixedPhases::new());
-    let grid = cortex_m::singleton!(GRID: [i32; LEN] = [0; LEN]);
-    let aux = cortex_m::singleton!(AUX_I32: [i32; AUX] = [0; AUX]);
-    let block = cortex_m::singleton!(BLOCK: [i16; LEN] = [0; LEN]);
-    let image = cortex_m::singleton!(IMAGE: [i16; LEN] = [0; LEN]);
-    let staged = cortex_m::singleton!(STAGED: [i16; LEN] = [0; LEN]);
-    let float_aux = cortex_m::singleton!(FLOAT_AUX_F32: [f32; FLOAT_AUX] = [0.0; FLOAT_AUX]);
-    let float_image = cortex_m::singleton!(FLOAT_IMAGE: [f32; LEN] = [0.0; LEN]);
-    let float_staged = cortex_m::singleton!(FLOAT_STAGED: [f32; LEN] = [0.0; LEN]);
-    let (
-        Some(phases),
-        Some(grid),
-        Some(aux),
-        Some(block),
-        Some(image),
-        Some(staged),
-        Some(float_aux),
-        Some(float_image),
-        Some(float_staged),
-    ) = (
-        phases,
-        grid,
-        aux,
-        block,
-        image,
-        staged,
-        float_aux,
-        float_image,
-        float_staged,
-    )
-    else {
-        fvr_firmware::device::abort("view buffers taken twice")
-    };
+    fn take<T>(buffer: Option<T>) -> T {
+        buffer.unwrap_or_else(|| fvr_firmware::device::abort("view buffers taken twice"))
+    }
     device::run(
         device::Blocks { q15, q31, f32 },
         device::Views {
-            phases,
-            grid,
-            aux,
-            block,
-            image,
-            staged,
-            float_aux,
-            float_image,
-            float_staged,
+            phases: take(cortex_m::singleton!(PHASES: FixedPhases<WIDTH> = FixedPhases::new())),
+            grid: take(cortex_m::singleton!(GRID: [i32; LEN] = [0; LEN])),
+            aux: take(cortex_m::singleton!(AUX_I32: [i32; AUX] = [0; AUX])),
+            block: take(cortex_m::singleton!(BLOCK: [i16; LEN] = [0; LEN])),
+            image: take(cortex_m::singleton!(IMAGE: [i16; LEN] = [0; LEN])),
+            staged: take(cortex_m::singleton!(STAGED: [i16; LEN] = [0; LEN])),
+            float_aux: take(cortex_m::singleton!(
+                FLOAT_AUX_F32: [f32; FLOAT_AUX] = [0.0; FLOAT_AUX]
+            )),
+            float_image: take(cortex_m::singleton!(FLOAT_IMAGE: [f32; LEN] = [0.0; LEN])),
+            float_staged: take(cortex_m::singleton!(FLOAT_STAGED: [f32; LEN] = [0.0; LEN])),
         },
     )
 }
 
 #[cfg(target_os = "none")]
-#[allow(unsafe_code)]
-#[cortex_m_rt::exception]
-unsafe fn HardFault(_frame: &cortex_m_rt::ExceptionFrame) -> ! {
-    fvr_firmware::device::hard_fault()
-}
+fvr_firmware::hard_fault_handler!();
 
 #[cfg(not(target_os = "none"))]
 fn main() {

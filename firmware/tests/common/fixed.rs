@@ -1,6 +1,7 @@
 //! The Cortex-M3's integer view on the host, its f64 reference and the
 //! SNR floor of its arithmetic (`tests/fixed_view.rs`, `tests/qemu_fixed.rs`).
 
+use super::NoClock;
 use fvr_core::dht::fixed::FixedTwiddles;
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::KernelTable;
@@ -11,18 +12,9 @@ use fvr_core::slice::fixed::FixedPhases;
 use fvr_core::spectrum::{prepare_scratch_len, Spectrum};
 use fvr_core::volume::DenseVolume;
 use fvr_firmware::fixed_view::{render_view, ViewBuffers, AUX_LEN, GRID_LEN, WIDTH};
-use fvr_firmware::frame::InstructionClock;
 use fvr_firmware::scene::{density, DIMS, IMAGE_SIDE, VIEW};
 use fvr_firmware::stored::DENSITY_KB3;
 use fvr_firmware::stored_q15::DENSITY_KB3_Q15;
-
-struct NoClock;
-
-impl InstructionClock for NoClock {
-    fn now(&self) -> u64 {
-        0
-    }
-}
 
 /// The integer view as the device renders it: the image's exponent and
 /// Q15 mantissas (`fvr_firmware::fixed_view::render_view`, phase table
@@ -90,16 +82,6 @@ pub fn f64_view() -> (Vec<f64>, Vec<f64>) {
     let mut slice = vec![0.0f64; grid_len(n)];
     extract_slice(&spec, &kernel, &VIEW.frame().unwrap(), &mut slice);
     (out, slice)
-}
-
-/// `10·log10(Σ r² / Σ (g − r)²)`.
-pub fn snr(reference: &[f64], got: &[f64]) -> f64 {
-    let (mut s, mut e) = (0.0, 0.0);
-    for (r, v) in reference.iter().zip(got) {
-        s += r * r;
-        e += (v - r) * (v - r);
-    }
-    10.0 * (s / e).log10()
 }
 
 /// Peak over RMS of the nonzero values.

@@ -3,12 +3,14 @@
 
 pub mod fixed;
 
+use std::path::{Path, PathBuf};
+
 use fvr_core::geometry::{center, Frame};
 use fvr_core::image::{aux_len, grid_len};
 use fvr_core::render::{render, Buffers, Request, Source};
 use fvr_core::shading::fields_len;
 use fvr_engine::volume::phantom::{Gaussian, GaussianMixture, Phantom};
-use fvr_firmware::frame::{tables_for, FrameTables};
+use fvr_firmware::frame::{tables_for, FrameTables, InstructionClock};
 use fvr_firmware::scene::{Blob, FrameSpec, Shading, BLOBS, DIMS, IMAGE_SIDE};
 use fvr_firmware::stored::{all, all_derivatives, twiddles};
 use fvr_host::reference::shaded::exact_scene_projection;
@@ -152,4 +154,60 @@ pub fn floor_db(spec: &FrameSpec) -> f64 {
         Kb6 => 65.0,
         _ => unreachable!("the scene stores Kaiser–Bessel spectra only"),
     }
+}
+
+/// A clock for running the device code on the host, where nothing is
+/// counted.
+pub struct NoClock;
+
+impl InstructionClock for NoClock {
+    fn now(&self) -> u64 {
+        0
+    }
+}
+
+/// Prints each `(name, dB, floor)` figure of `what` and returns one line for
+/// each below its floor (or NaN).
+pub fn below_floors(what: &str, figures: &[(&str, f64, f64)]) -> Vec<String> {
+    let mut failures = Vec::new();
+    for &(name, db, floor) in figures {
+        println!("{what}: {name} {db:.1} dB (floor {floor:.1})");
+        if db.is_nan() || db < floor {
+            failures.push(format!("{what}: {name} {db:.1} dB < {floor:.1}"));
+        }
+    }
+    failures
+}
+
+/// The file `name` QEMU wrote into `dir`.
+pub fn read_output(dir: &Path, name: &str) -> Vec<u8> {
+    let path = dir.join(name);
+    std::fs::read(&path)
+        .unwrap_or_else(|e| panic!("{}: {e} (did the firmware run?)", path.display()))
+}
+
+/// Little-endian `f32` values.
+pub fn le_f32s(bytes: &[u8]) -> Vec<f32> {
+    bytes
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect()
+}
+
+/// How many values of `a` and `b` differ in their bits (`bits`, e.g.
+/// `f32::to_bits`).
+pub fn count_differing<T: Copy, B: PartialEq>(a: &[T], b: &[T], bits: impl Fn(T) -> B) -> usize {
+    a.iter()
+        .zip(b)
+        .filter(|(x, y)| bits(**x) != bits(**y))
+        .count()
+}
+
+/// The directory QEMU wrote the firmware's files to (`FVR_QEMU_OUT`, set by
+/// `scripts/firmware.sh`).
+pub fn qemu_out_dir() -> PathBuf {
+    PathBuf::from(
+        std::env::var_os("FVR_QEMU_OUT")
+            .expect("FVR_QEMU_OUT must name the directory QEMU wrote the firmware's files to"),
+    )
 }

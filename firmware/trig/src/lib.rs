@@ -16,7 +16,6 @@
 //! normalisation.
 #![cfg_attr(not(test), no_std)]
 
-use fvr_core::dht::signed_index;
 use micromath::F32;
 
 /// Where the functions come from.
@@ -79,20 +78,7 @@ pub const fn phasors_len(m: usize) -> usize {
 /// as `fvr_core::image` fills it (Nyquist rows and columns get phase 0):
 /// `[cx | sx | cy | sy]`, `m` each.
 pub fn shift_phasors(trig: Trig, m: usize, t: [f64; 2], table: &mut [f32]) {
-    let (cx, rest) = table.split_at_mut(m);
-    let (sx, rest) = rest.split_at_mut(m);
-    let (cy, sy) = rest.split_at_mut(m);
-    let tau = -2.0 * core::f64::consts::PI / m as f64;
-    for k in 0..m {
-        let ks = signed_index(k, m) as f64;
-        let (phx, phy) = if 2 * k == m {
-            (0.0, 0.0)
-        } else {
-            (tau * ks * t[0], tau * ks * t[1])
-        };
-        (cx[k], sx[k]) = trig.phasor(phx);
-        (cy[k], sy[k]) = trig.phasor(phy);
-    }
+    fvr_core::image::shift_phasors(m, t, table, |ph| trig.phasor(ph));
 }
 
 /// Shift the Hartley slice `grid` (`m × m`, a power of two) by the phasors
@@ -100,22 +86,5 @@ pub fn shift_phasors(trig: Trig, m: usize, t: [f64; 2], table: &mut [f32]) {
 /// arithmetic of `fvr_core::image` (so [`Trig::LibmF64`] gives its values
 /// bit for bit).
 pub fn apply_phasors(grid: &mut [f32], m: usize, table: &[f32]) {
-    let (cx, rest) = table.split_at(m);
-    let (sx, rest) = rest.split_at(m);
-    let (cy, sy) = rest.split_at(m);
-    let neg = |k: usize| (m - k) & (m - 1);
-    for iy in 0..m {
-        let my = neg(iy);
-        for ix in 0..m {
-            let (a, b) = (iy * m + ix, my * m + neg(ix));
-            if a >= b {
-                continue;
-            }
-            let c = cx[ix] * cy[iy] - sx[ix] * sy[iy];
-            let s = sx[ix] * cy[iy] + cx[ix] * sy[iy];
-            let (h, hm) = (grid[a], grid[b]);
-            grid[a] = c * h + s * hm;
-            grid[b] = c * hm - s * h;
-        }
-    }
+    fvr_core::image::apply_phasors(grid, m, table);
 }

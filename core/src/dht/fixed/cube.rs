@@ -36,14 +36,7 @@ pub fn dht_3d<S: FixedSample>(
     [nx, ny, nz]: [usize; 3],
     tw: &FixedTwiddles<'_, S>,
 ) -> Result<i32> {
-    for n in [nx, ny, nz] {
-        tw.check(n)?;
-    }
-    check_len(
-        "3D array",
-        nx.saturating_mul(ny).saturating_mul(nz),
-        data.len(),
-    )?;
+    check_cube(data, [nx, ny, nz], tw)?;
     let top = peak(data);
     let (x_exp, top) = if nx == ny && nx > 1 {
         // Square planes: the x pass as a pass over whole rows between two
@@ -76,6 +69,24 @@ pub fn idht_3d<S: FixedSample>(
     let exp = dht_3d(data, dims, tw)?;
     let bits: u32 = dims.iter().map(|n| n.trailing_zeros()).sum();
     Ok(exp - bits as i32)
+}
+
+/// The checks of [`dht_3d`] and `dht_3d_lines`: every side a power of
+/// two the table serves, and `data` of `nx·ny·nz` values.
+pub(super) fn check_cube<S: FixedSample>(
+    data: &[S],
+    dims: [usize; 3],
+    tw: &FixedTwiddles<'_, S>,
+) -> Result<()> {
+    for n in dims {
+        tw.check(n)?;
+    }
+    let [nx, ny, nz] = dims;
+    check_len(
+        "3D array",
+        nx.saturating_mul(ny).saturating_mul(nz),
+        data.len(),
+    )
 }
 
 /// The length-`n` transforms along one axis of every block of `n·w`

@@ -2,7 +2,7 @@
 //! x-line: the layout of the Q15 spectra the integer view reads, and the
 //! precision of per-line exponents where the dynamic range is largest.
 
-use super::cube::axis_pass;
+use super::cube::{axis_pass, check_cube};
 use super::line::dht;
 use super::{peak, round_shift, FixedSample, FixedTwiddles, Shift};
 use crate::dht::neg_mod;
@@ -41,14 +41,7 @@ pub fn dht_3d_lines<S: FixedSample>(
     tw: &FixedTwiddles<'_, S>,
 ) -> Result<i32> {
     let [nx, ny, nz] = dims;
-    for n in dims {
-        tw.check(n)?;
-    }
-    check_len(
-        "3D array",
-        nx.saturating_mul(ny).saturating_mul(nz),
-        data.len(),
-    )?;
+    check_cube(data, dims, tw)?;
     check_len("x-line exponents", ny * nz, exponents.len())?;
     let top = peak(data);
     let (z_exp, top) = axis_pass(data, nz, nx * ny, top, tw);

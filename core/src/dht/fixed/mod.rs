@@ -121,53 +121,38 @@ pub trait FixedSample: Copy + Default + Debug + PartialEq + Send + Sync + privat
     fn to_i64(self) -> i64;
 }
 
-impl FixedSample for i16 {
-    type Wide = i32;
-    const FRAC_BITS: u32 = 15;
-    #[inline(always)]
-    fn widen(self) -> i32 {
-        self as i32
-    }
-    #[inline(always)]
-    fn narrow(w: i32) -> i16 {
-        w as i16
-    }
-    #[inline(always)]
-    fn wide_to_i64(w: i32) -> i64 {
-        w as i64
-    }
-    fn from_f64(v: f64) -> i16 {
-        clamp_round(v, 15) as i16
-    }
-    #[inline(always)]
-    fn to_i64(self) -> i64 {
-        self as i64
-    }
+/// `FixedSample` for a plain integer mantissa type with its wide type and
+/// fraction bits.
+macro_rules! plain_fixed_sample {
+    ($t:ty, $wide:ty, $frac:literal) => {
+        impl FixedSample for $t {
+            type Wide = $wide;
+            const FRAC_BITS: u32 = $frac;
+            #[inline(always)]
+            fn widen(self) -> $wide {
+                <$wide>::from(self)
+            }
+            #[inline(always)]
+            fn narrow(w: $wide) -> $t {
+                w as $t
+            }
+            #[inline(always)]
+            fn wide_to_i64(w: $wide) -> i64 {
+                i64::from(w)
+            }
+            fn from_f64(v: f64) -> $t {
+                clamp_round(v, $frac) as $t
+            }
+            #[inline(always)]
+            fn to_i64(self) -> i64 {
+                i64::from(self)
+            }
+        }
+    };
 }
 
-impl FixedSample for i32 {
-    type Wide = i64;
-    const FRAC_BITS: u32 = 31;
-    #[inline(always)]
-    fn widen(self) -> i64 {
-        self as i64
-    }
-    #[inline(always)]
-    fn narrow(w: i64) -> i32 {
-        w as i32
-    }
-    #[inline(always)]
-    fn wide_to_i64(w: i64) -> i64 {
-        w
-    }
-    fn from_f64(v: f64) -> i32 {
-        clamp_round(v, 31) as i32
-    }
-    #[inline(always)]
-    fn to_i64(self) -> i64 {
-        self as i64
-    }
-}
+plain_fixed_sample!(i16, i32, 15);
+plain_fixed_sample!(i32, i64, 31);
 
 /// The Q15 storage format of block-floating-point spectra, transformed in
 /// place as `i16` (its overflow flag, the most negative mantissa, is never

@@ -2,7 +2,8 @@
 //! for every power-of-two length up to its size.
 
 use super::{twiddle_pair_bound, FixedSample};
-use crate::error::{require_len, require_pow2, Error, Result};
+use crate::dht::twiddles::{check_serves, fill_quarter, quarter_of};
+use crate::error::{Error, Result};
 
 /// Quarter-wave sine table for fixed-point transforms of length up to
 /// `len`: `round(sin(2πk/len) · 2^F)` for `k = 0 ..= len/4` in a
@@ -38,13 +39,7 @@ impl<'a, S: FixedSample> FixedTwiddles<'a, S> {
     /// `len` not a power of two, or `buf` shorter than
     /// [`FixedTwiddles::buffer_len`]`(len)`.
     pub fn new(buf: &'a mut [S], len: usize) -> Result<Self> {
-        require_pow2("twiddle table length", len)?;
-        let entries = Self::buffer_len(len);
-        require_len("twiddle buffer", entries, buf.len())?;
-        let step = 2.0 * core::f64::consts::PI / len as f64;
-        for (k, slot) in buf[..entries].iter_mut().enumerate() {
-            *slot = S::from_f64(libm::sin(step * k as f64));
-        }
+        fill_quarter(buf, len, |_, angle| S::from_f64(libm::sin(angle)))?;
         Self::from_table(buf, len)
     }
 
@@ -56,10 +51,7 @@ impl<'a, S: FixedSample> FixedTwiddles<'a, S> {
     /// [`FixedTwiddles::buffer_len`]`(len)`, or an entry out of range
     /// ([`Error::TableEntryOutOfRange`]).
     pub fn from_table(table: &'a [S], len: usize) -> Result<Self> {
-        require_pow2("twiddle table length", len)?;
-        let entries = Self::buffer_len(len);
-        require_len("twiddle table", entries, table.len())?;
-        let quarter = &table[..entries];
+        let quarter = quarter_of(table, len)?;
         let max = (1i64 << S::FRAC_BITS) - 1;
         let pair = twiddle_pair_bound(S::FRAC_BITS);
         let q = len / 4;
@@ -95,13 +87,6 @@ impl<'a, S: FixedSample> FixedTwiddles<'a, S> {
     }
 
     pub(super) fn check(&self, n: usize) -> Result<()> {
-        require_pow2("transform length", n)?;
-        if n > self.len {
-            return Err(Error::TwiddlesTooShort {
-                table_len: self.len,
-                needed: n,
-            });
-        }
-        Ok(())
+        check_serves(self.len, n)
     }
 }

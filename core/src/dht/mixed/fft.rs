@@ -10,53 +10,8 @@
 //! sub-transform `q + s·k` of length `m` at stride `r·s`. The output of the
 //! last stage (`m = 1`) is in natural order; no permutation pass.
 
+use super::butterfly::{radix2, radix3, radix4, radix5, twiddle, C};
 use crate::num::Real;
-
-/// One complex value.
-#[derive(Clone, Copy)]
-pub(super) struct C<T> {
-    pub re: T,
-    pub im: T,
-}
-
-impl<T: Real> C<T> {
-    #[inline(always)]
-    fn add(self, o: Self) -> Self {
-        C {
-            re: self.re + o.re,
-            im: self.im + o.im,
-        }
-    }
-    #[inline(always)]
-    fn sub(self, o: Self) -> Self {
-        C {
-            re: self.re - o.re,
-            im: self.im - o.im,
-        }
-    }
-    #[inline(always)]
-    fn mul(self, o: Self) -> Self {
-        C {
-            re: self.re * o.re - self.im * o.im,
-            im: self.re * o.im + self.im * o.re,
-        }
-    }
-    #[inline(always)]
-    fn scale(self, a: T) -> Self {
-        C {
-            re: self.re * a,
-            im: self.im * a,
-        }
-    }
-    /// `self · (−i)`.
-    #[inline(always)]
-    fn mul_neg_i(self) -> Self {
-        C {
-            re: self.im,
-            im: -self.re,
-        }
-    }
-}
 
 /// Forward FFT of the `f = len/2` complex values in `a` (interleaved), with
 /// `b` of the same length as the other buffer. `table` holds `e^{−2πij/L}`
@@ -141,58 +96,6 @@ impl<T: Real> Stage<'_, T> {
     /// `ω_ℓ^e`, `e < ℓ`.
     #[inline(always)]
     fn twiddle(&self, e: usize) -> C<T> {
-        let i = 2 * e * self.step;
-        match self.table.get(i..i + 2) {
-            Some(t) => C { re: t[0], im: t[1] },
-            None => C {
-                re: T::ONE,
-                im: T::ZERO,
-            },
-        }
+        twiddle(self.table, self.step, e)
     }
-}
-
-#[inline(always)]
-fn radix2<T: Real>([a0, a1]: [C<T>; 2]) -> [C<T>; 2] {
-    [a0.add(a1), a0.sub(a1)]
-}
-
-#[inline(always)]
-fn radix3<T: Real>([a0, a1, a2]: [C<T>; 3]) -> [C<T>; 3] {
-    // ω_3 = −½ − i·√3/2.
-    let s3 = T::from_f64(0.866_025_403_784_438_6);
-    let t = a1.add(a2);
-    let d = a1.sub(a2).scale(s3).mul_neg_i();
-    let base = a0.sub(t.scale(T::HALF));
-    [a0.add(t), base.add(d), base.sub(d)]
-}
-
-#[inline(always)]
-fn radix4<T: Real>([a0, a1, a2, a3]: [C<T>; 4]) -> [C<T>; 4] {
-    let (t0, t1) = (a0.add(a2), a0.sub(a2));
-    let (t2, t3) = (a1.add(a3), a1.sub(a3).mul_neg_i());
-    [t0.add(t2), t1.add(t3), t0.sub(t2), t1.sub(t3)]
-}
-
-#[inline(always)]
-fn radix5<T: Real>([a0, a1, a2, a3, a4]: [C<T>; 5]) -> [C<T>; 5] {
-    // cos and sin of 2π/5 and 4π/5.
-    let c1 = T::from_f64(0.309_016_994_374_947_45);
-    let c2 = T::from_f64(-0.809_016_994_374_947_5);
-    let s1 = T::from_f64(0.951_056_516_295_153_5);
-    let s2 = T::from_f64(0.587_785_252_292_473_1);
-    let (t1, d1) = (a1.add(a4), a1.sub(a4));
-    let (t2, d2) = (a2.add(a3), a2.sub(a3));
-    let e1 = a0.add(t1.scale(c1)).add(t2.scale(c2));
-    let e2 = a0.add(t1.scale(c2)).add(t2.scale(c1));
-    // ω^k + ω^{−k} terms above; the odd parts times −i below.
-    let o1 = d1.scale(s1).add(d2.scale(s2)).mul_neg_i();
-    let o2 = d1.scale(s2).sub(d2.scale(s1)).mul_neg_i();
-    [
-        a0.add(t1).add(t2),
-        e1.add(o1),
-        e2.add(o2),
-        e2.sub(o2),
-        e1.sub(o1),
-    ]
 }

@@ -2,7 +2,8 @@
 //! and odd samples packed as complex values, then one pass that separates
 //! the two spectra and forms `H = Re X − Im X`.
 
-use super::fft::{fft, C};
+use super::butterfly::{even_split, C};
+use super::fft::fft;
 use super::plan::{mixed_scratch_len, MixedPlan};
 use crate::error::{require_len, Result};
 use crate::num::Real;
@@ -89,31 +90,11 @@ fn dht_even<T: Real>(data: &mut [T], scratch: &mut [T], plan: &MixedPlan<'_, T>)
     data[0] = z0.re + z0.im;
     data[m] = z0.re - z0.im;
     for k in 1..m {
-        let (a, b) = (z(k), z(m - k));
-        // 2E = Z(k) + Z̄(M−k), 2O = −i[Z(k) − Z̄(M−k)].
-        let e = C {
-            re: a.re + b.re,
-            im: a.im - b.im,
-        };
-        let d = C {
-            re: a.re - b.re,
-            im: a.im + b.im,
-        };
-        let o = C {
-            re: d.im,
-            im: -d.re,
-        };
         let w = C {
             re: table[2 * k],
             im: table[2 * k + 1],
         };
-        let wo = C {
-            re: w.re * o.re - w.im * o.im,
-            im: w.re * o.im + w.im * o.re,
-        };
-        let (xr, xi) = (T::HALF * (e.re + wo.re), T::HALF * (e.im + wo.im));
-        data[k] = xr - xi;
-        data[n - k] = xr + xi;
+        (data[k], data[n - k]) = even_split(z(k), z(m - k), w);
     }
 }
 

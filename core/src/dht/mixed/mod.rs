@@ -23,6 +23,7 @@
 //! `T`), as for radix 2; the tests bound it against a naive transform in
 //! f64 for every supported `N ≤ 512`.
 
+pub mod butterfly;
 mod fft;
 mod line;
 mod multi;

@@ -2,7 +2,9 @@
 //! (or fewer fraction bits), read with an integer interpolation.
 
 use crate::error::{mismatch, Error, Result};
-use crate::filter::{phase_entry, Filter, FilterKind, KernelTable, MAX_WIDTH, TABLE_RESOLUTION};
+use crate::filter::{
+    fill_rows, phase_entry, Filter, FilterKind, KernelTable, MAX_WIDTH, TABLE_RESOLUTION,
+};
 use crate::num::Real;
 
 /// Entries of the widest kernel table: `MAX_WIDTH·1024/2 + 1`.
@@ -125,15 +127,7 @@ impl<const W: usize> FixedPhases<W> {
                 }
             };
             let mut worst = 0i64;
-            for m in 0..W {
-                let mut w0 = entry(0, m);
-                for (i, [weights, differences]) in self.rows.iter_mut().enumerate() {
-                    let w1 = entry(i + 1, m);
-                    weights[m] = w0;
-                    differences[m] = w1 - w0;
-                    w0 = w1;
-                }
-            }
+            fill_rows(&mut self.rows, entry);
             for [weights, differences] in &self.rows {
                 let sum: i64 = (0..W)
                     .map(|m| {

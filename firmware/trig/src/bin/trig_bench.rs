@@ -14,7 +14,7 @@
 mod device {
     use core::hint::black_box;
     use fvr_core::image::placement;
-    use fvr_firmware::device::{RunError, SysTickClock};
+    use fvr_firmware::device::{calibrated_clock, exit_with, RunError, SysTickClock};
     use fvr_firmware::frame::InstructionClock;
     use fvr_firmware::scene::{IMAGE_SIDE, VIEW};
     use fvr_firmware_trig::{phasors_len, shift_phasors, Trig};
@@ -33,25 +33,11 @@ mod device {
     }
 
     pub fn run() -> ! {
-        let status = match measure() {
-            Ok(()) => 0,
-            Err(e) => {
-                defmt::error!("{=str}: {}", PROGRAM, defmt::Debug2Format(&e));
-                1
-            }
-        };
-        semihosting::process::exit(status)
+        exit_with(PROGRAM, measure())
     }
 
     fn measure() -> Result<(), RunError> {
-        let peripherals =
-            cortex_m::Peripherals::take().ok_or(RunError::Host("peripherals taken"))?;
-        let mut clock = SysTickClock::start(peripherals.SYST);
-        let (calibration, ()) = count(&clock, || cortex_m::asm::delay(1_000_000));
-        defmt::println!(
-            "calibration: delay loop of 2000002 instructions counted as {=u64}",
-            calibration
-        );
+        let mut clock = calibrated_clock()?;
         let view = black_box(VIEW);
         let (frame_count, frame) = count(&clock, || view.frame());
         let frame = frame.map_err(|_| RunError::Host("view frame"))?;
@@ -95,11 +81,7 @@ fn main() -> ! {
 }
 
 #[cfg(target_os = "none")]
-#[allow(unsafe_code)]
-#[cortex_m_rt::exception]
-unsafe fn HardFault(_frame: &cortex_m_rt::ExceptionFrame) -> ! {
-    fvr_firmware::device::hard_fault()
-}
+fvr_firmware::hard_fault_handler!();
 
 #[cfg(not(target_os = "none"))]
 fn main() {
