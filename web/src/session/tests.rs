@@ -29,7 +29,7 @@ fn ask(level: u32, zoom: f64) -> Ask {
 
 #[test]
 fn full_views_are_the_renderers_own() {
-    let mut s = session(PLAIN);
+    let s = session(PLAIN);
     let image = s.render(&ask(0, 1.0)).unwrap();
     let settings = Settings {
         accuracy_db: Some(40.0),
@@ -43,7 +43,7 @@ fn full_views_are_the_renderers_own() {
 
 #[test]
 fn previews_shrink_and_zoom_magnifies() {
-    let mut s = session(PLAIN);
+    let s = session(PLAIN);
     let full = s.render(&ask(0, 1.0)).unwrap();
     let preview = s.render(&ask(1, 1.0)).unwrap();
     assert_eq!(
