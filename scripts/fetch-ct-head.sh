@@ -10,14 +10,8 @@ set -euo pipefail
 
 path=/usr/share/doc/invesalius-examples/examples/Cranium.inv3
 
-if [[ -n "${FVR_CT_HEAD:-}" ]]; then
-    if [[ -f "$FVR_CT_HEAD" ]]; then
-        echo "$FVR_CT_HEAD"
-        exit 0
-    fi
-    echo "fetch-ct-head: FVR_CT_HEAD is set to '$FVR_CT_HEAD', which is not a file" >&2
-    exit 1
-fi
+source "$(dirname "$0")/lib/path-from-env.sh"
+path_from_env fetch-ct-head FVR_CT_HEAD
 
 if [[ ! -f "$path" ]]; then
     if [[ "$(id -u)" -ne 0 ]]; then

@@ -16,14 +16,8 @@ member=nilearn/datasets/data/mni_icbm152_t1_tal_nlin_sym_09a_converted.nii.gz
 dir=target/data/mri-head
 path="$dir/mni_icbm152_t1_tal_nlin_sym_09a.nii.gz"
 
-if [[ -n "${FVR_MRI_HEAD:-}" ]]; then
-    if [[ -f "$FVR_MRI_HEAD" ]]; then
-        echo "$FVR_MRI_HEAD"
-        exit 0
-    fi
-    echo "fetch-mri-head: FVR_MRI_HEAD is set to '$FVR_MRI_HEAD', which is not a file" >&2
-    exit 1
-fi
+source scripts/lib/path-from-env.sh
+path_from_env fetch-mri-head FVR_MRI_HEAD
 
 if [[ ! -f "$path" ]]; then
     pip=""

@@ -38,7 +38,9 @@ import time
 import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-from peers import line_integrals, phantom, read_nrrd_image, snr_db, write_nrrd  # noqa: E402
+from peers import (  # noqa: E402
+    line_integrals, median_ms, phantom, read_nrrd_image, snr_db, write_nrrd,
+)
 
 # View directions (d, up): an axis view on the turntable about z, two views
 # tilted off every axis, and the first view of the tilted orbit fvr times.
@@ -138,17 +140,6 @@ def make_plan(n, eps, upsampfac, threads):
                         upsampfac=upsampfac, fftw=FFTW_FLAGS[FFTW])
 
 
-def time_ms(fn, repeats, warm=True):
-    if warm:
-        fn()
-    times = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        fn()
-        times.append((time.perf_counter() - t) * 1e3)
-    return statistics.median(times)
-
-
 def run_finufft(vol, gaussians, n, eps, upsampfac, pad, threads, repeats, refs):
     t = time.perf_counter()
     plan = make_plan(n, eps, upsampfac, threads)
@@ -158,7 +149,7 @@ def run_finufft(vol, gaussians, n, eps, upsampfac, pad, threads, repeats, refs):
     for (d, up), ref in zip(VIEWS, refs):
         view = View(n, d, up, pad)
         dbs.append(snr_db(ref, view.render(plan, v)))  # also the warm-up
-        mss.append(time_ms(lambda: view.render(plan, v), repeats, warm=False))
+        mss.append(median_ms(lambda: view.render(plan, v), repeats, warm=False))
     del plan
     return plan_ms, dbs, mss
 
@@ -177,7 +168,7 @@ def run_finufft_batched(vol, n, eps, upsampfac, pad, threads, frames, repeats):
         for i, w in enumerate(views):
             w.image(vals[counts[i]:counts[i + 1]])
 
-    ms = time_ms(go, repeats) / frames
+    ms = median_ms(go, repeats) / frames
     del plan
     return ms
 

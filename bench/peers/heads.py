@@ -26,7 +26,7 @@ import time
 
 import numpy as np
 
-from peers import read_nrrd_image, snr_db
+from peers import read_nrrd_image, rtk_project, snr_db
 
 MIB = 1 << 20
 
@@ -51,15 +51,6 @@ def turntable(fvr, volume, flags, views, work, tag):
     return json.loads(out[out.index("{"):])
 
 
-def rtk_geometry(i):
-    from itk import RTK as rtk
-
-    geometry = rtk.ThreeDCircularProjectionGeometry.New()
-    # sid 1000, sdd 0: parallel rays; oblique gantry angle, 25 degree tilt.
-    geometry.AddProjection(1000.0, 0.0, 20.0 + 137.5 * i, 0.0, 0.0, 25.0, 0.0)
-    return geometry
-
-
 def run_rtk(path, dims, spacing, image, pixel, views):
     """RTK's median ms per view over `views` oblique views on a W x H
     detector of `pixel` mm, the first view's image (rows as RTK stores them)
@@ -82,26 +73,14 @@ def run_rtk(path, dims, spacing, image, pixel, views):
     source.SetSize([w, h, 1])
     source.SetConstant(0.0)
     source.Update()
-    times, first, world = [], None, None
-    for i in range(views + 1):
-        geometry = rtk_geometry(i)
-        joseph = rtk.JosephForwardProjectionImageFilter[image_type, image_type].New()
-        joseph.SetInput(0, source.GetOutput())
-        joseph.SetInput(1, volume)
-        joseph.SetGeometry(geometry)
-        t = time.perf_counter()
-        joseph.Update()
-        if i > 0:
-            times.append((time.perf_counter() - t) * 1e3)
-            continue
-        first = itk.array_from_image(joseph.GetOutput())[0].astype(np.float64)
-        m = np.array(itk.array_from_matrix(
-            geometry.GetProjectionCoordinatesToFixedSystemMatrix(0)))
-        u = -(w / 2.0) * pixel + pixel * np.arange(w)
-        v = (1 - h / 2.0) * pixel + pixel * np.arange(h)
-        world = u[None, :, None] * m[:3, 0] + v[:, None, None] * m[:3, 1] + m[:3, 3]
+    ms, first, geometry = rtk_project(volume, source, views)
+    m = np.array(itk.array_from_matrix(
+        geometry.GetProjectionCoordinatesToFixedSystemMatrix(0)))
+    u = -(w / 2.0) * pixel + pixel * np.arange(w)
+    v = (1 - h / 2.0) * pixel + pixel * np.arange(h)
+    world = u[None, :, None] * m[:3, 0] + v[:, None, None] * m[:3, 1] + m[:3, 3]
     threads = itk.MultiThreaderBase.GetGlobalDefaultNumberOfThreads()
-    return statistics.median(times), first, world, threads
+    return ms, first, world, threads
 
 
 def view_frame(world):

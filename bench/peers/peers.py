@@ -105,14 +105,53 @@ def fvr_reference(gaussians, n, d):
     return line_integrals(gaussians, points, d)
 
 
-def median_ms(fn, repeats):
-    fn()  # warm-up
+def median_ms(fn, repeats, warm=True):
+    """Median wall time of `repeats` calls of `fn` in ms, after one
+    untimed warm-up call unless `warm` is false."""
+    if warm:
+        fn()
     times = []
     for _ in range(repeats):
         t = time.perf_counter()
         fn()
         times.append((time.perf_counter() - t) * 1e3)
     return statistics.median(times)
+
+
+def rtk_geometry(i):
+    """RTK view `i`: parallel rays (sid 1000, sdd 0) at gantry angle
+    20 + 137.5 i degrees, tilted by 25 degrees."""
+    from itk import RTK as rtk
+
+    geometry = rtk.ThreeDCircularProjectionGeometry.New()
+    geometry.AddProjection(1000.0, 0.0, 20.0 + 137.5 * i, 0.0, 0.0, 25.0, 0.0)
+    return geometry
+
+
+def rtk_project(volume, detector, views):
+    """RTK's Joseph projector over the views 0 ... `views` of `rtk_geometry`
+    onto `detector` (an updated ConstantImageSource): the median ms of
+    views 1 ... `views`, view 0's image (float64, rows as RTK stores them)
+    and view 0's geometry."""
+    import itk
+    from itk import RTK as rtk
+
+    image_type = itk.Image[itk.F, 3]
+    times, first, first_geometry = [], None, None
+    for i in range(views + 1):
+        geometry = rtk_geometry(i)
+        joseph = rtk.JosephForwardProjectionImageFilter[image_type, image_type].New()
+        joseph.SetInput(0, detector.GetOutput())
+        joseph.SetInput(1, volume)
+        joseph.SetGeometry(geometry)
+        t = time.perf_counter()
+        joseph.Update()
+        if i > 0:
+            times.append((time.perf_counter() - t) * 1e3)
+        else:
+            first = itk.array_from_image(joseph.GetOutput())[0].astype(np.float64)
+            first_geometry = geometry
+    return statistics.median(times), first, first_geometry
 
 
 def run_rtk(vol, gaussians, views):
@@ -132,34 +171,20 @@ def run_rtk(vol, gaussians, views):
     source.SetSize([n, n, 1])
     source.SetConstant(0.0)
     source.Update()
-    times, snr = [], None
-    for i in range(views + 1):
-        geometry = rtk.ThreeDCircularProjectionGeometry.New()
-        # sid 1000, sdd 0: parallel rays; oblique gantry angle, 25 degree tilt.
-        geometry.AddProjection(1000.0, 0.0, 20.0 + 137.5 * i, 0.0, 0.0, 25.0, 0.0)
-        joseph = rtk.JosephForwardProjectionImageFilter[image_type, image_type].New()
-        joseph.SetInput(0, source.GetOutput())
-        joseph.SetInput(1, volume)
-        joseph.SetGeometry(geometry)
-        t = time.perf_counter()
-        joseph.Update()
-        if i > 0:
-            times.append((time.perf_counter() - t) * 1e3)
-        else:
-            image = itk.array_from_image(joseph.GetOutput())[0].astype(np.float64)
-            to_world = np.array(
-                itk.array_from_matrix(geometry.GetProjectionCoordinatesToFixedSystemMatrix(0))
-            )
-            ray = np.array(itk.array_from_matrix(geometry.GetRotationMatrix(0)))[2, :3]
-            uv = np.arange(n) - (n - 1) / 2
-            world = (
-                uv[None, :, None] * to_world[:3, 0]
-                + uv[:, None, None] * to_world[:3, 1]
-                + to_world[:3, 3]
-            )
-            # Physical coordinates put voxel index i at i - (n - 1)/2.
-            snr = snr_db(line_integrals(gaussians, world + (n - 1) / 2, ray), image)
-    return statistics.median(times), snr, itk.MultiThreaderBase.GetGlobalDefaultNumberOfThreads()
+    ms, image, geometry = rtk_project(volume, source, views)
+    to_world = np.array(
+        itk.array_from_matrix(geometry.GetProjectionCoordinatesToFixedSystemMatrix(0))
+    )
+    ray = np.array(itk.array_from_matrix(geometry.GetRotationMatrix(0)))[2, :3]
+    uv = np.arange(n) - (n - 1) / 2
+    world = (
+        uv[None, :, None] * to_world[:3, 0]
+        + uv[:, None, None] * to_world[:3, 1]
+        + to_world[:3, 3]
+    )
+    # Physical coordinates put voxel index i at i - (n - 1)/2.
+    snr = snr_db(line_integrals(gaussians, world + (n - 1) / 2, ray), image)
+    return ms, snr, itk.MultiThreaderBase.GetGlobalDefaultNumberOfThreads()
 
 
 # The tilted turntable's axis and first direction (not along the axis).

@@ -100,6 +100,16 @@ impl Bufs {
     }
 }
 
+/// The pointer and length of buffer `k` of `c`: 0 the grid, 1 the
+/// scratch, 2 the image.
+fn buffer(c: &mut fvr_buffers, k: usize) -> (&mut *mut f32, &mut usize) {
+    match k {
+        0 => (&mut c.grid, &mut c.grid_len),
+        1 => (&mut c.aux, &mut c.aux_len),
+        _ => (&mut c.out, &mut c.out_len),
+    }
+}
+
 fn lens(src: &fvr_source, req: &fvr_request) -> fvr_lens {
     let mut l = fvr_lens::default();
     assert_eq!(unsafe { fvr_buffer_lens(src, req, &mut l) }, FVR_OK);
@@ -194,11 +204,7 @@ fn null_pointers_are_fvr_err_null() {
         assert_eq!(fvr_render(&src, &req, std::ptr::null()), FVR_ERR_NULL);
         for k in 0..3 {
             let mut c = b.c();
-            match k {
-                0 => c.grid = null,
-                1 => c.aux = null,
-                _ => c.out = null,
-            }
+            *buffer(&mut c, k).0 = null;
             assert_eq!(fvr_render(&src, &req, &c), FVR_ERR_NULL, "buffer {k}");
         }
     }
@@ -212,11 +218,7 @@ fn short_buffers_are_fvr_err_buffer_too_small() {
     let mut b = Bufs::new(lens(&src, &req));
     for k in 0..3 {
         let mut c = b.c();
-        match k {
-            0 => c.grid_len -= 1,
-            1 => c.aux_len -= 1,
-            _ => c.out_len -= 1,
-        }
+        *buffer(&mut c, k).1 -= 1;
         assert_eq!(
             unsafe { fvr_render(&src, &req, &c) },
             FVR_ERR_BUFFER_TOO_SMALL,
@@ -234,12 +236,9 @@ fn misaligned_pointers_are_fvr_err_misaligned() {
     let mut b = Bufs::new(lens(&src, &req));
     for k in 0..3 {
         let mut c = b.c();
-        let nudge = |p: *mut f32| p.cast::<u8>().wrapping_add(1).cast::<f32>();
-        match k {
-            0 => c.grid = nudge(c.grid),
-            1 => c.aux = nudge(c.aux),
-            _ => c.out = nudge(c.out),
-        }
+        let (p, _) = buffer(&mut c, k);
+        // One byte on: no longer 4-byte aligned.
+        *p = p.cast::<u8>().wrapping_add(1).cast::<f32>();
         assert_eq!(
             unsafe { fvr_render(&src, &req, &c) },
             FVR_ERR_MISALIGNED,

@@ -33,7 +33,8 @@
 
 use std::hint::black_box;
 
-use criterion::{criterion_group, criterion_main, Criterion};
+use criterion::measurement::WallTime;
+use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion};
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
 use fvr_engine::render::adaptive::AdaptiveRenderer;
@@ -63,6 +64,11 @@ const CHAINS: [(&str, &[Cheaper], Bound); 4] = [
     ("zero_parseval", &[Cheaper::Zero], Bound::Parseval),
 ];
 
+/// Times `render`, one view into the bench's buffers, as `id` in `group`.
+fn time_view<R>(group: &mut BenchmarkGroup<'_, WallTime>, id: &str, mut render: impl FnMut() -> R) {
+    group.bench_function(id, |b| b.iter(&mut render));
+}
+
 /// The full and adaptive views of `volume` with `filter`, in group `name`.
 fn group(c: &mut Criterion, name: &str, volume: &Volume, filter: Filter) {
     let spec = OwnedSpectrum::<f16>::prepare::<f32>(volume, filter).unwrap();
@@ -79,12 +85,10 @@ fn group(c: &mut Criterion, name: &str, volume: &Volume, filter: Filter) {
     let mut out = vec![0.0f32; side * side];
     let mut group = c.benchmark_group(name);
     group.sample_size(20);
-    group.bench_function("full", |b| {
-        b.iter(|| {
-            renderer
-                .render_into(&spec, black_box(&view), side, side, &mut out)
-                .unwrap()
-        })
+    time_view(&mut group, "full", || {
+        renderer
+            .render_into(&spec, black_box(&view), side, side, &mut out)
+            .unwrap()
     });
     for (label, chain, bound) in CHAINS {
         // `fvr render`'s defaults also decide between the walks per view.
@@ -103,12 +107,10 @@ fn group(c: &mut Criterion, name: &str, volume: &Volume, filter: Filter) {
         )
         .unwrap();
         let mut adaptive = AdaptiveRenderer::<f32>::new(&marks, &spec).unwrap();
-        group.bench_function(format!("adaptive_40db_{label}"), |b| {
-            b.iter(|| {
-                adaptive
-                    .render_into(&spec, black_box(&view), side, side, &mut out)
-                    .unwrap()
-            })
+        time_view(&mut group, &format!("adaptive_40db_{label}"), || {
+            adaptive
+                .render_into(&spec, black_box(&view), side, side, &mut out)
+                .unwrap()
         });
         if label == "zero_parseval" {
             let probe_marks = AdaptiveMarks::build(
@@ -123,33 +125,27 @@ fn group(c: &mut Criterion, name: &str, volume: &Volume, filter: Filter) {
             )
             .unwrap();
             let mut probed = AdaptiveRenderer::<f32>::new(&probe_marks, &spec).unwrap();
-            group.bench_function(format!("adaptive_40db_{label}_probe"), |b| {
-                b.iter(|| {
-                    probed
-                        .render_into(&spec, black_box(&view), side, side, &mut out)
-                        .unwrap()
-                })
+            time_view(&mut group, &format!("adaptive_40db_{label}_probe"), || {
+                probed
+                    .render_into(&spec, black_box(&view), side, side, &mut out)
+                    .unwrap()
             });
             let mut exact = AdaptiveRenderer::<f32>::new(&marks, &spec)
                 .unwrap()
                 .with_walk(Walk::Exact);
-            group.bench_function(format!("adaptive_40db_{label}_exact"), |b| {
-                b.iter(|| {
-                    exact
-                        .render_into(&spec, black_box(&view), side, side, &mut out)
-                        .unwrap()
-                })
+            time_view(&mut group, &format!("adaptive_40db_{label}_exact"), || {
+                exact
+                    .render_into(&spec, black_box(&view), side, side, &mut out)
+                    .unwrap()
             });
         }
     }
     let mut core = AdaptiveRenderer::<f32>::new(&marks, &spec)
         .unwrap()
         .with_core(true);
-    group.bench_function("adaptive_40db_core", |b| {
-        b.iter(|| {
-            core.render_into(&spec, black_box(&view), side, side, &mut out)
-                .unwrap()
-        })
+    time_view(&mut group, "adaptive_40db_core", || {
+        core.render_into(&spec, black_box(&view), side, side, &mut out)
+            .unwrap()
     });
     group.finish();
 }
@@ -195,12 +191,10 @@ fn breakeven(c: &mut Criterion, name: &str, volume: &Volume, filter: Filter) {
     let mut out = vec![0.0f32; side * side];
     let mut group = c.benchmark_group(name);
     group.sample_size(20);
-    group.bench_function("plain", |b| {
-        b.iter(|| {
-            renderer
-                .render_into(&spec, black_box(&view), side, side, &mut out)
-                .unwrap()
-        })
+    time_view(&mut group, "plain", || {
+        renderer
+            .render_into(&spec, black_box(&view), side, side, &mut out)
+            .unwrap()
     });
     for db in [400.0, 120.0, 90.0, 70.0, 55.0, 40.0] {
         let settings = AdaptiveSettings {
@@ -213,13 +207,15 @@ fn breakeven(c: &mut Criterion, name: &str, volume: &Volume, filter: Filter) {
             .render_into(&spec, &view, side, side, &mut out)
             .unwrap();
         let share = 100.0 * (stats.samples - stats.per_filter[0]) as f64 / stats.samples as f64;
-        group.bench_function(format!("adaptive_{db}db_{share:.1}pct"), |b| {
-            b.iter(|| {
+        time_view(
+            &mut group,
+            &format!("adaptive_{db}db_{share:.1}pct"),
+            || {
                 adaptive
                     .render_into(&spec, black_box(&view), side, side, &mut out)
                     .unwrap()
-            })
-        });
+            },
+        );
     }
     group.finish();
 }

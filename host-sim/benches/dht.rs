@@ -10,8 +10,11 @@
 //!
 //! Run: `cargo bench -p fvr-host --bench dht`.
 
+mod common;
+
 use std::hint::black_box;
 
+use common::lcg_values;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use fvr_core::dht::{dht_2d, dht_2d_lines, dht_2d_sparse_len, Twiddles};
 
@@ -20,13 +23,7 @@ fn benches(c: &mut Criterion) {
     for n in [256usize, 512] {
         let mut tw_buf = vec![0.0f32; Twiddles::<f32>::buffer_len(n)];
         let tw = Twiddles::new(&mut tw_buf, n).unwrap();
-        let mut state = 12345u32;
-        let input: Vec<f32> = (0..n * n)
-            .map(|_| {
-                state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-                (state >> 8) as f32 / 16_777_216.0 - 0.5
-            })
-            .collect();
+        let input = lcg_values(n * n);
         let mut data = input.clone();
         let mut column = vec![0.0f32; n];
         // Each iteration restores the input first (timed separately as
@@ -56,19 +53,12 @@ fn sparse(c: &mut Criterion) {
     let (n, rows) = (256usize, 58);
     let mut tw_buf = vec![0.0f32; Twiddles::<f32>::buffer_len(n)];
     let tw = Twiddles::new(&mut tw_buf, n).unwrap();
-    let mut state = 12345u32;
     // Rows 0 … 28 and n − 29 … n − 1, as a slice's low frequencies.
     let held = |y: usize| y < rows / 2 || y >= n - rows / 2;
-    let input: Vec<f32> = (0..n * n)
-        .map(|i| {
-            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            let v = (state >> 8) as f32 / 16_777_216.0 - 0.5;
-            if held(i / n) {
-                v
-            } else {
-                0.0
-            }
-        })
+    let input: Vec<f32> = lcg_values(n * n)
+        .into_iter()
+        .enumerate()
+        .map(|(i, v)| if held(i / n) { v } else { 0.0 })
         .collect();
     let mut dense = input.clone();
     for y in (0..n).filter(|&y| !held(y)) {

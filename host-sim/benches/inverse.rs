@@ -9,8 +9,11 @@
 //!
 //! Run: `cargo bench -p fvr-host --bench inverse`.
 
+mod common;
+
 use std::hint::black_box;
 
+use common::lcg_values;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use fvr_core::dht::{mixed_table_len, MixedPlan, Twiddles};
 use fvr_core::image::{aux_len, finish_with, Crop, Inverse, Placement};
@@ -21,13 +24,7 @@ const IMAGE: usize = 256;
 
 fn bench_side(c: &mut Criterion, n: usize, inverse: Inverse<'_, f32>) {
     let mut group = c.benchmark_group("finish_f32");
-    let mut state = 12345u32;
-    let input: Vec<f32> = (0..n * n)
-        .map(|_| {
-            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (state >> 8) as f32 / 16_777_216.0 - 0.5
-        })
-        .collect();
+    let input = lcg_values(n * n);
     let place = Placement {
         col0: -(IMAGE as i64) / 2,
         row0: IMAGE as i64 / 2,

@@ -16,8 +16,11 @@
 //! Run: `FVR_CT_HEAD=$(bash scripts/fetch-ct-head.sh) cargo bench -p fvr-host --bench plan_cost`
 //! (Linux only). `FVR_BENCH_VIEWS` sets the views per figure (default 24).
 
+mod common;
+
 use std::hint::black_box;
 
+use common::thread_cpu_ms;
 use fvr_core::filter::KernelTable;
 use fvr_core::geometry::Sampling;
 use fvr_core::volume::GridOversampling;
@@ -29,20 +32,6 @@ use fvr_engine::slice::exact::{self, Tiling};
 use fvr_engine::spectrum::OwnedSpectrum;
 use fvr_host::sources::datasets::load_dataset;
 use half::f16;
-
-/// This thread's user + system time in ms (clock ticks of 10 ms).
-fn thread_cpu_ms() -> f64 {
-    let stat = std::fs::read_to_string("/proc/thread-self/stat").unwrap_or_default();
-    let rest = stat.rsplit_once(')').map_or("", |(_, r)| r);
-    let fields: Vec<&str> = rest.split_whitespace().collect();
-    let ticks = |i: usize| {
-        fields
-            .get(i)
-            .and_then(|v| v.parse::<f64>().ok())
-            .unwrap_or(0.0)
-    };
-    (ticks(11) + ticks(12)) * 10.0
-}
 
 /// Solve the normal equations `AᵀA x = Aᵀy` by Gaussian elimination.
 fn least_squares<const P: usize>(rows: &[([f64; P], f64)]) -> [f64; P] {

@@ -23,8 +23,11 @@
 //! prefetch that many lines ahead (`Tiling::ahead`), alternating, one
 //! thread.
 
+mod common;
+
 use std::hint::black_box;
 
+use common::thread_cpu_ms;
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::{Sampling, View};
 use fvr_core::render::Request;
@@ -38,22 +41,6 @@ use fvr_engine::spectrum::exchange::{exchanged, rows_along_y};
 use fvr_engine::spectrum::OwnedSpectrum;
 use fvr_engine::volume::phantom::{sample, GaussianMixture};
 use half::f16;
-
-/// This thread's user + system time in ms (clock ticks of 10 ms).
-fn thread_cpu_ms() -> f64 {
-    let stat = std::fs::read_to_string("/proc/thread-self/stat").unwrap_or_default();
-    // Fields after the command name in parentheses; utime and stime are
-    // fields 14 and 15 of the whole line.
-    let rest = stat.rsplit_once(')').map_or("", |(_, r)| r);
-    let fields: Vec<&str> = rest.split_whitespace().collect();
-    let ticks = |i: usize| {
-        fields
-            .get(i)
-            .and_then(|v| v.parse::<f64>().ok())
-            .unwrap_or(0.0)
-    };
-    (ticks(11) + ticks(12)) * 10.0
-}
 
 fn per_view(views: usize, mut f: impl FnMut()) -> f64 {
     f();

@@ -301,6 +301,34 @@ fn non_cubic_volumes_and_oversampling_bit_identical() {
     }
 }
 
+/// `renderer`'s `width × height` image of `view` is the core's finish of
+/// `grid` (the slice of `view`, with twiddles `tw`), bit for bit, and its
+/// statistics are `stats`.
+fn assert_renders_the_finish(
+    renderer: &mut AdaptiveRenderer<'_, f32>,
+    spec: &OwnedSpectrum<f16>,
+    view: &View,
+    (mut grid, stats, tw): (Vec<f32>, AdaptiveStats, &Twiddles<'_, f32>),
+    (width, height): (usize, usize),
+    what: &str,
+) {
+    let (view_spec, n) = (spec.view(), spec.n());
+    let frame = view.frame().unwrap();
+    let mut aux = vec![0f32; aux_len(n)];
+    let mut image = vec![0f32; width * height];
+    let place = placement(view_spec.dims(), &frame, width, height);
+    let crop = Crop::new(place, 1.0 / view_spec.scale(), width, height);
+    finish(&mut grid, n, &crop, tw, &mut aux, &mut image).unwrap();
+    let mut out = vec![0f32; width * height];
+    let got = renderer
+        .render_into(spec, view, width, height, &mut out)
+        .unwrap();
+    assert_eq!(got, stats, "{what}");
+    for (a, b) in image.iter().zip(&out) {
+        assert_eq!(a.to_bits(), b.to_bits(), "{what}");
+    }
+}
+
 /// The renderer's image (host extraction, then the core's finish) equals
 /// the core's adaptive extraction followed by the same finish, and its
 /// statistics the core's; `None` where the walk does not serve.
@@ -334,19 +362,16 @@ fn renderer_image_equals_core_extraction() {
             let mut grid = vec![0f32; n * n];
             let core_stats =
                 extract_slice_adaptive(&view_spec, &kernel, &levels, &frame, &mut grid).unwrap();
-            let mut aux = vec![0f32; aux_len(n)];
-            let mut core = vec![0f32; width * height];
-            let place = placement(view_spec.dims(), &frame, width, height);
-            let crop = Crop::new(place, 1.0 / view_spec.scale(), width, height);
-            finish(&mut grid, n, &crop, &tw, &mut aux, &mut core).unwrap();
-            let mut out = vec![0f32; width * height];
-            let stats = renderer
-                .render_into(&spec, &view, width, height, &mut out)
-                .unwrap();
-            assert_eq!(stats, core_stats, "{dir:?}");
-            for (a, b) in core.iter().zip(&out) {
-                assert_eq!(a.to_bits(), b.to_bits(), "{dir:?}, parallel {parallel}");
-            }
+            let what = format!("{dir:?}, parallel {parallel}");
+            let finished = (grid, core_stats, &tw);
+            assert_renders_the_finish(
+                &mut renderer,
+                &spec,
+                &view,
+                finished,
+                (width, height),
+                &what,
+            );
         }
     }
     // A kernel for another filter: the walk declines, the core reports it.
@@ -468,21 +493,9 @@ fn strip_walk_sums_the_large_filters_points_and_nothing_else() {
             if expected.is_empty() {
                 continue;
             }
-            let (width, height) = (48, 40);
-            let mut image = vec![0f32; width * height];
-            let mut grid = expected.clone();
-            let mut aux = vec![0f32; aux_len(n)];
-            let place = placement(view_spec.dims(), &frame, width, height);
-            let crop = Crop::new(place, 1.0 / view_spec.scale(), width, height);
-            finish(&mut grid, n, &crop, &tw, &mut aux, &mut image).unwrap();
-            let mut out = vec![0f32; width * height];
-            let stats = renderer
-                .render_into(&spec, &view, width, height, &mut out)
-                .unwrap();
-            assert_eq!(stats, core_stats, "{what}");
-            for (a, b) in image.iter().zip(&out) {
-                assert_eq!(a.to_bits(), b.to_bits(), "{what}: renderer");
-            }
+            let finished = (expected, core_stats, &tw);
+            let what = format!("{what}: renderer");
+            assert_renders_the_finish(&mut renderer, &spec, &view, finished, (48, 40), &what);
         }
     }
 }

@@ -1,7 +1,7 @@
 //! The `fvr` program end to end: outputs, and clear errors on bad input.
 
 mod common;
-use common::{assert_error, assert_ok, fvr, fvr_in, fvr_line, read, temp_dir};
+use common::{assert_error, assert_ok, assert_refused, fvr, fvr_in, fvr_line, read, temp_dir};
 
 use fvr_host::io::nrrd::SampleType::{F32, U16};
 use fvr_host::io::nrrd::{encode_nrrd, Encoding, Endian};
@@ -165,17 +165,21 @@ fn precision_study_writes_markdown_csv_and_png_with_no_non_finite_pixel() {
 fn precision_bad_formats_are_named_before_any_work() {
     let (dir, out) = fvr_in("precision-bad", "precision --formats e5m11");
     assert_error(&out, &["e5m11", "17 bits", "16"]);
-    let out = fvr_line("precision --formats e9m6", &dir);
-    assert_error(&out, &["e9m6", "f32"]);
-    let out = fvr_line("precision --formats f24", &dir);
-    assert_error(&out, &["unknown format `f24`"]);
-    let out = fvr_line(
-        "precision --volumes gaussians@16 --formats q15-brick6",
+    assert_refused(
         &dir,
+        &[
+            ("precision --formats e9m6", &["e9m6", "f32"]),
+            ("precision --formats f24", &["unknown format `f24`"]),
+            (
+                "precision --volumes gaussians@16 --formats q15-brick6",
+                &["q15-brick6", "block size 6 does not divide", "16"],
+            ),
+            (
+                "precision --formats e4m11-line",
+                &["only q15 and q7 take block exponents"],
+            ),
+        ],
     );
-    assert_error(&out, &["q15-brick6", "block size 6 does not divide", "16"]);
-    let out = fvr_line("precision --formats e4m11-line", &dir);
-    assert_error(&out, &["only q15 and q7 take block exponents"]);
 }
 
 #[test]

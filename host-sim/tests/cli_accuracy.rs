@@ -3,32 +3,13 @@
 //! and scene settings that win, and the warning for settings predicted low.
 
 mod common;
-use common::{assert_ok, fvr, temp_dir};
-
-fn json_line(stdout: &[u8]) -> serde_json::Value {
-    let text = String::from_utf8_lossy(stdout);
-    let line = text
-        .lines()
-        .find(|l| l.starts_with('{'))
-        .unwrap_or_else(|| panic!("no JSON line in: {text}"));
-    serde_json::from_str(line).unwrap()
-}
+use common::{assert_ok, fvr_line, json_line, temp_dir};
 
 #[test]
 fn accuracy_chooses_a_configuration_predicted_to_meet_the_target() {
     let dir = temp_dir("accuracy-choose");
-    let out = fvr(
-        &[
-            "render",
-            "brainsmall",
-            "--dir",
-            "1,0,0",
-            "--accuracy",
-            "45",
-            "--out",
-            "a.png",
-            "--stats-json",
-        ],
+    let out = fvr_line(
+        "render brainsmall --dir 1,0,0 --accuracy 45 --out a.png --stats-json",
         &dir,
     );
     assert_ok(&out);
@@ -45,20 +26,8 @@ fn accuracy_chooses_a_configuration_predicted_to_meet_the_target() {
 #[test]
 fn explicit_flags_win_and_an_unmet_target_warns() {
     let dir = temp_dir("accuracy-given");
-    let out = fvr(
-        &[
-            "turntable",
-            "brainsmall",
-            "--frames",
-            "2",
-            "--accuracy",
-            "45",
-            "--oversample",
-            "1",
-            "--out",
-            "a.apng",
-            "--stats-json",
-        ],
+    let out = fvr_line(
+        "turntable brainsmall --frames 2 --accuracy 45 --oversample 1 --out a.apng --stats-json",
         &dir,
     );
     assert_ok(&out);
@@ -78,16 +47,8 @@ fn explicit_flags_win_and_an_unmet_target_warns() {
 #[test]
 fn the_default_target_is_50_db_and_a_touching_head_gets_oversampled() {
     let dir = temp_dir("accuracy-default");
-    let out = fvr(
-        &[
-            "render",
-            "brainsmall",
-            "--dir",
-            "0,1,0",
-            "--out",
-            "a.png",
-            "--stats-json",
-        ],
+    let out = fvr_line(
+        "render brainsmall --dir 0,1,0 --out a.png --stats-json",
         &dir,
     );
     assert_ok(&out);
@@ -105,40 +66,17 @@ fn the_default_target_is_50_db_and_a_touching_head_gets_oversampled() {
 fn settings_given_without_accuracy_win_and_warn_when_predicted_low() {
     let dir = temp_dir("accuracy-warn");
     // All three given: used as given, predicted, and warned about.
-    let all = [
-        "render",
-        "brainsmall",
-        "--dir",
-        "0,1,0",
-        "--filter",
-        "kb4",
-        "--oversample",
-        "1",
-        "--precision",
-        "f16",
-        "--out",
-        "a.png",
-        "--stats-json",
-    ];
+    let all = "render brainsmall --dir 0,1,0 --filter kb4 --oversample 1 --precision f16 \
+               --out a.png --stats-json";
     // Only the oversampling given: the planner chooses the rest around it.
-    let one = [
-        "render",
-        "brainsmall",
-        "--dir",
-        "0,1,0",
-        "--oversample",
-        "1",
-        "--out",
-        "b.png",
-        "--stats-json",
-    ];
-    for args in [&all[..], &one[..]] {
-        let out = fvr(args, &dir);
+    let one = "render brainsmall --dir 0,1,0 --oversample 1 --out b.png --stats-json";
+    for line in [all, one] {
+        let out = fvr_line(line, &dir);
         assert_ok(&out);
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(
             err.contains("predicted to reach only") && err.contains("--accuracy"),
-            "{args:?}: {err}"
+            "{line}: {err}"
         );
         let stats = json_line(&out.stdout);
         assert_eq!(stats["oversample"], 1, "{stats}");
@@ -148,10 +86,7 @@ fn settings_given_without_accuracy_win_and_warn_when_predicted_low() {
         );
     }
     // A compact phantom at the default: nothing to warn about.
-    let out = fvr(
-        &["render", "gaussians@32", "--dir", "0,1,0", "--out", "c.png"],
-        &dir,
-    );
+    let out = fvr_line("render gaussians@32 --dir 0,1,0 --out c.png", &dir);
     assert_ok(&out);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!err.contains("warning"), "{err}");
@@ -175,38 +110,28 @@ fn a_scene_file_states_the_accuracy_and_its_settings_win() {
         "[volume]\nbuiltin = \"brainsmall\"\n[spectrum]\naccuracy = -3\n",
     )
     .unwrap();
-    let run = |scene: &str, extra: &[&str]| {
-        let mut args = vec![
-            "render",
-            "--scene",
-            scene,
-            "--dir",
-            "0,1,0",
-            "--out",
-            "s.png",
-            "--stats-json",
-        ];
-        args.extend_from_slice(extra);
-        fvr(&args, &dir)
+    let run = |scene: &str, extra: &str| {
+        let line = format!("render --scene {scene} --dir 0,1,0 --out s.png --stats-json {extra}");
+        fvr_line(&line, &dir)
     };
-    let out = run("target.toml", &[]);
+    let out = run("target.toml", "");
     assert_ok(&out);
     let stats = json_line(&out.stdout);
     assert_eq!(stats["accuracy"]["target_db"], 45.0, "{stats}");
     assert_eq!(stats["accuracy"]["target_is_default"], false, "{stats}");
     // The command line wins over the scene.
-    let out = run("target.toml", &["--accuracy", "60"]);
+    let out = run("target.toml", "--accuracy 60");
     assert_ok(&out);
     let stats = json_line(&out.stdout);
     assert_eq!(stats["accuracy"]["target_db"], 60.0, "{stats}");
     // A setting in the scene is the user's choice: kept, and warned about.
-    let out = run("fixed.toml", &[]);
+    let out = run("fixed.toml", "");
     assert_ok(&out);
     let stats = json_line(&out.stdout);
     assert_eq!(stats["oversample"], 1, "{stats}");
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("predicted to reach only"), "{err}");
-    let out = run("bad.toml", &[]);
+    let out = run("bad.toml", "");
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(

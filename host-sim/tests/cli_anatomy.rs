@@ -6,7 +6,7 @@
 //! image.
 
 mod common;
-use common::{assert_error, assert_ok, fvr, temp_dir};
+use common::{assert_error, assert_ok, fvr, fvr_line, temp_dir};
 
 use std::path::Path;
 
@@ -176,19 +176,7 @@ fn named_views_put_the_marker_where_the_patient_has_it() {
 #[test]
 fn view_conflicts_with_dir_and_notes_a_missing_orientation() {
     let dir = temp_dir("anatomy-cli");
-    let out = fvr(
-        &[
-            "render",
-            "sphere@16",
-            "--view",
-            "left",
-            "--dir",
-            "1,0,0",
-            "--out",
-            "x.png",
-        ],
-        &dir,
-    );
+    let out = fvr_line("render sphere@16 --view left --dir 1,0,0 --out x.png", &dir);
     assert_error(&out, &["fvr: error:", "--view", "--dir"]);
     assert_eq!(
         String::from_utf8_lossy(&out.stderr)
@@ -198,22 +186,9 @@ fn view_conflicts_with_dir_and_notes_a_missing_orientation() {
         1
     );
     assert!(!dir.join("x.png").exists());
-    let out = fvr(
-        &[
-            "render",
-            "sphere@16",
-            "--view",
-            "sideways",
-            "--out",
-            "x.png",
-        ],
-        &dir,
-    );
+    let out = fvr_line("render sphere@16 --view sideways --out x.png", &dir);
     assert_error(&out, &["fvr: error:", "sideways"]);
-    let out = fvr(
-        &["render", "sphere@16", "--view", "left", "--out", "x.png"],
-        &dir,
-    );
+    let out = fvr_line("render sphere@16 --view left --out x.png", &dir);
     assert_ok(&out);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
@@ -229,24 +204,12 @@ fn view_conflicts_with_dir_and_notes_a_missing_orientation() {
 #[test]
 fn brainsmall_named_views_need_no_note() {
     let dir = temp_dir("anatomy-brainsmall");
-    let out = fvr(
-        &["render", "brainsmall", "--view", "left", "--out", "a.nrrd"],
-        &dir,
-    );
+    let out = fvr_line("render brainsmall --view left --out a.nrrd", &dir);
     assert_ok(&out);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!err.contains("no orientation"), "{err}");
-    let out = fvr(
-        &[
-            "render",
-            "brainsmall",
-            "--dir",
-            "0,0,1",
-            "--up",
-            "0,-1,0",
-            "--out",
-            "b.nrrd",
-        ],
+    let out = fvr_line(
+        "render brainsmall --dir 0,0,1 --up 0,-1,0 --out b.nrrd",
         &dir,
     );
     assert_ok(&out);

@@ -3,7 +3,7 @@
 //! names are refused in one line before any work.
 
 mod common;
-use common::{assert_error, assert_ok, fvr, fvr_line, temp_dir};
+use common::{assert_error, assert_ok, fvr_line, temp_dir};
 
 use fvr_host::io::nrrd::{encode_nrrd, read_nrrd, Encoding, Endian, SampleType};
 use fvr_host::sources::{load_volume, RawLayout};
@@ -39,15 +39,8 @@ fn spacing_and_background_are_kept() {
     with_spacing.extend_from_slice(&bytes[header_end + 1..]);
     std::fs::write(dir.join("ct.nrrd"), with_spacing).unwrap();
 
-    assert_ok(&fvr(
-        &[
-            "convert",
-            "ct.nrrd",
-            "--background",
-            "-20",
-            "--out",
-            "f.nrrd",
-        ],
+    assert_ok(&fvr_line(
+        "convert ct.nrrd --background -20 --out f.nrrd",
         &dir,
     ));
     let back = read_nrrd(&dir.join("f.nrrd")).unwrap();

@@ -3,16 +3,7 @@
 //! the refusals for what needs a power-of-two side.
 
 mod common;
-use common::{assert_error, assert_ok, fvr_in, fvr_line};
-
-fn json_line(stdout: &[u8]) -> serde_json::Value {
-    let text = String::from_utf8_lossy(stdout);
-    let line = text
-        .lines()
-        .find(|l| l.starts_with('{'))
-        .unwrap_or_else(|| panic!("no JSON line in: {text}"));
-    serde_json::from_str(line).unwrap()
-}
+use common::{assert_error, assert_ok, assert_refused, fvr_in, fvr_line, json_line};
 
 #[test]
 fn an_explicit_mixed_grid_renders_on_its_side_with_the_default_image() {
@@ -72,16 +63,19 @@ fn mixed_grids_are_refused_where_a_power_of_two_is_needed() {
         "render brainsmall --dir 1,0,0 --oversample 1.5 --adaptive 40 --out a.png",
     );
     assert_error(&out, &["--oversample 1.5", "plain X-ray views", "1 or 2"]);
-    let out = fvr_line(
-        "render brainsmall --dir 1,0,0 --oversample 1.25 --light 0,1,0:1,1,1 --out a.png",
+    assert_refused(
         &dir,
+        &[
+            (
+                "render brainsmall --dir 1,0,0 --oversample 1.25 --light 0,1,0:1,1,1 --out a.png",
+                &["--oversample 1.25", "plain X-ray views"],
+            ),
+            (
+                "render brainsmall --dir 1,0,0 --oversample 3 --out a.png",
+                &["expected 1, 1.25, 1.5 or 2, got `3`"],
+            ),
+        ],
     );
-    assert_error(&out, &["--oversample 1.25", "plain X-ray views"]);
-    let out = fvr_line(
-        "render brainsmall --dir 1,0,0 --oversample 3 --out a.png",
-        &dir,
-    );
-    assert_error(&out, &["expected 1, 1.25, 1.5 or 2, got `3`"]);
 }
 
 #[test]

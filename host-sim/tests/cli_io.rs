@@ -31,13 +31,13 @@ fn png_info(path: &Path) -> png::Info<'static> {
 #[test]
 fn version_and_help_document_the_exit_status() {
     let dir = temp_dir("io-help");
-    let out = fvr(&["--version"], &dir);
+    let out = fvr_line("--version", &dir);
     assert_ok(&out);
     assert_eq!(
         stdout(&out).trim(),
         format!("fvr {}", env!("CARGO_PKG_VERSION"))
     );
-    let out = fvr(&["--help"], &dir);
+    let out = fvr_line("--help", &dir);
     assert_ok(&out);
     let help = stdout(&out);
     for needle in [

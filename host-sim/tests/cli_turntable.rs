@@ -4,26 +4,14 @@
 //! renders of their views.
 
 mod common;
-use common::{assert_error, assert_ok, fvr_line, temp_dir};
+use common::{assert_error, assert_ok, fvr_line, png_frames, temp_dir};
 use std::path::Path;
 
 /// Every frame of a PNG or APNG, decoded: (width, height, colour type,
 /// frames of bytes).
 fn frames(path: &Path) -> (u32, u32, png::ColorType, Vec<Vec<u8>>) {
-    let file = std::fs::File::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut reader = png::Decoder::new(std::io::BufReader::new(file))
-        .read_info()
-        .unwrap();
-    let info = reader.info().clone();
-    let count = info.animation_control.map_or(1, |a| a.num_frames);
-    let mut out = Vec::new();
-    for _ in 0..count {
-        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
-        let frame = reader.next_frame(&mut buf).unwrap();
-        buf.truncate(frame.buffer_size());
-        out.push(buf);
-    }
-    (info.width, info.height, info.color_type, out)
+    let (info, frames) = png_frames(path);
+    (info.width, info.height, info.color_type, frames)
 }
 
 /// Pearson correlation of two byte images.

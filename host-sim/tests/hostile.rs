@@ -6,7 +6,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{assert_error, fvr, fvr_line, temp_dir};
+use common::{assert_error, assert_refused, fvr_line, temp_dir};
 use fvr_host::io::nrrd::{encode_nrrd, Encoding::Raw, Endian::Little, SampleType::U8};
 
 /// `line` run in `dir` exits 2 naming every needle and leaves no `output`.
@@ -38,21 +38,23 @@ fn images_larger_than_the_slice_are_refused_before_allocating() {
 #[test]
 fn jobs_beyond_the_memory_limit_name_what_they_need() {
     let dir = temp_dir("hostile-memory");
-    let out = fvr_line(
-        "--max-memory 64M render sphere@32 --dir 1,0,0 --resample 2500 --out x.png",
+    assert_refused(
         &dir,
+        &[
+            (
+                "--max-memory 64M render sphere@32 --dir 1,0,0 --resample 2500 --out x.png",
+                &["resampled volume", "--max-memory", "--resample"],
+            ),
+            (
+                "--max-memory 1M turntable sphere@16 --frames 3600 --out t.apng",
+                &["frames", "--frames"],
+            ),
+            (
+                "--max-memory lots render sphere@16 --dir 1,0,0 --out x.png",
+                &["--max-memory `lots`"],
+            ),
+        ],
     );
-    assert_error(&out, &["resampled volume", "--max-memory", "--resample"]);
-    let out = fvr_line(
-        "--max-memory 1M turntable sphere@16 --frames 3600 --out t.apng",
-        &dir,
-    );
-    assert_error(&out, &["frames", "--frames"]);
-    let out = fvr_line(
-        "--max-memory lots render sphere@16 --dir 1,0,0 --out x.png",
-        &dir,
-    );
-    assert_error(&out, &["--max-memory `lots`"]);
 }
 
 /// The address-space limit of `ulimit -v` is a memory limit too: under
@@ -92,17 +94,7 @@ fn an_output_equal_to_the_input_is_refused_and_the_input_kept() {
     std::fs::write(dir.join("vol.nrrd"), &bytes).unwrap();
     let out = fvr_line("render vol.nrrd --dir 1,0,0 --out vol.nrrd", &dir);
     assert_error(&out, &["vol.nrrd", "overwrite an input"]);
-    let out = fvr(
-        &[
-            "render",
-            "vol.nrrd",
-            "--dir",
-            "1,0,0",
-            "--out",
-            "./sub/../vol.nrrd",
-        ],
-        &dir,
-    );
+    let out = fvr_line("render vol.nrrd --dir 1,0,0 --out ./sub/../vol.nrrd", &dir);
     assert_eq!(out.status.code(), Some(2));
     let out = fvr_line("turntable vol.nrrd --frames 2 --out vol.nrrd", &dir);
     assert_error(&out, &["vol.nrrd", ".apng"]);

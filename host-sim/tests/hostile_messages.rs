@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{assert_error, assert_ok, fvr, fvr_line, temp_dir};
+use common::{assert_error, assert_ok, fvr_line, temp_dir};
 use fvr_host::text::MAX_LINE_CHARS;
 
 /// No line of stderr is longer than the bound (plus its marker).
@@ -23,17 +23,8 @@ fn short_lines(out: &std::process::Output) {
 fn huge_values_and_keys_are_not_echoed_whole() {
     let dir = temp_dir("messages-long");
     let digits = "1".repeat(100_000);
-    let out = fvr(
-        &[
-            "render",
-            "sphere@16",
-            "--dir",
-            "1,0,0",
-            "--out",
-            "x.png",
-            "--resample",
-            &digits,
-        ],
+    let out = fvr_line(
+        &format!("render sphere@16 --dir 1,0,0 --out x.png --resample {digits}"),
         &dir,
     );
     assert_error(&out, &["--resample", "characters left out"]);
@@ -53,7 +44,7 @@ fn huge_values_and_keys_are_not_echoed_whole() {
     short_lines(&out);
     assert_eq!(String::from_utf8_lossy(&out.stderr).lines().count(), 1);
     let path = format!("{}.png", "p".repeat(5000));
-    let out = fvr(&["render", &path, "--dir", "1,0,0", "--out", "x.png"], &dir);
+    let out = fvr_line(&format!("render {path} --dir 1,0,0 --out x.png"), &dir);
     assert_error(&out, &["pppp"]);
     short_lines(&out);
 }
@@ -114,19 +105,8 @@ fn extreme_light_directions_light_the_volume() {
         "1e300,1e300,0:1",
         "-1e-300,1e-300,0:1,0.5,0.2",
     ] {
-        let out = fvr(
-            &[
-                "render",
-                "sphere@16",
-                "--dir",
-                "0,0,1",
-                "--up",
-                "0,1,0",
-                "--out",
-                "x.nrrd",
-                "--light",
-                light,
-            ],
+        let out = fvr_line(
+            &format!("render sphere@16 --dir 0,0,1 --up 0,1,0 --out x.nrrd --light {light}"),
             &dir,
         );
         assert_ok(&out);

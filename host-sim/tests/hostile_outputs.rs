@@ -9,7 +9,7 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use common::{assert_error, assert_ok, fvr, fvr_line, temp_dir};
+use common::{assert_error, assert_ok, fvr_line, png_frames, temp_dir};
 
 /// The names in `dir`, sorted.
 fn names(dir: &Path) -> Vec<String> {
@@ -23,21 +23,7 @@ fn names(dir: &Path) -> Vec<String> {
 
 /// Every frame of the (A)PNG at `path` decodes; returns the frame count.
 fn decoded_frames(path: &Path) -> usize {
-    let file = std::fs::File::open(path).unwrap();
-    let mut reader = png::Decoder::new(std::io::BufReader::new(file))
-        .read_info()
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let frames = reader
-        .info()
-        .animation_control
-        .map_or(1, |a| a.num_frames as usize);
-    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
-    for i in 0..frames {
-        reader
-            .next_frame(&mut buf)
-            .unwrap_or_else(|e| panic!("{} frame {i}: {e}", path.display()));
-    }
-    frames
+    png_frames(path).1.len()
 }
 
 /// A file-size limit (`ulimit -f`, SIGXFSZ ignored so a write past it fails
@@ -138,8 +124,8 @@ fn a_long_output_name_is_not_refused_for_its_temporary_file() {
     let dir = temp_dir("outputs-long");
     let name = format!("{}.apng", "t".repeat(245));
     assert_eq!(name.len(), 250);
-    let out = fvr(
-        &["turntable", "sphere@16", "--frames", "2", "--out", &name],
+    let out = fvr_line(
+        &format!("turntable sphere@16 --frames 2 --out {name}"),
         &dir,
     );
     assert_ok(&out);

@@ -1,6 +1,8 @@
 //! Outputs: window/level, 8- and 16-bit PNG, colormaps, APNG turntables.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use common::{png_frames, temp_dir};
 
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::Sampling;
@@ -10,28 +12,6 @@ use fvr_engine::volume::phantom::{sample, GaussianMixture};
 use fvr_host::image::output::{
     percentile_range, write_apng, write_png, Bits, Colormap, Style, Window,
 };
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("fvr-output-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// Decoded PNG: info and the bytes of every frame.
-fn decode(path: &Path) -> (png::Info<'static>, Vec<Vec<u8>>) {
-    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
-    let mut reader = decoder.read_info().unwrap();
-    let info = reader.info().clone();
-    let frames_expected = info.animation_control.map_or(1, |a| a.num_frames as usize);
-    let mut frames = Vec::new();
-    for _ in 0..frames_expected {
-        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
-        let out = reader.next_frame(&mut buf).unwrap();
-        buf.truncate(out.buffer_size());
-        frames.push(buf);
-    }
-    (info, frames)
-}
 
 #[test]
 fn sixteen_bit_grey_keeps_65536_levels_through_an_explicit_window() {
@@ -44,7 +24,7 @@ fn sixteen_bit_grey_keeps_65536_levels_through_an_explicit_window() {
     };
     let path = dir.join("g16.png");
     write_png(&path, 16, 16, &pixels, &style).unwrap();
-    let (info, frames) = decode(&path);
+    let (info, frames) = png_frames(&path);
     assert_eq!(
         (info.bit_depth, info.color_type),
         (png::BitDepth::Sixteen, png::ColorType::Grayscale)
@@ -147,7 +127,7 @@ fn colormapped_png_is_rgb_in_8_and_16_bits() {
         };
         let path = dir.join(format!("hot{bits:?}.png"));
         write_png(&path, 2, 2, &pixels, &style).unwrap();
-        let (info, frames) = decode(&path);
+        let (info, frames) = png_frames(&path);
         assert_eq!(info.color_type, png::ColorType::Rgb);
         let per = if bits == Bits::Eight { 1 } else { 2 };
         assert_eq!(frames[0].len(), 4 * 3 * per);
@@ -178,7 +158,7 @@ fn apng_holds_every_frame_with_one_window_and_loops() {
         },
     )
     .unwrap();
-    let (info, decoded) = decode(&path);
+    let (info, decoded) = png_frames(&path);
     let actl = info.animation_control.expect("animated");
     assert_eq!((actl.num_frames, actl.num_plays), (5, 0));
     assert_eq!(decoded.len(), 5);

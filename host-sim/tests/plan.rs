@@ -8,6 +8,9 @@
 //! prints the table of docs/accuracy.md (with ct-head rows when
 //! `FVR_CT_HEAD` names the CT head).
 
+mod common;
+
+use common::xorshift_noise;
 use fvr_core::filter::FilterKind;
 use fvr_core::volume::GridOversampling;
 use fvr_engine::plan::filter::KbDesign;
@@ -58,16 +61,7 @@ fn rolled_gaussians() -> Volume {
 
 /// Uniform noise in [0, 1) filling a 32³ box (fixed seed).
 fn noise_box() -> Volume {
-    let mut state = 0x2545_f491_4f6c_dd1du64;
-    let data = (0..32 * 32 * 32)
-        .map(|_| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        })
-        .collect();
-    Volume::new([32, 32, 32], data)
+    xorshift_noise([32; 3], 0x2545_f491_4f6c_dd1d)
 }
 
 /// Measured SNR of each axis view against the voxel sums, on the

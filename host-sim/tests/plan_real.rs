@@ -20,8 +20,8 @@ use fvr_core::geometry::View;
 use fvr_core::volume::GridOversampling;
 use fvr_engine::plan::filter::KbDesign;
 use fvr_engine::plan::{
-    choose, choose_among, grid_filter, image_side, predict_grid, Candidate, Constraints, ALL_GRIDS,
-    AXIS_VIEWS,
+    choose, choose_among, grid_filter, image_side, predict_grid, Candidate, Constraints, Plan,
+    ALL_GRIDS, AXIS_VIEWS,
 };
 use fvr_engine::spectrum::{AnySpectrum, Precision};
 use fvr_engine::volume::Volume;
@@ -38,6 +38,29 @@ const SIDE: usize = 64;
 
 /// The oblique views measured against the ideal slice DFT.
 const OBLIQUE: [[f64; 3]; 2] = [[1.0, 0.6, 0.3], [-0.3, 1.0, 0.8]];
+
+/// The configurations chosen for `target` dB on the power-of-two grids
+/// ([`choose`]) and on every grid ([`choose_among`]), each named.
+fn plans(volume: &Volume, target: f64) -> [(&'static str, Plan); 2] {
+    let d = Constraints::default();
+    let pow2 = choose(volume, KbDesign::Auto, target, d).unwrap();
+    let mixed = choose_among(volume, KbDesign::Auto, target, d, &ALL_GRIDS).unwrap();
+    [("choose", pow2), ("choose_among", mixed)]
+}
+
+/// Records in `failures` what is wrong with `case`: no candidate predicted
+/// to meet the target (`met` false), a measurement below it, or a
+/// prediction optimistic by more than [`OPTIMISM_LIMIT_DB`].
+fn judge(failures: &mut Vec<String>, case: &str, met: bool, target: f64, measured: f64, pred: f64) {
+    if !met {
+        failures.push(format!("{case}: no candidate predicted to meet it"));
+    } else if measured < target {
+        failures.push(format!("{case}: below the target"));
+    }
+    if measured < pred - OPTIMISM_LIMIT_DB {
+        failures.push(format!("{case}: optimistic by more than 3 dB"));
+    }
+}
 
 /// The real heads available: `brainsmall` always, the others when fetched.
 fn heads() -> Vec<(&'static str, Volume)> {
@@ -174,10 +197,7 @@ fn planner_meets_targets_on_real_heads_on_and_off_axis() {
         let side = fvr_core::volume::padded_size(volume.dims, 1).unwrap();
         let exact = references(&volume, side);
         for target in [40.0, 50.0, 60.0] {
-            let d = Constraints::default();
-            let pow2 = choose(&volume, KbDesign::Auto, target, d).unwrap();
-            let mixed = choose_among(&volume, KbDesign::Auto, target, d, &ALL_GRIDS).unwrap();
-            for (chooser, plan) in [("choose", pow2), ("choose_among", mixed)] {
+            for (chooser, plan) in plans(&volume, target) {
                 let (c, grid) = (plan.prediction.candidate, plan.prediction.grid);
                 let p = predict_grid(&volume, c, grid, KbDesign::Auto).unwrap();
                 let m = measure(&volume, c, grid, &exact);
@@ -200,14 +220,7 @@ fn planner_meets_targets_on_real_heads_on_and_off_axis() {
                         "{vname}, view {view}, target {target} ({chooser}): {} predicted {pred:.1} dB, measured {measured:.1} dB",
                         grid_name(c, grid)
                     );
-                    if !plan.met {
-                        failures.push(format!("{case}: no candidate predicted to meet it"));
-                    } else if measured < target {
-                        failures.push(format!("{case}: below the target"));
-                    }
-                    if measured < pred - OPTIMISM_LIMIT_DB {
-                        failures.push(format!("{case}: optimistic by more than 3 dB"));
-                    }
+                    judge(&mut failures, &case, plan.met, target, measured, pred);
                 }
             }
         }
@@ -232,10 +245,7 @@ fn planner_meets_targets_on_the_full_mri_head_on_axis() {
         .map(|view| axis_projection(&volume, view, side, side).unwrap().unwrap())
         .collect();
     for target in [40.0, 50.0, 60.0] {
-        let d = Constraints::default();
-        let pow2 = choose(&volume, KbDesign::Auto, target, d).unwrap();
-        let mixed = choose_among(&volume, KbDesign::Auto, target, d, &ALL_GRIDS).unwrap();
-        for (chooser, plan) in [("choose", pow2), ("choose_among", mixed)] {
+        for (chooser, plan) in plans(&volume, target) {
             let (c, grid) = (plan.prediction.candidate, plan.prediction.grid);
             let p = predict_grid(&volume, c, grid, KbDesign::Auto).unwrap();
             let filter = grid_filter(&volume, c.filter, grid, KbDesign::Auto).unwrap();
@@ -257,12 +267,7 @@ fn planner_meets_targets_on_the_full_mri_head_on_axis() {
                     "mri-head axis {v}, target {target} ({chooser}): {} predicted {pred:.1} dB, measured {measured:.1} dB",
                     grid_name(c, grid)
                 );
-                if !plan.met || measured < target {
-                    failures.push(format!("{case}: below the target"));
-                }
-                if measured < pred - OPTIMISM_LIMIT_DB {
-                    failures.push(format!("{case}: optimistic by more than 3 dB"));
-                }
+                judge(&mut failures, &case, plan.met, target, measured, pred);
             }
         }
     }

@@ -7,10 +7,12 @@ use std::process::Command;
 use fvr_core::fvrs::{Part, Precision};
 use fvr_host::io::fvrs::FvrsFile;
 
-fn fvr(dir: &Path, args: &[&str]) -> (i32, String) {
+/// Run `fvr` with the words of `line` (split at white space) in `dir`: the
+/// exit code and stderr.
+fn fvr(dir: &Path, line: &str) -> (i32, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_fvr"))
         .current_dir(dir)
-        .args(args)
+        .args(line.split_whitespace())
         .output()
         .unwrap();
     (
@@ -28,18 +30,7 @@ fn brainsmall_for_the_m4f_as_c_is_resampled_to_fit_and_parses() {
     let dir = tempdir();
     let (code, err) = fvr(
         dir.path(),
-        &[
-            "prepare",
-            "brainsmall",
-            "--for",
-            "m4f",
-            "--emit",
-            "c",
-            "--out",
-            "bs",
-            "--filter",
-            "kb3",
-        ],
+        "prepare brainsmall --for m4f --emit c --out bs --filter kb3",
     );
     assert_eq!(code, 0, "{err}");
     assert!(err.contains("resampled to 64 x 64 x 42"), "{err}");
@@ -72,16 +63,7 @@ fn too_large_for_the_part_is_refused_with_the_numbers_before_writing() {
     let dir = tempdir();
     let (code, err) = fvr(
         dir.path(),
-        &[
-            "prepare",
-            "brainsmall",
-            "--for",
-            "m4f",
-            "--resample",
-            "128",
-            "--out",
-            "x.fvrs",
-        ],
+        "prepare brainsmall --for m4f --resample 128 --out x.fvrs",
     );
     assert_eq!(code, 2);
     assert_eq!(err.lines().count(), 1, "{err}");
@@ -94,18 +76,7 @@ fn too_large_for_the_part_is_refused_with_the_numbers_before_writing() {
     // The RAM budget too: a 64-side image loaded into the M4F's RAM.
     let (code, err) = fvr(
         dir.path(),
-        &[
-            "prepare",
-            "brainsmall",
-            "--for",
-            "m4f",
-            "--resample",
-            "64",
-            "--emit",
-            "bin",
-            "--out",
-            "x.bin",
-        ],
+        "prepare brainsmall --for m4f --resample 64 --emit bin --out x.bin",
     );
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("of RAM") && err.contains("(524288)"), "{err}");
@@ -116,24 +87,7 @@ fn too_large_for_the_part_is_refused_with_the_numbers_before_writing() {
 fn host_f32_fvrs_and_bin_are_the_same_image() {
     let dir = tempdir();
     for (emit, out) in [("fvrs", "p.fvrs"), ("bin", "p.bin")] {
-        let (code, err) = fvr(
-            dir.path(),
-            &[
-                "prepare",
-                "gaussians@32",
-                "--for",
-                "host",
-                "--precision",
-                "f32",
-                "--filter",
-                "kb4",
-                "--emit",
-                emit,
-                "--out",
-                out,
-                "--quiet",
-            ],
-        );
+        let (code, err) = fvr(dir.path(), &format!("prepare gaussians@32 --for host --precision f32 --filter kb4 --emit {emit} --out {out} --quiet"));
         assert_eq!(code, 0, "{err}");
         assert!(err.is_empty(), "--quiet: {err}");
     }
@@ -149,44 +103,16 @@ fn host_f32_fvrs_and_bin_are_the_same_image() {
 #[test]
 fn bad_flags_are_one_line_and_write_nothing() {
     let dir = tempdir();
-    let cases: [&[&str]; 5] = [
-        &["prepare", "gaussians@32", "--for", "m9", "--out", "a.fvrs"],
-        &["prepare", "gaussians@32", "--for", "m4f", "--out", "a.png"],
-        &[
-            "prepare",
-            "gaussians@32",
-            "--for",
-            "m4f",
-            "--emit",
-            "c",
-            "--out",
-            "a.txt",
-        ],
-        &[
-            "prepare",
-            "gaussians@32",
-            "--for",
-            "m4f",
-            "--emit",
-            "c",
-            "--out",
-            "9bad",
-        ],
-        &[
-            "prepare",
-            "gaussians@32",
-            "--for",
-            "m4f",
-            "--precision",
-            "q15",
-            "--out",
-            "a.fvrs",
-        ],
-    ];
-    for args in cases {
-        let (code, err) = fvr(dir.path(), args);
-        assert_eq!(code, 2, "{args:?}: {err}");
-        assert!(err.contains("error"), "{args:?}: {err}");
+    for line in [
+        "prepare gaussians@32 --for m9 --out a.fvrs",
+        "prepare gaussians@32 --for m4f --out a.png",
+        "prepare gaussians@32 --for m4f --emit c --out a.txt",
+        "prepare gaussians@32 --for m4f --emit c --out 9bad",
+        "prepare gaussians@32 --for m4f --precision q15 --out a.fvrs",
+    ] {
+        let (code, err) = fvr(dir.path(), line);
+        assert_eq!(code, 2, "{line}: {err}");
+        assert!(err.contains("error"), "{line}: {err}");
     }
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 }
@@ -196,15 +122,7 @@ fn a_corrupt_file_is_named_in_one_line() {
     let dir = tempdir();
     let (code, err) = fvr(
         dir.path(),
-        &[
-            "prepare",
-            "gaussians@32",
-            "--for",
-            "host",
-            "--out",
-            "p.fvrs",
-            "--quiet",
-        ],
+        "prepare gaussians@32 --for host --out p.fvrs --quiet",
     );
     assert_eq!(code, 0, "{err}");
     let path = dir.path().join("p.fvrs");
@@ -233,47 +151,14 @@ fn a_prepared_spectrum_renders_as_the_volume_does() {
     let d = dir.path();
     for (precision, filter) in [("f16", "kb4"), ("f32", "kb3")] {
         let file = format!("s-{precision}.fvrs");
-        let (code, err) = fvr(
-            d,
-            &[
-                "prepare",
-                "sphere@32",
-                "--for",
-                "host",
-                "--precision",
-                precision,
-                "--filter",
-                filter,
-                "--out",
-                &file,
-                "--quiet",
-            ],
-        );
+        let (code, err) = fvr(d, &format!("prepare sphere@32 --for host --precision {precision} --filter {filter} --out {file} --quiet"));
         assert_eq!(code, 0, "{err}");
         for (k, view) in ["1,0.3,0.2", "0.2,-1,0.4"].into_iter().enumerate() {
             for ext in ["nrrd", "png"] {
                 let (a, b) = (format!("a{k}.{ext}"), format!("b{k}.{ext}"));
-                let (code, err) = fvr(d, &["render", &file, "--dir", view, "--out", &a]);
+                let (code, err) = fvr(d, &format!("render {file} --dir {view} --out {a}"));
                 assert_eq!(code, 0, "{err}");
-                let (code, err) = fvr(
-                    d,
-                    &[
-                        "render",
-                        "sphere@32",
-                        "--ignore-spacing",
-                        "--filter",
-                        filter,
-                        "--oversample",
-                        "1",
-                        "--precision",
-                        precision,
-                        "--dir",
-                        view,
-                        "--out",
-                        &b,
-                        "--quiet",
-                    ],
-                );
+                let (code, err) = fvr(d, &format!("render sphere@32 --ignore-spacing --filter {filter} --oversample 1 --precision {precision} --dir {view} --out {b} --quiet"));
                 assert_eq!(code, 0, "{err}");
                 let (a, b) = (
                     std::fs::read(d.join(a)).unwrap(),
@@ -286,15 +171,7 @@ fn a_prepared_spectrum_renders_as_the_volume_does() {
     // Only the JSON on stdout, in the stats schema's keys.
     let out = Command::new(env!("CARGO_BIN_EXE_fvr"))
         .current_dir(d)
-        .args([
-            "render",
-            "s-f16.fvrs",
-            "--dir",
-            "1,0,0",
-            "--out",
-            "j.png",
-            "--stats-json",
-        ])
+        .args("render s-f16.fvrs --dir 1,0,0 --out j.png --stats-json".split_whitespace())
         .output()
         .unwrap();
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
@@ -304,17 +181,16 @@ fn a_prepared_spectrum_renders_as_the_volume_does() {
     assert_eq!(json["image"], serde_json::json!([32, 32, 1]));
     assert!(json["ms_per_view"].as_f64().unwrap() > 0.0);
     // Options that need the volume, and a corrupt file.
-    for (args, needle) in [
+    for (option, needle) in [
         (
-            vec!["--light", "1,0,0:1"],
+            "--light 1,0,0:1",
             "--light does not apply to a prepared spectrum",
         ),
-        (vec!["--filter", "kb6"], "--filter does not apply"),
-        (vec!["--accuracy", "60"], "--accuracy does not apply"),
-        (vec!["--adaptive", "40"], "--adaptive does not apply"),
+        ("--filter kb6", "--filter does not apply"),
+        ("--accuracy 60", "--accuracy does not apply"),
+        ("--adaptive 40", "--adaptive does not apply"),
     ] {
-        let mut line = vec!["render", "s-f16.fvrs", "--dir", "1,0,0", "--out", "x.png"];
-        line.extend(args);
+        let line = format!("render s-f16.fvrs --dir 1,0,0 --out x.png {option}");
         let (code, err) = fvr(d, &line);
         assert_eq!(code, 2, "{err}");
         assert!(err.contains(needle), "{err}");
@@ -324,16 +200,7 @@ fn a_prepared_spectrum_renders_as_the_volume_does() {
     // The image and the spectrum's copy are budgeted before reading.
     let (code, err) = fvr(
         d,
-        &[
-            "--max-memory",
-            "64K",
-            "render",
-            "s-f16.fvrs",
-            "--dir",
-            "1,0,0",
-            "--out",
-            "x.png",
-        ],
+        "--max-memory 64K render s-f16.fvrs --dir 1,0,0 --out x.png",
     );
     assert_eq!(code, 2, "{err}");
     assert!(
@@ -346,10 +213,7 @@ fn a_prepared_spectrum_renders_as_the_volume_does() {
     let last = bytes.len() - 100;
     bytes[last] ^= 1;
     std::fs::write(d.join("bad.fvrs"), bytes).unwrap();
-    let (code, err) = fvr(
-        d,
-        &["render", "bad.fvrs", "--dir", "1,0,0", "--out", "x.png"],
-    );
+    let (code, err) = fvr(d, "render bad.fvrs --dir 1,0,0 --out x.png");
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("bad.fvrs") && err.contains("CRC"), "{err}");
     assert_eq!(err.lines().count(), 1, "{err}");

@@ -4,7 +4,7 @@
 //! file and the key.
 
 mod common;
-use common::{assert_error, assert_ok, fvr, fvr_in, fvr_line, temp_dir};
+use common::{assert_error, assert_ok, assert_refused, fvr, fvr_in, fvr_line, temp_dir};
 use std::path::PathBuf;
 use std::process::Output;
 
@@ -115,10 +115,19 @@ fn missing_scene_file_and_missing_settings_are_errors() {
     let (dir, out) = fvr_in("scenefile-missing", "render --scene nowhere.toml");
     assert_error(&out, &["cannot read scene file `nowhere.toml`"]);
     std::fs::write(dir.join("novolume.toml"), "[camera]\ndir = [1, 0, 0]\n").unwrap();
-    let out = fvr_line("render --scene novolume.toml --out a.png", &dir);
-    assert_error(&out, &["no volume", "volume.builtin"]);
-    let out = fvr_line("render --scene novolume.toml sphere@8", &dir);
-    assert_error(&out, &["no output file", "output.path"]);
+    assert_refused(
+        &dir,
+        &[
+            (
+                "render --scene novolume.toml --out a.png",
+                &["no volume", "volume.builtin"],
+            ),
+            (
+                "render --scene novolume.toml sphere@8",
+                &["no output file", "output.path"],
+            ),
+        ],
+    );
     let out = fvr_line("render --scene novolume.toml", &dir);
     assert_eq!(out.status.code(), Some(2));
     let out = fvr_line("render sphere@8 --out a.png", &dir);

@@ -5,6 +5,9 @@
 //! pipeline with kb6 at 2× padding, which must agree to its predicted
 //! accuracy (the planner's claim, never optimistic by more than 3 dB).
 
+mod common;
+
+use common::xorshift_noise;
 use fvr_core::filter::FilterKind;
 use fvr_core::geometry::View;
 use fvr_core::volume::{padded_size, GridOversampling};
@@ -20,16 +23,7 @@ use fvr_host::sources::datasets::load_dataset;
 /// Uniform noise in [0, 1) (fixed seed): every frequency present, content
 /// at every face.
 fn noise(dims: [usize; 3]) -> Volume {
-    let mut state = 0x9e37_79b9_7f4a_7c15u64;
-    let data = (0..dims[0] * dims[1] * dims[2])
-        .map(|_| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        })
-        .collect();
-    Volume::new(dims, data)
+    xorshift_noise(dims, 0x9e37_79b9_7f4a_7c15)
 }
 
 /// Rounding bound for an image of sums of `volume`: each DFT value sums

@@ -8,6 +8,9 @@
 //! on mixed-radix sides; from the linear spectrum and from bricked
 //! copies of it (`fvr_engine::spectrum::bricks`).
 
+mod common;
+
+use common::lcg_noise;
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::{Sampling, SliceAxes, View};
 use fvr_core::num::{Real, Sample};
@@ -26,16 +29,7 @@ use half::f16;
 /// the spectrum has energy up to the cube's faces and the wrapped taps
 /// carry weight.
 fn noise_volume(n: usize, seed: u64) -> Volume {
-    let mut state = seed;
-    let data = (0..n * n * n)
-        .map(|_| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            0.5 + ((state >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0)
-        })
-        .collect();
-    Volume::new([n, n, n], data)
+    lcg_noise([n; 3], seed, 0.5)
 }
 
 const DIRECTIONS: [[f64; 3]; 6] = [
@@ -158,6 +152,34 @@ fn physical_units_and_larger_cube_bit_identical() {
     }
 }
 
+/// The exact walk's renderer of side `n` with `filter`, on 0, 1 and 3
+/// threads, renders `spec` along each of [`DIRECTIONS`] at `width × height`
+/// as the core's single-threaded render does, bit for bit.
+fn assert_renderer_is_core(
+    spec: &OwnedSpectrum<f16>,
+    n: usize,
+    filter: Filter,
+    (width, height): (usize, usize),
+    what: &str,
+) {
+    for dir in DIRECTIONS {
+        let view = View::along(dir);
+        let request = Request::new(view, width, height);
+        let core = render_once::<f16, f32>(&spec.view(), &request).unwrap();
+        for threads in [0, 1, 3] {
+            let mut out = vec![0.0f32; width * height];
+            ViewRenderer::<f32>::new(n, filter)
+                .with_threads(threads)
+                .with_walk(Walk::Exact)
+                .render_into(spec, &view, width, height, &mut out)
+                .unwrap();
+            for (a, b) in core.iter().zip(&out) {
+                assert_eq!(a.to_bits(), (*b as f64).to_bits(), "{what} {dir:?}");
+            }
+        }
+    }
+}
+
 /// The renderer's whole view (host extraction, then the core's finish)
 /// equals the core's single-threaded render, pixel for pixel.
 #[test]
@@ -167,21 +189,7 @@ fn renderer_image_equals_core_render() {
     for kind in [FilterKind::Kb3, FilterKind::Kb4, FilterKind::Kb6] {
         let filter = Filter::new(kind, 1).unwrap();
         let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
-        for dir in DIRECTIONS {
-            let view = View::along(dir);
-            let core = render_once::<f16, f32>(&spec.view(), &Request::new(view, 24, 20)).unwrap();
-            for threads in [0, 1, 3] {
-                let mut out = vec![0.0f32; 24 * 20];
-                ViewRenderer::<f32>::new(n, filter)
-                    .with_threads(threads)
-                    .with_walk(Walk::Exact)
-                    .render_into(&spec, &view, 24, 20, &mut out)
-                    .unwrap();
-                for (a, b) in core.iter().zip(&out) {
-                    assert_eq!(a.to_bits(), (*b as f64).to_bits(), "{kind:?} {dir:?}");
-                }
-            }
-        }
+        assert_renderer_is_core(&spec, n, filter, (24, 20), &format!("{kind:?}"));
     }
 }
 
@@ -238,20 +246,6 @@ fn renderer_image_equals_core_render_on_mixed_sides() {
     for kind in [FilterKind::Kb3, FilterKind::Kb5] {
         let filter = Filter::for_grid(kind, GridOversampling::X1_25).unwrap();
         let spec = OwnedSpectrum::<f16>::prepare_on::<f32>(&volume, filter, n).unwrap();
-        for dir in DIRECTIONS {
-            let view = View::along(dir);
-            let core = render_once::<f16, f32>(&spec.view(), &Request::new(view, 30, 28)).unwrap();
-            for threads in [0, 1, 3] {
-                let mut out = vec![0.0f32; 30 * 28];
-                ViewRenderer::<f32>::new(n, filter)
-                    .with_threads(threads)
-                    .with_walk(Walk::Exact)
-                    .render_into(&spec, &view, 30, 28, &mut out)
-                    .unwrap();
-                for (a, b) in core.iter().zip(&out) {
-                    assert_eq!(a.to_bits(), (*b as f64).to_bits(), "{kind:?} {dir:?}");
-                }
-            }
-        }
+        assert_renderer_is_core(&spec, n, filter, (30, 28), &format!("{kind:?}"));
     }
 }

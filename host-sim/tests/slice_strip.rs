@@ -12,6 +12,9 @@
 //! mixed-radix sides; one thread and several. Views the walks do not serve
 //! are refused, and the renderer's image follows the walk it is given.
 
+mod common;
+
+use common::lcg_noise;
 use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::{Sampling, SliceAxes, View};
 use fvr_core::num::{Real, Sample};
@@ -36,16 +39,7 @@ use half::f16;
 /// weight, and no mean, so that no DC coefficient dwarfs the others and
 /// loosens the bound.
 fn noise_volume(dims: [usize; 3], seed: u64) -> Volume {
-    let mut state = seed;
-    let data = (0..dims.iter().product::<usize>())
-        .map(|_| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
-        })
-        .collect();
-    Volume::new(dims, data)
+    lcg_noise(dims, seed, 0.0)
 }
 
 /// Slice axes whose rows hold z (the default frame's), y and x, oblique

@@ -4,7 +4,7 @@
 use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
 use fvr_core::slice::adaptive::{mark, marks_words, threshold_for, Marks};
-use fvr_engine::slice::adaptive::{AdaptiveMarks, AdaptiveSettings, Bound, Cheaper};
+use fvr_engine::slice::adaptive::{AdaptiveMarks, AdaptiveSettings, Bound, Cheaper, Level};
 use fvr_engine::spectrum::{AnySpectrum, OwnedSpectrum};
 use fvr_engine::volume::phantom::{sample, GaussianMixture, SheppLogan};
 use fvr_host::options::{parse_chain, parse_tolerance};
@@ -29,6 +29,30 @@ fn eighth_spectrum() -> OwnedSpectrum<f16> {
     let n = 8;
     let volume = sample(&GaussianMixture::random(6, n, 4), [n; 3]);
     OwnedSpectrum::<f16>::prepare::<f32>(&volume, Filter::new(FilterKind::Kb4, 2).unwrap()).unwrap()
+}
+
+/// The one-filter chains the bounds are checked for, each with the gain of
+/// its level (NaN: the level's own).
+const CHEAPER: [(Cheaper, f64); 2] = [
+    (Cheaper::Zero, 0.0),
+    (Cheaper::Filter(FilterKind::Nearest), f64::NAN),
+];
+
+/// The level of the marks of `spec` for the chain of `cheaper` alone at
+/// `tol` dB, with `bound` and `probes`.
+fn first_level(
+    spec: &OwnedSpectrum<f16>,
+    cheaper: Cheaper,
+    tol: f64,
+    bound: Bound,
+    probes: usize,
+) -> Level {
+    let settings = AdaptiveSettings {
+        chain: vec![cheaper],
+        probes,
+        ..nearest(tol, bound)
+    };
+    AdaptiveMarks::build(spec, &settings).unwrap().levels[0].clone()
 }
 
 /// The guarantee: the adaptive image is never further from the full-filter
@@ -161,19 +185,9 @@ fn zero_filter_chains_stay_within_the_tolerance() {
 fn parseval_bound_bounds_the_error_energy() {
     let spec = eighth_spectrum();
     let mut checked = 0;
-    for (cheaper, gain) in [
-        (Cheaper::Zero, 0.0),
-        (Cheaper::Filter(FilterKind::Nearest), f64::NAN),
-    ] {
+    for (cheaper, gain) in CHEAPER {
         for tol in [20.0, 30.0, 40.0] {
-            let build = |bound| {
-                let settings = AdaptiveSettings {
-                    chain: vec![cheaper],
-                    probes: 0,
-                    ..nearest(tol, bound)
-                };
-                AdaptiveMarks::build(&spec, &settings).unwrap().levels[0].clone()
-            };
+            let build = |bound| first_level(&spec, cheaper, tol, bound, 0);
             let (bounded, exact) = (build(Bound::Parseval), build(Bound::Exact));
             assert_eq!(bounded.probes, Some(0));
             assert!(bounded.threshold <= exact.threshold, "{cheaper:?} {tol}");
@@ -207,19 +221,9 @@ fn parseval_bound_bounds_the_error_energy() {
 fn probes_raise_parsevals_threshold_within_budget() {
     let spec = eighth_spectrum();
     let mut raised = 0;
-    for (cheaper, gain) in [
-        (Cheaper::Zero, 0.0),
-        (Cheaper::Filter(FilterKind::Nearest), f64::NAN),
-    ] {
+    for (cheaper, gain) in CHEAPER {
         for tol in [20.0, 30.0, 40.0] {
-            let build = |probes| {
-                let settings = AdaptiveSettings {
-                    chain: vec![cheaper],
-                    probes,
-                    ..nearest(tol, Bound::Parseval)
-                };
-                AdaptiveMarks::build(&spec, &settings).unwrap().levels[0].clone()
-            };
+            let build = |probes| first_level(&spec, cheaper, tol, Bound::Parseval, probes);
             let alone = build(0);
             assert!(!alone.evaluated, "{cheaper:?} {tol}");
             for probes in [1, 2] {

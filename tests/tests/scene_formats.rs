@@ -78,10 +78,12 @@ fn block_floating_point_spectra_render_cued_and_shaded_scenes() {
     let to_f64 = |v: &[f32]| v.iter().map(|&x| x as f64).collect::<Vec<_>>();
 
     // Per-line exponents, prepared in place: the contiguous fast path.
-    let d = StoredSpectrum::<Q15>::prepare_line_blocks::<f32>(&volume, filter, Rounding::PerPass)
-        .unwrap();
-    let g = StoredSpectrum::<Q15>::prepare_line_blocks::<f32>(&gradient, filter, Rounding::PerPass)
-        .unwrap();
+    let d =
+        StoredSpectrum::<Q15>::prepare_in_place::<f32>(&volume, filter, Rounding::PerPass, true)
+            .unwrap();
+    let g =
+        StoredSpectrum::<Q15>::prepare_in_place::<f32>(&gradient, filter, Rounding::PerPass, true)
+            .unwrap();
     let line = render_scene(&d.view(), &g.view(), &scene, &view);
     let snr_line = snr_db(&to_f64(&reference), &to_f64(&line));
 

@@ -5,23 +5,15 @@ use fvr_core::dht::{
     Twiddles,
 };
 use fvr_core::Error;
+use fvr_engine::volume::phantom::SplitMix64;
 use fvr_host::reference::{naive_dht, naive_dht_2d, naive_dht_3d};
 use fvr_tests::twiddles;
 use half::f16;
 
 /// Deterministic test signal in [−1, 1) (SplitMix64).
 fn signal(len: usize, seed: u64) -> Vec<f64> {
-    let mut s = seed;
-    (0..len)
-        .map(|_| {
-            s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = s;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            z ^= z >> 31;
-            (z >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        })
-        .collect()
+    let mut rng = SplitMix64::new(seed);
+    (0..len).map(|_| rng.next_f64() * 2.0 - 1.0).collect()
 }
 
 /// Relative RMS error ‖a − b‖ / ‖b‖.

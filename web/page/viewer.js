@@ -99,11 +99,25 @@ function startPage(moduleUrl) {
     if (dims[0] * dims[1] * dims[2] > MAX_VOXELS)
       throw new Error(`a ${dims.join('x')} volume is too large for the browser's memory (at most 512^3 voxels)`);
   }
+  // Runs `work` with the viewer busy; its error is shown, and an option
+  // changed meanwhile is applied after it.
+  async function whileBusy(work) {
+    st.busy = true;
+    try {
+      await work();
+    } catch (e) {
+      say(e.message);
+    } finally {
+      st.busy = false;
+      progress(null);
+      afterBusy();
+    }
+  }
   async function open(label, fetchIt) {
     if (st.busy) return say('still preparing the last volume; wait for it');
-    st.busy = true;
-    say('');
-    try {
+    // On an error before the new volume was accepted, the old one is still there.
+    await whileBusy(async () => {
+      say('');
       progress(`loading ${label}`, 0);
       const bytes = await download(await fetchIt(), label);
       progress(`reading ${label}`, null);
@@ -115,14 +129,7 @@ function startPage(moduleUrl) {
       st.window = null;
       st.zoom = 1;
       await prepare();
-    } catch (e) {
-      // Until the new volume was accepted, the old one is still there.
-      say(e.message);
-    } finally {
-      st.busy = false;
-      progress(null);
-      afterBusy();
-    }
+    });
   }
   async function prepare() {
     if (!st.info) return;
@@ -316,17 +323,10 @@ function startPage(moduleUrl) {
   const reprepare = async () => {
     if (st.busy) return void (st.again = true);
     if (!st.info) return;
-    st.busy = true;
-    st.window = null;
-    try {
+    await whileBusy(async () => {
+      st.window = null;
       await prepare();
-    } catch (e) {
-      say(e.message);
-    } finally {
-      st.busy = false;
-      progress(null);
-      afterBusy();
-    }
+    });
   };
   function afterBusy() {
     if (st.again) {

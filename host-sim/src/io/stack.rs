@@ -156,25 +156,21 @@ pub fn write_stack(
 mod tests {
     use super::*;
 
+    fn shape([views, channels, width, height]: [usize; 4]) -> StackShape {
+        StackShape {
+            views,
+            channels,
+            width,
+            height,
+        }
+    }
+
     #[test]
     fn npy_headers_are_padded_to_64_bytes_and_name_the_shape() {
         for (shape, text) in [
+            (shape([5, 1, 7, 3]), "'shape': (5, 3, 7), }"),
             (
-                StackShape {
-                    views: 5,
-                    channels: 1,
-                    width: 7,
-                    height: 3,
-                },
-                "'shape': (5, 3, 7), }",
-            ),
-            (
-                StackShape {
-                    views: 100000,
-                    channels: 3,
-                    width: 4096,
-                    height: 2048,
-                },
+                shape([100000, 3, 4096, 2048]),
                 "'shape': (100000, 2048, 4096, 3), }",
             ),
         ] {
@@ -192,28 +188,12 @@ mod tests {
 
     #[test]
     fn nrrd_headers_give_kinds_and_spacing() {
-        let grey = nrrd_header(
-            StackShape {
-                views: 4,
-                channels: 1,
-                width: 8,
-                height: 6,
-            },
-            0.5,
-        );
+        let grey = nrrd_header(shape([4, 1, 8, 6]), 0.5);
         assert!(grey.contains("sizes: 8 6 4\n"));
         assert!(grey.contains("kinds: space space list\n"));
         assert!(grey.contains("spacings: 0.5 0.5 nan\n"));
         assert!(grey.ends_with("\n\n"));
-        let rgb = nrrd_header(
-            StackShape {
-                views: 2,
-                channels: 3,
-                width: 8,
-                height: 6,
-            },
-            1.0,
-        );
+        let rgb = nrrd_header(shape([2, 3, 8, 6]), 1.0);
         assert!(rgb.contains("dimension: 4\nsizes: 3 8 6 2\n"));
         assert!(rgb.contains("kinds: RGB-color space space list\n"));
     }
@@ -223,12 +203,7 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("fvr-stack-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("s.npy");
-        let shape = StackShape {
-            views: 2,
-            channels: 1,
-            width: 2,
-            height: 2,
-        };
+        let shape = shape([2, 1, 2, 2]);
         assert!(write_stack(&path, StackFormat::Npy, shape, 1.0, &[0.0; 7]).is_err());
         assert!(!path.exists());
         let data: Vec<f32> = (0..8).map(|i| i as f32 - 2.5).collect();

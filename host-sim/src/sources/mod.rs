@@ -231,22 +231,6 @@ fn no_such_volume(spec: &str) -> String {
     }
 }
 
-/// Levenshtein distance over characters.
-fn edit_distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut row: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut prev = row[0];
-        row[0] = i + 1;
-        for (j, &cb) in b.iter().enumerate() {
-            let cur = row[j + 1];
-            row[j + 1] = (prev + usize::from(ca != cb)).min(row[j] + 1).min(cur + 1);
-            prev = cur;
-        }
-    }
-    row[b.len()]
-}
-
 /// How close `candidate` is to `name` (lower is closer), or `None` when it
 /// is not close: an edit distance of at most 3 (and less than half the
 /// name), or one name a prefix or suffix of the other (`mni152.nii` and
@@ -255,7 +239,7 @@ fn closeness(name: &str, candidate: &str) -> Option<usize> {
     if name == candidate || name.is_empty() {
         return None;
     }
-    let d = edit_distance(name, candidate);
+    let d = crate::scene_file::edit_distance(name, candidate);
     let len = name.chars().count().min(candidate.chars().count());
     let affix = len >= 4
         && (candidate.starts_with(name)

@@ -11,6 +11,14 @@ const PLAIN: Options = Options {
     lights: false,
 };
 
+/// A session holding [`phantom`], prepared with `options`.
+fn session(options: Options) -> Session {
+    let mut s = Session::new();
+    s.set_volume(phantom());
+    s.prepare(options).unwrap();
+    s
+}
+
 fn ask(level: u32, zoom: f64) -> Ask {
     Ask {
         view: View::along([0.3, 1.0, -0.45]),
@@ -21,9 +29,7 @@ fn ask(level: u32, zoom: f64) -> Ask {
 
 #[test]
 fn full_views_are_the_renderers_own() {
-    let mut s = Session::new();
-    s.set_volume(phantom());
-    s.prepare(PLAIN).unwrap();
+    let s = session(PLAIN);
     let image = s.render(&ask(0, 1.0)).unwrap();
     let settings = Settings {
         accuracy_db: Some(40.0),
@@ -37,9 +43,7 @@ fn full_views_are_the_renderers_own() {
 
 #[test]
 fn previews_shrink_and_zoom_magnifies() {
-    let mut s = Session::new();
-    s.set_volume(phantom());
-    s.prepare(PLAIN).unwrap();
+    let s = session(PLAIN);
     let full = s.render(&ask(0, 1.0)).unwrap();
     let preview = s.render(&ask(1, 1.0)).unwrap();
     assert_eq!(
@@ -59,13 +63,10 @@ fn previews_shrink_and_zoom_magnifies() {
 
 #[test]
 fn lights_give_colour_and_cues_change_the_image() {
-    let mut s = Session::new();
-    s.set_volume(phantom());
-    s.prepare(Options {
+    let mut s = session(Options {
         lights: true,
         ..PLAIN
-    })
-    .unwrap();
+    });
     let lit = s.render(&ask(0, 1.0)).unwrap();
     assert_eq!(lit.channels, 3);
     s.prepare(Options {

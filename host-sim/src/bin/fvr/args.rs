@@ -300,6 +300,16 @@ pub(crate) fn prepare_with_progress(
     Ok(renderer?)
 }
 
+/// The spectra `scene` prepares, for [`plan_job`]: the volume's, and the
+/// `|∇f|` spectrum when it is lit.
+pub(crate) fn spectra(scene: &fvr_core::shading::Scene) -> u64 {
+    if scene.needs_gradient_spectrum() {
+        2
+    } else {
+        1
+    }
+}
+
 /// Declare, before loading, what the job builds from its volume: `spectra`
 /// spectra (2 with a `|∇f|` spectrum, which also needs a gradient volume),
 /// on the grid of `resample` (or of the volume's longest side) at the

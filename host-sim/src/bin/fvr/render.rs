@@ -147,11 +147,7 @@ fn declare_job(args: &RenderArgs, scene: &Scene) {
     crate::args::plan_job(
         &args.frame.spectrum,
         args.look.resample,
-        if scene.needs_gradient_spectrum() {
-            2
-        } else {
-            1
-        },
+        crate::args::spectra(scene),
         // Per-view grids (slice, scratch, output) and the RGB image.
         ("view buffers and image", move |n, side| {
             // A size beyond the grid is refused later, by name.

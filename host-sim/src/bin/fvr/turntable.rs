@@ -84,11 +84,7 @@ fn declare_job(args: &TurntableArgs, scene: &Scene, frames: usize) {
     crate::args::plan_job(
         &args.frame.spectrum,
         args.look.resample,
-        if scene.needs_gradient_spectrum() {
-            2
-        } else {
-            1
-        },
+        crate::args::spectra(scene),
         ("frames and view buffers", move |n, side| {
             let (w, h) = crate::args::planned_image(size, n, side);
             let frame = w

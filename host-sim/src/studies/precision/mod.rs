@@ -210,16 +210,13 @@ impl Subject {
                 } else {
                     Rounding::PerStage
                 };
-                match blocking {
-                    Blocking::Blocks(BlockLayout::Line) => {
-                        StoredSpectrum::<S>::prepare_line_blocks::<f32>(
-                            &self.volume,
-                            self.filter,
-                            rounding,
-                        )
-                    }
-                    _ => StoredSpectrum::<S>::prepare::<f32>(&self.volume, self.filter, rounding),
-                }
+                let line_blocks = matches!(blocking, Blocking::Blocks(BlockLayout::Line));
+                StoredSpectrum::<S>::prepare_in_place::<f32>(
+                    &self.volume,
+                    self.filter,
+                    rounding,
+                    line_blocks,
+                )
                 .map_err(|e| e.to_string())?
             }
             Arithmetic::HostOnce => {

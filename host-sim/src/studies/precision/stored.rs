@@ -36,53 +36,57 @@ impl<S: Sample> StoredSpectrum<S> {
         filter: Filter,
         rounding: Rounding,
     ) -> Result<Self, PipelineError> {
-        let (n, mut data, mut scratch, mut tw_buf) = buffers::<S, T>(volume, filter)?;
-        let source = DenseVolume::new(volume.dims, &volume.data)?;
-        let tw = Twiddles::new(&mut tw_buf, n)?;
-        let spec =
-            Spectrum::prepare_rounding(&source, filter, &mut data, &mut scratch, &tw, rounding)?;
-        let (scale, dims) = (spec.scale(), spec.dims());
-        Ok(Self {
-            data,
-            blocks: None,
-            n,
-            scale,
-            filter,
-            dims,
-        })
+        Self::prepare_in_place::<T>(volume, filter, rounding, false)
     }
 
-    /// Premultiply, pad and transform `volume` in place into block floating
-    /// point with per-line exponents ([`Spectrum::prepare_line_blocks`]).
+    /// Premultiply, pad and transform `volume` in place in format `S`, with
+    /// arithmetic `T` and the given rounding; with `line_blocks`, into block
+    /// floating point with per-line exponents
+    /// ([`Spectrum::prepare_line_blocks`]).
     ///
     /// # Errors
-    /// As [`Spectrum::prepare_line_blocks`], or a spectrum beyond memory.
-    pub fn prepare_line_blocks<T: Real>(
+    /// As [`Spectrum::prepare_rounding`] or [`Spectrum::prepare_line_blocks`],
+    /// or a spectrum beyond memory.
+    pub fn prepare_in_place<T: Real>(
         volume: &Volume,
         filter: Filter,
         rounding: Rounding,
+        line_blocks: bool,
     ) -> Result<Self, PipelineError> {
         let (n, mut data, mut scratch, mut tw_buf) = buffers::<S, T>(volume, filter)?;
         let source = DenseVolume::new(volume.dims, &volume.data)?;
-        let mut exps = vec![0i8; n * n];
-        let mut exps_scratch = vec![0i8; n * n];
         let tw = Twiddles::new(&mut tw_buf, n)?;
-        let spec = Spectrum::prepare_line_blocks(
-            &source,
-            filter,
-            LineBlockStorage {
-                mantissas: &mut data,
-                exponents: &mut exps,
-                exponent_scratch: &mut exps_scratch,
-            },
-            &mut scratch,
-            &tw,
-            rounding,
-        )?;
-        let (scale, dims) = (spec.scale(), spec.dims());
+        let (scale, dims, blocks) = if line_blocks {
+            let mut exps = vec![0i8; n * n];
+            let mut exps_scratch = vec![0i8; n * n];
+            let spec = Spectrum::prepare_line_blocks(
+                &source,
+                filter,
+                LineBlockStorage {
+                    mantissas: &mut data,
+                    exponents: &mut exps,
+                    exponent_scratch: &mut exps_scratch,
+                },
+                &mut scratch,
+                &tw,
+                rounding,
+            )?;
+            let (scale, dims) = (spec.scale(), spec.dims());
+            (scale, dims, Some((BlockLayout::Line, exps)))
+        } else {
+            let spec = Spectrum::prepare_rounding(
+                &source,
+                filter,
+                &mut data,
+                &mut scratch,
+                &tw,
+                rounding,
+            )?;
+            (spec.scale(), spec.dims(), None)
+        };
         Ok(Self {
             data,
-            blocks: Some((BlockLayout::Line, exps)),
+            blocks,
             n,
             scale,
             filter,

@@ -334,15 +334,13 @@ fn prepare_and_measure(
     .map_err(|e| e.to_string())?;
     macro_rules! go {
         ($s:ty, $line:expr) => {{
-            let spec = if $line {
-                StoredSpectrum::<$s>::prepare_line_blocks::<f32>(
-                    &subject.volume,
-                    filter,
-                    Rounding::PerPass,
-                )
-            } else {
-                StoredSpectrum::<$s>::prepare::<f32>(&subject.volume, filter, Rounding::PerPass)
-            }
+            let volume = &subject.volume;
+            let spec = StoredSpectrum::<$s>::prepare_in_place::<f32>(
+                volume,
+                filter,
+                Rounding::PerPass,
+                $line,
+            )
             .map_err(|e| e.to_string())?;
             let prepare_ms = t0.elapsed().as_secs_f64() * 1e3;
             let view = spec.view();

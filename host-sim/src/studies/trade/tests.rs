@@ -100,10 +100,11 @@ fn memory_model_matches_the_allocated_spectrum() {
                     .unwrap()
                     .bytes()
             }
-            _ => StoredSpectrum::<Q15>::prepare_line_blocks::<f32>(
+            _ => StoredSpectrum::<Q15>::prepare_in_place::<f32>(
                 &volume,
                 filter,
                 Rounding::PerPass,
+                true,
             )
             .unwrap()
             .bytes(),
