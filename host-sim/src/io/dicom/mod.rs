@@ -44,6 +44,7 @@ mod encode;
 #[cfg(test)]
 mod parity;
 mod reader;
+mod values;
 
 pub use encode::CtSlice;
 

@@ -31,6 +31,7 @@ use dicom_object::{DefaultDicomObject, FileMetaTableBuilder, InMemDicomObject};
 
 use crate::io::nrrd::{format_error, IoError};
 
+use super::values::{check_value_size, implicit_vr, numbers_u32, primitive, us_or_ss};
 use super::FORMAT;
 
 /// Transfer syntaxes whose data set is not explicit VR little endian.
@@ -46,7 +47,8 @@ const UNDEFINED: u32 = u32::MAX;
 const ITEM: (u16, u16) = (0xFFFE, 0xE000);
 const ITEM_END: (u16, u16) = (0xFFFE, 0xE00D);
 const SEQUENCE_END: (u16, u16) = (0xFFFE, 0xE0DD);
-const PIXEL_DATA: (u16, u16) = (0x7FE0, 0x0010);
+pub(super) const PIXEL_DATA: (u16, u16) = (0x7FE0, 0x0010);
+const PIXEL_REPRESENTATION: (u16, u16) = (0x0028, 0x0103);
 
 /// Read a whole Part 10 file (preamble optional).
 ///
@@ -170,10 +172,10 @@ fn inflate(deflated: &[u8]) -> Result<Vec<u8>, IoError> {
 
 /// An element header: tag, VR (from the file, or the dictionary in
 /// implicit VR; none for the item group), declared length.
-struct Header {
-    tag: (u16, u16),
-    vr: VR,
-    len: u32,
+pub(super) struct Header {
+    pub(super) tag: (u16, u16),
+    pub(super) vr: VR,
+    pub(super) len: u32,
 }
 
 /// A container being read: the data set or an item (elements), a sequence
@@ -226,6 +228,10 @@ struct Cursor<'a> {
     explicit: bool,
     big_endian: bool,
     charset: SpecificCharacterSet,
+    /// `PixelRepresentation` once read: with signed pixel data, elements
+    /// the dictionary gives "US or SS" are read as SS (as `dicom-parser`
+    /// does).
+    signed: Option<bool>,
 }
 
 fn structure_error(problem: String) -> IoError {
@@ -240,6 +246,7 @@ impl<'a> Cursor<'a> {
             explicit,
             big_endian,
             charset: SpecificCharacterSet::default(),
+            signed: None,
         }
     }
 
@@ -334,6 +341,11 @@ impl<'a> Cursor<'a> {
             (implicit_vr(tag), len, 8)
         };
         self.pos = at + header;
+        let vr = if self.signed == Some(true) && us_or_ss(tag) {
+            VR::SS
+        } else {
+            vr
+        };
         Ok(Some(Header { tag, vr, len }))
     }
 
@@ -500,7 +512,10 @@ impl<'a> Cursor<'a> {
                         });
                     } else {
                         let v = self.bounded_value(h.tag, h.len, limit)?;
-                        let value = self.primitive(&h, v)?;
+                        let value = primitive(&h, v, self.big_endian, &mut self.charset)?;
+                        if let (PIXEL_REPRESENTATION, PrimitiveValue::U16(r)) = (h.tag, &value) {
+                            self.signed = r.first().map(|r| *r != 0);
+                        }
                         if let Some(Frame::Item { elements, .. }) = stack.last_mut() {
                             // The declared length, as `dicom-parser` keeps it.
                             elements.push(DataElement::new_with_len(
@@ -543,128 +558,6 @@ impl<'a> Cursor<'a> {
         self.check(tag, len, limit)?;
         Ok(Some(self.pos + len as usize))
     }
-
-    /// The value `v` of the element `h` as `dicom-parser` reads it.
-    fn primitive(&mut self, h: &Header, v: &[u8]) -> Result<PrimitiveValue, IoError> {
-        if v.is_empty() {
-            return Ok(PrimitiveValue::Empty);
-        }
-        let big = self.big_endian;
-        macro_rules! numbers {
-            ($t:ty) => {
-                v.chunks_exact(std::mem::size_of::<$t>())
-                    .map(|c| {
-                        let mut a = [0u8; std::mem::size_of::<$t>()];
-                        a.copy_from_slice(c);
-                        if big {
-                            <$t>::from_be_bytes(a)
-                        } else {
-                            <$t>::from_le_bytes(a)
-                        }
-                    })
-                    .collect()
-            };
-        }
-        let not_text = |e: &dyn std::fmt::Display| {
-            format_error(
-                FORMAT,
-                "element value",
-                format!(
-                    "element ({:04X},{:04X}) is not text in its character set: {e}",
-                    h.tag.0, h.tag.1
-                ),
-            )
-        };
-        Ok(match h.vr {
-            VR::AT => {
-                let words: C<u16> = numbers!(u16);
-                PrimitiveValue::Tags(words.chunks_exact(2).map(|w| Tag(w[0], w[1])).collect())
-            }
-            VR::AE
-            | VR::AS
-            | VR::PN
-            | VR::SH
-            | VR::LO
-            | VR::UC
-            | VR::UI
-            | VR::IS
-            | VR::DS
-            | VR::DA
-            | VR::TM
-            | VR::DT
-            | VR::CS => {
-                let default = matches!(h.vr, VR::AE | VR::CS | VR::AS);
-                let parts = v
-                    .split(|b| *b == b'\\')
-                    .map(|part| match default {
-                        true => DefaultCharacterSetCodec.decode(part),
-                        false => self.charset.decode(part),
-                    })
-                    .collect::<Result<C<String>, _>>()
-                    .map_err(|e| not_text(&e))?;
-                if h.tag == (0x0008, 0x0005) {
-                    if let Some(set) = parts
-                        .first()
-                        .and_then(|c| SpecificCharacterSet::from_code(c))
-                    {
-                        self.charset = set;
-                    }
-                }
-                PrimitiveValue::Strs(parts)
-            }
-            VR::UT | VR::ST | VR::UR | VR::LT => {
-                PrimitiveValue::Str(self.charset.decode(v).map_err(|e| not_text(&e))?)
-            }
-            VR::US | VR::OW => PrimitiveValue::U16(numbers!(u16)),
-            VR::SS => PrimitiveValue::I16(numbers!(i16)),
-            VR::FD | VR::OD => PrimitiveValue::F64(numbers!(f64)),
-            VR::FL | VR::OF => PrimitiveValue::F32(numbers!(f32)),
-            VR::SL => PrimitiveValue::I32(numbers!(i32)),
-            VR::OL | VR::UL => PrimitiveValue::U32(numbers!(u32)),
-            VR::SV => PrimitiveValue::I64(numbers!(i64)),
-            VR::OV | VR::UV => PrimitiveValue::U64(numbers!(u64)),
-            // OB, UN, and SQ never reach here (sequences are frames).
-            _ => PrimitiveValue::U8(v.iter().copied().collect()),
-        })
-    }
-}
-
-/// A basic offset table's 32-bit offsets.
-fn numbers_u32(v: &[u8], big: bool) -> C<u32> {
-    v.chunks_exact(4)
-        .map(|c| {
-            let a = [c[0], c[1], c[2], c[3]];
-            if big {
-                u32::from_be_bytes(a)
-            } else {
-                u32::from_le_bytes(a)
-            }
-        })
-        .collect()
-}
-
-/// Refuse a length that is not a whole number of the VR's binary values:
-/// a reader that takes whole values would fall out of step with the
-/// element boundaries.
-fn check_value_size(h: &Header) -> Result<(), IoError> {
-    let size = match h.vr {
-        VR::SS | VR::US | VR::OW => 2,
-        VR::FL | VR::SL | VR::UL | VR::AT | VR::OF | VR::OL => 4,
-        VR::FD | VR::SV | VR::UV | VR::OD | VR::OV => 8,
-        _ => 1,
-    };
-    if h.len % size != 0 {
-        let (group, elem) = h.tag;
-        return Err(format_error(
-            FORMAT,
-            "element length",
-            format!(
-                "element ({group:04X},{elem:04X}) of {size}-byte values has length {}, not a multiple of {size}",
-                h.len
-            ),
-        ));
-    }
-    Ok(())
 }
 
 /// Close the top frame of `stack` into its parent: an item into its
@@ -723,17 +616,4 @@ fn close(stack: &mut Vec<Frame>) -> Result<(), IoError> {
         _ => return Err(structure_error("an item outside a sequence".into())),
     }
     Ok(())
-}
-
-/// The VR an element has in implicit VR: the standard dictionary's,
-/// relaxed, with pixel and overlay data as OW; UN (bytes) for a tag the
-/// dictionary does not know.
-fn implicit_vr((group, elem): (u16, u16)) -> VR {
-    use dicom_core::dictionary::{DataDictionary, DataDictionaryEntry};
-    if (group, elem) == PIXEL_DATA || (group >> 8 == 0x60 && elem == 0x3000) {
-        return VR::OW;
-    }
-    dicom_dictionary_std::StandardDataDictionary
-        .by_tag(Tag(group, elem))
-        .map_or(VR::UN, |entry| entry.vr().relaxed())
 }
