@@ -281,6 +281,39 @@ fn fuzz_regression_odd_ow_lengths_are_refused() {
     );
 }
 
+/// Found by `cargo fuzz run dicom -s none`: a transfer syntax UID with a
+/// trailing tab, which `dicom-object` trims (explicit VR big endian) and a
+/// length walk of exact matches did not (little endian), so the walk and
+/// the parser read different lengths; the parser allocated 4,278,190,080
+/// bytes (`fvr convert` peaked at 4.2 GB resident). Files are read by the
+/// bounded reader, which checks every length before allocating: under a
+/// 1 GiB address-space limit `fvr convert` refuses the file in one line.
+#[test]
+fn fuzz_regression_no_declared_length_is_allocated_before_it_is_checked() {
+    const NEEDLE: &str = "element (00FE,FFFF) declares 4278190080 bytes but the file has only 520";
+    let found = include_bytes!("data/fuzz/dicom-syntax-whitespace-4gb.dcm");
+    let e = parse_slice(found).unwrap_err().to_string();
+    assert!(e.contains(NEEDLE), "{e}");
+    let dir = temp_dir("whitespace-syntax");
+    let input = dir.join("found.dcm");
+    std::fs::write(&input, found).unwrap();
+    let out = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v 1048576 && exec '{}' convert '{}' --out '{}'",
+            env!("CARGO_BIN_EXE_fvr"),
+            input.display(),
+            dir.join("out.nrrd").display()
+        ))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains(NEEDLE), "{err}");
+    assert!(!dir.join("out.nrrd").exists());
+}
+
 /// Found by `cargo fuzz run dicom`: a BitsStored of 0 made
 /// `dicom-pixeldata` panic building its lookup table
 /// (`assertion failed: bits_stored != 0 && bits_stored <= 32`).

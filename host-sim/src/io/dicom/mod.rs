@@ -1,6 +1,7 @@
-//! DICOM series: a directory of single-frame slices (CT, MR, …), read with
-//! `dicom-object` and decoded with `dicom-pixeldata` (uncompressed, RLE,
-//! deflate and baseline JPEG transfer syntaxes).
+//! DICOM series: a directory of single-frame slices (CT, MR, …), read by
+//! [`reader`] (explicit VR little and big endian, implicit VR, deflated)
+//! and decoded with `dicom-pixeldata` (uncompressed, RLE and baseline JPEG
+//! pixel data).
 //!
 //! How the slices become a volume:
 //! - Files that are not DICOM (no `DICM` at byte 128), `DICOMDIR`, and
@@ -28,29 +29,30 @@
 //! Not supported: multi-frame objects (enhanced CT/MR), colour images,
 //! gantry tilt (it shows as a mismatch of orientation and position).
 //!
-//! Hostile input: `dicom-object` 0.10 allocates each value's declared
-//! length before reading it, and `dicom-pixeldata` the decoded image size.
-//! Before handing a file over, this module walks the element headers
-//! (explicit VR in either byte order, implicit VR little endian) and refuses
-//! lengths beyond the end of the file, and refuses image sizes the pixel
-//! data cannot hold. The walk follows the standard; where a corrupt file
-//! makes the parser read it differently (seen under fuzzing with implicit
-//! VR files) a declared length of up to 4 GiB can still be allocated, and
-//! fail, before the error is returned: memory and time, not a crash.
+//! Hostile input: files are read by a bounded reader of our own
+//! ([`reader`]), not by `dicom-parser` (which allocates each value's
+//! declared length before reading it): every declared length is checked
+//! against the bytes left in the file and in the item or sequence holding
+//! it before anything is allocated, so memory grows with the bytes present
+//! (a deflated data set is inflated up to the memory limit). The reader
+//! builds `dicom-object`'s in-memory object, from which `dicom-pixeldata`
+//! decodes the pixels; image sizes the pixel data cannot hold are refused
+//! before decoding, since the decoder allocates the decoded size first.
+//! `parity.rs` checks that valid files read as `dicom-object` reads them.
 
 mod encode;
-mod lengths;
+#[cfg(test)]
+mod parity;
+mod reader;
+mod values;
 
 pub use encode::CtSlice;
-use lengths::check_lengths;
 
 use std::fs;
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use dicom_dictionary_std::tags;
-use dicom_object::file::ReadPreamble;
-use dicom_object::{DefaultDicomObject, OpenFileOptions};
+use dicom_object::DefaultDicomObject;
 use dicom_pixeldata::{ConvertOptions, ModalityLutOption, PixelDecoder};
 use indicatif::ProgressBar;
 
@@ -104,17 +106,9 @@ pub fn parse_slice(bytes: &[u8]) -> Result<Slice, IoError> {
     slice_from(&obj)
 }
 
-/// Parse a whole file held in memory, after [`check_lengths`].
+/// Parse a whole file held in memory with the bounded reader.
 fn open_bytes(bytes: &[u8]) -> Result<DefaultDicomObject, IoError> {
-    check_lengths(bytes)?;
-    open(bytes)
-}
-
-pub(crate) fn open<R: Read>(reader: R) -> Result<DefaultDicomObject, IoError> {
-    OpenFileOptions::new()
-        .read_preamble(ReadPreamble::Auto)
-        .from_reader(reader)
-        .map_err(|e| format_error(FORMAT, "file meta", format!("cannot parse the file: {e}")))
+    reader::read(bytes)
 }
 
 fn has_pixel_data(obj: &DefaultDicomObject) -> bool {
