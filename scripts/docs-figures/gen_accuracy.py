@@ -69,16 +69,18 @@ def mixed_dht():
     err_span = (f"{min(errs)}–{max(errs)}·10{superscript(int(exps.pop()))}" if len(exps) == 1
                 else ", ".join(f"{e:.1e}" for _, e, _ in grid))
     worst = lambda rows, i: max(float(r[i]) for r in rows)  # noqa: E731
+    # The cases the table names: no degenerate axis in 2D, at most one in 3D.
+    two_named = [r for r in two if 1 not in (int(r[0]), int(r[1]))][:5]
+    three_named = [r for r in three if dims_name(r[0]).split("×").count("1") < 2][:4]
     rows = [
         [f"1D, all {smooth_lengths(512)} lengths ≤ 512 (worst)", f"{one['f64'][0]:.2f} (N = {one['f64'][1]})",
          f"{one['f32'][0]:.2f} (N = {one['f32'][1]})", "2"],
         ["1D, N = " + ", ".join(str(n) for n, _, _ in grid), "—",
          f"{span([r for _, _, r in grid], 2)} ({err_span})", "2"],
         ["1D forward then inverse against the input", f"{round_trip:.2f}", "—", "4"],
-        ["2D, " + ", ".join(f"{a}×{b}" for a, b, _, _ in [r for r in two if 1 not in (int(r[0]), int(r[1]))][:5]) + ", … (worst)",
+        ["2D, " + ", ".join(f"{a}×{b}" for a, b, _, _ in two_named) + ", … (worst)",
          f"{worst(two, 2):.2f}", f"{worst(two, 3):.2f}", "2"],
-        ["3D, " + ", ".join(dims_name(d) for d, _, _ in [r for r in three if dims_name(r[0]).split("×").count("1") < 2][:4])
-         + ", … (worst)",
+        ["3D, " + ", ".join(dims_name(d) for d, _, _ in three_named) + ", … (worst)",
          f"{worst(three, 1):.2f}", f"{worst(three, 2):.2f}", "2"],
         ["3D against radix-2 `dht_3d`, " + ", ".join(dims_name(d) for d, _ in radix2),
          f"{worst(radix2, 1):.2f}", "—", "4"],
@@ -159,9 +161,12 @@ def plan_real_log():
 GENERATORS.update({
     "accuracy-mixed-grid": mixed_grid,
     "accuracy-real-ideal": lambda: table_starting(plan_real_log(), "| volume | view | f64 kb6 σ2 against"),
-    "accuracy-real-planner": lambda: table_starting(plan_real_log(), "| volume | target | chooser | config | predicted dB (x, y, z; oblique)"),
-    "accuracy-real-oblique": lambda: table_starting(plan_real_log(), "| volume | view | ideal on an n slice against 2n"),
-    "accuracy-real-mri": lambda: table_starting(plan_real_log(), "| volume | target | chooser | config | predicted dB (x, y, z) |"),
+    "accuracy-real-planner": lambda: table_starting(plan_real_log(),
+                                                    "| volume | target | chooser | config | predicted dB (x, y, z; "),
+    "accuracy-real-oblique": lambda: table_starting(plan_real_log(),
+                                                    "| volume | view | ideal on an n slice against 2n"),
+    "accuracy-real-mri": lambda: table_starting(plan_real_log(),
+                                                "| volume | target | chooser | config | predicted dB (x, y, z) |"),
     "accuracy-oblique-heads": lambda: "\n".join(
         line for line in cached("oblique-heads", ["bash", "scripts/oblique-heads.sh"]).split("\n")
         if line.startswith("|")),

@@ -519,7 +519,8 @@ def device_prep():
         rows["bits"].append(same)
         rows["spectrum"].append(cell(program, "spectrum vs f64"))
         rows["image"].append(cell(program, "image vs f64", f"; goal {goal}" if q15 else ""))
-        rows["f16"].append(cell(program, "image vs the f16 spectrum's view" if q15 else "image vs fast host preparation"))
+        against = "image vs the f16 spectrum's view" if q15 else "image vs fast host preparation"
+        rows["f16"].append(cell(program, against))
     labels = [("cube", "cube (bytes)"), ("prep", "preparation (instructions)"), ("dht", "of which 3D DHT"),
               ("view", "view (instructions)"), ("beyond", "RAM beyond the spectrum (bytes)"),
               ("stack", "of which stack"), ("flash", "flash"), ("bits", "spectrum and image against the host core"),

@@ -4,7 +4,6 @@ generators write (docs/performance/*.md, docs/growth/growth.md): each
 block restates the latest run of its report."""
 
 import os
-import re
 
 from common import ROOT, para, serve, span
 

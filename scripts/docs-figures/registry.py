@@ -62,6 +62,7 @@ GENERATORS = [
     # docs/adaptive.md
     gen("adaptive-table-exact", "gen_studies.py", False, "slow", "fvr", "ct-head"),
     gen("adaptive-table-paper", "gen_studies.py", False, "slow", "fvr", "ct-head"),
+    gen("adaptive-marks-cost", "gen_studies.py", False, "slow", "fvr", "ct-head"),
     # docs/performance.md, from the reports above
     gen("perf-peers", "gen_perf.py", False, "quick"),
     gen("perf-heads", "gen_perf.py", False, "quick"),
