@@ -39,11 +39,19 @@ echo "== Python package (python/): a venv in target/, maturin develop --release,
 # CLI the package is compared with bit for bit: no second build of it.
 FVR_BIN="$PWD/target/debug/fvr" bash scripts/test-python.sh
 
+# Their output is kept for the docs' check below, which reads the figures
+# from it instead of running them again.
 echo "== firmware on a Cortex-M4F in QEMU: bit-for-bit agreement, instruction counts, footprint, budget"
-bash scripts/firmware.sh
+bash scripts/firmware.sh 2>&1 | tee target/firmware.log
 
 echo "== C API: fvr prepare --emit c, the header with -Werror, a host C program, the C firmware example in QEMU bit for bit"
-bash scripts/capi.sh
+bash scripts/capi.sh 2>&1 | tee target/capi.log
+
+# The quick deterministic figures only (docs/testing.md says how to check
+# and regenerate the rest); the fvr of the test build above.
+echo "== docs: the figures of README.md, docs/ and firmware/README.md as the program prints them"
+FVR="$PWD/target/debug/fvr" DOCS_FIGURES_FIRMWARE_LOG=target/firmware.log DOCS_FIGURES_CAPI_LOG=target/capi.log \
+    bash scripts/docs-figures.sh --check --quick
 
 # target/debug/fvr is the binary `cargo test` built above for the
 # integration tests (test profile, optimized): a release build, or even

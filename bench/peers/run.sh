@@ -23,6 +23,8 @@
 # [--accuracies 50,60,80] [--eps 1e-2,...,1e-9] [--upsampfacs 2.0,1.25]
 # [--upsampfacs-large 1.25] [--frames 21] [--repeats 2] [--fvr-repeats 3]
 # [--fftw estimate|measure] [--out FILE].
+# PEERS_OUT_DIR (default docs/performance) is where the Markdown goes
+# (scripts/docs-figures.sh writes it elsewhere, then compares or copies).
 # This is a manual benchmark: it is not part of scripts/test-all.sh. Run it
 # on an idle machine; the ratios come from one run, the absolute times drift.
 set -euo pipefail
@@ -48,7 +50,8 @@ case " $* " in
     *) cargo build --locked --release -p fvr-host ;;
 esac
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
-mkdir -p docs/performance
+out_dir="${PEERS_OUT_DIR:-docs/performance}"
+mkdir -p "$out_dir"
 case " $* " in
     *" --finufft "*)
         rest=()
@@ -56,7 +59,7 @@ case " $* " in
             [ "$arg" = "--finufft" ] || rest+=("$arg")
         done
         exec "$VENV/bin/python" bench/peers/finufft_peer.py --fvr "$TARGET/release/fvr" \
-            --work "$TARGET/peers/work" --out docs/performance/finufft.md \
+            --work "$TARGET/peers/work" --out "$out_dir/finufft.md" \
             --command "bash bench/peers/run.sh $*" "${rest[@]}"
         ;;
     *" --heads "*)
@@ -70,8 +73,8 @@ case " $* " in
         fi
         exec "$VENV/bin/python" bench/peers/heads.py --fvr "$TARGET/release/fvr" \
             --ct "$(bash scripts/fetch-ct-head.sh)" "${mri[@]}" \
-            --work "$TARGET/peers/work" --out docs/performance/heads.md "${rest[@]}"
+            --work "$TARGET/peers/work" --out "$out_dir/heads.md" "${rest[@]}"
         ;;
 esac
 "$VENV/bin/python" bench/peers/peers.py --fvr "$TARGET/release/fvr" \
-    --work "$TARGET/peers/work" --out docs/performance/peers.md "$@"
+    --work "$TARGET/peers/work" --out "$out_dir/peers.md" "$@"
