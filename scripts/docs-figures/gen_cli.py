@@ -2,9 +2,10 @@
 """Blocks of docs/cli.md."""
 
 import os
+import sys
 import tempfile
 
-from common import fvr, png_samples, serve
+from common import ROOT, fvr, fvr_bin, need_env, png_samples, run, serve
 
 
 def cue_window():
@@ -22,4 +23,11 @@ def cue_window():
             "FILE.png`, each pixel against the uncued one).")
 
 
-serve({"cli-cue-window": cue_window})
+def taper():
+    """`--taper` on the CT head's lateral view (scripts/taper-effect.py)."""
+    need_env("FVR_CT_HEAD", "the taper table")
+    script = os.path.join(ROOT, "scripts", "taper-effect.py")
+    return run([sys.executable, script], env={"FVR": fvr_bin()}).strip()
+
+
+serve({"cli-cue-window": cue_window, "cli-taper": taper})

@@ -42,6 +42,7 @@ GENERATORS = [
         writes=["docs/performance/finufft-fftw-measure.md"]),
     # docs/cli.md
     gen("cli-cue-window", "gen_cli.py", True, "quick", "fvr"),
+    gen("cli-taper", "gen_cli.py", True, "slow", "fvr", "ct-head"),
     # docs/accuracy.md
     gen("accuracy-table", "gen_accuracy.py", True, "quick", "fvr"),
     gen("accuracy-mixed-dht", "gen_accuracy.py", True, "quick", "cargo"),
