@@ -100,13 +100,19 @@ SUMMARY = [("f16", "f16 (e5m10)", "2"), ("bf16", "bf16", "2"), ("e4m11", "e4m11"
            ("q7-brick4", "Q7, one exponent per 4³ brick", None), ("q7-brick2", "Q7, one exponent per 2³ brick", None)]
 
 
-def precision_summary():
-    """docs/precision.md's summary of docs/precision/precision.md (the study's own file)."""
+def precision_cells():
+    """The study's SNR table against f64: (header, Gaussian columns,
+    Shepp–Logan columns, {(format, arithmetic): row})."""
     _, tables = report("docs/precision/precision.md")
     header, rows = tables[0]
     gauss = [i for i, h in enumerate(header) if h.startswith("gaussians@")]
     shepp = [i for i, h in enumerate(header) if h.startswith("shepp-logan@")]
-    cells = {(r[0], r[1]): r for r in rows}
+    return header, gauss, shepp, {(r[0], r[1]): r for r in rows}
+
+
+def precision_summary():
+    """docs/precision.md's summary of docs/precision/precision.md (the study's own file)."""
+    header, gauss, shepp, cells = precision_cells()
 
     def both(fmt, arith):
         r = cells.get((fmt, arith))
@@ -140,6 +146,77 @@ def precision_summary():
 
 
 GENERATORS["precision-summary"] = precision_summary
+
+
+
+def q15_tables():
+    """The two tables of the core's `q15_table` test."""
+    from common import cached
+    from gen_accuracy import tables_of
+    text = cached("core-q15-table", ["cargo", "test", "--locked", "-p", "fvr-core", "--lib", "q15_table", "--",
+                                     "--ignored", "--nocapture"])
+    tables = tables_of(text)
+    if len(tables) < 2:
+        raise SystemExit("the core's q15_table test printed no tables")
+    return tables
+
+
+GENERATORS["precision-q15"] = lambda: "\n".join(q15_tables()[0])
+GENERATORS["precision-q15-halving"] = lambda: "\n".join(q15_tables()[1])
+
+
+
+README_FORMATS = ["f32", "f16", "bf16", "e3m12", "e4m11", "e6m9", "e7m8", "q15", "q15-line", "q15-brick4",
+                  "q15-brick8", "e3m4", "e4m3", "e5m2", "q7", "q7-line", "q7-brick4", "q7-brick2"]
+
+
+def precision_table():
+    """docs/precision/README.md's table: per format and arithmetic, the
+    Gaussians / Shepp–Logan over the study's sizes (an arrow where the
+    SNR falls by more than 20 dB as n grows)."""
+    header, gauss, shepp, cells = precision_cells()
+
+    def values(r, cols):
+        v = [float(r[i]) for i in cols]
+        if v[0] - v[-1] > 20:
+            return " → ".join(f"{x:.1f}" if x else "0" for x in v)
+        return span(v)
+
+    def cell(fmt, arith):
+        r = cells.get((fmt, arith))
+        return f"{values(r, gauss)} / {values(r, shepp)}" if r else "—"
+
+    out = ["| format | B/voxel | per-pass | per-stage | host-once |", "|---|---|---|---|---|"]
+    for fmt in README_FORMATS:
+        any_row = next(r for (f, _), r in cells.items() if f == fmt)
+        size = any_row[2].rstrip("0").rstrip(".")
+        out.append(f"| {fmt} | {size} | {cell(fmt, 'per-pass')} | {cell(fmt, 'per-stage')} | "
+                   f"{cell(fmt, 'host-once')} |")
+    return "\n".join(out)
+
+
+def precision_ct():
+    _, tables = report("docs/precision/precision.md")
+    header, rows = tables[0]
+    ct = next(i for i, h in enumerate(header) if h.startswith("ct-head"))
+    v = {(r[0], r[1]): r[ct] for r in rows}
+    return "\n".join([
+        "Measured, worst of four views:",
+        f"- f16 in place: {v[('f16', 'per-pass')]} dB; host-once: {v[('f16', 'host-once')]} dB.",
+        f"- Q15 per line: {v[('q15-line', 'per-pass')]} dB in place and {v[('q15-line', 'host-once')]} dB host-once.",
+        f"- Q15 per 4³ brick: {v[('q15-brick4', 'host-once')]} dB.",
+        f"- The 8-bit formats: e4m3 host-once {v[('e4m3', 'host-once')]} dB, e5m2 {v[('e5m2', 'host-once')]} dB,",
+        f"  q7-brick4 {v[('q7-brick4', 'host-once')]} dB.",
+        "",
+        para("At one byte per spectrum sample, 40 dB on the CT head is reached by "
+             + (", ".join(f for f in ["e4m3", "e5m2", "q7-line", "q7-brick4", "q7-brick2"]
+                          if float(v[(f, "host-once")]) >= 40) or "no format")
+             + " (host-once)."),
+    ])
+
+
+GENERATORS["precision-readme-table"] = precision_table
+GENERATORS["precision-ct"] = precision_ct
 
 
 if __name__ == "__main__":

@@ -82,22 +82,6 @@ def indented(output, indent):
     return [(indent + line) if line.strip() else "" for line in lines]
 
 
-def write_atomically(path, text):
-    directory = os.path.dirname(path) or "."
-    fd, tmp = tempfile.mkstemp(prefix=".docs-figures-", suffix=".tmp", dir=directory)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as f:
-            f.write(text)
-            f.flush()
-            os.fsync(f.fileno())
-        shutil.copymode(path, tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-
-
 def ensure_fvr(env):
     if env.get("FVR"):
         env["FVR"] = os.path.abspath(env["FVR"])
@@ -135,7 +119,8 @@ def run_generator(gen, env, out_dir):
 
 
 def replace_file(path, data):
-    """Writes bytes over a repository file through a temporary file beside it."""
+    """Writes bytes over a repository file through a temporary file beside
+    it, renamed over it when whole (the mode kept)."""
     full = os.path.join(ROOT, path)
     os.makedirs(os.path.dirname(full), exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=".docs-figures-", suffix=".tmp", dir=os.path.dirname(full))
@@ -256,7 +241,7 @@ def main():
                 differ.append((path, name, old, fresh))
                 new[body:close] = fresh
         if not args.check and new != lines:
-            write_atomically(os.path.join(ROOT, path), "\n".join(new))
+            replace_file(path, "\n".join(new).encode("utf-8"))
             changed.append(path)
 
     if args.check:

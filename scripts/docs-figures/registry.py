@@ -55,6 +55,10 @@ GENERATORS = [
     gen("accuracy-oblique-heads", "gen_accuracy.py", True, "slow", "fvr", "ct-head", "mri-head"),
     # docs/precision.md, from docs/precision/precision.md
     gen("precision-summary", "gen_perf.py", True, "quick"),
+    gen("precision-readme-table", "gen_perf.py", True, "quick"),
+    gen("precision-ct", "gen_perf.py", True, "quick"),
+    gen("precision-q15", "gen_perf.py", True, "slow", "cargo"),
+    gen("precision-q15-halving", "gen_perf.py", True, "slow", "cargo"),
     # docs/geometry.md
     gen("geometry-anisotropic", "gen_geometry.py", True, "slow", "cargo"),
     # docs/shading.md
@@ -70,17 +74,12 @@ GENERATORS = [
     gen("perf-growth", "gen_perf.py", False, "quick"),
     # firmware/README.md and docs/firmware.md: scripts/firmware.sh and scripts/capi.sh
     gen("firmware-run-time", "gen_firmware.py", False, "slow", "firmware"),
-    gen("firmware-targets", "gen_firmware.py", True, "quick", "firmware"),
-    gen("firmware-device-prep", "gen_firmware.py", True, "quick", "firmware"),
-    gen("firmware-trig", "gen_firmware.py", True, "quick", "firmware"),
-    gen("firmware-m4f-agreement", "gen_firmware.py", True, "quick", "firmware", "cargo"),
-    gen("firmware-m4f-counts", "gen_firmware.py", True, "quick", "firmware"),
-    gen("firmware-f16", "gen_firmware.py", True, "quick", "firmware"),
-    gen("firmware-m4f-footprint", "gen_firmware.py", True, "quick", "firmware"),
-    gen("firmware-m3-transforms", "gen_firmware.py", True, "quick", "firmware"),
-    gen("firmware-m3-view", "gen_firmware.py", True, "quick", "firmware", "cargo"),
-    gen("firmware-m3-footprint", "gen_firmware.py", True, "quick", "firmware"),
-    gen("firmware-budget", "gen_firmware.py", True, "quick", "firmware"),
+    # (the agreement and the M3 view also read a host test's output)
+    *(gen(f"firmware-{name}", "gen_firmware.py", True, "quick", "firmware", *(("cargo",) if host else ()))
+      for name, host in [("targets", False), ("device-prep", False), ("trig", False), ("m4f-agreement", True),
+                         ("m4f-counts", False), ("f16", False), ("m4f-footprint", False),
+                         ("m3-transforms", False), ("m3-view", True), ("m3-footprint", False),
+                         ("budget", False)]),
     gen("firmware-q15-lines", "gen_firmware.py", True, "slow", "cargo"),
     gen("prepare-budget", "gen_prepare.py", True, "quick", "fvr"),
     gen("prepare-parts", "gen_prepare.py", True, "quick", "fvr"),
