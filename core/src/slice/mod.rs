@@ -130,21 +130,26 @@ fn extract_width<const W: usize, S: Sample, Z: CubeSide, T: Real>(
     let mut phases = PhaseTable::<T, W>::zeroed();
     let filled = phases.fill(kernel);
     // Selected once per view; a compile-time side folds it away.
+    if filled.is_err() {
+        // Only a kernel wider than MAX_WIDTH gets here, and no filter is.
+        grid.fill(T::ZERO);
+        return;
+    }
     if !spec.n().is_power_of_two() {
-        return match (filled, LineReads::of(spec)) {
-            (Ok(()), LineReads::Plain) => {
+        return match LineReads::of(spec) {
+            LineReads::Plain => {
                 extract_lines::<W, false, false, S, Z, T>(spec, &phases, &geometry, &[], grid)
             }
-            _ => extract_general::<W, false, S, Z, T>(spec, kernel, &geometry, grid),
+            _ => extract_general::<W, false, S, Z, T>(spec, &phases, &geometry, grid),
         };
     }
-    match (filled, LineReads::of(spec)) {
-        (Ok(()), LineReads::Plain) => {
+    match LineReads::of(spec) {
+        LineReads::Plain => {
             extract_lines::<W, false, true, S, Z, T>(spec, &phases, &geometry, &[], grid)
         }
-        (Ok(()), LineReads::LineExponents(e)) => {
+        LineReads::LineExponents(e) => {
             extract_lines::<W, true, true, S, Z, T>(spec, &phases, &geometry, e, grid)
         }
-        _ => extract_general::<W, true, S, Z, T>(spec, kernel, &geometry, grid),
+        LineReads::General => extract_general::<W, true, S, Z, T>(spec, &phases, &geometry, grid),
     }
 }

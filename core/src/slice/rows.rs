@@ -1,7 +1,6 @@
 //! The rows of a slice and the walk over its points inside the
 //! spectrum's Nyquist cube: row intervals, and mirror pairs.
 
-use crate::dht::signed_index;
 use crate::filter::PhaseTable;
 use crate::num::Real;
 
@@ -14,35 +13,6 @@ pub(super) struct SliceRows<T> {
 }
 
 impl<T: Real> SliceRows<T> {
-    /// Calls `pixel(slot, q)` for every slice point of the rows inside
-    /// the spectrum's Nyquist cube, with `q = kx·r + ky·u` (`ky·u` once per
-    /// row), and zeroes the points outside. The cube `|q_a| ≤ n/2` cuts each
-    /// row to one interval of `kx`, found once per row
-    /// ([`SliceRows::row_interval`]).
-    #[inline(always)]
-    pub(super) fn for_each<const W: usize>(
-        &self,
-        n: usize,
-        grid: &mut [T],
-        mut pixel: impl FnMut(&mut T, [T; 3]),
-    ) {
-        let m = self.m;
-        for (row_offset, row) in grid.chunks_exact_mut(m).enumerate() {
-            let ky = T::from_i32(signed_index(self.first_row + row_offset, m) as i32);
-            let kyu = self.up.map(|c| ky * c);
-            let (low, high) = self.row_interval_for::<W>(n, kyu);
-            for (ix, g) in row.iter_mut().enumerate() {
-                let k = signed_index(ix, m) as i32;
-                if k < low || k > high {
-                    *g = T::ZERO;
-                    continue;
-                }
-                let kx = T::from_i32(k);
-                pixel(g, core::array::from_fn(|a| kx * self.right[a] + kyu[a]));
-            }
-        }
-    }
-
     /// [`walk_pairs`] over this slice's rows, with the positions in `T`.
     /// `POW2`: `m` is a power of two, and `k mod m` is a mask; otherwise a
     /// comparison (mixed-radix sides).
