@@ -142,6 +142,7 @@ impl From<Error> for fvr_status {
         match e {
             Error::BufferTooSmall { .. } => fvr_status::FVR_ERR_BUFFER_TOO_SMALL,
             Error::ZeroViewVector { .. }
+            | Error::ShortViewVector { .. }
             | Error::ParallelViewVectors { .. }
             | Error::NonFiniteViewVector { .. } => fvr_status::FVR_ERR_VIEW,
             Error::ImageTooLarge { .. } | Error::EmptyImage | Error::TooMany { .. } => {

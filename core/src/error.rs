@@ -45,6 +45,14 @@ pub enum Error {
         /// Up hint as given.
         up: [f64; 3],
     },
+    /// The view direction or the up hint is too short to normalise: not
+    /// zero, but every component subnormal (below `2^−1022`).
+    ShortViewVector {
+        /// View direction as given.
+        dir: [f64; 3],
+        /// Up hint as given.
+        up: [f64; 3],
+    },
     /// The up hint is parallel to the view direction.
     ParallelViewVectors {
         /// View direction as given.
@@ -106,6 +114,12 @@ pub enum Error {
         index: usize,
         /// The value given.
         value: f64,
+    },
+    /// A light's direction is too short to normalise (every component
+    /// subnormal).
+    ShortLightVector {
+        /// Index of the light.
+        index: usize,
     },
     /// A light direction is zero.
     ZeroLightVector {
@@ -241,6 +255,13 @@ impl fmt::Display for Error {
                 V3(dir),
                 V3(up)
             ),
+            Error::ShortViewVector { dir, up } => write!(
+                f,
+                "view direction {} or up {} is too short to normalise (its components are \
+                 subnormal numbers): give components of ordinary size, such as 1,0,0",
+                V3(dir),
+                V3(up)
+            ),
             Error::ParallelViewVectors { dir, up } => write!(
                 f,
                 "view direction {} is parallel to up {}: choose another --up",
@@ -286,6 +307,11 @@ impl fmt::Display for Error {
             Error::InvalidSceneValue { what, index, value } => {
                 write!(f, "{what} #{index} is {}, which is not allowed", Num(value))
             }
+            Error::ShortLightVector { index } => write!(
+                f,
+                "light #{index} has a direction too short to normalise (its components are \
+                 subnormal numbers): give components of ordinary size, such as 1,0,0"
+            ),
             Error::ZeroLightVector { index } => write!(
                 f,
                 "light #{index} has a zero direction vector: give the direction towards the light"

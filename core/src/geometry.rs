@@ -193,13 +193,20 @@ impl View {
     /// The camera frame.
     ///
     /// # Errors
-    /// A non-finite component, a zero vector, or `up` parallel to `dir`
+    /// A non-finite component, a zero vector, one too short to normalise
+    /// ([`too_short`]), or `up` parallel to `dir`
     /// (within 1e-9 rad).
     pub fn frame(&self) -> Result<Frame> {
         let (d, u0) = (self.dir, self.up);
         let err_fields = (d, u0);
         if d.iter().chain(u0.iter()).any(|v| !v.is_finite()) {
             return Err(Error::NonFiniteViewVector {
+                dir: err_fields.0,
+                up: err_fields.1,
+            });
+        }
+        if too_short(d) || too_short(u0) {
+            return Err(Error::ShortViewVector {
                 dir: err_fields.0,
                 up: err_fields.1,
             });
@@ -271,6 +278,16 @@ pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
         a[2] * b[0] - a[0] * b[2],
         a[0] * b[1] - a[1] * b[0],
     ]
+}
+
+/// Whether `a` is not zero but too short to normalise: every component
+/// subnormal (below `2^−1022`), so that dividing by its largest one
+/// overflows. Front ends refuse such vectors with this rule before any
+/// work, naming their option; [`View::frame`] and the scene's validation
+/// refuse them too.
+pub fn too_short(a: [f64; 3]) -> bool {
+    let largest = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    largest > 0.0 && largest < f64::MIN_POSITIVE
 }
 
 /// `a` itself when its norm is comfortably inside the f64 range, else `a`

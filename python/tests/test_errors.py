@@ -152,3 +152,21 @@ def test_beyond_the_memory_limit_is_a_memory_error():
         [sys.executable, "-c", MEMORY_SCRIPT], capture_output=True, text=True, check=False
     )
     assert done.returncode == 0 and done.stdout.strip() == "ok", done.stderr
+
+
+@pytest.mark.parametrize(
+    "views, up",
+    [([1e-320, 0, 0], None), ([[1, 0, 0]], [0, 0, 1e-320]), ([[1, 0.2, 0], [0, -5e-324, 0]], None)],
+)
+def test_subnormal_view_vectors_are_refused_not_rendered_as_nan(renderer, views, up):
+    # Subnormal components pass a test for zero but overflow on the way to
+    # a unit vector; the core refuses them for every front end.
+    with pytest.raises(ValueError) as e:
+        renderer.project(views, up=up)
+    assert "too short to normalise" in one_line(e)
+
+
+def test_subnormal_light_direction_is_refused():
+    with pytest.raises(ValueError) as e:
+        fvr.Renderer("gaussians@16", lights=["1e-320,0,0:1"]).project([1, 0.2, 0])
+    assert "too short to normalise" in one_line(e)

@@ -410,6 +410,12 @@ fn bad_scene_values_are_refused_with_named_errors() {
     zero.lights[1].towards = [0.0; 3];
     assert_eq!(render(&zero), Err(Error::ZeroLightVector { index: 1 }));
 
+    // Subnormal components pass a test for zero but overflow on the way to
+    // a unit vector (1/1e-320 is infinite): refused, not a NaN image.
+    let mut short = good.clone();
+    short.lights[1].towards = [1e-320, 0.0, -1e-321];
+    assert_eq!(render(&short), Err(Error::ShortLightVector { index: 1 }));
+
     for bad in [f64::NAN, -0.5, f64::INFINITY] {
         let mut colour = good.clone();
         colour.lights[2].color[1] = bad;

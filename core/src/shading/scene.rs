@@ -100,8 +100,9 @@ impl Scene {
     /// Check every value against its documented range.
     ///
     /// # Errors
-    /// A negative or non-finite colour, weight or ambient term, a zero or
-    /// non-finite light direction, or a profile of the wrong size.
+    /// A negative or non-finite colour, weight or ambient term, a zero,
+    /// too short ([`crate::geometry::too_short`]) or non-finite light
+    /// direction, or a profile of the wrong size.
     pub fn validate(&self) -> Result<()> {
         for (c, &a) in self.ambient.iter().enumerate() {
             check_nonnegative("ambient colour component", c, a)?;
@@ -118,6 +119,9 @@ impl Scene {
             }
             if light.towards == [0.0; 3] {
                 return Err(Error::ZeroLightVector { index: i });
+            }
+            if crate::geometry::too_short(light.towards) {
+                return Err(Error::ShortLightVector { index: i });
             }
             for &v in light.color.iter() {
                 check_nonnegative("light colour component of light", i, v)?;

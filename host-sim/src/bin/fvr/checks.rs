@@ -42,8 +42,9 @@ pub(crate) fn check_not_input(out: &Path) -> Result<(), Error> {
 /// components (`1e-300`) and huge ones (`1e308`) are scaled by the
 /// renderer and keep their direction.
 pub(crate) fn check_direction(what: &str, v: [f64; 3]) -> Result<(), Error> {
-    let largest = v.iter().fold(0.0f64, |m, c| m.max(c.abs()));
-    if largest == 0.0 || largest >= f64::MIN_POSITIVE {
+    // The core's rule (`View::frame` and the scene's validation apply it
+    // too, for every front end); here it names the option before any work.
+    if !fvr_core::geometry::too_short(v) {
         return Ok(());
     }
     Err(format!(
