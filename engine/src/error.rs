@@ -16,6 +16,18 @@ pub enum PipelineError {
         /// Side of the padded cube.
         n: usize,
     },
+    /// An image overflowed `f32` ([`crate::image::finite`]).
+    #[error(
+        "view {view} has non-finite pixels once stored as f32 (the first is {value}): {cause}"
+    )]
+    Overflow {
+        /// The view's index in its batch.
+        view: usize,
+        /// The first non-finite value.
+        value: f32,
+        /// What to lower.
+        cause: String,
+    },
     /// Settings that no view can render, or a planner's refusal; one line.
     #[error("{0}")]
     Settings(String),

@@ -220,3 +220,45 @@ fn bad_input_is_refused_and_out_untouched() {
     let (empty, report) = renderer.render_batch(&[], None).unwrap();
     assert!(empty.is_empty() && report.shape.views == 0);
 }
+
+/// A frame that overflows f32 is refused, naming the view and the setting
+/// given, and `out` holds no NaN or infinity afterwards: a volume near
+/// `f32::MAX` blames the volume, an ambient of 1e300 the ambient colour.
+#[test]
+fn overflowing_frames_are_refused_and_not_left_in_out() {
+    let small = volume([16; 3], [1.0; 3]);
+    let mut scene = Scene::xray();
+    scene.ambient = [1e300; 3];
+    let settings = Settings {
+        scene,
+        ..Settings::default()
+    };
+    let renderer = Renderer::new(&small, settings).unwrap();
+    let views = [View::along([1.0, 0.3, 0.2]), View::along([0.0, 1.0, 0.0])];
+    let shape = renderer.batch_shape(views.len(), None).unwrap();
+    let mut out = vec![7.0f32; shape.len()];
+    match renderer.render_batch_into(&views, None, &mut out) {
+        Err(PipelineError::Overflow { view, cause, .. }) => {
+            assert_eq!(view, 0);
+            assert_eq!(cause, "a setting overflowed; lower the ambient colour");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(
+        out.iter().all(|v| v.is_finite()),
+        "non-finite values left in out"
+    );
+
+    let huge = {
+        let mut v = small.clone();
+        let peak = v.data.iter().fold(0.0f32, |m, x| m.max(x.abs()));
+        for x in v.data.iter_mut() {
+            *x *= 3e38 / peak;
+        }
+        v
+    };
+    let renderer = Renderer::new(&huge, Settings::default()).unwrap();
+    let err = renderer.render_batch(&views, None).unwrap_err().to_string();
+    assert!(err.starts_with("view 0 has non-finite pixels"), "{err}");
+    assert!(err.contains("rescale the volume"), "{err}");
+}

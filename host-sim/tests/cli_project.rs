@@ -169,3 +169,35 @@ fn bad_views_and_outputs_are_one_line_and_write_nothing() {
         "1,0,0\n0,zero,1\n"
     );
 }
+
+/// Views whose frames overflow f32 are refused by the job's view number,
+/// with the command line's advice, and no stack is written.
+#[test]
+fn frames_that_overflow_f32_are_refused_by_view_number() {
+    let dir = temp_dir("project-overflow");
+    // A smooth 8³ blob near f32::MAX: its line integrals exceed f32.
+    let data: Vec<u8> = (0..512)
+        .flat_map(|i: usize| {
+            let (x, y, z) = (i % 8, (i / 8) % 8, i / 64);
+            let r2 = [x, y, z]
+                .map(|c| (c as f32 - 3.5) / 3.5)
+                .iter()
+                .map(|d| d * d)
+                .sum::<f32>();
+            (3e38f32 * (1.0 - r2 / 3.0)).to_le_bytes()
+        })
+        .collect();
+    std::fs::write(dir.join("hot.raw"), data).unwrap();
+    let out = fvr_line(
+        "project hot.raw --raw-dims 8,8,8 --raw-type f32 --random 3 --seed 1 --out s.nrrd",
+        &dir,
+    );
+    assert_error(
+        &out,
+        &[
+            "view 0 has non-finite pixels",
+            "rescale the volume, or add --ignore-spacing",
+        ],
+    );
+    assert!(!dir.join("s.nrrd").exists());
+}

@@ -131,7 +131,7 @@ impl Options<'_> {
             Some(l) if !l.is_none() => parse_lights(l)?,
             _ => Vec::new(),
         };
-        let default_ambient = if lights.is_empty() { 1.0 } else { 0.2 };
+        let default_ambient = Scene::default_ambient(!lights.is_empty());
         let ambient = match &self.ambient {
             Some(a) if !a.is_none() => parse_rgb(a, "ambient")?,
             _ => [default_ambient; 3],

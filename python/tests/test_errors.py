@@ -170,3 +170,24 @@ def test_subnormal_light_direction_is_refused():
     with pytest.raises(ValueError) as e:
         fvr.Renderer("gaussians@16", lights=["1e-320,0,0:1"]).project([1, 0.2, 0])
     assert "too short to normalise" in one_line(e)
+
+
+@pytest.mark.parametrize(
+    "scale, kwargs, words",
+    [
+        (3e38, {}, "rescale the volume"),
+        (1.0, {"ambient": 1e300}, "lower the ambient colour"),
+        (1.0, {"lights": ["1,0,0:1e300"]}, "lower the light colours"),
+        (1.0, {"depth_cue": "linear:1e300,0"}, "lower the depth-cue weights"),
+    ],
+)
+def test_images_that_overflow_float32_raise_instead_of_returning_nan(scale, kwargs, words):
+    volume = np.random.default_rng(1).random((16, 16, 16)).astype(np.float32)
+    volume *= np.float32(scale)
+    renderer = fvr.Renderer(volume, **kwargs)
+    out = np.full((1, 16, 16, 3) if "lights" in kwargs else (1, 16, 16), 7, np.float32)
+    with pytest.raises(ValueError) as e:
+        renderer.project([[1, 0.2, 0.1]], size=16, out=out)
+    message = one_line(e)
+    assert "non-finite pixels" in message and words in message, message
+    assert np.isfinite(out).all()

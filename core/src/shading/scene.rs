@@ -76,6 +76,17 @@ impl Default for Scene {
 }
 
 impl Scene {
+    /// The grey ambient term front ends use when none is given: 1 for a
+    /// scene without lights (the plain projection, eq. 1), 0.2 with lights,
+    /// so that the shading they add (eq. 8) shows against it.
+    pub const fn default_ambient(lit: bool) -> f64 {
+        if lit {
+            0.2
+        } else {
+            1.0
+        }
+    }
+
     /// The plain X-ray projection: no cue, grey ambient 1, no lights.
     pub fn xray() -> Self {
         Self {

@@ -4,6 +4,7 @@
 //! agreement measure.
 
 mod agreement;
+pub mod finite;
 pub mod inverse;
 pub mod zoom;
 

@@ -20,6 +20,7 @@ use fvr_core::shading::DepthCue;
 use rayon::prelude::*;
 
 use crate::error::PipelineError;
+use crate::image::finite::check_frames;
 use crate::render::view::ViewRenderer;
 use crate::renderer::Renderer;
 use crate::spectrum::{with_arithmetic, AnySpectrum};
@@ -100,8 +101,10 @@ impl Renderer {
     /// reported by its index (`view 3: ...`) and `out` is left untouched.
     ///
     /// # Errors
-    /// `out` not of [`BatchShape::len`] values, a bad size or view, or a
-    /// view's own error (the adaptive marks', a refused sampling).
+    /// `out` not of [`BatchShape::len`] values, a bad size or view, a
+    /// view's own error (the adaptive marks', a refused sampling), or an
+    /// image that overflows `f32` ([`PipelineError::Overflow`]; `out` is
+    /// then zeroed).
     pub fn render_batch_into(
         &self,
         views: &[View],
@@ -137,6 +140,11 @@ impl Renderer {
         match self.plain_grey() {
             Some((sampling, grey)) => self.plain_batch(views, &shape, &sampling, grey, out)?,
             None => self.scene_batch(views, &shape, size, out)?,
+        }
+        if let Err(e) = check_frames(out, shape.frame_len(), &self.settings().scene) {
+            // No frame of NaN or infinity is left for a caller to use.
+            out.fill(0.0);
+            return Err(e);
         }
         Ok(BatchReport {
             shape,

@@ -101,24 +101,17 @@ pub(crate) fn check_finite(data: &[f64], cause: &str) -> Result<(), Error> {
     }
 }
 
-/// What to lower when an image overflows: the shading settings given
-/// (`--ambient`, lights, a depth cue), or else the volume itself.
+/// What to lower when an image overflows, by the command line's names
+/// (the engine's rule, [`fvr_engine::image::finite::overflow_cause`]).
 pub(crate) fn overflow_cause(ambient: bool, lights: bool, depth_cue: bool) -> String {
-    let given: Vec<&str> = [
-        (ambient, "--ambient"),
-        (lights, "the --light colours"),
-        (depth_cue, "the --depth-cue weights"),
-    ]
-    .iter()
-    .filter(|(g, _)| *g)
-    .map(|(_, name)| *name)
-    .collect();
-    match given.as_slice() {
-        [] => "the volume's values (times its voxel size in mm) are too large; rescale the \
-               volume, or add --ignore-spacing"
-            .to_string(),
-        [one] => format!("a setting overflowed; lower {one}"),
-        [a, b] => format!("a setting overflowed; lower {a} or {b}"),
-        _ => format!("a setting overflowed; lower {}", given.join(", ")),
-    }
+    fvr_engine::image::finite::overflow_cause(
+        [ambient, lights, depth_cue],
+        &fvr_engine::image::finite::SettingNames {
+            ambient: "--ambient",
+            lights: "the --light colours",
+            depth_cue: "the --depth-cue weights",
+            volume: "the volume's values (times its voxel size in mm) are too large; rescale the \
+                     volume, or add --ignore-spacing",
+        },
+    )
 }

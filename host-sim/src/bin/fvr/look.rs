@@ -100,7 +100,7 @@ impl LookArgs {
         if let Some((count, tilt)) = self.light_ring {
             lights.extend(light_ring(view, count, tilt)?);
         }
-        let default_ambient = if lights.is_empty() { 1.0 } else { 0.2 };
+        let default_ambient = Scene::default_ambient(!lights.is_empty());
         let mut scene = Scene {
             cue,
             ambient: self.ambient.unwrap_or([default_ambient; 3]),

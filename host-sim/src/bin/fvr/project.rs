@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::Args;
-use fvr_engine::{Plan, Settings};
+use fvr_engine::{PipelineError, Plan, Settings};
 use fvr_host::io::stack::{write_stack, StackFormat, StackShape};
 use fvr_host::progress;
 use serde::Serialize;
@@ -155,23 +155,27 @@ pub(crate) fn project(args: &ProjectArgs) -> Result<(), Error> {
     let bar = progress::count(views.len() as u64, "views");
     let t_views = Instant::now();
     let frame = shape.frame_len();
-    for (chunk, out) in views
+    for (k, (chunk, out)) in views
         .chunks(VIEWS_PER_CALL)
         .zip(stack.chunks_mut(VIEWS_PER_CALL * frame))
+        .enumerate()
     {
-        renderer.render_batch_into(chunk, size, out)?;
+        // The engine refuses a frame that overflows f32; the message here
+        // numbers the view in the whole job and names the options.
+        renderer
+            .render_batch_into(chunk, size, out)
+            .map_err(|e| match e {
+                PipelineError::Overflow { view, value, .. } => Error::from(format!(
+                    "view {} has non-finite pixels once stored as f32 (the first is {value}): {}",
+                    k * VIEWS_PER_CALL + view,
+                    crate::checks::overflow_cause(false, false, false)
+                )),
+                other => other.into(),
+            })?;
         bar.inc(chunk.len() as u64);
     }
     bar.finish_and_clear();
     let t_views = t_views.elapsed();
-    if let Some(i) = stack.iter().position(|v| !v.is_finite()) {
-        return Err(format!(
-            "view {} has non-finite pixels once stored as f32: {}",
-            i / frame.max(1),
-            crate::checks::overflow_cause(false, false, false)
-        )
-        .into());
-    }
     let t_write = Instant::now();
     let pixel_size = renderer.sampling().pixel_size();
     let stack_shape = StackShape {
