@@ -130,26 +130,23 @@ fn extract_width<const W: usize, S: Sample, Z: CubeSide, T: Real>(
     let mut phases = PhaseTable::<T, W>::zeroed();
     let filled = phases.fill(kernel);
     // Selected once per view; a compile-time side folds it away.
-    if filled.is_err() {
-        // Only a kernel wider than MAX_WIDTH gets here, and no filter is.
-        grid.fill(T::ZERO);
-        return;
-    }
+    // `fill` fails only for a kernel wider than MAX_WIDTH, and no filter
+    // is: the general arm then reads an all-zero table (a zero slice).
     if !spec.n().is_power_of_two() {
-        return match LineReads::of(spec) {
-            LineReads::Plain => {
+        return match (filled, LineReads::of(spec)) {
+            (Ok(()), LineReads::Plain) => {
                 extract_lines::<W, false, false, S, Z, T>(spec, &phases, &geometry, &[], grid)
             }
             _ => extract_general::<W, false, S, Z, T>(spec, &phases, &geometry, grid),
         };
     }
-    match LineReads::of(spec) {
-        LineReads::Plain => {
+    match (filled, LineReads::of(spec)) {
+        (Ok(()), LineReads::Plain) => {
             extract_lines::<W, false, true, S, Z, T>(spec, &phases, &geometry, &[], grid)
         }
-        LineReads::LineExponents(e) => {
+        (Ok(()), LineReads::LineExponents(e)) => {
             extract_lines::<W, true, true, S, Z, T>(spec, &phases, &geometry, e, grid)
         }
-        LineReads::General => extract_general::<W, true, S, Z, T>(spec, &phases, &geometry, grid),
+        _ => extract_general::<W, true, S, Z, T>(spec, &phases, &geometry, grid),
     }
 }
