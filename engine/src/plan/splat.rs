@@ -172,6 +172,14 @@ fn line_sums(
         let (a, b) = ring.split_at_mut(at);
         (&mut b[..len], &a[prev..][..len])
     };
+    add_row(row, before, source, back, shift);
+}
+
+/// [`line_sums`] on two rows given apart. Not inlined: as arguments of a
+/// function of their own the compiler knows the two rows apart (one is
+/// borrowed mutably), and the sum is a vector loop without overlap checks.
+#[inline(never)]
+fn add_row(row: &mut [f64], before: &[f64], source: &[f32], back: (usize, usize), shift: usize) {
     for (s, &v) in row[..back.0].iter_mut().zip(&source[..back.0]) {
         *s = f64::from(v);
     }

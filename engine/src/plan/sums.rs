@@ -260,16 +260,22 @@ pub(super) fn pixel_sums(
     let mut zs = Lines::new(d0 * d1);
     let mut row = vec![0.0f64; d0];
     let mut g2 = 0.0;
+    // Each row's term of Σg², kept until its block is done.
+    let mut squares = [0.0f64; BLOCK * BLOCK];
     for j0 in (0..d1).step_by(BLOCK) {
         for k0 in (0..d2).step_by(BLOCK) {
-            for j in j0..(j0 + BLOCK).min(d1) {
-                for k in k0..(k0 + BLOCK).min(d2) {
+            let (j1, k1) = ((j0 + BLOCK).min(d1), (k0 + BLOCK).min(d2));
+            // The block's rows in memory order: consecutive j are adjacent.
+            // Each y-view line k adds its rows in order of j, each z-view
+            // line j its rows in order of k, as before any reordering.
+            for k in k0..k1 {
+                for j in j0..j1 {
                     let source = &volume.data[(k * d1 + j) * d0..][..d0];
                     for (r, &v) in row.iter_mut().zip(source) {
                         *r = f64::from(v);
                     }
                     let pyz = w.p[gy(j)] * w.p[gz(k)];
-                    g2 += weighted_squares(&row, &px) * (pyz * pyz);
+                    squares[(j - j0) * BLOCK + k - k0] = weighted_squares(&row, &px) * (pyz * pyz);
                     let pixel = j + d1 * k;
                     for &(start, end, at) in &x_runs {
                         let sums = dot3(&row[start..end], &cx[start..end], &sx[start..end], sin);
@@ -279,6 +285,12 @@ pub(super) fn pixel_sums(
                     }
                     ys.add(wy[j], k, &row, sin);
                     zs.add(wz[k], j, &row, sin);
+                }
+            }
+            // Σg² adds the block's rows in order of j, then k.
+            for j in j0..j1 {
+                for k in k0..k1 {
+                    g2 += squares[(j - j0) * BLOCK + k - k0];
                 }
             }
         }
