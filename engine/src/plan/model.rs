@@ -5,7 +5,7 @@ use fvr_core::filter::{Filter, FilterKind};
 use fvr_core::geometry::View;
 use fvr_core::volume::{padded_size, DenseVolume, GridOversampling};
 
-use super::sums::{self, ViewSums};
+use super::sums::{self, PixelSums};
 use super::weights::{axis_weights, in_plane, AxisWeights};
 use super::wrap;
 use crate::plan::filter::{choose_filter, KbDesign};
@@ -180,7 +180,7 @@ pub(super) fn interpolation(
 ) -> Result<Interpolation, fvr_core::Error> {
     let dims = volume.dims;
     let weights = axis_weights(filter, n);
-    let (sums, g2) = sums::view_sums(volume, &weights, n)?;
+    let (sums, g2) = sums::pixel_sums(volume, &weights, n)?;
     let side = image_side(dims, n)?;
     let mut energies = [[0.0; 4]; 3];
     for (a, e) in energies.iter_mut().enumerate() {
@@ -202,7 +202,7 @@ pub(super) fn interpolation(
 /// `[Σref², Σe_edge², Σe_kernel², Σe²]` of the `side × side` image of the
 /// view along axis `a` ([`AXIS_VIEWS`]).
 fn view_energies(
-    sums: &ViewSums,
+    sums: &PixelSums,
     w: &AxisWeights,
     dims: [usize; 3],
     n: usize,
@@ -233,16 +233,14 @@ fn view_energies(
             let wrap = |r: i64| r.rem_euclid(n as i64) as usize;
             let (xp, xq) = (wrap(rel[pa]), wrap(rel[qa]));
             let (mp, mq) = (wrap(-rel[pa]), wrap(-rel[qa]));
-            let at = xp + n * xq;
-            let mirror = mp + n * mq;
+            let (at, mirror) = (sums.pixel(xp, xq), sums.pixel(mp, mq));
             let aa = w.c[xp] * w.c[xq] - w.s[xp] * w.s[xq];
             let bb = w.s[xp] * w.c[xq] + w.c[xp] * w.s[xq];
             let mut e = [0.0; 2];
             let mut reference = 0.0;
             for (b, eb) in e.iter_mut().enumerate() {
-                let image = aa * (sums.cos[b][at] - sums.sin[b][mirror])
-                    + bb * (sums.cos[b][mirror] - sums.sin[b][at]);
-                let r = if inside { sums.plain[b][at] } else { 0.0 };
+                let image = aa * (at[b][1] - mirror[b][2]) + bb * (mirror[b][1] - at[b][2]);
+                let r = if inside { at[b][0] } else { 0.0 };
                 reference += r;
                 *eb = image - r;
             }

@@ -21,13 +21,16 @@ use crate::memory::written_zeros;
 use crate::volume::Volume;
 
 /// Per-view sums over the projection axis, split by edge (0) and interior
-/// (1) voxels, on the `n × n` grid of the two other axes (lower axis fastest).
+/// (1) voxels, on the `n × n` grid of the two other axes (lower axis
+/// fastest): [`PixelSums`] written out, for the tests.
+#[cfg(test)]
 pub(super) struct ViewSums {
     pub(super) plain: [Vec<f64>; 2],
     pub(super) cos: [Vec<f64>; 2],
     pub(super) sin: [Vec<f64>; 2],
 }
 
+#[cfg(test)]
 impl ViewSums {
     fn new(n: usize) -> Self {
         let z = || [written_zeros(n * n), written_zeros(n * n)];
@@ -35,6 +38,43 @@ impl ViewSums {
             plain: z(),
             cos: z(),
             sin: z(),
+        }
+    }
+}
+
+/// One view's sums over the projection axis, kept on the pixels of the
+/// volume's own extent ([`Lines`]) and read on the `n × n` grid of the two
+/// other axes by [`PixelSums::pixel`]: no `n²` arrays, zero beyond the
+/// extent.
+pub(super) struct PixelSums {
+    sums: [Vec<f64>; SUMS],
+    /// Per grid index of the lower in-plane axis, the extent's index, or
+    /// `None` beyond it; of the upper one, that index times the lower
+    /// extent.
+    p: Vec<Option<usize>>,
+    q: Vec<Option<usize>>,
+    /// Whether a grid index is an edge position.
+    edge: Vec<bool>,
+}
+
+impl PixelSums {
+    /// The pixel at grid indices `(gp, gq)`: for the edge (0) and interior
+    /// (1) voxels, the plain, `c` and `s` sums. An edge pixel counts every
+    /// voxel to 0.
+    #[inline]
+    pub(super) fn pixel(&self, gp: usize, gq: usize) -> [[f64; 3]; 2] {
+        let (Some(p), Some(q)) = (self.p[gp], self.q[gq]) else {
+            return [[0.0; 3]; 2];
+        };
+        let i = p + q;
+        let s = &self.sums;
+        if self.edge[gp] || self.edge[gq] {
+            [
+                [s[0][i] + s[3][i], s[1][i] + s[4][i], s[2][i] + s[5][i]],
+                [0.0; 3],
+            ]
+        } else {
+            [[s[0][i], s[1][i], s[2][i]], [s[3][i], s[4][i], s[5][i]]]
         }
     }
 }
@@ -104,22 +144,29 @@ impl Lines {
 
     /// Adds the row `row`, weighted by `c`, to the pixels `line·len ..` of
     /// the sums `c.at ..`: plain, `c` and, unless `sin` is false (all `s`
-    /// weights zero, as for odd widths), `s`.
+    /// weights zero, as for odd widths), `s`; the three in one loop, which
+    /// reads the row once.
     fn add(&mut self, c: Weight, line: usize, row: &[f64], sin: bool) {
         let len = row.len();
         let [plain, cos, s] = &mut self.sums[c.at..c.at + 3] else {
             unreachable!("three sums from 0 or 3");
         };
         let pixels = line * len..(line + 1) * len;
-        for (p, &v) in plain[pixels.clone()].iter_mut().zip(row) {
-            *p += v;
-        }
-        for (p, &v) in cos[pixels.clone()].iter_mut().zip(row) {
-            *p += v * c.w[1];
-        }
+        let (wc, ws) = (c.w[1], c.w[2]);
+        let both = plain[pixels.clone()]
+            .iter_mut()
+            .zip(&mut cos[pixels.clone()])
+            .zip(row);
         if sin {
-            for (p, &v) in s[pixels].iter_mut().zip(row) {
-                *p += v * c.w[2];
+            for (((p, q), &v), r) in both.zip(&mut s[pixels]) {
+                *p += v;
+                *q += v * wc;
+                *r += v * ws;
+            }
+        } else {
+            for ((p, q), &v) in both {
+                *p += v;
+                *q += v * wc;
             }
         }
     }
@@ -143,22 +190,33 @@ fn weighted_squares(row: &[f64], weight: &[f64]) -> f64 {
     lanes.iter().sum()
 }
 
-/// `Σ row·w[t]` over `weights` for the plain, `c` and (if `sin`) `s`
-/// weights, in [`LANES`] partial sums each.
-fn dot3(row: &[f64], weights: &[Weight], sin: bool) -> [f64; 3] {
+/// `Σ row·w[t]` for the plain, `c` and (if `sin`) `s` weights of the
+/// positions, `c` and `s` given apart (contiguous, so that the lanes are
+/// vector lanes), in [`LANES`] partial sums each. The plain weight is 1:
+/// `v·1 = v`.
+fn dot3(row: &[f64], c: &[f64], s: &[f64], sin: bool) -> [f64; 3] {
     let mut lanes = [[0.0; LANES]; 3];
     let tail = row.len() / LANES * LANES;
-    let terms = if sin { 3 } else { 2 };
-    for (v, w) in row.chunks_exact(LANES).zip(weights.chunks_exact(LANES)) {
-        for t in 0..terms {
+    let chunks = row
+        .chunks_exact(LANES)
+        .zip(c.chunks_exact(LANES))
+        .zip(s.chunks_exact(LANES));
+    for ((v, c), s) in chunks {
+        for l in 0..LANES {
+            lanes[0][l] += v[l];
+            lanes[1][l] += v[l] * c[l];
+        }
+        if sin {
             for l in 0..LANES {
-                lanes[t][l] += v[l] * w[l].w[t];
+                lanes[2][l] += v[l] * s[l];
             }
         }
     }
-    for (&v, w) in row[tail..].iter().zip(&weights[tail..]) {
-        for t in 0..terms {
-            lanes[t][0] += v * w.w[t];
+    for ((&v, &c), &s) in row[tail..].iter().zip(&c[tail..]).zip(&s[tail..]) {
+        lanes[0][0] += v;
+        lanes[1][0] += v * c;
+        if sin {
+            lanes[2][0] += v * s;
         }
     }
     lanes.map(|l| l.iter().sum())
@@ -174,11 +232,11 @@ fn dot3(row: &[f64], weights: &[Weight], sin: bool) -> [f64; 3] {
 /// # Errors
 /// [`fvr_core::Error::NonFiniteVoxel`] naming a non-finite voxel (the
 /// first in memory order).
-pub(super) fn view_sums(
+pub(super) fn pixel_sums(
     volume: &Volume,
     w: &AxisWeights,
     n: usize,
-) -> Result<([ViewSums; 3], f64), fvr_core::Error> {
+) -> Result<([PixelSums; 3], f64), fvr_core::Error> {
     if let Some(at) = volume.first_non_finite() {
         let [d0, d1, _] = volume.dims;
         return Err(fvr_core::Error::NonFiniteVoxel {
@@ -193,6 +251,7 @@ pub(super) fn view_sums(
     // Odd widths have no `s` weights: their sums stay zero.
     let sin = w.s.iter().any(|&s| s != 0.0);
     let x_runs = runs(&wx);
+    let (cx, sx): (Vec<f64>, Vec<f64>) = wx.iter().map(|w| (w.w[1], w.w[2])).unzip();
     let px: Vec<f64> = (0..d0).map(|i| w.p[gx(i)]).collect();
     // Pixel sums on the volume's own extent: x view (j, k), y view (i, k),
     // z view (i, j).
@@ -201,19 +260,25 @@ pub(super) fn view_sums(
     let mut zs = Lines::new(d0 * d1);
     let mut row = vec![0.0f64; d0];
     let mut g2 = 0.0;
+    // Each row's term of Σg², kept until its block is done.
+    let mut squares = [0.0f64; BLOCK * BLOCK];
     for j0 in (0..d1).step_by(BLOCK) {
         for k0 in (0..d2).step_by(BLOCK) {
-            for j in j0..(j0 + BLOCK).min(d1) {
-                for k in k0..(k0 + BLOCK).min(d2) {
+            let (j1, k1) = ((j0 + BLOCK).min(d1), (k0 + BLOCK).min(d2));
+            // The block's rows in memory order: consecutive j are adjacent.
+            // Each y-view line k adds its rows in order of j, each z-view
+            // line j its rows in order of k, as before any reordering.
+            for k in k0..k1 {
+                for j in j0..j1 {
                     let source = &volume.data[(k * d1 + j) * d0..][..d0];
                     for (r, &v) in row.iter_mut().zip(source) {
                         *r = f64::from(v);
                     }
                     let pyz = w.p[gy(j)] * w.p[gz(k)];
-                    g2 += weighted_squares(&row, &px) * (pyz * pyz);
+                    squares[(j - j0) * BLOCK + k - k0] = weighted_squares(&row, &px) * (pyz * pyz);
                     let pixel = j + d1 * k;
                     for &(start, end, at) in &x_runs {
-                        let sums = dot3(&row[start..end], &wx[start..end], sin);
+                        let sums = dot3(&row[start..end], &cx[start..end], &sx[start..end], sin);
                         for (t, s) in sums.into_iter().enumerate() {
                             xs.sums[at + t][pixel] += s;
                         }
@@ -222,40 +287,63 @@ pub(super) fn view_sums(
                     zs.add(wz[k], j, &row, sin);
                 }
             }
-        }
-    }
-    let edge = |a: usize, i: usize| w.edge[grid(a)(i)];
-    let mut out = [ViewSums::new(n), ViewSums::new(n), ViewSums::new(n)];
-    // View `a`: in-plane axes (pa, qa), the pixel sums' extents (lp, lq).
-    for (a, (lines, lp, lq, pa, qa)) in [
-        (&xs, d1, d2, 1, 2),
-        (&ys, d0, d2, 0, 2),
-        (&zs, d0, d1, 0, 1),
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        let view = &mut out[a];
-        let s = &lines.sums;
-        for q in 0..lq {
-            for p in 0..lp {
-                let i = p + lp * q;
-                let at = grid(pa)(p) + n * grid(qa)(q);
-                if edge(pa, p) || edge(qa, q) {
-                    // Edge pixels: every voxel counts to b = 0.
-                    view.plain[0][at] = s[0][i] + s[3][i];
-                    view.cos[0][at] = s[1][i] + s[4][i];
-                    view.sin[0][at] = s[2][i] + s[5][i];
-                } else {
-                    for (b, t) in [(0, 0), (1, 3)] {
-                        view.plain[b][at] = s[t][i];
-                        view.cos[b][at] = s[t + 1][i];
-                        view.sin[b][at] = s[t + 2][i];
-                    }
+            // Σg² adds the block's rows in order of j, then k.
+            for j in j0..j1 {
+                for k in k0..k1 {
+                    g2 += squares[(j - j0) * BLOCK + k - k0];
                 }
             }
         }
     }
+    // View `a`: in-plane axes (pa, qa), the pixel sums' extents (lp, lq).
+    let view = |lines: Lines, lp: usize, lq: usize, pa: usize, qa: usize| {
+        let mut p = vec![None; n];
+        for i in 0..lp {
+            p[grid(pa)(i)] = Some(i);
+        }
+        let mut q = vec![None; n];
+        for i in 0..lq {
+            q[grid(qa)(i)] = Some(i * lp);
+        }
+        PixelSums {
+            sums: lines.sums,
+            p,
+            q,
+            edge: w.edge.clone(),
+        }
+    };
+    Ok((
+        [
+            view(xs, d1, d2, 1, 2),
+            view(ys, d0, d2, 0, 2),
+            view(zs, d0, d1, 0, 1),
+        ],
+        g2,
+    ))
+}
+
+/// [`pixel_sums`] written out on the `n × n` grids.
+#[cfg(test)]
+pub(super) fn view_sums(
+    volume: &Volume,
+    w: &AxisWeights,
+    n: usize,
+) -> Result<([ViewSums; 3], f64), fvr_core::Error> {
+    let (pixels, g2) = pixel_sums(volume, w, n)?;
+    let out = pixels.map(|sums| {
+        let mut view = ViewSums::new(n);
+        for gq in 0..n {
+            for gp in 0..n {
+                let at = gp + n * gq;
+                for (b, [plain, cos, sin]) in sums.pixel(gp, gq).into_iter().enumerate() {
+                    view.plain[b][at] = plain;
+                    view.cos[b][at] = cos;
+                    view.sin[b][at] = sin;
+                }
+            }
+        }
+        view
+    });
     Ok((out, g2))
 }
 

@@ -34,7 +34,7 @@ use fvr_core::volume::padded_size;
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
-use super::splat::{lattice_step, splat};
+use super::splat::{lattice_step, splat_in};
 use super::tails::Tails;
 use crate::memory::written_zeros;
 use crate::volume::Volume;
@@ -59,7 +59,7 @@ const DIRECTIONS: [[f64; 3]; 14] = [
     [-1.0, -1.0, 1.0],
 ];
 
-/// One view's unwrapped shadow ([`splat`]): per pixel of a square canvas
+/// One view's unwrapped shadow ([`splat_in`]): per pixel of a square canvas
 /// of side `2·half + 1`, `Σf` and `Σf·sin(πδ)` along the image's right and
 /// up axes.
 struct Shadow {
@@ -104,7 +104,7 @@ impl<'a> Shadows<'a> {
         self.shadows.get_or_init(|| {
             DIRECTIONS
                 .par_iter()
-                .map(|&dir| {
+                .map_init(Vec::new, |ring, &dir| {
                     let up = if dir[0] == 0.0 && dir[1] == 0.0 {
                         [0.0, 1.0, 0.0]
                     } else {
@@ -112,7 +112,7 @@ impl<'a> Shadows<'a> {
                     };
                     let frame = View { dir, up }.frame().expect("fixed directions");
                     let step = lattice_step(dir);
-                    let cells = splat(volume, frame.right, frame.up, half, step);
+                    let cells = splat_in(volume, frame.right, frame.up, half, step, ring);
                     Shadow { half, cells }
                 })
                 .collect()
