@@ -426,8 +426,20 @@ impl Renderer {
     /// adaptively filtered as the settings say, in physical units.
     ///
     /// # Errors
-    /// A bad view or size, or the adaptive marks' errors.
+    /// A bad view or size, the adaptive marks' errors, or an image that
+    /// overflows `f32` ([`PipelineError::Overflow`]).
     pub fn render(
+        &self,
+        view: &View,
+        size: Option<(usize, usize)>,
+    ) -> Result<(Image, ViewReport), PipelineError> {
+        let (image, report) = self.render_unchecked(view, size)?;
+        crate::image::finite::check_image(&image.data, &self.settings.scene)?;
+        Ok((image, report))
+    }
+
+    /// [`Renderer::render`] before the image is checked for overflow.
+    fn render_unchecked(
         &self,
         view: &View,
         size: Option<(usize, usize)>,

@@ -262,3 +262,33 @@ fn overflowing_frames_are_refused_and_not_left_in_out() {
     assert!(err.starts_with("view 0 has non-finite pixels"), "{err}");
     assert!(err.contains("rescale the volume"), "{err}");
 }
+
+/// One view ([`Renderer::render`]) and a magnified one
+/// ([`Renderer::render_zoomed`]) refuse an image that overflows f32 as a
+/// batch does: their `f64` pixels are finite, the `f32` every output
+/// stores is not.
+#[test]
+fn single_views_that_overflow_f32_are_refused() {
+    let small = volume([16; 3], [1.0; 3]);
+    let mut scene = Scene::xray();
+    scene.ambient = [1e300; 3];
+    let settings = Settings {
+        scene,
+        ..Settings::default()
+    };
+    let renderer = Renderer::new(&small, settings).unwrap();
+    let view = View::along([1.0, 0.3, 0.2]);
+    for zoom in [1, 2] {
+        match renderer.render_zoomed(&view, None, zoom) {
+            Err(PipelineError::Overflow { view, cause, .. }) => {
+                assert_eq!(view, 0);
+                assert_eq!(cause, "a setting overflowed; lower the ambient colour");
+            }
+            other => panic!("zoom {zoom}: {other:?}"),
+        }
+    }
+    // The same renderer's scene at a sane ambient renders.
+    let fine = Renderer::new(&small, Settings::default()).unwrap();
+    let (image, _) = fine.render(&view, None).unwrap();
+    assert!(image.data.iter().all(|v| v.is_finite()));
+}

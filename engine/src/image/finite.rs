@@ -73,6 +73,24 @@ pub fn check_frames(out: &[f32], frame: usize, scene: &Scene) -> Result<(), Pipe
     }
 }
 
+/// [`check_frames`] for one image held in `f64` ([`crate::Renderer::render`]):
+/// `Ok` when every value is finite once narrowed to `f32`, as every output
+/// stores it.
+///
+/// # Errors
+/// A value that is NaN or infinite in `f32`, as [`PipelineError::Overflow`]
+/// of view 0.
+pub fn check_image(data: &[f64], scene: &Scene) -> Result<(), PipelineError> {
+    match data.iter().position(|&v| !(v as f32).is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(PipelineError::Overflow {
+            view: 0,
+            value: data[i] as f32,
+            cause: overflow_cause(given(scene), &ENGINE_NAMES),
+        }),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -114,5 +132,15 @@ mod tests {
         assert!(e.contains("(the first is inf): "), "{e}");
         out[6] = f32::NAN;
         assert!(check_frames(&out, 4, &scene).is_err());
+    }
+
+    #[test]
+    fn an_image_that_overflows_f32_is_refused() {
+        let scene = Scene::xray();
+        assert!(check_image(&[1.0, f64::from(f32::MAX)], &scene).is_ok());
+        // Finite in f64, infinite once stored as f32.
+        let e = check_image(&[1.0, 1e39], &scene).unwrap_err();
+        assert!(matches!(e, PipelineError::Overflow { view: 0, .. }), "{e}");
+        assert!(check_image(&[f64::NAN], &scene).is_err());
     }
 }

@@ -45,7 +45,8 @@ impl Renderer {
     /// [`Renderer::render`].
     ///
     /// # Errors
-    /// As [`Renderer::render`]; a zoom the transforms do not serve; a
+    /// As [`Renderer::render`] (an image that overflows `f32` included); a
+    /// zoom the transforms do not serve; a
     /// zoom with a preview level, adaptive filtering, a varying depth cue
     /// or lights (plain X-ray views only).
     pub fn render_zoomed(
@@ -93,6 +94,7 @@ impl Renderer {
             time: t0.elapsed(),
             adaptive: None,
         };
+        crate::image::finite::check_image(&image.data, &settings.scene)?;
         Ok((image, report))
     }
 

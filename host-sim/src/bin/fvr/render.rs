@@ -14,7 +14,7 @@ use fvr_host::image::{Image, ImageFiles};
 use serde::Serialize;
 
 use crate::adaptive_report::{AdaptiveJson, AdaptiveReport};
-use crate::checks::{check_finite, check_output, check_resample};
+use crate::checks::{check_output, check_resample};
 
 use clap::Args;
 use fvr_core::geometry::{Sampling, View};
@@ -270,7 +270,17 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     }
     crate::look::warn_negative_cue(&volume, &scene, &view)?;
     let (w, h) = renderer.image_size(args.frame.size)?;
-    let (image, view_report) = renderer.render_zoomed(&view, Some((w, h)), args.zoom.zoom)?;
+    // The engine refuses an image that overflows f32; the message names
+    // the command line's options.
+    let (image, view_report) = renderer
+        .render_zoomed(&view, Some((w, h)), args.zoom.zoom)
+        .map_err(|e| match e {
+            fvr_engine::PipelineError::Overflow { value, .. } => Error::from(format!(
+                "the image has non-finite pixels once stored as f32 (the first is {value}): {}",
+                args.look.overflow_cause()
+            )),
+            other => other.into(),
+        })?;
     let (w, h) = (image.width, image.height);
     let adaptive_report = match &view_report.adaptive {
         Some(a) => Some(AdaptiveReport::new(
@@ -283,7 +293,6 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         None => None,
     };
     let t_view = view_report.time;
-    check_finite(&image.data, &args.look.overflow_cause())?;
     // A cued view keeps the window of its uncued view (look::cue_window).
     let cued = match ext.as_str() {
         "png" => crate::look::cue_window(&renderer, &scene, &view, (w, h), &style.window)?,
