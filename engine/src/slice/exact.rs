@@ -131,16 +131,10 @@ pub fn extract<S: Sample, T: Real + Send + Sync>(
     let geometry = Geometry::new(axes, n, tiling, parallel);
     let data = spec.data();
     if n.is_power_of_two() {
-        let source = Linear::<S, true> {
-            data,
-            side: Side { n },
-        };
+        let source = Linear::<S, true>::new::<T>(data, n);
         by_width::<true, S, T, _>(&source, kernel, &geometry, grid)
     } else {
-        let source = Linear::<S, false> {
-            data,
-            side: Side { n },
-        };
+        let source = Linear::<S, false>::new::<T>(data, n);
         by_width::<false, S, T, _>(&source, kernel, &geometry, grid)
     }
 }
@@ -186,11 +180,31 @@ trait TapSource<S>: Sync {
 struct Linear<'a, S, const POW2: bool> {
     data: &'a [S],
     side: Side<POW2>,
+    /// Whether [`crate::slice::f16c::tap_sum`] serves the sums (binary16
+    /// in `f32` on a core with F16C).
+    f16c: bool,
+}
+
+impl<'a, S: Sample, const POW2: bool> Linear<'a, S, POW2> {
+    fn new<T: Real>(data: &'a [S], n: usize) -> Self {
+        Self {
+            data,
+            side: Side { n },
+            f16c: crate::slice::f16c_available::<S, T>(),
+        }
+    }
 }
 
 impl<S: Sample + Sync, const POW2: bool> TapSource<S> for Linear<'_, S, POW2> {
     #[inline(always)]
     fn sum<const W: usize, T: Real>(&self, taps: [i32; 3], weights: [&[T; W]; 3]) -> T {
+        #[cfg(target_arch = "x86_64")]
+        if self.f16c {
+            // SAFETY: `f16c` is set only where `f16c::available` detected
+            // F16C and AVX on this core, the features `tap_sum` enables.
+            #[allow(unsafe_code)]
+            return unsafe { crate::slice::f16c::tap_sum(self.data, self.side, taps, weights) };
+        }
         tap_sum_on(self.data, self.side, taps, weights)
     }
 

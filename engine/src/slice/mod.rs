@@ -6,7 +6,19 @@
 pub mod adaptive;
 pub mod column;
 pub mod exact;
+#[cfg(target_arch = "x86_64")]
+mod f16c;
 mod prefetch;
 mod runs;
 pub mod strip;
 mod taps;
+
+/// Whether this core has F16C and AVX and `S` and `T` are binary16 summed
+/// in `f32`: the case the walks' lane sums ([`f16c`]) serve. Always
+/// `false` off x86-64.
+fn f16c_available<S: fvr_core::num::Sample, T: fvr_core::num::Real>() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    return f16c::available::<S, T>();
+    #[cfg(not(target_arch = "x86_64"))]
+    false
+}

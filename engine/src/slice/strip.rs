@@ -188,6 +188,9 @@ struct Strip<'a, const W: usize, S, T> {
     inner_w: bool,
     /// Lines prefetched ahead ([`Tiling::ahead`]).
     ahead: usize,
+    /// Whether [`crate::slice::f16c::scale_add`] reduces the planes
+    /// (binary16 in `f32` on a core with F16C).
+    f16c: bool,
 }
 
 #[inline(never)]
@@ -216,6 +219,7 @@ fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
         step: g.right.map(PhaseTable::<T, W>::fixed_step),
         inner_w,
         ahead: g.tiling.ahead,
+        f16c: crate::slice::f16c_available::<S, T>(),
     };
     let mut bands = bands_of_pairs(grid, n, g.tiling.band);
     let fill = |band: &mut Vec<Pair<'_, T>>| {
@@ -395,6 +399,16 @@ impl<const W: usize, S: Sample, T: Real> Strip<'_, W, S, T> {
                 let Some(src) = self.data.get(planes[c] + start..planes[c] + start + len) else {
                     return;
                 };
+                #[cfg(target_arch = "x86_64")]
+                if self.f16c {
+                    // SAFETY: `f16c` is set only where F16C and AVX were
+                    // detected on this core, the features `scale_add` enables.
+                    #[allow(unsafe_code)]
+                    unsafe {
+                        crate::slice::f16c::scale_add(weight, src, cells, c == 0)
+                    };
+                    continue;
+                }
                 if c == 0 {
                     for (o, &v) in cells.iter_mut().zip(src) {
                         *o = weight * T::load_raw(v);
