@@ -198,10 +198,10 @@ impl<'a, S: Sample, const POW2: bool> Linear<'a, S, POW2> {
 impl<S: Sample + Sync, const POW2: bool> TapSource<S> for Linear<'_, S, POW2> {
     #[inline(always)]
     fn sum<const W: usize, T: Real>(&self, taps: [i32; 3], weights: [&[T; W]; 3]) -> T {
-        #[cfg(target_arch = "x86_64")]
         if self.f16c {
             // SAFETY: `f16c` is set only where `f16c::available` detected
             // F16C and AVX on this core, the features `tap_sum` enables.
+            #[cfg(target_arch = "x86_64")]
             #[allow(unsafe_code)]
             return unsafe { crate::slice::f16c::tap_sum(self.data, self.side, taps, weights) };
         }

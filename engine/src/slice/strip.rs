@@ -399,14 +399,15 @@ impl<const W: usize, S: Sample, T: Real> Strip<'_, W, S, T> {
                 let Some(src) = self.data.get(planes[c] + start..planes[c] + start + len) else {
                     return;
                 };
-                #[cfg(target_arch = "x86_64")]
                 if self.f16c {
                     // SAFETY: `f16c` is set only where F16C and AVX were
                     // detected on this core, the features `scale_add` enables.
+                    #[cfg(target_arch = "x86_64")]
                     #[allow(unsafe_code)]
                     unsafe {
                         crate::slice::f16c::scale_add(weight, src, cells, c == 0)
                     };
+                    #[cfg(target_arch = "x86_64")]
                     continue;
                 }
                 if c == 0 {
