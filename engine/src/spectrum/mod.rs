@@ -270,18 +270,43 @@ impl<S: Sample> OwnedSpectrum<S> {
     /// fills the grid) inflates `Σg²` and shows up here.
     pub fn storage_snr_estimate_db(&self, volume_sum: f64, unit_roundoff: f64) -> f64 {
         let n3 = (self.n * self.n * self.n) as f64;
-        let sum_sq: f64 = self
-            .data
-            .iter()
-            .map(|v| {
-                let x = v.to_f64() / self.scale;
-                x * x
-            })
-            .sum();
-        let g2 = sum_sq / n3;
+        let g2 = self.stored_sum_of_squares() / (self.scale * self.scale) / n3;
         let signal = volume_sum * volume_sum / (self.n * self.n) as f64;
         let noise = 4.0 * unit_roundoff * unit_roundoff / 3.0 * g2;
         10.0 * (signal / noise).log10()
+    }
+
+    /// `Σ c²` over the stored values `c`, on all cores: each chunk of
+    /// 2¹⁶ values summed in order, then the chunks' sums in order, so the
+    /// result is the same bits on any number of threads. Formats up to 32
+    /// bits are widened raw ([`Sample::to_f32_raw`], a loop the compiler
+    /// vectorizes) and the power of two put back on the sum.
+    fn stored_sum_of_squares(&self) -> f64 {
+        use rayon::prelude::*;
+        let raw = S::BITS <= 32;
+        let chunk_sums: Vec<f64> = self
+            .data
+            .par_chunks(1 << 16)
+            .map(|chunk| {
+                chunk
+                    .iter()
+                    .map(|v| {
+                        let x = if raw {
+                            v.to_f32_raw() as f64
+                        } else {
+                            v.to_f64()
+                        };
+                        x * x
+                    })
+                    .sum::<f64>()
+            })
+            .collect();
+        let sum: f64 = chunk_sums.iter().sum();
+        if raw {
+            sum * 4f64.powi(S::RAW_EXPONENT_F32)
+        } else {
+            sum
+        }
     }
 
     /// Stored coefficients.

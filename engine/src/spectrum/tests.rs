@@ -142,3 +142,44 @@ fn fast_budget_counts_the_half_spectrum() {
         Err(PipelineError::OutOfMemory { .. })
     ));
 }
+
+/// The storage SNR estimate's `Σg²` is the stored spectrum's energy, as a
+/// value-by-value f64 sum computes it, for f16, f32 and f64 storage.
+#[test]
+fn storage_snr_estimate_sums_the_stored_energy() {
+    let volume = random_volume([20, 18, 16], 7);
+    let filter = Filter::new(FilterKind::Kb4, 1).unwrap();
+    let sum: f64 = volume.data.iter().map(|&v| v as f64).sum();
+    fn naive<S: Sample>(s: &OwnedSpectrum<S>, sum: f64, u: f64) -> f64 {
+        let n = s.n() as f64;
+        let g2: f64 = s
+            .data()
+            .iter()
+            .map(|v| (v.to_f64() / s.scale()).powi(2))
+            .sum::<f64>()
+            / (n * n * n);
+        10.0 * ((sum * sum / (n * n)) / (4.0 * u * u / 3.0 * g2)).log10()
+    }
+    let u = 2f64.powi(-11);
+    let f16s = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+    let f32s = OwnedSpectrum::<f32>::prepare::<f32>(&volume, filter).unwrap();
+    let f64s = OwnedSpectrum::<f64>::prepare::<f64>(&volume, filter).unwrap();
+    for (got, want) in [
+        (f16s.storage_snr_estimate_db(sum, u), naive(&f16s, sum, u)),
+        (f32s.storage_snr_estimate_db(sum, u), naive(&f32s, sum, u)),
+        (f64s.storage_snr_estimate_db(sum, u), naive(&f64s, sum, u)),
+    ] {
+        assert!(want.is_finite() && want > 20.0, "{want}");
+        assert!((got - want).abs() < 1e-9, "{got} against {want}");
+    }
+    // On one thread and on the default pool: the same bits.
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let single = one.install(|| f16s.storage_snr_estimate_db(sum, u));
+    assert_eq!(
+        single.to_bits(),
+        f16s.storage_snr_estimate_db(sum, u).to_bits()
+    );
+}
