@@ -8,6 +8,10 @@ pub use orientation::Orientation;
 
 use std::fmt;
 
+/// The samples a resampled volume may have along its longest side: the
+/// one rule for `--resample` and a scene's `volume.resample`.
+pub const RESAMPLE_RANGE: std::ops::RangeInclusive<usize> = 2..=4096;
+
 /// Voxel spacing when a format gives none: 1 mm on every axis.
 pub const DEFAULT_SPACING: [f64; 3] = [1.0, 1.0, 1.0];
 
@@ -86,10 +90,14 @@ impl Volume {
     /// along the longest physical side.
     ///
     /// # Errors
-    /// `largest` is 0.
+    /// `largest` outside [`RESAMPLE_RANGE`].
     pub fn resampled_dims(&self, largest: usize) -> Result<[usize; 3], String> {
-        if largest == 0 {
-            return Err("resampling needs at least 1 sample along the longest side".into());
+        if !RESAMPLE_RANGE.contains(&largest) {
+            return Err(format!(
+                "resampling to {largest} samples along the longest side: give {} to {}",
+                RESAMPLE_RANGE.start(),
+                RESAMPLE_RANGE.end()
+            ));
         }
         let extent = self.extent_mm();
         let longest = extent.iter().copied().fold(0.0f64, f64::max);
@@ -201,7 +209,7 @@ impl Volume {
     /// zero-padded"); trilinear interpolation low-passes the data slightly.
     ///
     /// # Errors
-    /// `largest` of 0.
+    /// `largest` outside [`RESAMPLE_RANGE`].
     pub fn resample_isotropic(&self, largest: usize) -> Result<Volume, String> {
         let dims = self.resampled_dims(largest)?;
         let h = self.extent_mm().iter().copied().fold(0.0f64, f64::max) / largest as f64;
@@ -318,5 +326,18 @@ mod tests {
         v.data[1] = f32::MIN;
         v.data[2] = f32::MIN_POSITIVE / 2.0;
         assert_eq!(v.first_non_finite(), None);
+    }
+
+    /// Resampling takes 2 to 4096 samples along the longest side, as the
+    /// command line and scene files say, whoever calls it.
+    #[test]
+    fn resampling_outside_its_range_is_refused() {
+        let v = Volume::filled([8, 6, 4], 1.0);
+        for bad in [0, 1, 4097, usize::MAX] {
+            let e = v.resample_isotropic(bad).unwrap_err();
+            assert!(e.contains("give 2 to 4096"), "{bad}: {e}");
+        }
+        assert_eq!(v.resampled_dims(2).unwrap(), [2, 2, 1]);
+        assert_eq!(v.resample_isotropic(16).unwrap().dims, [16, 12, 8]);
     }
 }

@@ -14,6 +14,7 @@ use crate::options::parse_depth_cue;
 use fvr_engine::plan::filter::KbDesign;
 use fvr_engine::render::shaded::DEFAULT_PROFILE_HARMONICS;
 use fvr_engine::spectrum::Precision;
+use fvr_engine::volume::RESAMPLE_RANGE;
 
 use super::{
     parse_endian, CameraSection, OutputSection, SceneFile, ShadingSection, SpectrumSection,
@@ -384,7 +385,15 @@ impl Checker<'_> {
             raw_type: self.parsed(t, p, "raw_type", str::parse::<SampleType>),
             raw_endian: self.parsed(t, p, "raw_endian", parse_endian),
             background: self.number(t, p, "background"),
-            resample: self.integer(t, p, "resample", 2, 4096).map(|v| v as usize),
+            resample: self
+                .integer(
+                    t,
+                    p,
+                    "resample",
+                    *RESAMPLE_RANGE.start() as i64,
+                    *RESAMPLE_RANGE.end() as i64,
+                )
+                .map(|v| v as usize),
             taper: self.integer(t, p, "taper", 1, 4096).map(|v| v as usize),
             ignore_spacing: self.boolean(t, p, "ignore_spacing"),
         }

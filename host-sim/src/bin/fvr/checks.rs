@@ -56,8 +56,8 @@ pub(crate) fn check_direction(what: &str, v: [f64; 3]) -> Result<(), Error> {
 }
 
 /// The samples `--resample` (or a scene's `volume.resample`) may ask for
-/// along the longest side; one rule for both.
-pub(crate) const RESAMPLE_RANGE: std::ops::RangeInclusive<usize> = 2..=4096;
+/// along the longest side: the engine's one rule.
+pub(crate) use fvr_engine::volume::RESAMPLE_RANGE;
 
 /// Refuse a `--resample` outside [`RESAMPLE_RANGE`] before any work.
 pub(crate) fn check_resample_count(resample: Option<usize>) -> Result<(), Error> {
