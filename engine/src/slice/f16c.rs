@@ -57,24 +57,32 @@ pub(crate) fn tap_sum<const W: usize, const POW2: bool, S: Sample, T: Real>(
     let weights: __m256 = bytemuck::cast(lanes);
     let mut acc = 0.0f32;
     for c in 0..W {
-        let mut acc_y = 0.0f32;
-        for b in 0..W {
+        // The plane's runs widened and multiplied first, then their sums
+        // side by side: each run's products still added in order, from
+        // zero, but the W chains of additions overlap.
+        let mut products = [[0.0f32; 8]; W];
+        for (b, p) in products.iter_mut().enumerate() {
             let start = planes[c] + lines[b] + x0;
-            let mut acc_x = 0.0f32;
             if let Some(run) = data.get(start..start + 8) {
                 let bits: [u16; 8] =
                     core::array::from_fn(|t| run[t].pattern16().unwrap_or_default());
                 let wide = _mm256_cvtph_ps(bytemuck::cast::<[u16; 8], __m128i>(bits));
-                let products: [f32; 8] = bytemuck::cast(_mm256_mul_ps(wide, weights));
-                for p in &products[..W] {
-                    acc_x += *p;
-                }
+                *p = bytemuck::cast(_mm256_mul_ps(wide, weights));
             } else if let Some(run) = data.get(start..start + W) {
                 for t in 0..W {
-                    acc_x += lanes[t] * run[t].to_f32_raw();
+                    p[t] = lanes[t] * run[t].to_f32_raw();
                 }
             }
-            acc_y += wy[b].to_f64() as f32 * acc_x;
+        }
+        let mut acc_x = [0.0f32; W];
+        for t in 0..W {
+            for b in 0..W {
+                acc_x[b] += products[b][t];
+            }
+        }
+        let mut acc_y = 0.0f32;
+        for b in 0..W {
+            acc_y += wy[b].to_f64() as f32 * acc_x[b];
         }
         acc += wz[c].to_f64() as f32 * acc_y;
     }
