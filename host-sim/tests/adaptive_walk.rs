@@ -23,7 +23,7 @@ use fvr_engine::slice::adaptive::walk::{
     extract, extract_with_strip, extract_with_strip_if, Settled,
 };
 use fvr_engine::slice::adaptive::{AdaptiveMarks, AdaptiveSettings, Bound, Cheaper};
-use fvr_engine::slice::exact::Tiling;
+use fvr_engine::slice::exact::{SliceJob, Tiling};
 use fvr_engine::slice::strip;
 use fvr_engine::spectrum::OwnedSpectrum;
 use fvr_engine::volume::phantom::{sample, GaussianMixture};
@@ -436,9 +436,8 @@ fn strip_walk_sums_the_large_filters_points_and_nothing_else() {
                 extract_slice_adaptive(&view_spec, &kernel, &levels, &frame, &mut core).unwrap();
             let mut plain = vec![0f32; n * n];
             let tiling = Tiling::default();
-            assert!(strip::extract(
-                &view_spec, &kernel, &axes, tiling, true, &mut plain
-            ));
+            let job = SliceJob::new(&view_spec, &kernel, &axes, tiling, true);
+            assert!(strip::extract(&job, &mut plain));
             let large = core_stats.per_filter[0] as usize;
             assert!(
                 large > 0 && large < core_stats.samples as usize / 4,

@@ -26,7 +26,7 @@ use crate::render::view::Walk;
 use crate::slice::adaptive::walk::{self, Settled};
 use crate::slice::adaptive::AdaptiveMarks;
 use crate::slice::column;
-use crate::slice::exact::{self, Tiling};
+use crate::slice::exact::{self, SliceJob, Tiling};
 use crate::slice::strip;
 use crate::spectrum::OwnedSpectrum;
 
@@ -266,9 +266,10 @@ fn plain<S: Sample, T: Real>(
     along: &mut Vec<T>,
 ) -> Option<fvr_core::geometry::SliceAxes> {
     let axes = Sampling::UNIT.slice_axes(frame);
-    let walked = column::extract(spec, kernel, &axes, tiling, parallel, grid, along)
-        || strip::extract(spec, kernel, &axes, tiling, parallel, grid)
-        || exact::extract(spec, kernel, &axes, tiling, parallel, grid);
+    let job = SliceJob::new(spec, kernel, &axes, tiling, parallel);
+    let walked = column::extract(&job, grid, along)
+        || strip::extract(&job, grid)
+        || exact::extract(&job, grid);
     walked.then_some(axes)
 }
 

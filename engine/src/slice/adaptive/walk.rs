@@ -36,7 +36,7 @@ use rayon::prelude::*;
 
 use crate::slice::adaptive::spans::PartialSpans;
 use crate::slice::adaptive::summary::MarksSummary;
-use crate::slice::exact::{row_interval, supports, tap_sum, Tiling};
+use crate::slice::exact::{row_interval, supports, tap_sum, SliceJob, Tiling};
 use crate::slice::strip;
 
 /// One filter of the chain as the walk applies it.
@@ -256,15 +256,8 @@ pub fn extract_with_strip_if<S: Sample, T: Real + Send + Sync>(
     if let Some(w) = within.first_mut().filter(|w| w.0 <= w.1) {
         *w = (w.0.min(-w.1), w.1.max(-w.0));
     }
-    if !strip::extract_within(
-        spec,
-        kernel,
-        &axes,
-        tiling,
-        parallel && sum,
-        strong,
-        &within,
-    ) {
+    let job = SliceJob::new(spec, kernel, &axes, tiling, parallel && sum);
+    if !strip::extract_within(&job, strong, &within) {
         drop(bands);
         return extract(spec, kernel, levels, whole, frame, tiling, parallel, grid)
             .map(Settled::Extracted);
@@ -611,14 +604,7 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
     /// its width.
     #[inline(always)]
     fn value(&self, filter: &Applied<'_, T>, q: [T; 3]) -> T {
-        match filter.width {
-            1 => self.interpolate::<1>(filter.table, q),
-            2 => self.interpolate::<2>(filter.table, q),
-            3 => self.interpolate::<3>(filter.table, q),
-            4 => self.interpolate::<4>(filter.table, q),
-            5 => self.interpolate::<5>(filter.table, q),
-            _ => self.interpolate::<MAX_WIDTH>(filter.table, q),
-        }
+        for_width!(filter.width, W => self.interpolate::<W>(filter.table, q))
     }
 
     /// The core's separable interpolation for width `W` (the table's):
