@@ -22,7 +22,7 @@ use fvr_engine::render::adaptive::AdaptiveRenderer;
 use fvr_engine::render::view::Walk;
 use fvr_engine::slice::adaptive::summary::MarksSummary;
 use fvr_engine::slice::adaptive::walk::{
-    extract, extract_with_strip, extract_with_strip_if, Settled,
+    extract, extract_with_strip, extract_with_strip_if, AdaptiveJob, Settled,
 };
 use fvr_engine::slice::adaptive::{AdaptiveMarks, AdaptiveSettings, Bound, Cheaper};
 use fvr_engine::slice::exact::{SliceJob, Tiling};
@@ -109,10 +109,8 @@ fn check_busy<S: Sample, T: Real>(
         for parallel in [false, true] {
             // Garbage first: every point must be written.
             let mut host = vec![T::from_f64(7.0); n * n];
-            let stats = extract(
-                &view, &kernel, &levels, whole, &frame, tiling, parallel, &mut host,
-            )
-            .unwrap_or_else(|| panic!("{what}: not served"));
+            let job = AdaptiveJob::new(&view, &kernel, &levels, whole, &frame, tiling, parallel);
+            let stats = extract(&job, &mut host).unwrap_or_else(|| panic!("{what}: not served"));
             assert_eq!(stats, core_stats, "{what}, {tiling:?}, parallel {parallel}");
             let differ = core
                 .iter()
@@ -380,7 +378,8 @@ fn renderer_image_equals_core_extraction() {
     let mut grid = vec![0f32; n * n];
     let tiling = Tiling::default();
     let whole = marks.summary();
-    assert!(extract(&view_spec, &other, &levels, whole, &frame, tiling, true, &mut grid).is_none());
+    let job = AdaptiveJob::new(&view_spec, &other, &levels, whole, &frame, tiling, true);
+    assert!(extract(&job, &mut grid).is_none());
 }
 
 /// The slice [`extract_with_strip`] should give: the core's adaptive
@@ -457,18 +456,10 @@ fn strip_walk_sums_the_large_filters_points_and_nothing_else() {
                     let mut host = vec![7f32; n * n];
                     let mut strong = vec![-3f32; n * n];
                     let whole = marks.summary();
-                    let stats = extract_with_strip(
-                        &view_spec,
-                        &kernel,
-                        &levels,
-                        whole,
-                        &frame,
-                        tiling,
-                        parallel,
-                        &mut host,
-                        &mut strong,
-                    )
-                    .unwrap();
+                    let job = AdaptiveJob::new(
+                        &view_spec, &kernel, &levels, whole, &frame, tiling, parallel,
+                    );
+                    let stats = extract_with_strip(&job, &mut host, &mut strong).unwrap();
                     let at = format!("{what}, {tiling:?}, parallel {parallel}");
                     assert_eq!(stats, core_stats, "{at}");
                     if !expected.is_empty() {
@@ -528,18 +519,8 @@ fn without_a_held_axis_the_strip_extraction_is_the_cores() {
     let mut host = vec![7f32; n * n];
     let mut strong = vec![0f32; n * n];
     let (whole, tiling) = (marks.summary(), Tiling::default());
-    let stats = extract_with_strip(
-        &view_spec,
-        &kernel,
-        &levels,
-        whole,
-        &frame,
-        tiling,
-        true,
-        &mut host,
-        &mut strong,
-    )
-    .unwrap();
+    let job = AdaptiveJob::new(&view_spec, &kernel, &levels, whole, &frame, tiling, true);
+    let stats = extract_with_strip(&job, &mut host, &mut strong).unwrap();
     assert_eq!(stats, core_stats);
     for (a, b) in core.iter().zip(&host) {
         assert_eq!(a.to_bits(), b.to_bits());
@@ -572,30 +553,14 @@ fn the_strip_walk_decides_on_the_cores_statistics() {
             extract_slice_adaptive(&view_spec, &kernel, &levels, &frame, &mut core).unwrap();
         let mut expected = vec![7f32; n * n];
         let mut strong = vec![0f32; n * n];
-        let args = (&view_spec, &kernel, &levels[..], whole, &frame);
-        extract_with_strip(
-            args.0,
-            args.1,
-            args.2,
-            args.3,
-            args.4,
-            tiling,
-            true,
-            &mut expected,
-            &mut strong,
-        )
-        .unwrap();
+        let job = AdaptiveJob::new(&view_spec, &kernel, &levels, whole, &frame, tiling, true);
+        extract_with_strip(&job, &mut expected, &mut strong).unwrap();
         for parallel in [false, true] {
             for accept in [false, true] {
                 let mut seen = None;
                 let mut host = vec![7f32; n * n];
                 let settled = extract_with_strip_if(
-                    args.0,
-                    args.1,
-                    args.2,
-                    args.3,
-                    args.4,
-                    (tiling, parallel),
+                    &AdaptiveJob { parallel, ..job },
                     &mut host,
                     &mut strong,
                     |stats| {
