@@ -368,15 +368,7 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
     /// The walk of the job's levels over its spectrum on its frame, or
     /// `None` where [`extract`] declines.
     fn new(job: &AdaptiveJob<'a, S, T>) -> Option<Self> {
-        let AdaptiveJob {
-            spec,
-            kernel,
-            levels,
-            whole,
-            frame,
-            tiling,
-            ..
-        } = *job;
+        let (spec, kernel, levels, whole) = (job.spec, job.kernel, job.levels, job.whole);
         let n = spec.n();
         // Its walk wraps by masks: power-of-two sides only.
         if !supports(spec)
@@ -397,7 +389,7 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
         Some(Self {
             data: spec.data(),
             n,
-            right: frame.right.map(T::from_f64),
+            right: job.frame.right.map(T::from_f64),
             filters,
             marks,
             whole: whole.filter(|_| !levels.is_empty()),
@@ -405,10 +397,11 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
                 .filter(|_| levels.first().is_some_and(|l| l.gain == T::ZERO))
                 .and_then(|summary| {
                     let rounded = |v: [f64; 3]| v.map(|c| T::from_f64(c).to_f64());
+                    let frame = job.frame;
                     PartialSpans::new(summary, n, rounded(frame.right), rounded(frame.up))
                 }),
             raw_gain: T::exp2i(T::raw_exponent::<S>()),
-            chunk: tiling.chunk.clamp(1, n) as i32,
+            chunk: job.tiling.chunk.clamp(1, n) as i32,
             defer: false,
         })
     }
