@@ -28,7 +28,7 @@ use fvr_engine::plan::filter::KbDesign;
 use fvr_engine::plan::{grid_filter, image_side, ALL_GRIDS, CANDIDATE_FILTERS};
 use fvr_engine::render::turntable::orbit;
 use fvr_engine::render::view::ViewRenderer;
-use fvr_engine::slice::exact::{self, Tiling};
+use fvr_engine::slice::exact::{self, SliceJob, Tiling};
 use fvr_engine::spectrum::OwnedSpectrum;
 use fvr_host::sources::datasets::load_dataset;
 use half::f16;
@@ -115,14 +115,8 @@ fn main() {
             let start = thread_cpu_ms();
             for a in &axes {
                 let (spec, tiling) = (spec.view(), Tiling::default());
-                assert!(exact::extract(
-                    &spec,
-                    &kernel,
-                    black_box(a),
-                    tiling,
-                    false,
-                    &mut slice
-                ));
+                let job = SliceJob::new(&spec, &kernel, black_box(a), tiling, false);
+                assert!(exact::extract(&job, &mut slice));
             }
             let extract_ms = (thread_cpu_ms() - start) / views as f64;
             let w = kind.width() as f64;

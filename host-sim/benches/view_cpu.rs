@@ -34,7 +34,7 @@ use fvr_core::render::Request;
 use fvr_core::volume::GridOversampling;
 use fvr_engine::render::view::ViewRenderer;
 use fvr_engine::render::view::{render_once, Walk};
-use fvr_engine::slice::exact::{extract, extract_bricked, Tiling};
+use fvr_engine::slice::exact::{extract, extract_bricked, SliceJob, Tiling};
 use fvr_engine::slice::{column, strip};
 use fvr_engine::spectrum::bricks::Bricked;
 use fvr_engine::spectrum::exchange::{exchanged, rows_along_y};
@@ -145,6 +145,7 @@ fn slice_walks(spec: &OwnedSpectrum<f16>, view: &View, tiling: Tiling, views: us
     let mut grid = vec![0.0f32; n * n];
     let owned = spec;
     let spec = spec.view();
+    let job = SliceJob::new(&spec, &kernel, &axes, tiling, false);
     let mut time = |walk: &dyn Fn(&mut [f32]) -> bool| {
         if walk(&mut grid) {
             format!("{:6.2}", per_view(views, || assert!(walk(&mut grid))))
@@ -153,27 +154,24 @@ fn slice_walks(spec: &OwnedSpectrum<f16>, view: &View, tiling: Tiling, views: us
         }
     };
     let along = std::cell::RefCell::new(Vec::new());
-    let column = time(&|g| {
-        column::extract(
-            &spec,
-            &kernel,
-            &axes,
-            tiling,
-            false,
-            g,
-            &mut along.borrow_mut(),
-        )
-    });
-    let strip = time(&|g| strip::extract(&spec, &kernel, &axes, tiling, false, g));
+    let column = time(&|g| column::extract(&job, g, &mut along.borrow_mut()));
+    let strip = time(&|g| strip::extract(&job, g));
     // Built before the timing, on all cores, where the memory limit holds it.
     let swapped = owned.exchanged_xy().filter(|_| rows_along_y(&axes));
     let swapped_axes = exchanged(&axes);
     let exchanged = time(&|g| {
-        swapped
-            .as_ref()
-            .is_some_and(|s| strip::extract_exchanged(s, &kernel, &swapped_axes, tiling, false, g))
+        swapped.as_ref().is_some_and(|s| {
+            strip::extract_exchanged(
+                &SliceJob {
+                    spec: s,
+                    axes: &swapped_axes,
+                    ..job
+                },
+                g,
+            )
+        })
     });
-    let exact = time(&|g| extract(&spec, &kernel, &axes, tiling, false, g));
+    let exact = time(&|g| extract(&job, g));
     format!("column {column}  strip {strip}  exchanged {exchanged}  exact {exact}")
 }
 
@@ -247,19 +245,14 @@ fn slices(spec: &OwnedSpectrum<f16>, bricks: &str, tiling: Tiling, views: usize)
         for _ in 0..2 {
             linear.push(per_view(views, || {
                 assert!(extract(
-                    &spec.view(),
-                    &kernel,
-                    &axes,
-                    tiling,
-                    false,
+                    &SliceJob::new(&spec.view(), &kernel, &axes, tiling, false),
                     &mut grid
                 ));
             }));
             for (i, (_, copy)) in copies.iter().enumerate() {
                 bricked[i].push(per_view(views, || {
-                    assert!(extract_bricked(
-                        copy, &kernel, &axes, tiling, false, &mut other
-                    ));
+                    let job = SliceJob::new(copy, &kernel, &axes, tiling, false);
+                    assert!(extract_bricked(&job, &mut other));
                 }));
                 assert!(grid
                     .iter()

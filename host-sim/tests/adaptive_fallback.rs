@@ -11,7 +11,7 @@ use fvr_core::filter::{Filter, FilterKind, KernelTable};
 use fvr_core::geometry::View;
 use fvr_engine::render::adaptive::{AdaptiveRenderer, Walked};
 use fvr_engine::render::view::ViewRenderer;
-use fvr_engine::slice::adaptive::walk::{extract, tally};
+use fvr_engine::slice::adaptive::walk::{extract, tally, AdaptiveJob};
 use fvr_engine::slice::adaptive::{AdaptiveMarks, AdaptiveSettings};
 use fvr_engine::slice::exact::Tiling;
 use fvr_engine::spectrum::{AnySpectrum, OwnedSpectrum};
@@ -146,21 +146,26 @@ fn tally_counts_as_the_walk_does() {
     for dir in DIRECTIONS.into_iter().chain([[0.02, -1.0, 0.01]]) {
         let frame = View::along(dir).frame().unwrap();
         let mut grid = vec![0.0f32; n * n];
-        let walked = extract(
+        let whole = marks.summary();
+        let job = AdaptiveJob::new(
             &view_spec,
             &kernel,
             &levels,
-            marks.summary(),
+            whole,
             &frame,
             Tiling::default(),
             true,
-            &mut grid,
-        )
-        .unwrap();
+        );
+        let walked = extract(&job, &mut grid).unwrap();
         for parallel in [false, true] {
             // With the summary of the first level's marks or without.
             for whole in [marks.summary(), None] {
-                let counted = tally(&view_spec, &kernel, &levels, whole, &frame, parallel).unwrap();
+                let counted = tally(&AdaptiveJob {
+                    whole,
+                    parallel,
+                    ..job
+                })
+                .unwrap();
                 assert_eq!(counted, walked, "{dir:?}, parallel {parallel}");
             }
         }

@@ -16,14 +16,16 @@ use fvr_core::geometry::View;
 use fvr_core::image::{aux_len, finish, placement, Crop};
 use fvr_core::num::{Real, Sample};
 use fvr_core::slice::adaptive::{extract_slice_adaptive, AdaptiveStats};
+use fvr_engine::dht::real::FftReal;
+use fvr_engine::dht::store::StoreFormat;
 use fvr_engine::render::adaptive::AdaptiveRenderer;
 use fvr_engine::render::view::Walk;
 use fvr_engine::slice::adaptive::summary::MarksSummary;
 use fvr_engine::slice::adaptive::walk::{
-    extract, extract_with_strip, extract_with_strip_if, Settled,
+    extract, extract_with_strip, extract_with_strip_if, AdaptiveJob, Settled,
 };
 use fvr_engine::slice::adaptive::{AdaptiveMarks, AdaptiveSettings, Bound, Cheaper};
-use fvr_engine::slice::exact::Tiling;
+use fvr_engine::slice::exact::{SliceJob, Tiling};
 use fvr_engine::slice::strip;
 use fvr_engine::spectrum::OwnedSpectrum;
 use fvr_engine::volume::phantom::{sample, GaussianMixture};
@@ -50,6 +52,22 @@ const TILINGS: [Tiling; 3] = [
 fn smooth(dims: [usize; 3], seed: u64) -> Volume {
     let side = dims.iter().copied().max().unwrap_or(1);
     sample(&GaussianMixture::random(seed, side, 6), dims)
+}
+
+/// The kb6 spectrum (oversampling 1) of `volume`, stored in `S` and
+/// prepared in `T`.
+fn kb6<S: StoreFormat, T: FftReal>(volume: &Volume) -> OwnedSpectrum<S> {
+    let filter = Filter::new(FilterKind::Kb6, 1).unwrap();
+    OwnedSpectrum::<S>::prepare::<T>(volume, filter).unwrap()
+}
+
+/// The marks of `spec` for `db` decibels with the cheaper filters `chain`.
+fn marks_for<S: Sample>(spec: &OwnedSpectrum<S>, db: f64, chain: &[Cheaper]) -> AdaptiveMarks {
+    let settings = AdaptiveSettings {
+        chain: chain.to_vec(),
+        ..AdaptiveSettings::new(db)
+    };
+    AdaptiveMarks::build(spec, &settings).unwrap()
 }
 
 /// The core's slice and statistics, then the host's for every tiling and
@@ -91,10 +109,8 @@ fn check_busy<S: Sample, T: Real>(
         for parallel in [false, true] {
             // Garbage first: every point must be written.
             let mut host = vec![T::from_f64(7.0); n * n];
-            let stats = extract(
-                &view, &kernel, &levels, whole, &frame, tiling, parallel, &mut host,
-            )
-            .unwrap_or_else(|| panic!("{what}: not served"));
+            let job = AdaptiveJob::new(&view, &kernel, &levels, whole, &frame, tiling, parallel);
+            let stats = extract(&job, &mut host).unwrap_or_else(|| panic!("{what}: not served"));
             assert_eq!(stats, core_stats, "{what}, {tiling:?}, parallel {parallel}");
             let differ = core
                 .iter()
@@ -117,9 +133,7 @@ fn assert_mixed(stats: &AdaptiveStats, levels: usize, what: &str) {
 #[test]
 fn kb6_to_nearest_bit_identical_f16() {
     let n = 32;
-    let volume = smooth([n; 3], 1);
-    let filter = Filter::new(FilterKind::Kb6, 1).unwrap();
-    let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+    let spec = kb6::<f16, f32>(&smooth([n; 3], 1));
     let marks = AdaptiveMarks::build(&spec, &AdaptiveSettings::new(40.0)).unwrap();
     for dir in DIRECTIONS {
         let stats = check::<f16, f32>(&spec, &marks, dir, &format!("kb6 → 1³ {dir:?}"));
@@ -133,18 +147,14 @@ fn two_level_chain_f32_and_f64_bit_identical() {
     // nearest,kb3` puts slice samples on all three filters.
     let n = 16;
     let volume = sample(&GaussianMixture::random(1, n, 8), [n; 3]);
-    let filter = Filter::new(FilterKind::Kb6, 1).unwrap();
-    let settings = AdaptiveSettings {
-        chain: vec![
-            Cheaper::Filter(FilterKind::Nearest),
-            Cheaper::Filter(FilterKind::Kb3),
-        ],
-        ..AdaptiveSettings::new(30.0)
-    };
-    let spec32 = OwnedSpectrum::<f32>::prepare::<f32>(&volume, filter).unwrap();
-    let spec64 = OwnedSpectrum::<f64>::prepare::<f64>(&volume, filter).unwrap();
-    let marks32 = AdaptiveMarks::build(&spec32, &settings).unwrap();
-    let marks64 = AdaptiveMarks::build(&spec64, &settings).unwrap();
+    let chain = [
+        Cheaper::Filter(FilterKind::Nearest),
+        Cheaper::Filter(FilterKind::Kb3),
+    ];
+    let spec32 = kb6::<f32, f32>(&volume);
+    let spec64 = kb6::<f64, f64>(&volume);
+    let marks32 = marks_for(&spec32, 30.0, &chain);
+    let marks64 = marks_for(&spec64, 30.0, &chain);
     let mut used = [0u64; 3];
     for dir in DIRECTIONS {
         let s = check::<f32, f32>(&spec32, &marks32, dir, &format!("kb6 f32 {dir:?}"));
@@ -165,13 +175,12 @@ fn zero_level_reads_nothing_and_matches_the_core() {
     // and without taps, the slice and statistics the core's bit for bit.
     let n = 32;
     let volume = sample(&GaussianMixture::random(4, n, 8), [n; 3]);
-    let filter = Filter::new(FilterKind::Kb6, 1).unwrap();
-    let settings = AdaptiveSettings {
-        chain: vec![Cheaper::Zero, Cheaper::Filter(FilterKind::Nearest)],
-        ..AdaptiveSettings::new(40.0)
-    };
-    let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
-    let marks = AdaptiveMarks::build(&spec, &settings).unwrap();
+    let spec = kb6::<f16, f32>(&volume);
+    let marks = marks_for(
+        &spec,
+        40.0,
+        &[Cheaper::Zero, Cheaper::Filter(FilterKind::Nearest)],
+    );
     assert_eq!(marks.levels[0].gain, 0.0);
     // The walks settle some points from the summary of the zero level.
     let summary = marks.summary().unwrap();
@@ -197,9 +206,7 @@ fn zero_level_reads_nothing_and_matches_the_core() {
 /// The f16 kb6 spectrum of a smooth volume at 64, whose strong samples lie
 /// near the origin.
 fn smooth_kb6_64() -> OwnedSpectrum<f16> {
-    let volume = sample(&GaussianMixture::random(4, 64, 8), [64; 3]);
-    let filter = Filter::new(FilterKind::Kb6, 1).unwrap();
-    OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap()
+    kb6::<f16, f32>(&sample(&GaussianMixture::random(4, 64, 8), [64; 3]))
 }
 
 #[test]
@@ -213,11 +220,7 @@ fn points_among_whole_zero_bricks_are_counted_as_the_core_walks_them() {
         vec![Cheaper::Zero, Cheaper::Filter(FilterKind::Nearest)],
     ] {
         let levels = chain.len();
-        let settings = AdaptiveSettings {
-            chain,
-            ..AdaptiveSettings::new(40.0)
-        };
-        let marks = AdaptiveMarks::build(&spec, &settings).unwrap();
+        let marks = marks_for(&spec, 40.0, &chain);
         let partial = marks.summary().unwrap().partial().unwrap().len();
         let m = n / 8;
         // Few enough for the walk to take spans (at most 2m²).
@@ -240,11 +243,7 @@ fn spans_reach_scattered_unmarked_bricks() {
     // but lies outside its row's spans would be counted as zero where the
     // core filters it.
     let (n, spec) = (64, smooth_kb6_64());
-    let settings = AdaptiveSettings {
-        chain: vec![Cheaper::Zero],
-        ..AdaptiveSettings::new(40.0)
-    };
-    let mut marks = AdaptiveMarks::build(&spec, &settings).unwrap();
+    let mut marks = marks_for(&spec, 40.0, &[Cheaper::Zero]);
     let mut state = 0x9e37_79b9_7f4a_7c15u64;
     let m = n / 8;
     let unmarked: Vec<bool> = (0..m * m * m)
@@ -336,9 +335,8 @@ fn assert_renders_the_finish(
 fn renderer_image_equals_core_extraction() {
     let n = 32;
     let (width, height) = (24, 20);
-    let volume = smooth([n, n, 20], 4);
-    let filter = Filter::new(FilterKind::Kb6, 1).unwrap();
-    let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+    let spec = kb6::<f16, f32>(&smooth([n, n, 20], 4));
+    let filter = spec.filter();
     // Always the adaptive walk: this compares it with the core's.
     let settings = AdaptiveSettings {
         plain_below: 0.0,
@@ -380,7 +378,8 @@ fn renderer_image_equals_core_extraction() {
     let mut grid = vec![0f32; n * n];
     let tiling = Tiling::default();
     let whole = marks.summary();
-    assert!(extract(&view_spec, &other, &levels, whole, &frame, tiling, true, &mut grid).is_none());
+    let job = AdaptiveJob::new(&view_spec, &other, &levels, whole, &frame, tiling, true);
+    assert!(extract(&job, &mut grid).is_none());
 }
 
 /// The slice [`extract_with_strip`] should give: the core's adaptive
@@ -436,9 +435,8 @@ fn strip_walk_sums_the_large_filters_points_and_nothing_else() {
                 extract_slice_adaptive(&view_spec, &kernel, &levels, &frame, &mut core).unwrap();
             let mut plain = vec![0f32; n * n];
             let tiling = Tiling::default();
-            assert!(strip::extract(
-                &view_spec, &kernel, &axes, tiling, true, &mut plain
-            ));
+            let job = SliceJob::new(&view_spec, &kernel, &axes, tiling, true);
+            assert!(strip::extract(&job, &mut plain));
             let large = core_stats.per_filter[0] as usize;
             assert!(
                 large > 0 && large < core_stats.samples as usize / 4,
@@ -458,18 +456,10 @@ fn strip_walk_sums_the_large_filters_points_and_nothing_else() {
                     let mut host = vec![7f32; n * n];
                     let mut strong = vec![-3f32; n * n];
                     let whole = marks.summary();
-                    let stats = extract_with_strip(
-                        &view_spec,
-                        &kernel,
-                        &levels,
-                        whole,
-                        &frame,
-                        tiling,
-                        parallel,
-                        &mut host,
-                        &mut strong,
-                    )
-                    .unwrap();
+                    let job = AdaptiveJob::new(
+                        &view_spec, &kernel, &levels, whole, &frame, tiling, parallel,
+                    );
+                    let stats = extract_with_strip(&job, &mut host, &mut strong).unwrap();
                     let at = format!("{what}, {tiling:?}, parallel {parallel}");
                     assert_eq!(stats, core_stats, "{at}");
                     if !expected.is_empty() {
@@ -529,18 +519,8 @@ fn without_a_held_axis_the_strip_extraction_is_the_cores() {
     let mut host = vec![7f32; n * n];
     let mut strong = vec![0f32; n * n];
     let (whole, tiling) = (marks.summary(), Tiling::default());
-    let stats = extract_with_strip(
-        &view_spec,
-        &kernel,
-        &levels,
-        whole,
-        &frame,
-        tiling,
-        true,
-        &mut host,
-        &mut strong,
-    )
-    .unwrap();
+    let job = AdaptiveJob::new(&view_spec, &kernel, &levels, whole, &frame, tiling, true);
+    let stats = extract_with_strip(&job, &mut host, &mut strong).unwrap();
     assert_eq!(stats, core_stats);
     for (a, b) in core.iter().zip(&host) {
         assert_eq!(a.to_bits(), b.to_bits());
@@ -573,30 +553,14 @@ fn the_strip_walk_decides_on_the_cores_statistics() {
             extract_slice_adaptive(&view_spec, &kernel, &levels, &frame, &mut core).unwrap();
         let mut expected = vec![7f32; n * n];
         let mut strong = vec![0f32; n * n];
-        let args = (&view_spec, &kernel, &levels[..], whole, &frame);
-        extract_with_strip(
-            args.0,
-            args.1,
-            args.2,
-            args.3,
-            args.4,
-            tiling,
-            true,
-            &mut expected,
-            &mut strong,
-        )
-        .unwrap();
+        let job = AdaptiveJob::new(&view_spec, &kernel, &levels, whole, &frame, tiling, true);
+        extract_with_strip(&job, &mut expected, &mut strong).unwrap();
         for parallel in [false, true] {
             for accept in [false, true] {
                 let mut seen = None;
                 let mut host = vec![7f32; n * n];
                 let settled = extract_with_strip_if(
-                    args.0,
-                    args.1,
-                    args.2,
-                    args.3,
-                    args.4,
-                    (tiling, parallel),
+                    &AdaptiveJob { parallel, ..job },
                     &mut host,
                     &mut strong,
                     |stats| {

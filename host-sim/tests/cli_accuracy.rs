@@ -3,17 +3,15 @@
 //! and scene settings that win, and the warning for settings predicted low.
 
 mod common;
-use common::{assert_ok, fvr_line, json_line, temp_dir};
+use common::{assert_ok, fvr_line, stats_json, temp_dir};
 
 #[test]
 fn accuracy_chooses_a_configuration_predicted_to_meet_the_target() {
     let dir = temp_dir("accuracy-choose");
-    let out = fvr_line(
+    let (stats, _) = stats_json(
         "render brainsmall --dir 1,0,0 --accuracy 45 --out a.png --stats-json",
         &dir,
     );
-    assert_ok(&out);
-    let stats = json_line(&out.stdout);
     let acc = &stats["accuracy"];
     assert_eq!(acc["target_db"], 45.0, "{stats}");
     assert!(acc["predicted_db"].as_f64().unwrap() >= 45.0, "{stats}");
@@ -26,17 +24,14 @@ fn accuracy_chooses_a_configuration_predicted_to_meet_the_target() {
 #[test]
 fn explicit_flags_win_and_an_unmet_target_warns() {
     let dir = temp_dir("accuracy-given");
-    let out = fvr_line(
+    let (stats, err) = stats_json(
         "turntable brainsmall --frames 2 --accuracy 45 --oversample 1 --out a.apng --stats-json",
         &dir,
     );
-    assert_ok(&out);
-    let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         err.contains("no configuration is predicted to reach 45 dB"),
         "{err}"
     );
-    let stats = json_line(&out.stdout);
     assert_eq!(stats["oversample"], 1, "{stats}");
     assert!(
         stats["accuracy"]["predicted_db"].as_f64().unwrap() < 45.0,
@@ -47,14 +42,11 @@ fn explicit_flags_win_and_an_unmet_target_warns() {
 #[test]
 fn the_default_target_is_50_db_and_a_touching_head_gets_oversampled() {
     let dir = temp_dir("accuracy-default");
-    let out = fvr_line(
+    let (stats, err) = stats_json(
         "render brainsmall --dir 0,1,0 --out a.png --stats-json",
         &dir,
     );
-    assert_ok(&out);
-    let err = String::from_utf8_lossy(&out.stderr);
     assert!(!err.contains("warning"), "{err}");
-    let stats = json_line(&out.stdout);
     let acc = &stats["accuracy"];
     assert_eq!(acc["target_db"], 50.0, "{stats}");
     assert_eq!(acc["target_is_default"], true, "{stats}");
@@ -71,14 +63,11 @@ fn settings_given_without_accuracy_win_and_warn_when_predicted_low() {
     // Only the oversampling given: the planner chooses the rest around it.
     let one = "render brainsmall --dir 0,1,0 --oversample 1 --out b.png --stats-json";
     for line in [all, one] {
-        let out = fvr_line(line, &dir);
-        assert_ok(&out);
-        let err = String::from_utf8_lossy(&out.stderr);
+        let (stats, err) = stats_json(line, &dir);
         assert!(
             err.contains("predicted to reach only") && err.contains("--accuracy"),
             "{line}: {err}"
         );
-        let stats = json_line(&out.stdout);
         assert_eq!(stats["oversample"], 1, "{stats}");
         assert!(
             stats["accuracy"]["predicted_db"].as_f64().unwrap() < 40.0,
@@ -110,28 +99,20 @@ fn a_scene_file_states_the_accuracy_and_its_settings_win() {
         "[volume]\nbuiltin = \"brainsmall\"\n[spectrum]\naccuracy = -3\n",
     )
     .unwrap();
-    let run = |scene: &str, extra: &str| {
-        let line = format!("render --scene {scene} --dir 0,1,0 --out s.png --stats-json {extra}");
-        fvr_line(&line, &dir)
+    let line = |scene: &str, extra: &str| {
+        format!("render --scene {scene} --dir 0,1,0 --out s.png --stats-json {extra}")
     };
-    let out = run("target.toml", "");
-    assert_ok(&out);
-    let stats = json_line(&out.stdout);
+    let (stats, _) = stats_json(&line("target.toml", ""), &dir);
     assert_eq!(stats["accuracy"]["target_db"], 45.0, "{stats}");
     assert_eq!(stats["accuracy"]["target_is_default"], false, "{stats}");
     // The command line wins over the scene.
-    let out = run("target.toml", "--accuracy 60");
-    assert_ok(&out);
-    let stats = json_line(&out.stdout);
+    let (stats, _) = stats_json(&line("target.toml", "--accuracy 60"), &dir);
     assert_eq!(stats["accuracy"]["target_db"], 60.0, "{stats}");
     // A setting in the scene is the user's choice: kept, and warned about.
-    let out = run("fixed.toml", "");
-    assert_ok(&out);
-    let stats = json_line(&out.stdout);
+    let (stats, err) = stats_json(&line("fixed.toml", ""), &dir);
     assert_eq!(stats["oversample"], 1, "{stats}");
-    let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("predicted to reach only"), "{err}");
-    let out = run("bad.toml", "");
+    let out = fvr_line(&line("bad.toml", ""), &dir);
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(

@@ -19,7 +19,7 @@ use fvr_core::slice::extract_slice_rows;
 use fvr_core::volume::GridOversampling;
 use fvr_engine::render::view::ViewRenderer;
 use fvr_engine::render::view::{render_once, Walk};
-use fvr_engine::slice::exact::{extract, extract_bricked, supports, Tiling};
+use fvr_engine::slice::exact::{extract, extract_bricked, supports, SliceJob, Tiling};
 use fvr_engine::spectrum::bricks::Bricked;
 use fvr_engine::spectrum::OwnedSpectrum;
 use fvr_engine::volume::Volume;
@@ -84,13 +84,13 @@ fn check<S: Sample, T: Real + Send + Sync>(
         for parallel in [false, true] {
             // Garbage first: every point must be written.
             let mut host = vec![T::from_f64(7.0); n * n];
-            assert!(extract(&view, &kernel, axes, tiling, parallel, &mut host));
+            let job = SliceJob::new(&view, &kernel, axes, tiling, parallel);
+            assert!(extract(&job, &mut host));
             assert_eq!(differ(&host), 0, "{what}, {tiling:?}, parallel {parallel}");
             for copy in &bricked {
                 let mut host = vec![T::from_f64(7.0); n * n];
-                assert!(extract_bricked(
-                    copy, &kernel, axes, tiling, parallel, &mut host
-                ));
+                let job = SliceJob::new(copy, &kernel, axes, tiling, parallel);
+                assert!(extract_bricked(&job, &mut host));
                 let brick = copy.brick();
                 let d = differ(&host);
                 assert_eq!(d, 0, "{what}, {brick:?}, {tiling:?}, parallel {parallel}");

@@ -26,7 +26,7 @@ use fvr_engine::render::turntable::orbit;
 use fvr_engine::render::view::ViewRenderer;
 use fvr_engine::render::view::{render_once, Walk};
 use fvr_engine::slice::column::{self, column_axis};
-use fvr_engine::slice::exact::Tiling;
+use fvr_engine::slice::exact::{SliceJob, Tiling};
 use fvr_engine::slice::strip::{self, held_axis};
 use fvr_engine::spectrum::exchange::{exchange_xy, exchanged, rows_along_y};
 use fvr_engine::spectrum::OwnedSpectrum;
@@ -133,11 +133,10 @@ impl Fast {
         grid: &mut [T],
     ) -> bool {
         let tiling = Tiling::default();
+        let job = SliceJob::new(spec, kernel, axes, tiling, parallel);
         match self {
-            Self::Strip => strip::extract(spec, kernel, axes, tiling, parallel, grid),
-            Self::Column => {
-                column::extract(spec, kernel, axes, tiling, parallel, grid, &mut Vec::new())
-            }
+            Self::Strip => strip::extract(&job, grid),
+            Self::Column => column::extract(&job, grid, &mut Vec::new()),
             Self::Exchanged => {
                 let n = spec.n();
                 let data = exchange_xy(spec.data(), n).unwrap();
@@ -146,16 +145,22 @@ impl Fast {
                     Spectrum::from_parts(&data, n, spec.scale(), *spec.filter(), [b, a, c])
                         .unwrap();
                 let axes = exchanged(axes);
-                let done =
-                    strip::extract_exchanged(&swapped, kernel, &axes, tiling, parallel, grid);
+                let done = strip::extract_exchanged(
+                    &SliceJob {
+                        spec: &swapped,
+                        axes: &axes,
+                        ..job
+                    },
+                    grid,
+                );
                 // Summed as the strip walk sums on the spectrum itself.
                 let mut linear = vec![T::from_f64(3.0); grid.len()];
+                let unswapped = exchanged(&axes);
                 assert!(strip::extract(
-                    spec,
-                    kernel,
-                    &exchanged(&axes),
-                    tiling,
-                    parallel,
+                    &SliceJob {
+                        axes: &unswapped,
+                        ..job
+                    },
                     &mut linear
                 ));
                 assert!(grid
@@ -489,13 +494,18 @@ fn prefetching_leaves_every_value_unchanged() {
         let column = Sampling::UNIT.slice_axes(&View::along([1.0, -0.3, 0.0]).frame().unwrap());
         let walks: [(&str, &Walker); 3] = [
             ("strip", &|t, p, g| {
-                strip::extract(&view, &kernel, &strip, t, p, g)
+                strip::extract(&SliceJob::new(&view, &kernel, &strip, t, p), g)
             }),
             ("exchanged", &|t, p, g| {
-                strip::extract_exchanged(&swapped, &kernel, &exchanged(&strip), t, p, g)
+                let axes = exchanged(&strip);
+                strip::extract_exchanged(&SliceJob::new(&swapped, &kernel, &axes, t, p), g)
             }),
             ("column", &|t, p, g| {
-                column::extract(&view, &kernel, &column, t, p, g, &mut Vec::new())
+                column::extract(
+                    &SliceJob::new(&view, &kernel, &column, t, p),
+                    g,
+                    &mut Vec::new(),
+                )
             }),
         ];
         for (what, walk) in walks {

@@ -23,10 +23,10 @@ use fvr_core::num::{Real, Sample};
 use fvr_core::slice::adaptive::{extract_slice_adaptive, AdaptiveStats};
 
 use crate::render::view::Walk;
-use crate::slice::adaptive::walk::{self, Settled};
+use crate::slice::adaptive::walk::{self, AdaptiveJob, Settled};
 use crate::slice::adaptive::AdaptiveMarks;
 use crate::slice::column;
-use crate::slice::exact::{self, Tiling};
+use crate::slice::exact::{self, SliceJob, Tiling};
 use crate::slice::strip;
 use crate::spectrum::OwnedSpectrum;
 
@@ -166,41 +166,22 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
         };
         let whole = self.marks.summary();
         let (kernel, tiling, parallel) = (&self.kernel, self.tiling, self.parallel);
+        let job = AdaptiveJob::new(&core_spec, kernel, &levels, whole, &frame, tiling, parallel);
         let host = match (self.core, self.walk) {
             (true, _) => None,
             (false, Walk::Exact) => {
                 let counted = match decide {
-                    true => walk::tally(&core_spec, kernel, &levels, whole, &frame, parallel),
+                    true => walk::tally(&job),
                     false => None,
                 };
                 match counted.filter(|stats| !adaptive(stats)) {
                     Some(stats) => Some(Settled::Declined(stats)),
-                    None => walk::extract(
-                        &core_spec,
-                        kernel,
-                        &levels,
-                        whole,
-                        &frame,
-                        tiling,
-                        parallel,
-                        &mut self.grid,
-                    )
-                    .map(Settled::Extracted),
+                    None => walk::extract(&job, &mut self.grid).map(Settled::Extracted),
                 }
             }
             (false, Walk::Strip) => {
                 self.strong.resize(n * n, T::ZERO);
-                walk::extract_with_strip_if(
-                    &core_spec,
-                    kernel,
-                    &levels,
-                    whole,
-                    &frame,
-                    (tiling, parallel),
-                    &mut self.grid,
-                    &mut self.strong,
-                    adaptive,
-                )
+                walk::extract_with_strip_if(&job, &mut self.grid, &mut self.strong, adaptive)
             }
         };
         let stats = match host {
@@ -227,9 +208,7 @@ impl<'m, T: Real> AdaptiveRenderer<'m, T> {
                 }
                 // No plain walk serves the spectrum: the adaptive one does.
                 let grid = &mut self.grid;
-                match walk::extract(
-                    &core_spec, kernel, &levels, whole, &frame, tiling, parallel, grid,
-                ) {
+                match walk::extract(&job, grid) {
                     Some(stats) => stats,
                     None => extract_slice_adaptive(&core_spec, kernel, &levels, &frame, grid)?,
                 }
@@ -266,9 +245,10 @@ fn plain<S: Sample, T: Real>(
     along: &mut Vec<T>,
 ) -> Option<fvr_core::geometry::SliceAxes> {
     let axes = Sampling::UNIT.slice_axes(frame);
-    let walked = column::extract(spec, kernel, &axes, tiling, parallel, grid, along)
-        || strip::extract(spec, kernel, &axes, tiling, parallel, grid)
-        || exact::extract(spec, kernel, &axes, tiling, parallel, grid);
+    let job = SliceJob::new(spec, kernel, &axes, tiling, parallel);
+    let walked = column::extract(&job, grid, along)
+        || strip::extract(&job, grid)
+        || exact::extract(&job, grid);
     walked.then_some(axes)
 }
 

@@ -14,7 +14,7 @@ use fvr_core::spectrum::Spectrum;
 use crate::image::inverse::MixedFinish;
 use crate::image::zoom::ZoomFinish;
 use crate::slice::column;
-use crate::slice::exact::{self, Tiling};
+use crate::slice::exact::{self, SliceJob, Tiling};
 use crate::slice::strip;
 use crate::spectrum::exchange;
 use crate::spectrum::{with_arithmetic, AnySpectrum, OwnedSpectrum};
@@ -245,13 +245,14 @@ impl<T: Real> ViewRenderer<T> {
             let (kernel, tiling, grid) = (&self.kernel, self.tiling, &mut self.grid);
             let (walk, along) = (self.walk, &mut self.along);
             let mut extract = |parallel: bool, grid: &mut [T]| {
+                let job = SliceJob::new(&spec, kernel, &axes, tiling, parallel);
                 (walk == Walk::Strip
-                    && (column::extract(&spec, kernel, &axes, tiling, parallel, grid, along)
+                    && (column::extract(&job, grid, along)
                         || exchanged.as_ref().is_some_and(|(spec, axes)| {
-                            strip::extract_exchanged(spec, kernel, axes, tiling, parallel, grid)
+                            strip::extract_exchanged(&SliceJob { spec, axes, ..job }, grid)
                         })
-                        || strip::extract(&spec, kernel, &axes, tiling, parallel, grid)))
-                    || exact::extract(&spec, kernel, &axes, tiling, parallel, grid)
+                        || strip::extract(&job, grid)))
+                    || exact::extract(&job, grid)
             };
             let filled = match (&self.pool, self.threads) {
                 (_, 1) => extract(false, grid),

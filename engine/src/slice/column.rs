@@ -33,13 +33,13 @@
 //! differs from the core's by at most `γ·Σ|wu·ww·wz·c|`, `γ = (3W + 8)·ε`
 //! of `T` (tested in `tests/fast_strip.rs`).
 
-use fvr_core::filter::{KernelTable, PhaseTable, MAX_WIDTH};
+use fvr_core::filter::{KernelTable, PhaseTable};
 use fvr_core::geometry::SliceAxes;
 use fvr_core::num::{Real, Sample};
 use fvr_core::spectrum::Spectrum;
 use rayon::prelude::*;
 
-use crate::slice::exact::{row_setup, supports, Geometry, Tiling};
+use crate::slice::exact::{phase_table, row_setup, Geometry, SliceJob};
 use crate::slice::prefetch::prefetch;
 use crate::slice::runs::{axes_and_strides, wrap, Runs};
 
@@ -58,41 +58,23 @@ pub const fn along_len(n: usize) -> usize {
     2 * n * n
 }
 
-/// Fill the `n × n` slice `grid` (`kx` fastest, natural DHT order) on
-/// `axes` as [`crate::slice::exact::extract`] does, to within rounding (see
-/// the module's bound), `tiling.chunk` columns per unit of work: on the
-/// current rayon pool's threads when `parallel`, else on this thread.
+/// Fill the `n × n` slice `grid` (`kx` fastest, natural DHT order) of
+/// `job` as [`crate::slice::exact::extract`] does, to within rounding (see
+/// the module's bound), `job.tiling.chunk` columns per unit of work.
 /// `along` holds the planes' sums between the passes (`2n²` values; kept
 /// by the caller, so that views after the first allocate nothing).
 /// `false` (grid untouched) when the slice contains no axis
-/// ([`column_axis`]), [`supports`] does not hold, the grid is not `n²` or
-/// `kernel` is not the spectrum's filter.
+/// ([`column_axis`]) or [`SliceJob::geometry`] declines.
 pub fn extract<S: Sample, T: Real + Send + Sync>(
-    spec: &Spectrum<'_, S>,
-    kernel: &KernelTable<T>,
-    axes: &SliceAxes,
-    tiling: Tiling,
-    parallel: bool,
+    job: &SliceJob<'_, Spectrum<'_, S>, T>,
     grid: &mut [T],
     along: &mut Vec<T>,
 ) -> bool {
-    let n = spec.n();
-    if !supports(spec) || grid.len() != n * n || kernel.filter() != spec.filter() {
-        return false;
-    }
-    let Some(axis) = column_axis(axes) else {
+    let (Some(g), Some(axis)) = (job.geometry(grid), column_axis(job.axes)) else {
         return false;
     };
-    let g = Geometry::new(axes, n, tiling, parallel);
-    let data = spec.data();
-    match kernel.filter().width() {
-        1 => walk::<1, S, T>(data, kernel, &g, axis, grid, along),
-        2 => walk::<2, S, T>(data, kernel, &g, axis, grid, along),
-        3 => walk::<3, S, T>(data, kernel, &g, axis, grid, along),
-        4 => walk::<4, S, T>(data, kernel, &g, axis, grid, along),
-        5 => walk::<5, S, T>(data, kernel, &g, axis, grid, along),
-        _ => walk::<MAX_WIDTH, S, T>(data, kernel, &g, axis, grid, along),
-    }
+    let (data, kernel) = (job.spec.data(), job.kernel);
+    for_width!(kernel.filter().width(), W => walk::<W, S, T>(data, kernel, &g, axis, grid, along))
 }
 
 /// One stretch of a grid row: its signed columns `lo ..= hi` and its taps
@@ -216,10 +198,9 @@ fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
     grid: &mut [T],
     along: &mut Vec<T>,
 ) -> bool {
-    let mut phases = Box::new(PhaseTable::<T, W>::zeroed());
-    if phases.fill(kernel).is_err() {
+    let Some(phases) = phase_table::<W, T>(kernel) else {
         return false;
-    }
+    };
     let n = g.n;
     let (axes @ [_, u, w], strides) = axes_and_strides(axis, n);
     let gain = T::exp2i(T::raw_exponent::<S>());

@@ -33,7 +33,7 @@
 //! power-of-two side, else by one remainder per axis and a conditional
 //! subtraction per tap ([`Side`]); the sums are the same either way.
 
-use fvr_core::filter::{KernelTable, PhaseTable, MAX_WIDTH};
+use fvr_core::filter::{KernelTable, PhaseTable};
 use fvr_core::geometry::SliceAxes;
 use fvr_core::num::{Real, Sample};
 use fvr_core::spectrum::Spectrum;
@@ -110,26 +110,70 @@ pub fn supports<S: Sample>(spec: &Spectrum<'_, S>) -> bool {
     (n.is_power_of_two() || n % 2 == 0) && spec.blocks().is_none() && spec.data().len() == n * n * n
 }
 
-/// Fill the `n × n` slice `grid` (`kx` fastest, natural DHT order) on
-/// `axes`, as `fvr_core::slice::extract_slice_rows` over all rows would,
-/// bit for bit: on the current rayon pool's threads when `parallel`, else
-/// on this thread. `false` (grid untouched)
-/// when [`supports`] does not hold, the grid is not `n²` or `kernel`
-/// is not the spectrum's filter.
+/// One slice for a walk to fill: the spectrum `spec` (a [`Spectrum`], or
+/// a [`Bricked`] copy for [`extract_bricked`]), the table of its filter,
+/// the plane spanned by `axes.right` and `axes.up`, the tiling, and
+/// whether to run on the current rayon pool's threads (`parallel`) or on
+/// this thread. Every walk of this module, [`crate::slice::strip`] and
+/// [`crate::slice::column`] takes one and checks it the same way
+/// ([`SliceJob::geometry`]).
+#[derive(Clone, Copy)]
+pub struct SliceJob<'a, Spec, T> {
+    /// The stored spectrum.
+    pub spec: &'a Spec,
+    /// The table of the spectrum's filter.
+    pub kernel: &'a KernelTable<T>,
+    /// The slice's plane.
+    pub axes: &'a SliceAxes,
+    /// How the walk splits and tiles the slice.
+    pub tiling: Tiling,
+    /// On the current rayon pool's threads, else on this thread.
+    pub parallel: bool,
+}
+
+impl<'a, Spec, T> SliceJob<'a, Spec, T> {
+    /// The job of filling the slice of `spec` on `axes` with `kernel`.
+    pub const fn new(
+        spec: &'a Spec,
+        kernel: &'a KernelTable<T>,
+        axes: &'a SliceAxes,
+        tiling: Tiling,
+        parallel: bool,
+    ) -> Self {
+        Self {
+            spec,
+            kernel,
+            axes,
+            tiling,
+            parallel,
+        }
+    }
+}
+
+impl<S: Sample, T: Real> SliceJob<'_, Spectrum<'_, S>, T> {
+    /// The walk's geometry: `None` (the walk declines, grid untouched)
+    /// when [`supports`] does not hold, `grid` is not `n²` or the kernel
+    /// is not the spectrum's filter.
+    #[inline]
+    pub(crate) fn geometry(&self, grid: &[T]) -> Option<Geometry<T>> {
+        let n = self.spec.n();
+        (supports(self.spec) && grid.len() == n * n && self.kernel.filter() == self.spec.filter())
+            .then(|| Geometry::new(self.axes, n, self.tiling, self.parallel))
+    }
+}
+
+/// Fill the `n × n` slice `grid` (`kx` fastest, natural DHT order) of
+/// `job`, as `fvr_core::slice::extract_slice_rows` over all rows would,
+/// bit for bit. `false` (grid untouched) when [`SliceJob::geometry`]
+/// declines.
 pub fn extract<S: Sample, T: Real + Send + Sync>(
-    spec: &Spectrum<'_, S>,
-    kernel: &KernelTable<T>,
-    axes: &SliceAxes,
-    tiling: Tiling,
-    parallel: bool,
+    job: &SliceJob<'_, Spectrum<'_, S>, T>,
     grid: &mut [T],
 ) -> bool {
-    let n = spec.n();
-    if !supports(spec) || grid.len() != n * n || kernel.filter() != spec.filter() {
+    let Some(geometry) = job.geometry(grid) else {
         return false;
-    }
-    let geometry = Geometry::new(axes, n, tiling, parallel);
-    let data = spec.data();
+    };
+    let (data, n, kernel) = (job.spec.data(), job.spec.n(), job.kernel);
     if n.is_power_of_two() {
         let source = Linear::<S, true>::new::<T>(data, n);
         by_width::<true, S, T, _>(&source, kernel, &geometry, grid)
@@ -140,21 +184,18 @@ pub fn extract<S: Sample, T: Real + Send + Sync>(
 }
 
 /// [`extract`] from a bricked copy of the spectrum: the same slice, bit
-/// for bit. `false` (grid untouched) when the grid is not `n²` or `kernel`
-/// is not the spectrum's filter.
+/// for bit. `false` (grid untouched) when the grid is not `n²` or the
+/// kernel is not the spectrum's filter.
 pub fn extract_bricked<S: Sample + Sync, T: Real + Send + Sync>(
-    spec: &Bricked<S>,
-    kernel: &KernelTable<T>,
-    axes: &SliceAxes,
-    tiling: Tiling,
-    parallel: bool,
+    job: &SliceJob<'_, Bricked<S>, T>,
     grid: &mut [T],
 ) -> bool {
+    let SliceJob { spec, kernel, .. } = *job;
     let n = spec.n();
     if grid.len() != n * n || *kernel.filter() != spec.filter() {
         return false;
     }
-    let geometry = Geometry::new(axes, n, tiling, parallel);
+    let geometry = Geometry::new(job.axes, n, job.tiling, job.parallel);
     // The bricked sums need no wrapping; `POW2` only picks how grid rows
     // are indexed.
     if n.is_power_of_two() {
@@ -233,14 +274,9 @@ fn by_width<const POW2: bool, S: Sample, T: Real + Send + Sync, Src: TapSource<S
     geometry: &Geometry<T>,
     grid: &mut [T],
 ) -> bool {
-    match kernel.filter().width() {
-        1 => walk::<1, POW2, S, T, Src>(source, kernel, geometry, grid),
-        2 => walk::<2, POW2, S, T, Src>(source, kernel, geometry, grid),
-        3 => walk::<3, POW2, S, T, Src>(source, kernel, geometry, grid),
-        4 => walk::<4, POW2, S, T, Src>(source, kernel, geometry, grid),
-        5 => walk::<5, POW2, S, T, Src>(source, kernel, geometry, grid),
-        _ => walk::<MAX_WIDTH, POW2, S, T, Src>(source, kernel, geometry, grid),
-    }
+    for_width!(kernel.filter().width(), W => {
+        walk::<W, POW2, S, T, Src>(source, kernel, geometry, grid)
+    })
 }
 
 /// The slice's axes in `T`, the cube side and the walk.
@@ -291,10 +327,9 @@ fn walk<const W: usize, const POW2: bool, S: Sample, T: Real + Send + Sync, Src:
     g: &Geometry<T>,
     grid: &mut [T],
 ) -> bool {
-    let mut phases = Box::new(PhaseTable::<T, W>::zeroed());
-    if phases.fill(kernel).is_err() {
+    let Some(phases) = phase_table::<W, T>(kernel) else {
         return false;
-    }
+    };
     let n = g.n;
     let side = Side::<POW2> { n };
     let mut bands = bands_of_pairs(grid, n, g.tiling.band);
@@ -314,6 +349,17 @@ fn walk<const W: usize, const POW2: bool, S: Sample, T: Real + Send + Sync, Src:
         bands.iter_mut().for_each(fill);
     }
     true
+}
+
+/// The phase table of `kernel` for width `W`, on the heap (it is large);
+/// `None` where it cannot be filled (a kernel wider than `W`), and the
+/// walk declines.
+pub(crate) fn phase_table<const W: usize, T: Real>(
+    kernel: &KernelTable<T>,
+) -> Option<Box<PhaseTable<T, W>>> {
+    let mut phases = Box::new(PhaseTable::<T, W>::zeroed());
+    phases.fill(kernel).ok()?;
+    Some(phases)
 }
 
 /// The grid's rows as mirror pairs (`p`, `−p`) for `p = 0 … n/2`, in

@@ -30,13 +30,13 @@
 //! `W` terms and the interpolation `W²` in two levels; tested in
 //! `tests/fast_strip.rs`).
 
-use fvr_core::filter::{KernelTable, PhaseTable, MAX_WIDTH};
+use fvr_core::filter::{KernelTable, PhaseTable};
 use fvr_core::geometry::SliceAxes;
 use fvr_core::num::{Real, Sample};
 use fvr_core::spectrum::Spectrum;
 use rayon::prelude::*;
 
-use crate::slice::exact::{bands_of_pairs, set_up_pair, supports, Geometry, Pair, Tiling};
+use crate::slice::exact::{bands_of_pairs, phase_table, set_up_pair, Geometry, Pair, SliceJob};
 use crate::slice::prefetch::prefetch;
 use crate::slice::runs::{axes_and_strides, wrap, Runs};
 
@@ -46,21 +46,12 @@ pub fn held_axis(axes: &SliceAxes) -> Option<usize> {
     [2, 1, 0].into_iter().find(|&a| axes.right[a] == 0.0)
 }
 
-/// Fill the `n × n` slice `grid` (`kx` fastest, natural DHT order) on
-/// `axes` as [`crate::slice::exact::extract`] does, to within rounding (see
-/// the module's bound): on the current rayon pool's threads when
-/// `parallel`, else on this thread. `false` (grid untouched) when the rows
-/// hold no coordinate ([`held_axis`]), [`supports`] does not hold, the
-/// grid is not `n²` or `kernel` is not the spectrum's filter.
-pub fn extract<S: Sample, T: Real + Send + Sync>(
-    spec: &Spectrum<'_, S>,
-    kernel: &KernelTable<T>,
-    axes: &SliceAxes,
-    tiling: Tiling,
-    parallel: bool,
-    grid: &mut [T],
-) -> bool {
-    extract_nested(spec, kernel, axes, tiling, parallel, grid, false, None)
+/// Fill the `n × n` slice `grid` (`kx` fastest, natural DHT order) of
+/// `job` as [`crate::slice::exact::extract`] does, to within rounding (see
+/// the module's bound). `false` (grid untouched) when the rows hold no
+/// coordinate ([`held_axis`]) or [`SliceJob::geometry`] declines.
+pub fn extract<S: Sample, T: Real + Send + Sync>(job: &Job<'_, '_, S, T>, grid: &mut [T]) -> bool {
+    extract_nested(job, grid, false, None)
 }
 
 /// [`extract`] on the points `k = within[p].0 ..= within[p].1` of each
@@ -69,75 +60,44 @@ pub fn extract<S: Sample, T: Real + Send + Sync>(
 /// point's value the same bit for bit as [`extract`]'s: a strip's cells do
 /// not depend on which of the row's points are summed from them. The rows
 /// of the pairs walked are zeroed first; the others are left as they are.
-#[allow(clippy::too_many_arguments)]
 pub fn extract_within<S: Sample, T: Real + Send + Sync>(
-    spec: &Spectrum<'_, S>,
-    kernel: &KernelTable<T>,
-    axes: &SliceAxes,
-    tiling: Tiling,
-    parallel: bool,
+    job: &Job<'_, '_, S, T>,
     grid: &mut [T],
     within: &[(i32, i32)],
 ) -> bool {
-    extract_nested(
-        spec,
-        kernel,
-        axes,
-        tiling,
-        parallel,
-        grid,
-        false,
-        Some(within),
-    )
+    extract_nested(job, grid, false, Some(within))
 }
 
 /// [`extract`] on the spectrum with x and y exchanged
-/// ([`crate::spectrum::exchange`]) and `axes` exchanged to match, for rows
-/// that hold z: the interpolation's inner sum runs over the exchanged
+/// ([`crate::spectrum::exchange`]) and `job.axes` exchanged to match, for
+/// rows that hold z: the interpolation's inner sum runs over the exchanged
 /// spectrum's y (the original x), so that every value is summed as
 /// [`extract`] sums it on the original spectrum, bit for bit.
 pub fn extract_exchanged<S: Sample, T: Real + Send + Sync>(
-    spec: &Spectrum<'_, S>,
-    kernel: &KernelTable<T>,
-    axes: &SliceAxes,
-    tiling: Tiling,
-    parallel: bool,
+    job: &Job<'_, '_, S, T>,
     grid: &mut [T],
 ) -> bool {
-    held_axis(axes) == Some(2)
-        && extract_nested(spec, kernel, axes, tiling, parallel, grid, true, None)
+    held_axis(job.axes) == Some(2) && extract_nested(job, grid, true, None)
 }
+
+/// A walk of a plain spectrum.
+type Job<'a, 's, S, T> = SliceJob<'a, Spectrum<'s, S>, T>;
 
 /// [`extract`], the interpolation's inner sum over the strip's `w` axis
 /// when `inner_w`, else over its `u` axis.
-#[allow(clippy::too_many_arguments)]
 fn extract_nested<S: Sample, T: Real + Send + Sync>(
-    spec: &Spectrum<'_, S>,
-    kernel: &KernelTable<T>,
-    axes: &SliceAxes,
-    tiling: Tiling,
-    parallel: bool,
+    job: &Job<'_, '_, S, T>,
     grid: &mut [T],
     inner_w: bool,
     within: Option<&[(i32, i32)]>,
 ) -> bool {
-    let n = spec.n();
-    if !supports(spec) || grid.len() != n * n || kernel.filter() != spec.filter() {
-        return false;
-    }
-    let Some(held) = held_axis(axes) else {
+    let (Some(g), Some(held)) = (job.geometry(grid), held_axis(job.axes)) else {
         return false;
     };
-    let g = Geometry::new(axes, n, tiling, parallel);
-    let data = spec.data();
-    match kernel.filter().width() {
-        1 => walk::<1, S, T>(data, kernel, &g, held, inner_w, within, grid),
-        2 => walk::<2, S, T>(data, kernel, &g, held, inner_w, within, grid),
-        3 => walk::<3, S, T>(data, kernel, &g, held, inner_w, within, grid),
-        4 => walk::<4, S, T>(data, kernel, &g, held, inner_w, within, grid),
-        5 => walk::<5, S, T>(data, kernel, &g, held, inner_w, within, grid),
-        _ => walk::<MAX_WIDTH, S, T>(data, kernel, &g, held, inner_w, within, grid),
-    }
+    let (data, kernel) = (job.spec.data(), job.kernel);
+    for_width!(kernel.filter().width(), W => {
+        walk::<W, S, T>(data, kernel, &g, held, inner_w, within, grid)
+    })
 }
 
 /// One point of a row: its column in the grid row, its first taps and
@@ -203,10 +163,9 @@ fn walk<const W: usize, S: Sample, T: Real + Send + Sync>(
     within: Option<&[(i32, i32)]>,
     grid: &mut [T],
 ) -> bool {
-    let mut phases = Box::new(PhaseTable::<T, W>::zeroed());
-    if phases.fill(kernel).is_err() {
+    let Some(phases) = phase_table::<W, T>(kernel) else {
         return false;
-    }
+    };
     let n = g.n;
     let (axes, strides) = axes_and_strides(held, n);
     let strip = Strip::<W, S, T> {

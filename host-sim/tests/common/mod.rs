@@ -122,6 +122,16 @@ pub fn json_line(stdout: &[u8]) -> serde_json::Value {
     serde_json::from_str(line).unwrap()
 }
 
+/// Run `command` (as [`fvr_line`]) in `dir`, which must succeed
+/// ([`assert_ok`]): its `--stats-json` object ([`json_line`]) and its
+/// stderr.
+pub fn stats_json(command: &str, dir: &Path) -> (serde_json::Value, String) {
+    let out = fvr_line(command, dir);
+    assert_ok(&out);
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    (json_line(&out.stdout), err)
+}
+
 /// A volume of `dims` filled with uniform values in `[0, 1)` from a
 /// xorshift stream seeded with `seed`: white noise, every frequency
 /// present, content at every face.

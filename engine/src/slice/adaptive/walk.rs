@@ -36,7 +36,7 @@ use rayon::prelude::*;
 
 use crate::slice::adaptive::spans::PartialSpans;
 use crate::slice::adaptive::summary::MarksSummary;
-use crate::slice::exact::{row_interval, supports, tap_sum, Tiling};
+use crate::slice::exact::{row_interval, supports, tap_sum, SliceJob, Tiling};
 use crate::slice::strip;
 
 /// One filter of the chain as the walk applies it.
@@ -101,36 +101,73 @@ struct Row<'g, T> {
     strong: (i32, i32),
 }
 
+/// One slice for the adaptive walk to fill: the spectrum, the table of
+/// its filter (the large one), the cheaper filters' levels, the summary of
+/// the first level's marks (`whole`: it settles the points in its whole
+/// bricks without reading the marks), the view's frame, the tiling, and
+/// whether to run on the current rayon pool's threads (`parallel`) or on
+/// this thread.
+#[derive(Clone, Copy)]
+pub struct AdaptiveJob<'a, S, T> {
+    /// The stored spectrum.
+    pub spec: &'a Spectrum<'a, S>,
+    /// The table of the spectrum's filter.
+    pub kernel: &'a KernelTable<T>,
+    /// The cheaper filters and their marks.
+    pub levels: &'a [AdaptiveLevel<'a, 'a, T>],
+    /// The summary of the first level's marks, if any.
+    pub whole: Option<&'a MarksSummary>,
+    /// The view's frame.
+    pub frame: &'a Frame,
+    /// How the walk splits and tiles the slice.
+    pub tiling: Tiling,
+    /// On the current rayon pool's threads, else on this thread.
+    pub parallel: bool,
+}
+
+impl<'a, S, T> AdaptiveJob<'a, S, T> {
+    /// The job of filling the slice of `spec` on `frame` with `kernel` and
+    /// `levels`.
+    pub const fn new(
+        spec: &'a Spectrum<'a, S>,
+        kernel: &'a KernelTable<T>,
+        levels: &'a [AdaptiveLevel<'a, 'a, T>],
+        whole: Option<&'a MarksSummary>,
+        frame: &'a Frame,
+        tiling: Tiling,
+        parallel: bool,
+    ) -> Self {
+        Self {
+            spec,
+            kernel,
+            levels,
+            whole,
+            frame,
+            tiling,
+            parallel,
+        }
+    }
+}
+
 /// Fill the `n × n` slice `grid` (`kx` fastest, natural DHT order) as
 /// `extract_slice_adaptive(spec, kernel, levels, frame, grid)` would, bit
-/// for bit, with the same statistics: on the current rayon pool's threads
-/// when `parallel`, else on this thread. `whole`, the summary of the first
-/// level's marks, settles the points in its whole bricks without reading
-/// the marks. `None` (grid untouched) when
-/// [`supports`] does not hold for `spec` or its side is not a power of
-/// two, the grid is not `n²`, `kernel`
-/// is not the spectrum's filter, or the levels are more than
-/// [`MAX_LEVELS`] or have marks of another side: the core's function
-/// reports those.
-#[allow(clippy::too_many_arguments)]
+/// for bit, with the same statistics. `None` (grid untouched) when
+/// [`supports`] does not hold for the spectrum or its side is not a power
+/// of two, the grid is not `n²`, the kernel is not the spectrum's filter,
+/// or the levels are more than [`MAX_LEVELS`] or have marks of another
+/// side: the core's function reports those.
 pub fn extract<S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
-    kernel: &KernelTable<T>,
-    levels: &[AdaptiveLevel<'_, '_, T>],
-    whole: Option<&MarksSummary>,
-    frame: &Frame,
-    tiling: Tiling,
-    parallel: bool,
+    job: &AdaptiveJob<'_, S, T>,
     grid: &mut [T],
 ) -> Option<AdaptiveStats> {
-    let n = spec.n();
+    let n = job.spec.n();
     if grid.len() != n * n {
         return None;
     }
-    let walk = Walk::new(spec, kernel, levels, whole, frame, tiling)?;
-    let up = frame.up.map(T::from_f64);
-    let mut bands = walk.bands(grid, up, tiling.band.max(1));
-    Some(walk.fill_bands(&mut bands, parallel))
+    let walk = Walk::new(job)?;
+    let up = job.frame.up.map(T::from_f64);
+    let mut bands = walk.bands(grid, up, job.tiling.band.max(1));
+    Some(walk.fill_bands(&mut bands, job.parallel))
 }
 
 /// [`extract`] with the points on the large filter summed by the plain
@@ -142,29 +179,12 @@ pub fn extract<S: Sample, T: Real>(
 /// [`extract`]'s bit for bit; each point on the large filter is the plain
 /// strip walk's value there, bit for bit, which is the core's to within
 /// the strip's rounding bound (`host-sim/tests/fast_adaptive.rs`).
-#[allow(clippy::too_many_arguments)]
 pub fn extract_with_strip<S: Sample, T: Real + Send + Sync>(
-    spec: &Spectrum<'_, S>,
-    kernel: &KernelTable<T>,
-    levels: &[AdaptiveLevel<'_, '_, T>],
-    whole: Option<&MarksSummary>,
-    frame: &Frame,
-    tiling: Tiling,
-    parallel: bool,
+    job: &AdaptiveJob<'_, S, T>,
     grid: &mut [T],
     strong: &mut [T],
 ) -> Option<AdaptiveStats> {
-    let walked = extract_with_strip_if(
-        spec,
-        kernel,
-        levels,
-        whole,
-        frame,
-        (tiling, parallel),
-        grid,
-        strong,
-        |_| true,
-    );
+    let walked = extract_with_strip_if(job, grid, strong, |_| true);
     walked.map(|walked| match walked {
         Settled::Extracted(stats) | Settled::Declined(stats) => stats,
     })
@@ -200,29 +220,30 @@ pub const SUM_ON_POOL_FROM: u64 = 1 << 20;
 /// render the view another way decides without a separate count
 /// ([`tally`]). Where the strip walk does not serve, the statistics come
 /// from [`tally`] and the slice, if accepted, from [`extract`].
-#[allow(clippy::too_many_arguments)]
 pub fn extract_with_strip_if<S: Sample, T: Real + Send + Sync>(
-    spec: &Spectrum<'_, S>,
-    kernel: &KernelTable<T>,
-    levels: &[AdaptiveLevel<'_, '_, T>],
-    whole: Option<&MarksSummary>,
-    frame: &Frame,
-    (tiling, parallel): (Tiling, bool),
+    job: &AdaptiveJob<'_, S, T>,
     grid: &mut [T],
     strong: &mut [T],
     proceed: impl FnOnce(&AdaptiveStats) -> bool,
 ) -> Option<Settled> {
+    let AdaptiveJob {
+        spec,
+        kernel,
+        frame,
+        tiling,
+        parallel,
+        ..
+    } = *job;
     let n = spec.n();
     let axes = frame.slice_axes();
     if grid.len() != n * n || strong.len() != n * n || strip::held_axis(&axes).is_none() {
-        let stats = tally(spec, kernel, levels, whole, frame, parallel)?;
+        let stats = tally(job)?;
         if !proceed(&stats) {
             return Some(Settled::Declined(stats));
         }
-        return extract(spec, kernel, levels, whole, frame, tiling, parallel, grid)
-            .map(Settled::Extracted);
+        return extract(job, grid).map(Settled::Extracted);
     }
-    let mut walk = Walk::new(spec, kernel, levels, whole, frame, tiling)?;
+    let mut walk = Walk::new(job)?;
     walk.defer = true;
     let up = frame.up.map(T::from_f64);
     let mut bands = walk.bands(grid, up, tiling.band.max(1));
@@ -256,18 +277,10 @@ pub fn extract_with_strip_if<S: Sample, T: Real + Send + Sync>(
     if let Some(w) = within.first_mut().filter(|w| w.0 <= w.1) {
         *w = (w.0.min(-w.1), w.1.max(-w.0));
     }
-    if !strip::extract_within(
-        spec,
-        kernel,
-        &axes,
-        tiling,
-        parallel && sum,
-        strong,
-        &within,
-    ) {
+    let strip_job = SliceJob::new(spec, kernel, &axes, tiling, parallel && sum);
+    if !strip::extract_within(&strip_job, strong, &within) {
         drop(bands);
-        return extract(spec, kernel, levels, whole, frame, tiling, parallel, grid)
-            .map(Settled::Extracted);
+        return extract(job, grid).map(Settled::Extracted);
     }
     // On this thread: the strong points are few (about 1,400 on a kb6
     // view at 40 dB on a 256³ volume), and waking the pool for them cost
@@ -279,21 +292,18 @@ pub fn extract_with_strip_if<S: Sample, T: Real + Send + Sync>(
     Some(Settled::Extracted(stats))
 }
 
-/// The statistics [`extract`] would return for the same arguments, without
+/// The statistics [`extract`] would return for the same job, without
 /// interpolating: each point's position, its test against the cube and its
 /// nearest sample's marks, as the walk computes them, so the counts are
-/// the walk's exactly. `None` where [`extract`] would return `None`.
-pub fn tally<S: Sample, T: Real>(
-    spec: &Spectrum<'_, S>,
-    kernel: &KernelTable<T>,
-    levels: &[AdaptiveLevel<'_, '_, T>],
-    whole: Option<&MarksSummary>,
-    frame: &Frame,
-    parallel: bool,
-) -> Option<AdaptiveStats> {
-    let n = spec.n();
-    let walk = Walk::new(spec, kernel, levels, whole, frame, Tiling::default())?;
-    let up = frame.up.map(T::from_f64);
+/// the walk's exactly (whatever the job's tiling). `None` where [`extract`]
+/// would return `None`.
+pub fn tally<S: Sample, T: Real>(job: &AdaptiveJob<'_, S, T>) -> Option<AdaptiveStats> {
+    let n = job.spec.n();
+    let walk = Walk::new(&AdaptiveJob {
+        tiling: Tiling::default(),
+        ..*job
+    })?;
+    let up = job.frame.up.map(T::from_f64);
     let count = |p: usize| {
         let mut stats = AdaptiveStats::default();
         let ky = signed(p, n);
@@ -302,7 +312,7 @@ pub fn tally<S: Sample, T: Real>(
         walk.fill_row(&mut row, low, high, &mut stats);
         stats
     };
-    Some(match parallel {
+    Some(match job.parallel {
         true => (0..n)
             .into_par_iter()
             .map(count)
@@ -355,16 +365,10 @@ fn merged(a: AdaptiveStats, b: AdaptiveStats) -> AdaptiveStats {
 }
 
 impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
-    /// The walk of `levels` over `spec` on `frame`, or `None` where
-    /// [`extract`] declines.
-    fn new(
-        spec: &Spectrum<'a, S>,
-        kernel: &'a KernelTable<T>,
-        levels: &[AdaptiveLevel<'a, 'a, T>],
-        whole: Option<&'a MarksSummary>,
-        frame: &Frame,
-        tiling: Tiling,
-    ) -> Option<Self> {
+    /// The walk of the job's levels over its spectrum on its frame, or
+    /// `None` where [`extract`] declines.
+    fn new(job: &AdaptiveJob<'a, S, T>) -> Option<Self> {
+        let (spec, kernel, levels, whole) = (job.spec, job.kernel, job.levels, job.whole);
         let n = spec.n();
         // Its walk wraps by masks: power-of-two sides only.
         if !supports(spec)
@@ -385,7 +389,7 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
         Some(Self {
             data: spec.data(),
             n,
-            right: frame.right.map(T::from_f64),
+            right: job.frame.right.map(T::from_f64),
             filters,
             marks,
             whole: whole.filter(|_| !levels.is_empty()),
@@ -393,10 +397,11 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
                 .filter(|_| levels.first().is_some_and(|l| l.gain == T::ZERO))
                 .and_then(|summary| {
                     let rounded = |v: [f64; 3]| v.map(|c| T::from_f64(c).to_f64());
+                    let frame = job.frame;
                     PartialSpans::new(summary, n, rounded(frame.right), rounded(frame.up))
                 }),
             raw_gain: T::exp2i(T::raw_exponent::<S>()),
-            chunk: tiling.chunk.clamp(1, n) as i32,
+            chunk: job.tiling.chunk.clamp(1, n) as i32,
             defer: false,
         })
     }
@@ -611,14 +616,7 @@ impl<'a, S: Sample, T: Real> Walk<'a, S, T> {
     /// its width.
     #[inline(always)]
     fn value(&self, filter: &Applied<'_, T>, q: [T; 3]) -> T {
-        match filter.width {
-            1 => self.interpolate::<1>(filter.table, q),
-            2 => self.interpolate::<2>(filter.table, q),
-            3 => self.interpolate::<3>(filter.table, q),
-            4 => self.interpolate::<4>(filter.table, q),
-            5 => self.interpolate::<5>(filter.table, q),
-            _ => self.interpolate::<MAX_WIDTH>(filter.table, q),
-        }
+        for_width!(filter.width, W => self.interpolate::<W>(filter.table, q))
     }
 
     /// The core's separable interpolation for width `W` (the table's):

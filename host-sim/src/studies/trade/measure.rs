@@ -17,7 +17,7 @@ use half::f16;
 use crate::reference::snr_db;
 use crate::studies::precision::StoredSpectrum;
 use fvr_engine::plan::filter::{choose_filter, KbDesign};
-use fvr_engine::slice::adaptive::walk;
+use fvr_engine::slice::adaptive::walk::{self, AdaptiveJob};
 use fvr_engine::slice::adaptive::{AdaptiveMarks, AdaptiveSettings, Bound};
 use fvr_engine::slice::exact::Tiling;
 use fvr_engine::volume::phantom::{sample, Phantom};
@@ -178,7 +178,7 @@ impl<'s, 'm, S: Sample> Renderer<'s, 'm, S> {
             // walk where it serves the spectrum, else the core's.
             let (kernel, grid) = (&self.kernel, &mut self.grid);
             let tiling = Tiling::default();
-            let stats = match walk::extract(
+            let job = AdaptiveJob::new(
                 self.spec,
                 kernel,
                 &levels,
@@ -186,8 +186,8 @@ impl<'s, 'm, S: Sample> Renderer<'s, 'm, S> {
                 &frame,
                 tiling,
                 false,
-                grid,
-            ) {
+            );
+            let stats = match walk::extract(&job, grid) {
                 Some(stats) => stats,
                 None => extract_slice_adaptive(self.spec, kernel, &levels, &frame, grid)?,
             };
