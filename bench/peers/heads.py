@@ -36,7 +36,14 @@ def nrrd_layout(path):
     head = pathlib.Path(path).read_bytes().split(b"\n\n", 1)[0].decode()
     fields = dict(line.split(": ", 1) for line in head.splitlines()[1:] if ": " in line)
     dims = [int(v) for v in fields["sizes"].split()]
-    spacing = [float(v) for v in fields["spacings"].split()]
+    if "spacings" in fields:
+        spacing = [float(v) for v in fields["spacings"].split()]
+    else:
+        # An oriented volume (NIfTI, DICOM) keeps its axes as space
+        # directions; the spacing of each axis is its vector's length.
+        vectors = fields["space directions"].replace("(", " ").replace(")", " ").split()
+        values = [float(v) for v in ",".join(vectors).split(",") if v]
+        spacing = [sum(x * x for x in values[3 * a:3 * a + 3]) ** 0.5 for a in range(3)]
     return dims, spacing
 
 
@@ -64,6 +71,9 @@ def run_rtk(path, dims, spacing, image, pixel, views):
     # fvr's centre (n/2) D at the origin: voxel i sits at (i - n/2) D.
     volume.SetOrigin([-(dims[a] / 2.0) * spacing[a] for a in range(3)])
     volume.SetSpacing(spacing)
+    # fvr renders in the voxel frame: an oriented file's axes (its space
+    # directions, which ITK reads as the image's direction) do not turn it.
+    volume.SetDirection(itk.matrix_from_array(np.eye(3)))
     w, h = image
     source = rtk.ConstantImageSource[image_type].New()
     # Column i at (i - W/2) P and row j at (j + 1 - H/2) P: fvr's pixels
