@@ -221,19 +221,25 @@ fn bad_input_is_refused_and_out_untouched() {
     assert!(empty.is_empty() && report.shape.views == 0);
 }
 
-/// A frame that overflows f32 is refused, naming the view and the setting
-/// given, and `out` holds no NaN or infinity afterwards: a volume near
-/// `f32::MAX` blames the volume, an ambient of 1e300 the ambient colour.
-#[test]
-fn overflowing_frames_are_refused_and_not_left_in_out() {
-    let small = volume([16; 3], [1.0; 3]);
+/// A renderer of `volume` with an ambient colour of 1e300: every image
+/// overflows f32.
+fn blinding(volume: &Volume) -> Renderer {
     let mut scene = Scene::xray();
     scene.ambient = [1e300; 3];
     let settings = Settings {
         scene,
         ..Settings::default()
     };
-    let renderer = Renderer::new(&small, settings).unwrap();
+    Renderer::new(volume, settings).unwrap()
+}
+
+/// A frame that overflows f32 is refused, naming the view and the setting
+/// given, and `out` holds no NaN or infinity afterwards: a volume near
+/// `f32::MAX` blames the volume, an ambient of 1e300 the ambient colour.
+#[test]
+fn overflowing_frames_are_refused_and_not_left_in_out() {
+    let small = volume([16; 3], [1.0; 3]);
+    let renderer = blinding(&small);
     let views = [View::along([1.0, 0.3, 0.2]), View::along([0.0, 1.0, 0.0])];
     let shape = renderer.batch_shape(views.len(), None).unwrap();
     let mut out = vec![7.0f32; shape.len()];
@@ -270,13 +276,7 @@ fn overflowing_frames_are_refused_and_not_left_in_out() {
 #[test]
 fn single_views_that_overflow_f32_are_refused() {
     let small = volume([16; 3], [1.0; 3]);
-    let mut scene = Scene::xray();
-    scene.ambient = [1e300; 3];
-    let settings = Settings {
-        scene,
-        ..Settings::default()
-    };
-    let renderer = Renderer::new(&small, settings).unwrap();
+    let renderer = blinding(&small);
     let view = View::along([1.0, 0.3, 0.2]);
     for zoom in [1, 2] {
         match renderer.render_zoomed(&view, None, zoom) {
