@@ -119,3 +119,39 @@ fn rgb_images_are_announced_as_rgb() {
         assert_eq!(stats["kind"], "RGB", "{stats}");
     }
 }
+
+/// `--stats` and `--stats-json` read the same in every renderer's help:
+/// one wording, because they are one option pair.
+#[test]
+fn the_stats_options_are_described_alike() {
+    let dir = temp_dir("stats-help");
+    let described = |command: &str| -> Vec<String> {
+        let out = fvr_line(&format!("{command} --help"), &dir);
+        assert_ok(&out);
+        let text = String::from_utf8_lossy(&out.stdout).to_string();
+        let lines: Vec<&str> = text.lines().map(str::trim).collect();
+        ["--stats", "--stats-json"]
+            .iter()
+            .map(|flag| {
+                let at = lines
+                    .iter()
+                    .position(|l| l.split_whitespace().next() == Some(flag))
+                    .unwrap_or_else(|| panic!("{command}: no {flag} in its help"));
+                // clap prints a short help on the option's line, a long one
+                // on the lines below it up to a blank line.
+                let beside: Vec<&str> = lines[at].split_whitespace().skip(1).collect();
+                let below = lines[at + 1..].iter().take_while(|l| !l.is_empty());
+                if beside.is_empty() {
+                    below.copied().collect::<Vec<_>>().join(" ")
+                } else {
+                    beside.join(" ")
+                }
+            })
+            .collect()
+    };
+    let render = described("render");
+    assert!(render[1].contains("JSON"), "{render:?}");
+    for command in ["turntable", "project"] {
+        assert_eq!(described(command), render, "{command} against render");
+    }
+}

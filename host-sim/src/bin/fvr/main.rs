@@ -263,8 +263,10 @@ fn default_scene() -> Result<(), Error> {
             colormap: Colormap::Gray,
             display: fvr_host::image::film::Display::Linear,
         },
-        stats: true,
-        stats_json: false,
+        report: crate::stats::StatsArgs {
+            stats: true,
+            stats_json: false,
+        },
         adaptive: None,
         adaptive_chain: render::DEFAULT_CHAIN.into(),
         adaptive_hd: None,

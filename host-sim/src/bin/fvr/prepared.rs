@@ -146,12 +146,12 @@ pub(crate) fn render(
         taper: None,
         window,
     };
-    if args.stats_json {
+    if args.report.stats_json {
         say!("{}", crate::json::one_line(&stats));
         return Ok(());
     }
     say!("wrote {} ({w}x{h} grey)", out.display());
-    if args.stats {
+    if args.report.stats {
         say!(
             "  volume        {}x{}x{} ({path}, prepared)",
             dims[0],

@@ -52,13 +52,8 @@ pub(crate) struct ProjectArgs {
     /// that --views reads back): the geometry of a --random set.
     #[arg(long, value_name = "FILE.csv")]
     pub(crate) save_views: Option<PathBuf>,
-    /// Print the choices and timings after the run.
-    #[arg(long)]
-    pub(crate) stats: bool,
-    /// Print them as one JSON object on stdout instead (and nothing else
-    /// there).
-    #[arg(long)]
-    pub(crate) stats_json: bool,
+    #[command(flatten)]
+    pub(crate) report: crate::stats::StatsArgs,
     #[command(flatten)]
     pub(crate) taper: TaperArgs,
     #[command(flatten)]
@@ -191,7 +186,7 @@ pub(crate) fn project(args: &ProjectArgs) -> Result<(), Error> {
     let t_write = t_write.elapsed();
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     let (w, h, c) = (shape.width, shape.height, shape.channels);
-    if !args.stats_json {
+    if !args.report.stats_json {
         say!(
             "wrote {} ({} views of {w}x{h} {})",
             args.out.display(),
@@ -213,11 +208,11 @@ pub(crate) fn project(args: &ProjectArgs) -> Result<(), Error> {
         zoom: 1,
         taper,
     };
-    if args.stats_json {
+    if args.report.stats_json {
         job.print_json(&ProjectExtra {
             write_ms: ms(t_write),
         });
-    } else if args.stats {
+    } else if args.report.stats {
         job.print_human();
         say!("  write         {:.1} ms", ms(t_write));
     }

@@ -56,12 +56,8 @@ pub(crate) struct RenderArgs {
     pub(crate) out: Option<PathBuf>,
     #[command(flatten)]
     pub(crate) png: PngArgs,
-    /// Print timing, memory and filter details.
-    #[arg(long)]
-    pub(crate) stats: bool,
-    /// Print the statistics as one JSON object instead (implies --stats).
-    #[arg(long)]
-    pub(crate) stats_json: bool,
+    #[command(flatten)]
+    pub(crate) report: crate::stats::StatsArgs,
     /// Adaptive filtering (paper §4): use a cheaper filter wherever the
     /// spectrum is weak, keeping the image within DB decibels of the
     /// full-filter image (eq. 16). Plain X-ray views only.
@@ -336,7 +332,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
             * (1u64 << args.look.preview_level.min(62)) as f64;
         fvr_host::image::nrrd_image::write_image_nrrd(out, &image, Some(pitch))?;
     }
-    if !args.stats_json {
+    if !args.report.stats_json {
         let kind = crate::stats::kind(image.channels);
         say!("wrote {} ({w}x{h} {kind})", out.display());
     }
@@ -374,7 +370,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
     } else {
         None
     };
-    if args.stats_json {
+    if args.report.stats_json {
         job.print_json(&RenderExtra {
             preview_level: args.look.preview_level,
             window: window.map(|(lo, hi)| [lo, hi]),
@@ -384,7 +380,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Error> {
         });
         return Ok(());
     }
-    if args.stats {
+    if args.report.stats {
         job.print_human();
         rendered.print_human()?;
         if let Some((lo, hi)) = window {

@@ -18,6 +18,20 @@ use crate::args::FrameArgs;
 use crate::json::{debug_triple, one_line};
 use crate::taper::TaperJson;
 
+/// `--stats` and `--stats-json`, worded and parsed once for every
+/// subcommand that renders.
+#[derive(clap::Args, Clone, Copy, Debug, Default)]
+pub(crate) struct StatsArgs {
+    /// Print the sizes, choices and timings after the run (load, plan,
+    /// prepare, views).
+    #[arg(long)]
+    pub(crate) stats: bool,
+    /// Print them as one JSON object on stdout instead, and nothing else
+    /// there.
+    #[arg(long)]
+    pub(crate) stats_json: bool,
+}
+
 /// `grey` for one channel, `RGB` for three.
 pub(crate) fn kind(channels: usize) -> &'static str {
     if channels == 1 {

@@ -53,13 +53,8 @@ pub(crate) struct TurntableArgs {
     /// for coloured lights).
     #[arg(long, default_value = "spin.apng")]
     pub(crate) out: PathBuf,
-    /// Print the sizes, choices and timings (load, plan, prepare, views).
-    #[arg(long)]
-    pub(crate) stats: bool,
-    /// Print them as one JSON object on stdout instead, and nothing else
-    /// there.
-    #[arg(long)]
-    pub(crate) stats_json: bool,
+    #[command(flatten)]
+    pub(crate) report: crate::stats::StatsArgs,
     #[command(flatten)]
     pub(crate) png: PngArgs,
     #[command(flatten)]
@@ -224,7 +219,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
     let t_views = t2.elapsed().saturating_sub(encode);
     let frames = views.len();
     let kind = crate::stats::kind(channels);
-    if !args.stats_json {
+    if !args.report.stats_json {
         say!(
             "wrote {} ({frames} frame{}, {w}x{h} {kind}, {} fps)",
             args.out.display(),
@@ -247,7 +242,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
         taper,
     };
     let views_per_second = frames as f64 / t_views.as_secs_f64().max(1e-9);
-    if args.stats_json {
+    if args.report.stats_json {
         job.print_json(&TurntableExtra {
             frames,
             fps: args.fps,
@@ -255,7 +250,7 @@ pub(crate) fn turntable(args: &TurntableArgs) -> Result<(), Error> {
             views_per_second,
             window: [range.0, range.1],
         });
-    } else if args.stats {
+    } else if args.report.stats {
         job.print_human();
         say!("  rate          {views_per_second:.1} views/s");
         say!(
