@@ -22,6 +22,7 @@ mod rows;
 mod taps;
 
 pub(crate) use reads::{scaled, LineReads, XRun};
+pub use rows::row_interval;
 
 use crate::error::{Error, Result};
 use crate::filter::{KernelTable, PhaseTable, MAX_WIDTH};

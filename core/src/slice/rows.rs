@@ -54,27 +54,37 @@ impl<T: Real> SliceRows<T> {
     /// [`SliceRows::row_interval`], always inlined.
     #[inline(always)]
     fn row_interval_inlined(&self, n: usize, c: [T; 3]) -> (i32, i32) {
-        let half = T::from_usize(n) * T::HALF;
-        let (mut low, mut high) = (-T::from_usize(n), T::from_usize(n));
-        for a in 0..3 {
-            let (r, c) = (self.right[a], c[a]);
-            if r == T::ZERO {
-                if c > half || -c > half {
-                    return (1, 0);
-                }
-                continue;
-            }
-            let (t1, t2) = ((-half - c) / r, (half - c) / r);
-            let (t_low, t_high) = if t1 < t2 { (t1, t2) } else { (t2, t1) };
-            if t_low > low {
-                low = t_low;
-            }
-            if t_high < high {
-                high = t_high;
-            }
-        }
-        (-((-low).floor_i64() as i32), high.floor_i64() as i32)
+        row_interval(n, &self.right, c)
     }
+}
+
+/// The integers `kx` for which `|kx·r_a + c_a| ≤ n/2` on every axis `a`
+/// (`r = right`, `c = ky·up`): the intersection of three intervals, each
+/// `(±n/2 − c_a)/r_a`, rounded inwards; `(1, 0)` (empty) when an axis
+/// the row does not move along lies outside. The host's walks call it too,
+/// so that their rows cover the same points as the core's.
+#[inline(always)]
+pub fn row_interval<T: Real>(n: usize, right: &[T; 3], c: [T; 3]) -> (i32, i32) {
+    let half = T::from_usize(n) * T::HALF;
+    let (mut low, mut high) = (-T::from_usize(n), T::from_usize(n));
+    for a in 0..3 {
+        let (r, c) = (right[a], c[a]);
+        if r == T::ZERO {
+            if c > half || -c > half {
+                return (1, 0);
+            }
+            continue;
+        }
+        let (t1, t2) = ((-half - c) / r, (half - c) / r);
+        let (t_low, t_high) = if t1 < t2 { (t1, t2) } else { (t2, t1) };
+        if t_low > low {
+            low = t_low;
+        }
+        if t_high < high {
+            high = t_high;
+        }
+    }
+    (-((-low).floor_i64() as i32), high.floor_i64() as i32)
 }
 
 /// Where the rows of a slice run through the spectrum, in the 32.32

@@ -408,7 +408,7 @@ pub(crate) fn row_setup<const W: usize, T: Real>(
     let half = (g.n / 2) as i32;
     let ky = T::from_usize(p);
     let kyu = g.up.map(|c| ky * c);
-    let (low, high) = row_interval(g.n, &g.right, kyu);
+    let (low, high) = fvr_core::slice::row_interval(g.n, &g.right, kyu);
     let k_low = if p == 0 { 0 } else { -half };
     let (low, high) = (low.max(k_low), high.min(half));
     if low > high {
@@ -514,32 +514,6 @@ fn fill_pair<const W: usize, const POW2: bool, S: Sample, T: Real, Src: TapSourc
             }
         }
     }
-}
-
-/// The integers `kx` with `|kx·r_a + c_a| ≤ n/2` on every axis, as the
-/// core's row interval computes them (the same operations in `T`, so the
-/// same interval).
-pub(crate) fn row_interval<T: Real>(n: usize, right: &[T; 3], c: [T; 3]) -> (i32, i32) {
-    let half = T::from_usize(n) * T::HALF;
-    let (mut low, mut high) = (-T::from_usize(n), T::from_usize(n));
-    for a in 0..3 {
-        let (r, c) = (right[a], c[a]);
-        if r == T::ZERO {
-            if c > half || -c > half {
-                return (1, 0);
-            }
-            continue;
-        }
-        let (t1, t2) = ((-half - c) / r, (half - c) / r);
-        let (t_low, t_high) = if t1 < t2 { (t1, t2) } else { (t2, t1) };
-        if t_low > low {
-            low = t_low;
-        }
-        if t_high < high {
-            high = t_high;
-        }
-    }
-    (-((-low).floor_i64() as i32), high.floor_i64() as i32)
 }
 
 /// The tap sums of one point and its mirror from the phase table.

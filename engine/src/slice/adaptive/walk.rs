@@ -36,8 +36,9 @@ use rayon::prelude::*;
 
 use crate::slice::adaptive::spans::PartialSpans;
 use crate::slice::adaptive::summary::MarksSummary;
-use crate::slice::exact::{row_interval, supports, tap_sum, SliceJob, Tiling};
+use crate::slice::exact::{supports, tap_sum, SliceJob, Tiling};
 use crate::slice::strip;
+use fvr_core::slice::row_interval;
 
 /// One filter of the chain as the walk applies it.
 #[derive(Clone, Copy)]
