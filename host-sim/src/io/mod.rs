@@ -292,18 +292,19 @@ pub(crate) fn is_gzip<R: BufRead>(reader: &mut R) -> Result<bool, IoError> {
 pub(crate) enum MaybeGzip<R: BufRead> {
     /// Uncompressed.
     Plain(R),
-    /// Gzip, decompressed on the fly (several members allowed).
-    Gzip(BufReader<MultiGzDecoder<R>>),
+    /// Gzip, decompressed on the fly (several members allowed); boxed, as
+    /// zlib-rs's inflate state is a few hundred bytes.
+    Gzip(Box<BufReader<MultiGzDecoder<R>>>),
 }
 
 impl<R: BufRead> MaybeGzip<R> {
     /// Wrap `reader`, looking at its first bytes.
     pub(crate) fn new(mut reader: R) -> Result<Self, IoError> {
         Ok(if is_gzip(&mut reader)? {
-            MaybeGzip::Gzip(BufReader::with_capacity(
+            MaybeGzip::Gzip(Box::new(BufReader::with_capacity(
                 FILE_BUFFER_BYTES,
                 MultiGzDecoder::new(reader),
-            ))
+            )))
         } else {
             MaybeGzip::Plain(reader)
         })
