@@ -26,7 +26,7 @@ use fvr_engine::render::turntable::orbit;
 use fvr_engine::render::view::ViewRenderer;
 use fvr_engine::render::view::{render_once, Walk};
 use fvr_engine::slice::column::{self, column_axis};
-use fvr_engine::slice::exact::{SliceJob, Tiling};
+use fvr_engine::slice::exact::{self, SliceJob, Tiling};
 use fvr_engine::slice::strip::{self, held_axis};
 use fvr_engine::spectrum::exchange::{exchange_xy, exchanged, rows_along_y};
 use fvr_engine::spectrum::OwnedSpectrum;
@@ -121,6 +121,9 @@ enum Fast {
     /// axes exchanged to match (`fvr_engine::spectrum::exchange`): also
     /// checked bit for bit against the strip walk on the spectrum itself.
     Exchanged,
+    /// The exact walk with each point's sum reordered into lanes
+    /// (`fvr_engine::slice::exact::extract_reordered`), on any plane.
+    Reordered,
 }
 
 impl Fast {
@@ -137,6 +140,7 @@ impl Fast {
         match self {
             Self::Strip => strip::extract(&job, grid),
             Self::Column => column::extract(&job, grid, &mut Vec::new()),
+            Self::Reordered => exact::extract_reordered(&job, grid),
             Self::Exchanged => {
                 let n = spec.n();
                 let data = exchange_xy(spec.data(), n).unwrap();
@@ -175,7 +179,9 @@ impl Fast {
     /// `γ / ε` for width `w`.
     fn sums(self, w: usize) -> f64 {
         match self {
-            Self::Strip | Self::Exchanged => 3.0 * w as f64 + 2.0,
+            // The reordered sums round `2W + 4` times (`u = ε/2` each)
+            // and the core's `3W + 1`: `(5W + 5)·u`, inside `(3W + 2)·ε`.
+            Self::Strip | Self::Exchanged | Self::Reordered => 3.0 * w as f64 + 2.0,
             Self::Column => 3.0 * w as f64 + 8.0,
         }
     }
@@ -257,6 +263,65 @@ fn every_filter_and_held_axis_within_rounding_f16() {
             assert_eq!(column_axis(&axes), Some(axis), "{axes:?}");
             let what = format!("{kind:?} column f16 {axes:?}");
             check::<f16, f32>(Fast::Column, &spec, &axes, &what);
+        }
+    }
+}
+
+/// The reordered exact walk on every plane the other walks take and on
+/// those they refuse, every filter, a power-of-two and a mixed-radix side
+/// with physical units; it declines where the core has no lanes for it
+/// (binary16 in f32 only), leaving the grid as it was.
+#[test]
+fn reordered_sums_within_rounding_on_any_plane() {
+    let volume = noise_volume([32; 3], 9);
+    // Random rolls: no image axis holds a coordinate.
+    let refused = [
+        ([0.7, 0.2, 1.0], [0.3, 1.0, 0.1]),
+        ([1.0, 0.35, -0.6], [0.2, -0.4, 1.0]),
+        ([0.15, 0.8, -1.0], [1.0, 0.3, 0.4]),
+    ]
+    .map(|(dir, up)| {
+        let view = View { dir, up };
+        let axes = Sampling::UNIT.slice_axes(&view.frame().unwrap());
+        assert_eq!(held_axis(&axes), None, "{view:?}");
+        (axes, view)
+    });
+    let f32_spec = {
+        let filter = Filter::new(FilterKind::Kb4, 1).unwrap();
+        OwnedSpectrum::<f32>::prepare::<f32>(&volume, filter).unwrap()
+    };
+    let (spec, kernel) = (
+        f32_spec.view(),
+        KernelTable::<f32>::new(*f32_spec.view().filter()),
+    );
+    let job = SliceJob::new(&spec, &kernel, &refused[0].0, Tiling::default(), true);
+    let mut untouched = vec![5.0f32; 32 * 32];
+    assert!(!exact::extract_reordered(&job, &mut untouched));
+    assert!(untouched.iter().all(|&v| v == 5.0));
+    if !exact::reorders::<f16, f32>() {
+        eprintln!("this core has no F16C, AVX and FMA: the reordered walk declines");
+        return;
+    }
+    for kind in FilterKind::ALL {
+        let filter = Filter::new(kind, 1).unwrap();
+        let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
+        let planes = axes_list().into_iter().chain(column_axes_list());
+        for axes in planes
+            .map(|(a, _)| a)
+            .chain(refused.iter().map(|(a, _)| *a))
+        {
+            let what = format!("{kind:?} reordered {axes:?}");
+            check::<f16, f32>(Fast::Reordered, &spec, &axes, &what);
+        }
+    }
+    let sampling = Sampling::new([0.7, 1.0, 1.9], 1.3).unwrap();
+    for kind in [FilterKind::Kb3, FilterKind::Kb6] {
+        let filter = Filter::for_grid(kind, GridOversampling::X1_25).unwrap();
+        let spec = OwnedSpectrum::<f16>::prepare_on::<f32>(&volume, filter, 40).unwrap();
+        for (_, view) in &refused {
+            let axes = sampling.slice_axes(&view.frame().unwrap());
+            let what = format!("{kind:?} reordered n 40 {view:?}");
+            check::<f16, f32>(Fast::Reordered, &spec, &axes, &what);
         }
     }
 }
@@ -376,8 +441,16 @@ fn rows_holding_no_coordinate_are_refused() {
 fn renderer_follows_its_walk() {
     let n = 64;
     let volume = sample(&GaussianMixture::random(5, n, 8), [n; 3]);
-    for dir in [[1.0, 0.3, 0.2], [1.0, 0.3, 0.0]] {
-        let view = View::along(dir);
+    // Rows holding z (the strip walk), a slice containing z (the column
+    // walk) and rows holding no axis (the reordered exact walk, where the
+    // core has its lanes).
+    for (dir, up) in [
+        ([1.0, 0.3, 0.2], [0.0, 0.0, 1.0]),
+        ([1.0, 0.3, 0.0], [0.0, 0.0, 1.0]),
+        ([0.7, 0.2, 1.0], [0.3, 1.0, 0.1]),
+    ] {
+        let view = View { dir, up };
+        let held = held_axis(&Sampling::UNIT.slice_axes(&view.frame().unwrap())).is_some();
         for kind in [FilterKind::Kb4, FilterKind::Kb6] {
             let filter = Filter::new(kind, 1).unwrap();
             let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
@@ -402,9 +475,10 @@ fn renderer_follows_its_walk() {
                 noise += (a - *b as f64).powi(2);
             }
             // The column walk nests its sums as the core does (x, then y,
-            // then z) and may match it bit for bit; the strip walk cannot.
-            if dir[2] != 0.0 {
-                assert!(noise > 0.0, "{kind:?} {dir:?}: the strip walk was not used");
+            // then z) and may match it bit for bit; the strip walk and the
+            // reordered sums cannot.
+            if dir[2] != 0.0 && (held || exact::reorders::<f16, f32>()) {
+                assert!(noise > 0.0, "{kind:?} {dir:?}: the fast walk was not used");
             }
             let snr = 10.0 * (signal / noise).log10();
             assert!(

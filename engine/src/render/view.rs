@@ -45,13 +45,15 @@ pub struct ViewRenderer<T> {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Walk {
     /// Factored along the axis the slice contains, where there is one
-    /// ([`fast_column`]), else reduced along the axis the slice's rows
-    /// hold, where there is one ([`fast_strip`]): the core's values to
+    /// ([`column::extract`]), else reduced along the axis the slice's rows
+    /// hold, where there is one ([`strip::extract`]): the core's values to
     /// within rounding, with a third to a sixth of the products. Elsewhere
-    /// as [`Walk::Exact`].
+    /// point by point with the sums in lanes where the core has them
+    /// ([`exact::extract_reordered`]: the core's values to within
+    /// rounding), else as [`Walk::Exact`].
     #[default]
     Strip,
-    /// Tap by tap in the core's order ([`fast_slice`]): the core's
+    /// Tap by tap in the core's order ([`exact::extract`]): the core's
     /// values bit for bit.
     Exact,
 }
@@ -251,7 +253,8 @@ impl<T: Real> ViewRenderer<T> {
                         || exchanged.as_ref().is_some_and(|(spec, axes)| {
                             strip::extract_exchanged(&SliceJob { spec, axes, ..job }, grid)
                         })
-                        || strip::extract(&job, grid)))
+                        || strip::extract(&job, grid)
+                        || exact::extract_reordered(&job, grid)))
                     || exact::extract(&job, grid)
             };
             let filled = match (&self.pool, self.threads) {

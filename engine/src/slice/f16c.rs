@@ -14,12 +14,21 @@
 //! reduction of a plane ([`scale_add`]) runs eight cells a step the same
 //! way.
 //!
-//! The features are detected at run time ([`available`]); the sums are
-//! `#[target_feature]` functions, so each call is an `unsafe` block, the
-//! only ones in this crate ([`crate::slice::exact`],
-//! [`crate::slice::strip`]).
+//! [`fused_sum`] is the same tap sum reordered for the default walk,
+//! which promises the core's values to within rounding, not bit for bit:
+//! the `W × W` x-runs accumulate in lanes by fused multiply-adds and meet
+//! in one horizontal sum, a quarter of the exact order's operations at kb5.
+//!
+//! The features are detected at run time ([`available`],
+//! [`fused_available`]); the sums are `#[target_feature]` functions, so
+//! each call is an `unsafe` block, the only ones in this crate
+//! ([`crate::slice::exact`], [`crate::slice::strip`]).
 
-use core::arch::x86_64::{__m128i, __m256, _mm256_add_ps, _mm256_cvtph_ps, _mm256_mul_ps};
+use core::arch::x86_64::{
+    __m128i, __m256, _mm256_add_ps, _mm256_castps256_ps128, _mm256_cvtph_ps, _mm256_extractf128_ps,
+    _mm256_fmadd_ps, _mm256_mul_ps, _mm256_set1_ps, _mm256_setzero_ps, _mm_add_ps, _mm_add_ss,
+    _mm_and_si128, _mm_cvtss_f32, _mm_movehl_ps, _mm_shuffle_ps,
+};
 
 use fvr_core::num::{Real, Sample};
 
@@ -89,6 +98,72 @@ pub(crate) fn tap_sum<const W: usize, const POW2: bool, S: Sample, T: Real>(
     T::from_f64(acc as f64)
 }
 
+/// Whether this core also has FMA, for [`fused_sum`]: [`available`] and
+/// the `vfmadd` instructions.
+pub(crate) fn fused_available<S: Sample, T: Real>() -> bool {
+    available::<S, T>() && std::arch::is_x86_feature_detected!("fma")
+}
+
+/// [`crate::slice::taps::tap_sum_on`] for `W ≤ 8`, reordered: per plane
+/// `c`, the plane's x-runs (lanes `t`, widened, the lanes past `W`
+/// zeroed) accumulate `Σ_b wy_b·run_b` by fused multiply-adds; the planes
+/// accumulate `Σ_c wz_c·plane_c` the same way; then `Σ_t wx_t·acc_t` in
+/// one multiply and a horizontal sum (lanes 0 + 4, 1 + 5, … then halves).
+/// Only for binary16 `S` and `f32` `T` ([`fused_available`]); a run that
+/// wraps around the cube is summed by the core's order.
+///
+/// Every product `w·c` is the same and each of the `2W + 4` roundings on
+/// its way to the value is at most `u = ε/2` relative, so the value is the
+/// exact one to within `(2W + 4)·u·Σ|w·c|` and the core's to within
+/// `(5W + 5)·u·Σ|w·c|` (the core's own sum rounds `3W + 1` times).
+#[target_feature(enable = "avx,f16c,fma")]
+pub(crate) fn fused_sum<const W: usize, const POW2: bool, S: Sample, T: Real>(
+    data: &[S],
+    side: Side<POW2>,
+    taps: [i32; 3],
+    [wx, wy, wz]: [&[T; W]; 3],
+) -> T {
+    let (lines, planes, x0) = run_starts::<W, POW2>(side, taps);
+    if W > 8 || x0 + W > side.n {
+        return crate::slice::taps::tap_sum_on(data, side, taps, [wx, wy, wz]);
+    }
+    // The lanes past `W` hold the next taps of the line (or of the next
+    // line): zeroed as bits, so that no value there, finite or not, enters.
+    let keep: __m128i =
+        bytemuck::cast::<[u16; 8], _>(core::array::from_fn(|t| if t < W { u16::MAX } else { 0 }));
+    let mut acc = _mm256_setzero_ps();
+    for c in 0..W {
+        let mut plane = _mm256_setzero_ps();
+        for b in 0..W {
+            let start = planes[c] + lines[b] + x0;
+            // The last runs of the data, within 8 values of its end, are
+            // read value by value (`x0 + W ≤ n`: the run itself is there).
+            let bits: [u16; 8] = match data.get(start..start + 8) {
+                Some(run) => core::array::from_fn(|t| run[t].pattern16().unwrap_or_default()),
+                None => core::array::from_fn(|t| {
+                    data.get(start + t)
+                        .filter(|_| t < W)
+                        .and_then(|v| v.pattern16())
+                        .unwrap_or_default()
+                }),
+            };
+            let run = _mm_and_si128(bytemuck::cast::<[u16; 8], __m128i>(bits), keep);
+            let weight = _mm256_set1_ps(wy[b].to_f64() as f32);
+            plane = _mm256_fmadd_ps(_mm256_cvtph_ps(run), weight, plane);
+        }
+        acc = _mm256_fmadd_ps(plane, _mm256_set1_ps(wz[c].to_f64() as f32), acc);
+    }
+    let x: [f32; 8] = core::array::from_fn(|t| if t < W { wx[t].to_f64() as f32 } else { 0.0 });
+    let lanes = _mm256_mul_ps(acc, bytemuck::cast(x));
+    let four = _mm_add_ps(
+        _mm256_castps256_ps128(lanes),
+        _mm256_extractf128_ps::<1>(lanes),
+    );
+    let two = _mm_add_ps(four, _mm_movehl_ps(four, four));
+    let one = _mm_add_ss(two, _mm_shuffle_ps::<1>(two, two));
+    T::from_f64(f64::from(_mm_cvtss_f32(one)))
+}
+
 /// `cells[i] = weight·src[i]` (`first`), else `cells[i] += weight·src[i]`,
 /// for binary16 `src` and `f32` `T` ([`available`]): the strip walk's
 /// reduction of one plane ([`crate::slice::strip`]), eight cells a step,
@@ -143,6 +218,100 @@ mod tests {
                 f16::from_bits(if exponent == 31 { bits & 0x83ff } else { bits })
             })
             .collect()
+    }
+
+    /// `(Σ w·c, Σ|w·c|)` of a point's taps in f64: the exact value (every
+    /// product of an f32 weight triple and a binary16 is exact in f64 to
+    /// well below the bound) and the mass the bound scales with.
+    fn exact_sum<const W: usize>(
+        data: &[f16],
+        n: usize,
+        [x, y, z]: [i32; 3],
+        [wx, wy, wz]: [&[f32; W]; 3],
+    ) -> (f64, f64) {
+        let at = |i: i32, k: usize| (i as usize + k) % n;
+        let (mut sum, mut mass) = (0.0, 0.0);
+        for c in 0..W {
+            for b in 0..W {
+                for t in 0..W {
+                    let v = data[(at(z, c) * n + at(y, b)) * n + at(x, t)].to_f64();
+                    let w = f64::from(wx[t]) * f64::from(wy[b]) * f64::from(wz[c]);
+                    sum += w * v;
+                    mass += (w * v).abs();
+                }
+            }
+        }
+        (sum, mass)
+    }
+
+    #[test]
+    fn fused_sums_are_exact_to_their_roundings_and_read_no_other_lane() {
+        if !fused_available::<f16, f32>() {
+            eprintln!("this core has no F16C, AVX and FMA: nothing to check");
+            return;
+        }
+        assert!(!fused_available::<f16, f64>() && !fused_available::<f32, f32>());
+        let n = 16;
+        let data = samples(n * n * n);
+        let weights: [f32; 8] = [0.37, -1.25, 2.5e-3, 0.9, -0.061, 1.5, 0.25, -3.0];
+        fn check<const W: usize>(data: &[f16], n: usize, w: &[f32; 8]) -> usize {
+            let wx: [f32; W] = core::array::from_fn(|t| w[t]);
+            let wy: [f32; W] = core::array::from_fn(|t| w[(t + 3) % 8]);
+            let wz: [f32; W] = core::array::from_fn(|t| w[(t + 5) % 8]);
+            let side = Side::<true> { n };
+            let u = f64::from(f32::EPSILON) / 2.0;
+            let mut reordered = 0;
+            for z in [0, 7, n as i32 - 2, n as i32 - 1] {
+                for y in [0, 5, n as i32 - 1] {
+                    for x in -2..n as i32 {
+                        let taps = [x, y, z];
+                        let wrapped = [x.rem_euclid(n as i32), y, z];
+                        // SAFETY: the caller checked `fused_available`.
+                        #[allow(unsafe_code)]
+                        let fused = unsafe { fused_sum(data, side, taps, [&wx, &wy, &wz]) };
+                        let (sum, mass) = exact_sum(data, n, wrapped, [&wx, &wy, &wz]);
+                        let bound = (2 * W + 4) as f64 * u * mass * 1.001;
+                        let err = (f64::from(fused) - sum).abs();
+                        assert!(err <= bound, "W {W} at {taps:?}: {err:e} > {bound:e}");
+                        let core = tap_sum_on(data, side, taps, [&wx, &wy, &wz]);
+                        reordered += usize::from(core.to_bits() != fused.to_bits());
+                    }
+                }
+            }
+            reordered
+        }
+        // Not vacuous: the reordered sums differ from the core's somewhere.
+        assert!(check::<3>(&data, n, &weights) > 0);
+        assert!(check::<4>(&data, n, &weights) > 0);
+        assert!(check::<5>(&data, n, &weights) > 0);
+        assert!(check::<6>(&data, n, &weights) > 0);
+        assert!(check::<8>(&data, n, &weights) > 0);
+
+        // A point's runs in a cube of NaN and infinities: the lanes past
+        // `W`, read and dropped, change nothing.
+        let mut poisoned: Vec<f16> = (0..n * n * n)
+            .map(|i| if i % 2 == 0 { f16::NAN } else { f16::INFINITY })
+            .collect();
+        let (wx, wy, wz) = (
+            [0.5f32, -0.25, 2.0],
+            [1.0f32, 0.75, -0.5],
+            [0.125f32, 1.5, 1.0],
+        );
+        let taps = [3, 4, 5];
+        for c in 0..3 {
+            for b in 0..3 {
+                for t in 0..3 {
+                    poisoned[((5 + c) * n + 4 + b) * n + 3 + t] =
+                        f16::from_f32((c * 9 + b * 3 + t) as f32);
+                }
+            }
+        }
+        let side = Side::<true> { n };
+        // SAFETY: checked above.
+        #[allow(unsafe_code)]
+        let fused = unsafe { fused_sum(&poisoned, side, taps, [&wx, &wy, &wz]) };
+        let core = tap_sum_on(&poisoned, side, taps, [&wx, &wy, &wz]);
+        assert!(fused.is_finite() && fused == core, "{fused} against {core}");
     }
 
     #[test]
