@@ -338,22 +338,36 @@ fn walk(
 }
 
 /// Whether every axis view's reference image is sure to have positive
-/// energy `Σs²` on any grid: every voxel is finite and non-negative, and
-/// each axis's central line (the other two coordinates at `⌊dims/2⌋`)
-/// holds a positive voxel. The view along that axis images the line at the
-/// image's centre pixel, inside the volume on any grid whose image side is
-/// even, and its reference there is a sum of non-negative voxels, one of
-/// them positive: positive, so the view's `Σs²` is too.
+/// energy `Σs²` on any grid: every voxel is finite, and each axis's
+/// central line (the other two coordinates at `⌊dims/2⌋`) sums to a value
+/// no order of additions can round to zero. The view along that axis
+/// images the line at the image's centre pixel, inside the volume on any
+/// grid whose image side is even, and its reference there is the line's
+/// sum, added in some order: with `m` voxels `|fl(Σf) − Σf| ≤ γ_m·Σ|f|`
+/// (`γ_m ≈ m·u`) whatever the order, so a sum that exceeds twice that
+/// bound (this function's own rounding included) is non-zero in every
+/// order, and so is the view's `Σs²`. A non-negative volume with a
+/// positive voxel on each line always passes; a signed one (CT in
+/// Hounsfield units) passes unless a line cancels.
 fn signal_on_every_view(volume: &Volume) -> bool {
     let [d0, d1, d2] = volume.dims;
-    if !volume.data.iter().all(|v| v.is_finite() && *v >= 0.0) {
+    if volume.first_non_finite().is_some() {
         return false;
     }
     let (c0, c1, c2) = (d0 / 2, d1 / 2, d2 / 2);
-    let at = |i: usize, j: usize, k: usize| volume.data[(k * d1 + j) * d0 + i];
-    (0..d0).any(|i| at(i, c1, c2) > 0.0)
-        && (0..d1).any(|j| at(c0, j, c2) > 0.0)
-        && (0..d2).any(|k| at(c0, c1, k) > 0.0)
+    let at = |i: usize, j: usize, k: usize| f64::from(volume.data[(k * d1 + j) * d0 + i]);
+    let certain = |line: &mut dyn Iterator<Item = f64>| {
+        let (mut sum, mut mass, mut m) = (0.0f64, 0.0f64, 0usize);
+        for v in line {
+            sum += v;
+            mass += v.abs();
+            m += 1;
+        }
+        sum.abs() > 2.0 * (m + 1) as f64 * f64::EPSILON * mass
+    };
+    certain(&mut (0..d0).map(|i| at(i, c1, c2)))
+        && certain(&mut (0..d1).map(|j| at(c0, j, c2)))
+        && certain(&mut (0..d2).map(|k| at(c0, c1, k)))
 }
 
 #[cfg(test)]
@@ -386,7 +400,8 @@ mod tests {
         let mut met = 0;
         for non_negative in [true, false] {
             let v = volume(non_negative);
-            assert_eq!(signal_on_every_view(&v), non_negative);
+            // Signed or not, the random volume's central lines do not cancel.
+            assert!(signal_on_every_view(&v));
             for target in [20.0, 35.0, 50.0, 65.0, 90.0] {
                 let constraints = Constraints::default();
                 let grids = &crate::plan::ALL_GRIDS;
@@ -427,13 +442,16 @@ mod tests {
     }
 
     #[test]
-    fn the_signal_test_needs_non_negative_voxels_and_each_central_line() {
+    fn the_signal_test_needs_each_central_line_to_sum_to_a_certain_non_zero() {
         let dims = [5, 4, 3];
         let len = 5 * 4 * 3;
         let index = |i: usize, j: usize, k: usize| (k * 4 + j) * 5 + i;
         // Only the centre voxel (2, 2, 1) lies on all three central lines.
         let mut data = vec![0.0f32; len];
         data[index(2, 2, 1)] = 1.0;
+        assert!(signal_on_every_view(&Volume::new(dims, data.clone())));
+        // Negative works as well as positive (CT in Hounsfield units).
+        data[index(2, 2, 1)] = -1024.0;
         assert!(signal_on_every_view(&Volume::new(dims, data.clone())));
         // Off the central line of x and z (on y's): not sure.
         let mut off = vec![0.0f32; len];
@@ -445,9 +463,35 @@ mod tests {
             lines[at] = 1.0;
         }
         assert!(signal_on_every_view(&Volume::new(dims, lines)));
-        // A negative voxel anywhere could cancel a sum; a non-finite one is
-        // for the jobs to report.
-        for bad in [-1.0, f32::INFINITY, f32::NAN] {
+        // A line that cancels exactly, or to within its rounding, is not
+        // sure; values elsewhere change nothing.
+        // x's central line: (j, k) = (2, 1). 3e38 − 3e38 + 1e-30 is not
+        // zero, but adding 3e38 first rounds it to zero.
+        for (line, sure) in [
+            ([3.0f32, -3.0, 0.0], false),
+            ([3.0e38, -3.0e38, 1.0e-30], false),
+            ([3.0, -2.0, 0.0], true),
+        ] {
+            let mut d = data.clone();
+            for (i, v) in line.into_iter().enumerate() {
+                d[index(i, 2, 1)] = v;
+            }
+            d[index(2, 3, 1)] = 1.0;
+            d[index(2, 2, 0)] = 1.0;
+            assert_eq!(
+                signal_on_every_view(&Volume::new(dims, d.clone())),
+                sure,
+                "{line:?}"
+            );
+            d[index(4, 0, 0)] = -7.0;
+            assert_eq!(
+                signal_on_every_view(&Volume::new(dims, d)),
+                sure,
+                "{line:?}"
+            );
+        }
+        // A non-finite voxel anywhere is for the jobs to report.
+        for bad in [f32::INFINITY, f32::NAN] {
             let mut d = data.clone();
             d[index(4, 0, 0)] = bad;
             assert!(!signal_on_every_view(&Volume::new(dims, d)), "{bad}");
