@@ -107,6 +107,37 @@ fn stats_json_is_alone_on_stdout() {
     assert!(v["accuracy"]["predicted_db"].as_f64().is_some(), "{v}");
 }
 
+/// `--filter`, `--oversample` and `--precision` are kept as given, each
+/// alone (the planner chooses the rest) and all three (none chosen), as
+/// `render` keeps them; they were once dropped for the planner's choice.
+#[test]
+fn the_spectrum_flags_given_are_kept() {
+    let dir = temp_dir("project-given");
+    let base = "project gaussians@32 --random 2 --seed 1 --out g.nrrd --stats-json --quiet";
+    for (flags, key, value) in [
+        ("--filter linear", "filter", serde_json::json!("linear")),
+        ("--filter kb3", "filter", serde_json::json!("kb3")),
+        ("--oversample 2", "oversample", serde_json::json!(2)),
+        ("--precision f64", "precision", serde_json::json!("f64")),
+    ] {
+        let (v, _) = common::stats_json(&format!("{base} {flags}"), &dir);
+        assert_eq!(v[key], value, "{flags}: {v}");
+    }
+    let all = format!("{base} --filter cubic --oversample 1 --precision f32");
+    let (v, _) = common::stats_json(&all, &dir);
+    let chosen = (
+        v["filter"].clone(),
+        v["oversample"].clone(),
+        v["precision"].clone(),
+    );
+    let want = (
+        serde_json::json!("cubic"),
+        serde_json::json!(1),
+        serde_json::json!("f32"),
+    );
+    assert_eq!(chosen, want, "{v}");
+}
+
 #[test]
 fn bad_views_and_outputs_are_one_line_and_write_nothing() {
     let dir = temp_dir("project-bad");

@@ -218,7 +218,10 @@ where
             args.frame.spectrum.given = plan::Given::from_flags(&|id| given("turntable", id));
             merge_scene(&mut *args, &|id| given("turntable", id)).and_then(|()| turntable(&args))
         }
-        Some(Command::Project(args)) => crate::project::project(&args),
+        Some(Command::Project(mut args)) => {
+            args.frame.spectrum.given = plan::Given::from_flags(&|id| given("project", id));
+            crate::project::project(&args)
+        }
         Some(Command::Compare(args)) => compare(&args),
         Some(Command::Convert(args)) => crate::convert::convert(&args),
         Some(Command::Accuracy(args)) => accuracy(&args),
