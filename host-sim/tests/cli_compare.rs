@@ -118,3 +118,63 @@ fn a_png_is_refused_without_echoing_its_bytes() {
         "non-printable or non-ASCII in: {err:?}"
     );
 }
+
+/// Two stacks of the same views from `fvr project` at different
+/// accuracies: compared view by view, gated on the worst view, and a
+/// stack refused as a volume to render. A colour image reports its width
+/// and height, not its channel axis.
+#[test]
+fn stacks_of_views_are_compared_view_by_view() {
+    let dir = temp_dir("compare-stacks");
+    for (name, filter) in [("fine", "kb6 --oversample 2"), ("coarse", "linear")] {
+        let cmd = format!(
+            "project gaussians@32 --random 5 --seed 3 --filter {filter} --out {name}.nrrd --quiet"
+        );
+        let out = fvr_line(&cmd, &dir);
+        assert_eq!(out.status.code(), Some(0), "{out:?}");
+    }
+    let out = fvr_line("compare fine.nrrd coarse.nrrd --json", &dir);
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+    let v = json(&out.stdout);
+    assert_eq!(v["views"], 5);
+    assert_eq!(
+        (v["width"].clone(), v["height"].clone()),
+        (32.into(), 32.into())
+    );
+    let (db, worst) = (
+        v["snr_db"].as_f64().unwrap(),
+        v["worst_view_db"].as_f64().unwrap(),
+    );
+    let view = v["worst_view"].as_u64().unwrap();
+    assert!(view < 5 && worst <= db && worst > 5.0, "{v}");
+    // The gate is the worst view: between it and the whole stack's SNR, a
+    // threshold fails.
+    let between = format!(
+        "compare fine.nrrd coarse.nrrd --min-db {}",
+        (worst + db) / 2.0
+    );
+    let out = fvr_line(&between, &dir);
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("worst view"), "{err}");
+    let line = fvr_line("compare fine.nrrd coarse.nrrd", &dir);
+    let text = String::from_utf8_lossy(&line.stdout);
+    assert!(
+        text.contains(&format!("worst of 5 views: {worst:.2} dB at view {view}")),
+        "{text}"
+    );
+    // A stack is not a volume.
+    let out = fvr_line("render fine.nrrd --dir 1,0,0 --out x.png", &dir);
+    assert_error(&out, &["axis 2 is `list`"]);
+
+    let out = fvr_line(
+        "render teapot@32 --dir 1,0.2,0 --light-ring 3 --out rgb.nrrd --quiet",
+        &dir,
+    );
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+    let v = json(&fvr_line("compare rgb.nrrd rgb.nrrd --json", &dir).stdout);
+    assert_eq!(
+        (v["width"].clone(), v["height"].clone(), v["views"].clone()),
+        (32.into(), 32.into(), 1.into())
+    );
+}

@@ -102,36 +102,66 @@ pub fn read_nrrd(path: &Path) -> Result<Volume, IoError> {
 /// [`read_nrrd`], advancing `progress` by the bytes read from the file
 /// that holds the samples (its length is set to that file's size).
 pub fn read_nrrd_with_progress(path: &Path, progress: &ProgressBar) -> Result<Volume, IoError> {
-    read_nrrd_limited(path, crate::budget::limit_bytes(), progress, false)
+    read_nrrd_limited(path, crate::budget::limit_bytes(), progress, None)
 }
 
-/// [`read_nrrd`] for an image `fvr render` wrote: also a colour image
-/// (`kinds: RGB-color domain domain`, `sizes: 3 W H`), as dims `[3, W, H]`.
+/// What an image file holds, from its `kinds` ([`read_nrrd_image_kind`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageKind {
+    /// Scalar samples on spatial axes: an image `[W, H, 1]` (or a volume).
+    Scalar,
+    /// `kinds: RGB-color domain domain`: dims `[3, W, H]`.
+    Colour,
+    /// `kinds: space space list`, as `fvr project` writes: `[W, H, views]`.
+    Stack,
+}
+
+/// [`read_nrrd`] for an image `fvr render` or `fvr project` wrote: also a
+/// colour image (`kinds: RGB-color domain domain`, `sizes: 3 W H`), as
+/// dims `[3, W, H]`, and a stack of views (`kinds: space space list`).
 ///
 /// # Errors
 /// As [`read_nrrd`].
 pub fn read_nrrd_image(path: &Path) -> Result<Volume, IoError> {
-    read_nrrd_limited(
+    read_nrrd_image_kind(path).map(|(image, _)| image)
+}
+
+/// [`read_nrrd_image`], and what the image is.
+///
+/// # Errors
+/// As [`read_nrrd`].
+pub fn read_nrrd_image_kind(path: &Path) -> Result<(Volume, ImageKind), IoError> {
+    let mut kind = ImageKind::Scalar;
+    let image = read_nrrd_limited(
         path,
         crate::budget::limit_bytes(),
         &ProgressBar::hidden(),
-        true,
-    )
+        Some(&mut kind),
+    )?;
+    Ok((image, kind))
 }
 
+/// Read `path`: a volume, or with `image` any image, whose kind is set.
 fn read_nrrd_limited(
     path: &Path,
     limit: u64,
     progress: &ProgressBar,
-    image: bool,
+    mut image: Option<&mut ImageKind>,
 ) -> Result<Volume, IoError> {
-    let open = || -> Result<Volume, IoError> {
+    let mut open = || -> Result<Volume, IoError> {
         let file = crate::io::open_file(path)?;
         progress.set_length(file.metadata().map(|m| m.len()).unwrap_or(0));
         let mut reader = BufReader::with_capacity(FILE_BUFFER_BYTES, progress.wrap_read(file));
         let layout = read_header(&mut reader)?;
-        if !image {
-            layout.check_volume()?;
+        match image.as_deref_mut() {
+            None => layout.check_volume()?,
+            Some(kind) => {
+                *kind = match (layout.colour, layout.stack) {
+                    (true, _) => ImageKind::Colour,
+                    (_, true) => ImageKind::Stack,
+                    _ => ImageKind::Scalar,
+                }
+            }
         }
         check_memory(layout.dims, layout.count, layout.ty, limit)?;
         let Some(name) = &layout.data_file else {

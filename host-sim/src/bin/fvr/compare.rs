@@ -1,12 +1,14 @@
 //! `fvr compare`: the SNR of one NRRD image against another, as a line or
 //! as JSON, optionally gated by a least SNR (`--min-db`, exit 1 below it).
+//! Stacks of views (`fvr project`'s) are also compared view by view, and
+//! gated on their worst view.
 
 use crate::Error;
 use std::path::PathBuf;
 
 use clap::Args;
 
-use fvr_host::io::nrrd::read_nrrd_image as read_nrrd;
+use fvr_host::io::nrrd::{read_nrrd_image_kind as read_nrrd, ImageKind};
 use fvr_host::reference::{max_abs_error, snr_db};
 
 #[derive(Args)]
@@ -16,14 +18,16 @@ pub(crate) struct CompareArgs {
     /// Image to measure.
     pub(crate) b: PathBuf,
     /// Print one JSON object on stdout instead of the line: `a`, `b`,
-    /// `width`, `height`, `dims`, `snr_db`, `identical`, `max_abs_error`,
-    /// and `min_db` and `passed` with --min-db. Identical images have an
-    /// infinite SNR, which JSON cannot hold: `snr_db` is then `null` and
-    /// `identical` is `true`.
+    /// `width`, `height`, `views`, `dims`, `snr_db`, `identical`,
+    /// `max_abs_error`, for stacks of views also `worst_view` (from 0) and
+    /// `worst_view_db`, and `min_db` and `passed` with --min-db. Identical
+    /// images have an infinite SNR, which JSON cannot hold: `snr_db` is then
+    /// `null` and `identical` is `true`.
     #[arg(long)]
     pub(crate) json: bool,
-    /// Exit with status 1 (and one line on stderr) when the SNR is below DB;
-    /// identical images always pass. Errors still exit 2.
+    /// Exit with status 1 (and one line on stderr) when the SNR is below DB
+    /// (for a stack of views, `fvr project`'s, the worst view's); identical
+    /// images always pass. Errors still exit 2.
     #[arg(long, value_name = "DB", allow_negative_numbers = true)]
     pub(crate) min_db: Option<f64>,
 }
@@ -54,11 +58,11 @@ pub(crate) fn compare(args: &CompareArgs) -> Result<(), Error> {
         }
         budget
     });
-    let ia = read_nrrd(a)?;
+    let (ia, kind) = read_nrrd(a)?;
     first_read.store(true, std::sync::atomic::Ordering::SeqCst);
     // The first image counts against the limit while the second is read.
     let _first = fvr_host::budget::hold(ia.data.len() as u64 * 4);
-    let ib = read_nrrd(b)?;
+    let (ib, _) = read_nrrd(b)?;
     if ia.dims != ib.dims {
         return Err(format!("images differ in size: {:?} against {:?}", ia.dims, ib.dims).into());
     }
@@ -78,32 +82,44 @@ pub(crate) fn compare(args: &CompareArgs) -> Result<(), Error> {
     let db = snr_db(ra, rb);
     let err = max_abs_error(ra, rb);
     let identical = ra == rb;
-    let passed = args.min_db.map(|min| identical || db >= min);
+    let (width, height, views) = match kind {
+        ImageKind::Colour => (ia.dims[1], ia.dims[2], 1),
+        ImageKind::Scalar | ImageKind::Stack => (ia.dims[0], ia.dims[1], ia.dims[2]),
+    };
+    let worst = (views > 1).then(|| worst_view(ra, rb, views)).flatten();
+    // A stack is gated on its worst view.
+    let gated = worst.map_or(db, |(_, view_db)| view_db);
+    let passed = args.min_db.map(|min| identical || gated >= min);
+    let finite = |db: f64| db.is_finite().then_some(db);
     if args.json {
-        let [width, height, _] = ia.dims;
-        let json = serde_json::json!({
+        let mut json = serde_json::json!({
             "a": a.display().to_string(),
             "b": b.display().to_string(),
             "width": width,
             "height": height,
+            "views": views,
             "dims": ia.dims,
-            "snr_db": if db.is_finite() { Some(db) } else { None },
+            "snr_db": finite(db),
             "identical": identical,
             "max_abs_error": err,
-            "min_db": args.min_db,
-            "passed": passed,
         });
-        let mut json = json;
-        if args.min_db.is_none() {
-            if let Some(o) = json.as_object_mut() {
-                o.remove("min_db");
-                o.remove("passed");
+        if let Some(o) = json.as_object_mut() {
+            if let Some((view, view_db)) = worst {
+                o.insert("worst_view".into(), view.into());
+                o.insert("worst_view_db".into(), finite(view_db).into());
+            }
+            if let (Some(min), Some(passed)) = (args.min_db, passed) {
+                o.insert("min_db".into(), min.into());
+                o.insert("passed".into(), passed.into());
             }
         }
         say!("{json}");
     } else {
+        let worst = worst.map_or(String::new(), |(view, view_db)| {
+            format!(", worst of {views} views: {view_db:.2} dB at view {view}")
+        });
         say!(
-            "SNR of {} against {}: {:.2} dB (max abs error {:.3e})",
+            "SNR of {} against {}: {:.2} dB (max abs error {:.3e}){worst}",
             b.display(),
             a.display(),
             db,
@@ -111,9 +127,24 @@ pub(crate) fn compare(args: &CompareArgs) -> Result<(), Error> {
         );
     }
     if let (Some(min), Some(false)) = (args.min_db, passed) {
+        let what = if views > 1 { "the worst view's " } else { "" };
         return Err(Box::new(BelowMinDb(format!(
-            "compare: {db:.2} dB is below --min-db {min}"
+            "compare: {what}{gated:.2} dB is below --min-db {min}"
         ))));
     }
     Ok(())
+}
+
+/// The view (from 0) with the lowest SNR among `views` equal slices, and
+/// that SNR; views whose reference is all zero have none and are left out
+/// (`None` when every view's is).
+fn worst_view(reference: &[f32], test: &[f32], views: usize) -> Option<(usize, f64)> {
+    let len = reference.len() / views;
+    reference
+        .chunks_exact(len)
+        .zip(test.chunks_exact(len))
+        .enumerate()
+        .filter(|(_, (r, _))| r.iter().any(|&v| v != 0.0))
+        .map(|(view, (r, t))| (view, snr_db(r, t)))
+        .min_by(|x, y| x.1.total_cmp(&y.1))
 }

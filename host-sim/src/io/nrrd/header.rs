@@ -41,6 +41,9 @@ pub(crate) struct Layout {
     /// `kinds: RGB-color domain domain` (or `space`): a colour image, which
     /// only the image reader accepts ([`Layout::check_volume`]).
     pub colour: bool,
+    /// `kinds: space space list` (or `domain`): a stack of images, one per
+    /// view, as `fvr project` writes it; also only for the image reader.
+    pub stack: bool,
 }
 
 impl Layout {
@@ -66,22 +69,25 @@ impl Layout {
             data_file: None,
             orientation: None,
             colour: false,
+            stack: false,
         }
     }
 
-    /// `Ok` unless this is a colour image: a volume's axes must all be
-    /// spatial.
+    /// `Ok` unless this is a colour image or a stack: a volume's axes must
+    /// all be spatial.
     ///
     /// # Errors
-    /// The `kinds` error naming the colour axis.
+    /// The `kinds` error naming the colour or list axis.
     pub(crate) fn check_volume(&self) -> Result<(), IoError> {
-        match self.colour {
-            true => Err(field_error(
-                "kinds",
-                "axis 0 is `RGB-color`: only scalar volumes with spatial axes can be rendered",
-            )),
-            false => Ok(()),
-        }
+        let axis = match (self.colour, self.stack) {
+            (true, _) => "axis 0 is `RGB-color`",
+            (_, true) => "axis 2 is `list`",
+            _ => return Ok(()),
+        };
+        Err(field_error(
+            "kinds",
+            format!("{axis}: only scalar volumes with spatial axes can be rendered"),
+        ))
     }
 }
 
@@ -155,10 +161,11 @@ impl Fields {
         let byte_skip = parse_skip(self.byte_skip.as_deref(), "byte skip")?;
         let line_skip = parse_skip(self.line_skip.as_deref(), "line skip")?;
         let (dims, count, data_bytes) = geometry(&sizes, ty)?;
-        let colour = match &self.kinds {
+        let kinds = match &self.kinds {
             Some(kinds) => check_kinds(kinds)?,
-            None => false,
+            None => Kinds::Space,
         };
+        let (colour, stack) = (kinds == Kinds::Colour, kinds == Kinds::Stack);
         let mut vectors = Vec::new();
         let spacing = match (self.spacings, self.space_directions) {
             // The format forbids both; `space directions` is the fuller one.
@@ -167,7 +174,7 @@ impl Fields {
                 vectors = v;
                 spacing
             }
-            (Some(s), None) => parse_spacings(&s, dimension, colour)?,
+            (Some(s), None) => parse_spacings(&s, dimension, kinds.unspaced_axis())?,
             (None, None) => fvr_engine::volume::DEFAULT_SPACING,
         };
         let orientation = super::space::orientation(
@@ -192,6 +199,7 @@ impl Fields {
             data_file,
             orientation,
             colour,
+            stack,
         })
     }
 }
@@ -233,8 +241,13 @@ fn parse_sizes(value: &str, dimension: usize) -> Result<Vec<usize>, IoError> {
     }
 }
 
-/// The `spacings` field: one finite positive number per axis.
-fn parse_spacings(value: &str, dimension: usize, colour: bool) -> Result<[f64; 3], IoError> {
+/// The `spacings` field: one finite positive number per axis (`nan` on
+/// the axis `unspaced`, a colour or list axis, which has none).
+fn parse_spacings(
+    value: &str,
+    dimension: usize,
+    unspaced: Option<usize>,
+) -> Result<[f64; 3], IoError> {
     let words: Vec<&str> = value.split_whitespace().collect();
     if words.len() != dimension {
         return Err(field_error(
@@ -248,8 +261,8 @@ fn parse_spacings(value: &str, dimension: usize, colour: bool) -> Result<[f64; 3
     }
     let mut spacing = fvr_engine::volume::DEFAULT_SPACING;
     for (axis, (slot, word)) in spacing.iter_mut().zip(&words).enumerate() {
-        // A colour axis has no spacing.
-        if colour && axis == 0 && word.eq_ignore_ascii_case("nan") {
+        // A colour or list axis has no spacing.
+        if unspaced == Some(axis) && word.eq_ignore_ascii_case("nan") {
             continue;
         }
         *slot = word
@@ -338,19 +351,42 @@ fn parse_space_directions(
     Ok((spacing, vectors))
 }
 
+/// What the `kinds` field says the axes are.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kinds {
+    /// Every axis spatial (or unknown).
+    Space,
+    /// `RGB-color` then two spatial axes.
+    Colour,
+    /// Two spatial axes then a `list`: a stack of images.
+    Stack,
+}
+
+impl Kinds {
+    /// The axis without a spacing.
+    fn unspaced_axis(self) -> Option<usize> {
+        match self {
+            Kinds::Space => None,
+            Kinds::Colour => Some(0),
+            Kinds::Stack => Some(2),
+        }
+    }
+}
+
 /// The `kinds` field: every axis must be a spatial one (`domain`, `space`,
 /// or unknown: `none`, `???`). A colour, vector or list axis would be
 /// rendered as space.
 ///
-/// `Ok(true)` for a colour image, `RGB-color` then two spatial axes (which
-/// only the image reader accepts).
-fn check_kinds(value: &str) -> Result<bool, IoError> {
+/// A colour image (`RGB-color` then two spatial axes) and a stack of
+/// images (two spatial axes then `list`) are told apart: only the image
+/// reader accepts them.
+fn check_kinds(value: &str) -> Result<Kinds, IoError> {
     let words: Vec<&str> = value.split_whitespace().collect();
     let spatial = |k: &str| matches!(k, "domain" | "space" | "none" | "???");
-    if let ["RGB-color", a, b] = words[..] {
-        if spatial(a) && spatial(b) {
-            return Ok(true);
-        }
+    match words[..] {
+        ["RGB-color", a, b] if spatial(a) && spatial(b) => return Ok(Kinds::Colour),
+        [a, b, "list"] if spatial(a) && spatial(b) => return Ok(Kinds::Stack),
+        _ => {}
     }
     for (axis, kind) in value.split_whitespace().enumerate() {
         if !matches!(kind, "domain" | "space" | "none" | "???") {
@@ -363,7 +399,7 @@ fn check_kinds(value: &str) -> Result<bool, IoError> {
             ));
         }
     }
-    Ok(false)
+    Ok(Kinds::Space)
 }
 
 /// The `data file` field: a single file name. The multi-file forms
