@@ -43,6 +43,17 @@ pub(crate) fn available<S: Sample, T: Real>() -> bool {
         && std::arch::is_x86_feature_detected!("avx")
 }
 
+/// The starts of a point's runs ([`run_starts`]) when each run fits one
+/// 8-lane read: `W ≤ 8` and the run does not wrap around the cube.
+#[inline(always)]
+fn lane_runs<const W: usize, const POW2: bool>(
+    side: Side<POW2>,
+    taps: [i32; 3],
+) -> Option<([usize; W], [usize; W], usize)> {
+    let (lines, planes, x0) = run_starts::<W, POW2>(side, taps);
+    (W <= 8 && x0 + W <= side.n).then_some((lines, planes, x0))
+}
+
 /// [`crate::slice::taps::tap_sum_on`] for `W ≤ 8`, bit for bit, with each
 /// x-run widened and multiplied in lanes. Only for binary16 `S` and `f32`
 /// `T` ([`available`]); a run that wraps around the cube or ends within
@@ -54,10 +65,9 @@ pub(crate) fn tap_sum<const W: usize, const POW2: bool, S: Sample, T: Real>(
     taps: [i32; 3],
     [wx, wy, wz]: [&[T; W]; 3],
 ) -> T {
-    let (lines, planes, x0) = run_starts::<W, POW2>(side, taps);
-    if W > 8 || x0 + W > side.n {
+    let Some((lines, planes, x0)) = lane_runs::<W, POW2>(side, taps) else {
         return crate::slice::taps::tap_sum_on(data, side, taps, [wx, wy, wz]);
-    }
+    };
     // `T` is f32 here: these conversions are exact and fold away.
     let mut lanes = [0.0f32; 8];
     for t in 0..W {
@@ -123,10 +133,9 @@ pub(crate) fn fused_sum<const W: usize, const POW2: bool, S: Sample, T: Real>(
     taps: [i32; 3],
     [wx, wy, wz]: [&[T; W]; 3],
 ) -> T {
-    let (lines, planes, x0) = run_starts::<W, POW2>(side, taps);
-    if W > 8 || x0 + W > side.n {
+    let Some((lines, planes, x0)) = lane_runs::<W, POW2>(side, taps) else {
         return crate::slice::taps::tap_sum_on(data, side, taps, [wx, wy, wz]);
-    }
+    };
     // The lanes past `W` hold the next taps of the line (or of the next
     // line): zeroed as bits, so that no value there, finite or not, enters.
     let keep: __m128i =
@@ -220,6 +229,12 @@ mod tests {
             .collect()
     }
 
+    /// x, y and z weights of width `W`, of both signs and several scales.
+    fn weights<const W: usize>() -> [[f32; W]; 3] {
+        let w = [0.37, -1.25, 2.5e-3, 0.9, -0.061, 1.5, 0.25, -3.0];
+        [0, 3, 5].map(|shift| core::array::from_fn(|t| w[(t + shift) % 8]))
+    }
+
     /// `(Σ w·c, Σ|w·c|)` of a point's taps in f64: the exact value (every
     /// product of an f32 weight triple and a binary16 is exact in f64 to
     /// well below the bound) and the mass the bound scales with.
@@ -253,11 +268,8 @@ mod tests {
         assert!(!fused_available::<f16, f64>() && !fused_available::<f32, f32>());
         let n = 16;
         let data = samples(n * n * n);
-        let weights: [f32; 8] = [0.37, -1.25, 2.5e-3, 0.9, -0.061, 1.5, 0.25, -3.0];
-        fn check<const W: usize>(data: &[f16], n: usize, w: &[f32; 8]) -> usize {
-            let wx: [f32; W] = core::array::from_fn(|t| w[t]);
-            let wy: [f32; W] = core::array::from_fn(|t| w[(t + 3) % 8]);
-            let wz: [f32; W] = core::array::from_fn(|t| w[(t + 5) % 8]);
+        fn check<const W: usize>(data: &[f16], n: usize) -> usize {
+            let [wx, wy, wz] = weights::<W>();
             let side = Side::<true> { n };
             let u = f64::from(f32::EPSILON) / 2.0;
             let mut reordered = 0;
@@ -281,11 +293,11 @@ mod tests {
             reordered
         }
         // Not vacuous: the reordered sums differ from the core's somewhere.
-        assert!(check::<3>(&data, n, &weights) > 0);
-        assert!(check::<4>(&data, n, &weights) > 0);
-        assert!(check::<5>(&data, n, &weights) > 0);
-        assert!(check::<6>(&data, n, &weights) > 0);
-        assert!(check::<8>(&data, n, &weights) > 0);
+        assert!(check::<3>(&data, n) > 0);
+        assert!(check::<4>(&data, n) > 0);
+        assert!(check::<5>(&data, n) > 0);
+        assert!(check::<6>(&data, n) > 0);
+        assert!(check::<8>(&data, n) > 0);
 
         // A point's runs in a cube of NaN and infinities: the lanes past
         // `W`, read and dropped, change nothing.
@@ -323,11 +335,8 @@ mod tests {
         assert!(!available::<f16, f64>() && !available::<f32, f32>());
         let n = 16;
         let data = samples(n * n * n);
-        let weights: [f32; 8] = [0.37, -1.25, 2.5e-3, 0.9, -0.061, 1.5, 0.25, -3.0];
-        fn check<const W: usize>(data: &[f16], n: usize, w: &[f32; 8]) {
-            let wx: [f32; W] = core::array::from_fn(|t| w[t]);
-            let wy: [f32; W] = core::array::from_fn(|t| w[(t + 3) % 8]);
-            let wz: [f32; W] = core::array::from_fn(|t| w[(t + 5) % 8]);
+        fn check<const W: usize>(data: &[f16], n: usize) {
+            let [wx, wy, wz] = weights::<W>();
             let side = Side::<true> { n };
             // Every start, those whose runs wrap around the cube included,
             // and the last ones, whose 8-value reads pass the data's end.
@@ -344,11 +353,11 @@ mod tests {
                 }
             }
         }
-        check::<3>(&data, n, &weights);
-        check::<4>(&data, n, &weights);
-        check::<5>(&data, n, &weights);
-        check::<6>(&data, n, &weights);
-        check::<8>(&data, n, &weights);
+        check::<3>(&data, n);
+        check::<4>(&data, n);
+        check::<5>(&data, n);
+        check::<6>(&data, n);
+        check::<8>(&data, n);
 
         for len in [0, 1, 7, 8, 9, 23, 64] {
             let src = &data[100..100 + len];
