@@ -60,6 +60,57 @@ fn every_frame_is_the_render_of_its_view_bit_for_bit() {
     }
 }
 
+/// `--zoom F`: every frame is `fvr render --zoom F`'s image of its view
+/// bit for bit, F times as wide and high, with the pixel size over F; and
+/// lit or cued scenes are not a question here (project renders X-rays).
+#[test]
+fn zoomed_frames_are_the_zoomed_renders() {
+    let dir = temp_dir("project-zoom");
+    std::fs::write(dir.join("v.csv"), "1,0.45,0.3\n-1,1,1,0.2,0.3,1\n").unwrap();
+    let out = assert_ok(&fvr_line(
+        "project gaussians@32 --views v.csv --zoom 2 --out s.nrrd --quiet",
+        &dir,
+    ));
+    assert!(out.contains("(2 views of 64x64 grey)"), "{out}");
+    let (header, stack) = nrrd_payload(&dir.join("s.nrrd"));
+    assert!(header.contains("sizes: 64 64 2\n"), "{header}");
+    let (plain_header, _) = {
+        let line = "project gaussians@32 --views v.csv --out p.nrrd --quiet";
+        assert_ok(&fvr_line(line, &dir));
+        nrrd_payload(&dir.join("p.nrrd"))
+    };
+    let spacing = |h: &str| -> f64 {
+        let line = h
+            .lines()
+            .find(|l| l.starts_with("spacings:"))
+            .expect("spacings");
+        line.split_whitespace().nth(1).unwrap().parse().unwrap()
+    };
+    assert_eq!(spacing(&header) * 2.0, spacing(&plain_header), "{header}");
+    for (i, (d, u)) in [("1,0.45,0.3", "0,0,1"), ("-1,1,1", "0.2,0.3,1")]
+        .iter()
+        .enumerate()
+    {
+        let line =
+            format!("render gaussians@32 --dir {d} --up {u} --zoom 2 --out r{i}.nrrd --quiet");
+        assert_ok(&fvr_line(&line, &dir));
+        let (_, image) = nrrd_payload(&dir.join(format!("r{i}.nrrd")));
+        assert_eq!(image.len(), 64 * 64 * 4);
+        let frame = &stack[i * image.len()..(i + 1) * image.len()];
+        assert!(
+            frame == image.as_slice(),
+            "view {i} differs from fvr render --zoom 2"
+        );
+    }
+    // A zoom the transforms do not serve is refused before any work.
+    let out = fvr_line(
+        "project gaussians@32 --random 2 --zoom 7 --out z.nrrd",
+        &dir,
+    );
+    assert_error(&out, &["--zoom", "prime factor"]);
+    assert!(!dir.join("z.nrrd").exists());
+}
+
 #[test]
 fn random_views_are_saved_and_read_back_to_the_same_stack_in_npy() {
     let dir = temp_dir("project-random");
@@ -221,6 +272,18 @@ fn frames_that_overflow_f32_are_refused_by_view_number() {
     std::fs::write(dir.join("hot.raw"), data).unwrap();
     let out = fvr_line(
         "project hot.raw --raw-dims 8,8,8 --raw-type f32 --random 3 --seed 1 --out s.nrrd",
+        &dir,
+    );
+    assert_error(
+        &out,
+        &[
+            "view 0 has non-finite pixels",
+            "rescale the volume, or add --ignore-spacing",
+        ],
+    );
+    // Magnified, the same refusal by the same view.
+    let out = fvr_line(
+        "project hot.raw --raw-dims 8,8,8 --raw-type f32 --random 3 --seed 1 --zoom 2 --out s.nrrd",
         &dir,
     );
     assert_error(

@@ -57,6 +57,8 @@ pub(crate) struct ProjectArgs {
     #[command(flatten)]
     pub(crate) taper: TaperArgs,
     #[command(flatten)]
+    pub(crate) zoom: crate::zoom::ZoomArgs,
+    #[command(flatten)]
     pub(crate) input: InputArgs,
 }
 
@@ -72,10 +74,12 @@ struct ProjectExtra {
 }
 
 /// What the job holds beside the spectrum: the stack, and per-thread view
-/// buffers ([`crate::args::plan_job`]).
+/// buffers ([`crate::args::plan_job`]); with --zoom, the stack magnified
+/// and one view's zero-padded grid and its transposed copy at f64.
 fn declare_job(args: &ProjectArgs, count: usize) {
     let size = args.frame.size;
     let threads = rayon::current_num_threads() as u64;
+    let zoom = args.zoom.zoom as u64;
     crate::args::plan_job(
         &args.frame.spectrum,
         None,
@@ -85,12 +89,18 @@ fn declare_job(args: &ProjectArgs, count: usize) {
             let stack = w
                 .saturating_mul(h)
                 .saturating_mul(4)
-                .saturating_mul(count as u64);
+                .saturating_mul(count as u64)
+                .saturating_mul(zoom * zoom);
             // Each thread's view grids, as a turntable's.
             let grids = crate::args::view_grid_bytes(n).saturating_mul(threads);
-            stack.saturating_add(grids)
+            let m = n.saturating_mul(zoom);
+            let zoomed = match zoom {
+                1 => 0,
+                _ => m.saturating_mul(m).saturating_mul(16),
+            };
+            stack.saturating_add(grids).saturating_add(zoomed)
         }),
-        "use fewer views, a smaller --size, --precision f16 or --oversample 1",
+        "use fewer views, a smaller --size or --zoom, --precision f16 or --oversample 1",
     );
 }
 
@@ -145,34 +155,58 @@ pub(crate) fn project(args: &ProjectArgs) -> Result<(), Error> {
         eprintln!("fvr: warning: {w}");
     }
     let size = args.frame.size;
-    let shape = renderer.batch_shape(views.len(), size)?;
+    let zoom = args.zoom.zoom;
+    let mut shape = renderer.batch_shape(views.len(), size)?;
+    (shape.width, shape.height) = (shape.width * zoom, shape.height * zoom);
     let mut stack = vec![0.0f32; shape.len()];
     let bar = progress::count(views.len() as u64, "views");
     let t_views = Instant::now();
     let frame = shape.frame_len();
-    for (k, (chunk, out)) in views
-        .chunks(VIEWS_PER_CALL)
-        .zip(stack.chunks_mut(VIEWS_PER_CALL * frame))
-        .enumerate()
-    {
-        // The engine refuses a frame that overflows f32; the message here
-        // numbers the view in the whole job and names the options.
-        renderer
-            .render_batch_into(chunk, size, out)
-            .map_err(|e| match e {
-                PipelineError::Overflow { view, value, .. } => Error::from(format!(
-                    "view {} has non-finite pixels once stored as f32 (the first is {value}): {}",
-                    k * VIEWS_PER_CALL + view,
-                    crate::checks::overflow_cause(false, false, false)
-                )),
-                other => other.into(),
-            })?;
-        bar.inc(chunk.len() as u64);
+    // The engine refuses a frame that overflows f32; the message here
+    // numbers the view in the whole job and names the options.
+    let overflow = |view: usize, value: f32| {
+        Error::from(format!(
+            "view {view} has non-finite pixels once stored as f32 (the first is {value}): {}",
+            crate::checks::overflow_cause(false, false, false)
+        ))
+    };
+    if zoom > 1 {
+        // One magnified view at a time, each on every core: the engine's
+        // zoomed render, frame by frame.
+        let plain = Some(renderer.image_size(size)?);
+        for (k, (view, out)) in views.iter().zip(stack.chunks_mut(frame)).enumerate() {
+            let (image, _) = renderer
+                .render_zoomed(view, plain, zoom)
+                .map_err(|e| match e {
+                    PipelineError::Overflow { value, .. } => overflow(k, value),
+                    other => other.into(),
+                })?;
+            for (o, v) in out.iter_mut().zip(&image.data) {
+                *o = *v as f32;
+            }
+            bar.inc(1);
+        }
+    } else {
+        for (k, (chunk, out)) in views
+            .chunks(VIEWS_PER_CALL)
+            .zip(stack.chunks_mut(VIEWS_PER_CALL * frame))
+            .enumerate()
+        {
+            renderer
+                .render_batch_into(chunk, size, out)
+                .map_err(|e| match e {
+                    PipelineError::Overflow { view, value, .. } => {
+                        overflow(k * VIEWS_PER_CALL + view, value)
+                    }
+                    other => other.into(),
+                })?;
+            bar.inc(chunk.len() as u64);
+        }
     }
     bar.finish_and_clear();
     let t_views = t_views.elapsed();
     let t_write = Instant::now();
-    let pixel_size = renderer.sampling().pixel_size();
+    let pixel_size = renderer.zoomed_sampling(zoom)?.pixel_size();
     let stack_shape = StackShape {
         views: shape.views,
         channels: shape.channels,
@@ -205,7 +239,7 @@ pub(crate) fn project(args: &ProjectArgs) -> Result<(), Error> {
         views: views.len(),
         views_time: t_views,
         output: &args.out,
-        zoom: 1,
+        zoom,
         taper,
     };
     if args.report.stats_json {
