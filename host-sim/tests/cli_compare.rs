@@ -137,6 +137,26 @@ fn stacks_of_views_are_compared_view_by_view() {
     assert_eq!(out.status.code(), Some(0), "{out:?}");
     let v = json(&out.stdout);
     assert_eq!(v["views"], 5);
+    // The same stacks as `.npy` (and one of each) give the same figures.
+    for (name, filter) in [("fine", "kb6 --oversample 2"), ("coarse", "linear")] {
+        let cmd = format!(
+            "project gaussians@32 --random 5 --seed 3 --filter {filter} --out {name}.npy --quiet"
+        );
+        assert_eq!(fvr_line(&cmd, &dir).status.code(), Some(0));
+    }
+    for pair in ["fine.npy coarse.npy", "fine.nrrd coarse.npy"] {
+        let w = json(&fvr_line(&format!("compare {pair} --json"), &dir).stdout);
+        for key in [
+            "views",
+            "width",
+            "height",
+            "snr_db",
+            "worst_view",
+            "worst_view_db",
+        ] {
+            assert_eq!(w[key], v[key], "{pair}: {key}");
+        }
+    }
     assert_eq!(
         (v["width"].clone(), v["height"].clone()),
         (32.into(), 32.into())

@@ -31,6 +31,7 @@ pub mod inputs;
 pub mod inv3;
 pub mod nifti;
 mod nifti_encode;
+pub mod npy;
 pub mod nrrd;
 pub mod paths;
 pub mod stack;

@@ -1,14 +1,16 @@
 //! `fvr compare`: the SNR of one NRRD image against another, as a line or
 //! as JSON, optionally gated by a least SNR (`--min-db`, exit 1 below it).
-//! Stacks of views (`fvr project`'s) are also compared view by view, and
-//! gated on their worst view.
+//! Stacks of views (`fvr project`'s, NRRD or `.npy`) are also compared
+//! view by view, and gated on their worst view.
 
 use crate::Error;
 use std::path::PathBuf;
 
 use clap::Args;
 
-use fvr_host::io::nrrd::{read_nrrd_image_kind as read_nrrd, ImageKind};
+use fvr_host::io::npy::{is_npy, read_npy_image};
+use fvr_host::io::nrrd::{read_nrrd_image_kind, ImageKind};
+use fvr_host::io::IoError;
 use fvr_host::reference::{max_abs_error, snr_db};
 
 #[derive(Args)]
@@ -58,11 +60,11 @@ pub(crate) fn compare(args: &CompareArgs) -> Result<(), Error> {
         }
         budget
     });
-    let (ia, kind) = read_nrrd(a)?;
+    let (ia, kind) = read_image(a)?;
     first_read.store(true, std::sync::atomic::Ordering::SeqCst);
     // The first image counts against the limit while the second is read.
     let _first = fvr_host::budget::hold(ia.data.len() as u64 * 4);
-    let (ib, _) = read_nrrd(b)?;
+    let (ib, _) = read_image(b)?;
     if ia.dims != ib.dims {
         return Err(format!("images differ in size: {:?} against {:?}", ia.dims, ib.dims).into());
     }
@@ -133,6 +135,18 @@ pub(crate) fn compare(args: &CompareArgs) -> Result<(), Error> {
         ))));
     }
     Ok(())
+}
+
+/// An image or stack: a `.npy` file (by its magic bytes) or a NRRD one.
+fn read_image(path: &std::path::Path) -> Result<(fvr_engine::volume::Volume, ImageKind), IoError> {
+    let mut lead = [0u8; 6];
+    let npy = fvr_host::io::open_file(path)
+        .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut lead))
+        .is_ok_and(|()| is_npy(&lead));
+    match npy {
+        true => read_npy_image(path),
+        false => read_nrrd_image_kind(path),
+    }
 }
 
 /// The view (from 0) with the lowest SNR among `views` equal slices, and
