@@ -10,7 +10,8 @@
 //! table, then the pass that splits the even and odd spectra and forms
 //! `H = Re X ∓ Im X` (`core/src/dht/mixed/`).
 
-use fvr_core::dht::mixed::butterfly::{even_split, radix2, radix3, radix4, radix5, twiddle, C};
+use fvr_core::dht::mixed::butterfly::{even_split, C};
+use fvr_core::dht::mixed::stage::{run_stages, Stage, StageKernel};
 use fvr_core::num::Real;
 
 /// Lines transformed together.
@@ -72,32 +73,12 @@ impl<T: Real> Lanes<T> {
                 }
             }
         }
-        let mut in_b = false;
-        let (mut s, mut m) = (1, half);
-        for &r in &self.radices {
-            m /= r;
-            let [ar, ai] = &mut self.a;
-            let [br, bi] = &mut self.b;
-            let (x, y) = if in_b {
-                ([&br[..], &bi[..]], [&mut ar[..], &mut ai[..]])
-            } else {
-                ([&ar[..], &ai[..]], [&mut br[..], &mut bi[..]])
-            };
-            let st = Stage {
-                m,
-                s,
-                table: &self.table,
-                step: 2 * s,
-            };
-            match r {
-                2 => st.run::<2>(x, y, radix2),
-                3 => st.run::<3>(x, y, radix3),
-                4 => st.run::<4>(x, y, radix4),
-                _ => st.run::<5>(x, y, radix5),
-            }
-            in_b = !in_b;
-            s *= r;
-        }
+        let radices = self.radices.iter().copied();
+        let mut buffers = Planes {
+            a: &mut self.a,
+            b: &mut self.b,
+        };
+        let in_b = run_stages(&mut buffers, half, radices, &self.table, 2);
         let (z, out) = if in_b {
             (&self.b, &mut self.a)
         } else {
@@ -169,27 +150,31 @@ fn lanes_mut<T>(values: &mut [T], at: usize) -> &mut [T; LANES] {
         .expect("a whole run of lanes")
 }
 
-/// One Stockham stage (the core's `Stage`), every complex value a run of
-/// lanes.
-struct Stage<'t, T> {
-    m: usize,
-    s: usize,
-    table: &'t [T],
-    /// Table index of `ω_ℓ^1`.
-    step: usize,
+/// The two ping-pong buffers of the FFT, each a complex plane of runs of
+/// lanes (real and imaginary parts apart).
+struct Planes<'a, T> {
+    a: &'a mut [Vec<T>; 2],
+    b: &'a mut [Vec<T>; 2],
 }
 
-impl<T: Real> Stage<'_, T> {
+/// One Stockham stage, every complex value a run of lanes.
+impl<T: Real> StageKernel<T> for Planes<'_, T> {
     /// Element `p` of input sub-transform `q`, for `j`, sits at complex
     /// index `p·s + j·m·s + q`; the output for `k` at `p·R·s + k·s + q`.
     #[inline(always)]
     fn run<const R: usize>(
-        &self,
-        [xr, xi]: [&[T]; 2],
-        [yr, yi]: [&mut [T]; 2],
+        &mut self,
+        stage: &Stage<'_, T>,
+        from_b: bool,
         bfly: impl Fn([C<T>; R]) -> [C<T>; R],
     ) {
-        let (m, s) = (self.m, self.s);
+        let ([ar, ai], [br, bi]) = (&mut *self.a, &mut *self.b);
+        let ([xr, xi], [yr, yi]): ([&[T]; 2], [&mut [T]; 2]) = if from_b {
+            ([br, bi], [ar, ai])
+        } else {
+            ([ar, ai], [br, bi])
+        };
+        let (m, s) = (stage.m, stage.s);
         let block = R * s * LANES;
         for (p, (out_r, out_i)) in yr
             .chunks_exact_mut(block)
@@ -197,7 +182,7 @@ impl<T: Real> Stage<'_, T> {
             .enumerate()
             .take(m)
         {
-            let w: [C<T>; R] = core::array::from_fn(|k| self.twiddle(p * k));
+            let w: [C<T>; R] = core::array::from_fn(|k| stage.twiddle(p * k));
             let mut chunks_r = out_r.chunks_exact_mut(s * LANES);
             let mut chunks_i = out_i.chunks_exact_mut(s * LANES);
             let mut outs_r: [&mut [T]; R] =
@@ -225,11 +210,5 @@ impl<T: Real> Stage<'_, T> {
                 }
             }
         }
-    }
-
-    /// `ω_ℓ^e`, `e < ℓ`.
-    #[inline(always)]
-    fn twiddle(&self, e: usize) -> C<T> {
-        twiddle(self.table, self.step, e)
     }
 }

@@ -2,15 +2,11 @@
 //! (`X(t) = Σ z(x) e^{−2πixt/F}`), ping-ponging between two buffers of
 //! interleaved complex values.
 //!
-//! A stage of radix `r` on sub-transforms of length `ℓ = r·m`, `s` of them
-//! interleaved (element `p` of sub-transform `q` at `q + s·p`), splits each
-//! input index as `p + j·m` and each output index as `k + r·t`:
-//! `X(k + r·t) = Σ_p ω_m^{pt} · [ω_ℓ^{pk} · Σ_j z(p + j·m) ω_r^{jk}]`,
-//! so the bracket, stored at `q + s·(r·p + k)`, is element `p` of
-//! sub-transform `q + s·k` of length `m` at stride `r·s`. The output of the
-//! last stage (`m = 1`) is in natural order; no permutation pass.
+//! The stages themselves are [`super::stage`]'s; this file is their
+//! kernel on interleaved buffers.
 
-use super::butterfly::{radix2, radix3, radix4, radix5, twiddle, C};
+use super::butterfly::C;
+use super::stage::{run_stages, Stage, StageKernel};
 use crate::num::Real;
 
 /// Forward FFT of the `f = len/2` complex values in `a` (interleaved), with
@@ -24,48 +20,34 @@ pub(super) fn fft<T: Real>(
     g: usize,
 ) -> bool {
     let f = a.len() / 2;
-    let mut s = 1;
-    let mut m = f;
-    let mut in_b = false;
-    for &r in radices {
-        let r = r as usize;
-        m /= r;
-        let (x, y): (&[T], &mut [T]) = if in_b { (&*b, &mut *a) } else { (&*a, &mut *b) };
-        let st = Stage {
-            m,
-            s,
-            table,
-            step: g * s,
-        };
-        match r {
-            2 => st.run::<2>(x, y, radix2),
-            3 => st.run::<3>(x, y, radix3),
-            4 => st.run::<4>(x, y, radix4),
-            _ => st.run::<5>(x, y, radix5),
-        }
-        in_b = !in_b;
-        s *= r;
-    }
-    in_b
+    let radices = radices.iter().map(|&r| r as usize);
+    run_stages(&mut Interleaved { a, b }, f, radices, table, g)
 }
 
-struct Stage<'t, T> {
-    m: usize,
-    s: usize,
-    table: &'t [T],
-    /// Table index of `ω_ℓ^1`.
-    step: usize,
+/// The two buffers of interleaved complex values.
+struct Interleaved<'a, T> {
+    a: &'a mut [T],
+    b: &'a mut [T],
 }
 
-impl<T: Real> Stage<'_, T> {
-    /// One stage of radix `R` from `x` into `y`.
+impl<T: Real> StageKernel<T> for Interleaved<'_, T> {
     #[inline(always)]
-    fn run<const R: usize>(&self, x: &[T], y: &mut [T], bfly: impl Fn([C<T>; R]) -> [C<T>; R]) {
-        let (m, s) = (self.m, self.s);
+    fn run<const R: usize>(
+        &mut self,
+        stage: &Stage<'_, T>,
+        from_b: bool,
+        bfly: impl Fn([C<T>; R]) -> [C<T>; R],
+    ) {
+        let (x, y): (&[T], &mut [T]) = if from_b {
+            (&*self.b, &mut *self.a)
+        } else {
+            (&*self.a, &mut *self.b)
+        };
+        let (m, s) = (stage.m, stage.s);
         let run = 2 * s; // reals in one run of s complex values
         let span = 2 * m * s; // reals from input index p to p + m
         for (p, out) in y.chunks_exact_mut(R * run).enumerate().take(m) {
-            let w: [C<T>; R] = core::array::from_fn(|k| self.twiddle(p * k));
+            let w: [C<T>; R] = core::array::from_fn(|k| stage.twiddle(p * k));
             let ins: [&[T]; R] = core::array::from_fn(|j| {
                 let start = p * run + j * span;
                 x.get(start..start + run).unwrap_or(&[])
@@ -91,11 +73,5 @@ impl<T: Real> Stage<'_, T> {
                 }
             }
         }
-    }
-
-    /// `ω_ℓ^e`, `e < ℓ`.
-    #[inline(always)]
-    fn twiddle(&self, e: usize) -> C<T> {
-        twiddle(self.table, self.step, e)
     }
 }

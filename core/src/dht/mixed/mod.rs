@@ -28,6 +28,7 @@ mod fft;
 mod line;
 mod multi;
 mod plan;
+pub mod stage;
 
 pub use line::{dht_mixed, idht_mixed};
 pub use multi::{
