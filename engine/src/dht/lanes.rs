@@ -162,19 +162,14 @@ impl<T: Real> StageKernel<T> for Planes<'_, T> {
     /// Element `p` of input sub-transform `q`, for `j`, sits at complex
     /// index `p·s + j·m·s + q`; the output for `k` at `p·R·s + k·s + q`.
     #[inline(always)]
-    fn run<const R: usize>(
-        &mut self,
-        stage: &Stage<'_, T>,
-        from_b: bool,
-        bfly: impl Fn([C<T>; R]) -> [C<T>; R],
-    ) {
+    fn run<const R: usize>(&mut self, st: &Stage<T>, bfly: impl Fn([C<T>; R]) -> [C<T>; R]) {
         let ([ar, ai], [br, bi]) = (&mut *self.a, &mut *self.b);
-        let ([xr, xi], [yr, yi]): ([&[T]; 2], [&mut [T]; 2]) = if from_b {
+        let ([xr, xi], [yr, yi]): ([&[T]; 2], [&mut [T]; 2]) = if st.from_b {
             ([br, bi], [ar, ai])
         } else {
             ([ar, ai], [br, bi])
         };
-        let (m, s) = (stage.m, stage.s);
+        let (m, s) = (st.m, st.s);
         let block = R * s * LANES;
         for (p, (out_r, out_i)) in yr
             .chunks_exact_mut(block)
@@ -182,7 +177,7 @@ impl<T: Real> StageKernel<T> for Planes<'_, T> {
             .enumerate()
             .take(m)
         {
-            let w: [C<T>; R] = core::array::from_fn(|k| stage.twiddle(p * k));
+            let w: [C<T>; R] = core::array::from_fn(|k| st.twiddle(p * k));
             let mut chunks_r = out_r.chunks_exact_mut(s * LANES);
             let mut chunks_i = out_i.chunks_exact_mut(s * LANES);
             let mut outs_r: [&mut [T]; R] =

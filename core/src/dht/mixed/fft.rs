@@ -32,22 +32,17 @@ struct Interleaved<'a, T> {
 
 impl<T: Real> StageKernel<T> for Interleaved<'_, T> {
     #[inline(always)]
-    fn run<const R: usize>(
-        &mut self,
-        stage: &Stage<'_, T>,
-        from_b: bool,
-        bfly: impl Fn([C<T>; R]) -> [C<T>; R],
-    ) {
-        let (x, y): (&[T], &mut [T]) = if from_b {
+    fn run<const R: usize>(&mut self, st: &Stage<T>, bfly: impl Fn([C<T>; R]) -> [C<T>; R]) {
+        let (x, y): (&[T], &mut [T]) = if st.from_b {
             (&*self.b, &mut *self.a)
         } else {
             (&*self.a, &mut *self.b)
         };
-        let (m, s) = (stage.m, stage.s);
+        let (m, s) = (st.m, st.s);
         let run = 2 * s; // reals in one run of s complex values
         let span = 2 * m * s; // reals from input index p to p + m
         for (p, out) in y.chunks_exact_mut(R * run).enumerate().take(m) {
-            let w: [C<T>; R] = core::array::from_fn(|k| stage.twiddle(p * k));
+            let w: [C<T>; R] = core::array::from_fn(|k| st.twiddle(p * k));
             let ins: [&[T]; R] = core::array::from_fn(|j| {
                 let start = p * run + j * span;
                 x.get(start..start + run).unwrap_or(&[])

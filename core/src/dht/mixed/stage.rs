@@ -23,6 +23,8 @@ pub struct Stage<'t, T> {
     pub m: usize,
     /// Sub-transforms interleaved on input.
     pub s: usize,
+    /// The data is in the second buffer (and goes into the first).
+    pub from_b: bool,
     table: &'t [T],
     /// Table index of `ω_ℓ^1`.
     step: usize,
@@ -37,16 +39,11 @@ impl<T: Real> Stage<'_, T> {
 }
 
 /// A memory layout's stage: one stage of radix `R`, from the buffer that
-/// holds the data (the second one if `from_b`) into the other, each
-/// `R`-point butterfly computed by `bfly`.
+/// holds the data (the second one if [`Stage::from_b`]) into the other,
+/// each `R`-point butterfly computed by `bfly`.
 pub trait StageKernel<T> {
-    /// Runs `stage`.
-    fn run<const R: usize>(
-        &mut self,
-        stage: &Stage<'_, T>,
-        from_b: bool,
-        bfly: impl Fn([C<T>; R]) -> [C<T>; R],
-    );
+    /// Runs `st`.
+    fn run<const R: usize>(&mut self, st: &Stage<T>, bfly: impl Fn([C<T>; R]) -> [C<T>; R]);
 }
 
 /// Every stage of the forward FFT of `f` complex values, radices in order
@@ -67,14 +64,15 @@ pub fn run_stages<T: Real, K: StageKernel<T>>(
         let stage = Stage {
             m,
             s,
+            from_b: in_b,
             table,
             step: g * s,
         };
         match r {
-            2 => kernel.run::<2>(&stage, in_b, radix2),
-            3 => kernel.run::<3>(&stage, in_b, radix3),
-            4 => kernel.run::<4>(&stage, in_b, radix4),
-            _ => kernel.run::<5>(&stage, in_b, radix5),
+            2 => kernel.run::<2>(&stage, radix2),
+            3 => kernel.run::<3>(&stage, radix3),
+            4 => kernel.run::<4>(&stage, radix4),
+            _ => kernel.run::<5>(&stage, radix5),
         }
         in_b = !in_b;
         s *= r;
