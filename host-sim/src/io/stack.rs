@@ -27,6 +27,16 @@ pub struct StackShape {
 }
 
 impl StackShape {
+    /// The sizes of the stack's axes, fastest first: the channels (colour
+    /// only), then width, height and views.
+    fn sizes(&self) -> Vec<usize> {
+        let colour = (self.channels != 1).then_some(self.channels);
+        colour
+            .into_iter()
+            .chain([self.width, self.height, self.views])
+            .collect()
+    }
+
     /// Values in the whole stack.
     pub fn len(&self) -> usize {
         self.views * self.channels * self.width * self.height
@@ -62,27 +72,18 @@ impl StackFormat {
 /// The NRRD header of a stack whose pixels are `pixel_size` apart (mm, or
 /// voxels in voxel units).
 pub fn nrrd_header(shape: StackShape, pixel_size: f64) -> String {
-    let StackShape {
-        views,
-        channels,
-        width,
-        height,
-    } = shape;
-    let (dimension, sizes, kinds, spacings) = if channels == 1 {
-        (
-            3,
-            format!("{width} {height} {views}"),
-            "space space list",
-            format!("{pixel_size} {pixel_size} nan"),
-        )
+    let sizes = shape.sizes();
+    let (kinds, spacings) = if shape.channels == 1 {
+        ("space space list", format!("{pixel_size} {pixel_size} nan"))
     } else {
         (
-            4,
-            format!("{channels} {width} {height} {views}"),
             "RGB-color space space list",
             format!("nan {pixel_size} {pixel_size} nan"),
         )
     };
+    let (views, dimension) = (shape.views, sizes.len());
+    let sizes: Vec<String> = sizes.iter().map(usize::to_string).collect();
+    let sizes = sizes.join(" ");
     format!(
         "NRRD0004\n# {views} projections by fvr: one frame per view, row 0 at the top\n\
          type: float\ndimension: {dimension}\nsizes: {sizes}\nkinds: {kinds}\n\
@@ -94,17 +95,9 @@ pub fn nrrd_header(shape: StackShape, pixel_size: f64) -> String {
 /// header's length and the dictionary, padded with spaces to a multiple of
 /// 64 bytes and ended by a newline, as NumPy's format document asks.
 pub fn npy_header(shape: StackShape) -> Vec<u8> {
-    let StackShape {
-        views,
-        channels,
-        width,
-        height,
-    } = shape;
-    let dims = if channels == 1 {
-        format!("({views}, {height}, {width})")
-    } else {
-        format!("({views}, {height}, {width}, {channels})")
-    };
+    // NumPy's C order: slowest axis first.
+    let dims: Vec<String> = shape.sizes().iter().rev().map(usize::to_string).collect();
+    let dims = format!("({})", dims.join(", "));
     let mut dict = format!("{{'descr': '<f4', 'fortran_order': False, 'shape': {dims}, }}");
     // 6 magic + 2 version + 2 length bytes, then the dictionary and '\n'.
     while (10 + dict.len() + 1) % 64 != 0 {
