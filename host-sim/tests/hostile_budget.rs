@@ -7,7 +7,7 @@ mod common;
 use std::io::Write;
 use std::path::Path;
 
-use common::{assert_error, assert_ok, fvr_line, temp_dir};
+use common::{assert_error, assert_ok, fvr_line, fvr_ok, temp_dir};
 use fvr_host::image::output::{ApngStream, Style};
 
 /// A NRRD header declaring `sizes` of uchar, followed by `data` (which may
@@ -35,10 +35,7 @@ fn a_thin_volume_is_not_padded_into_a_huge_cube() {
     }
     // A slab within the ratio renders.
     nrrd_header(&dir, "slab.nrrd", "32 32 2", "raw", &[1u8; 2048]);
-    assert_ok(&fvr_line(
-        "render slab.nrrd --dir 0,0,1 --up 0,1,0 --out s.png",
-        &dir,
-    ));
+    fvr_ok("render slab.nrrd --dir 0,0,1 --up 0,1,0 --out s.png", &dir);
 }
 
 /// The gzip data is the 10-byte header of a stream declared to inflate to
@@ -113,7 +110,7 @@ fn compare_plans_for_both_images() {
 fn spectra_of_a_scene_are_summed() {
     let dir = temp_dir("budget-scene");
     let base = "--max-memory 120M render sphere@128 --oversample 2 --dir 1,0,0 --out x.png";
-    assert_ok(&fvr_line(base, &dir));
+    fvr_ok(base, &dir);
     let out = fvr_line(&format!("{base} --light 0,1,0:1"), &dir);
     assert_error(&out, &["this job needs about", "spectrum", "--max-memory"]);
 }
@@ -154,18 +151,18 @@ fn an_unfinished_animation_leaves_nothing_behind() {
     std::fs::write(&path, b"the previous animation").unwrap();
     let style = Style::default();
     {
-        let mut s = ApngStream::create(&path, (4, 2), 2, 10, &style, (0.0, 1.0)).unwrap();
+        let mut s = ApngStream::create(&path, (4, 2), 2, 10, &style, (0.0, 1.0), false).unwrap();
         s.push(&[0.5; 8]).unwrap();
         assert!(s.push(&[0.5; 7]).is_err(), "a frame of the wrong size");
         // Dropped after one of two frames.
     }
-    let mut s = ApngStream::create(&path, (4, 2), 2, 10, &style, (0.0, 1.0)).unwrap();
+    let mut s = ApngStream::create(&path, (4, 2), 2, 10, &style, (0.0, 1.0), false).unwrap();
     s.push(&[0.5; 8]).unwrap();
     let e = s.finish().unwrap_err();
     assert!(e.contains("1 frames were never written"), "{e}");
     assert_eq!(std::fs::read(&path).unwrap(), b"the previous animation");
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
-    let mut s = ApngStream::create(&path, (4, 2), 1, 10, &style, (0.0, 1.0)).unwrap();
+    let mut s = ApngStream::create(&path, (4, 2), 1, 10, &style, (0.0, 1.0), false).unwrap();
     s.push(&[0.25; 8]).unwrap();
     assert!(s.push(&[0.25; 8]).is_err(), "more frames than declared");
     s.finish().unwrap();

@@ -27,48 +27,15 @@ pub struct ApngStream {
 impl ApngStream {
     /// Start an animation of `frames` frames of `width × height` at `fps`
     /// frames per second, looping forever, each frame mapped through the
-    /// window `range` in `style`.
+    /// window `range` in `style`; or, if `rgb`, of 8-bit RGB frames of
+    /// `width × height` interleaved R, G, B values, all three mapped
+    /// through the window `range` (one window keeps the lights' colour
+    /// balance, as [`crate::image::ImageFiles::write_png`] does).
     ///
     /// # Errors
     /// No frames, a frame rate outside 1–1000, a size PNG cannot store, or
     /// file creation failure; the message names the path.
     pub fn create(
-        path: &Path,
-        (width, height): (usize, usize),
-        frames: usize,
-        fps: u16,
-        style: &Style,
-        range: (f64, f64),
-    ) -> Result<Self, String> {
-        Self::start(path, (width, height), frames, fps, style, range, false)
-    }
-
-    /// Start an 8-bit RGB animation like [`ApngStream::create`]: each frame
-    /// holds `width × height` interleaved R, G, B values, all three mapped
-    /// through the window `range` (one window keeps the lights' colour
-    /// balance, as [`crate::image::ImageFiles::write_png`] does).
-    ///
-    /// # Errors
-    /// As [`ApngStream::create`].
-    pub fn create_rgb(
-        path: &Path,
-        (width, height): (usize, usize),
-        frames: usize,
-        fps: u16,
-        range: (f64, f64),
-    ) -> Result<Self, String> {
-        Self::start(
-            path,
-            (width, height),
-            frames,
-            fps,
-            &Style::default(),
-            range,
-            true,
-        )
-    }
-
-    fn start(
         path: &Path,
         (width, height): (usize, usize),
         frames: usize,
@@ -199,7 +166,15 @@ pub fn write_apng(
         Window::Range(lo, hi) => (lo, hi),
         Window::Percentiles(..) => style.window.resolve(&frames.concat()),
     };
-    let mut stream = ApngStream::create(path, (width, height), frames.len(), fps, style, range)?;
+    let mut stream = ApngStream::create(
+        path,
+        (width, height),
+        frames.len(),
+        fps,
+        style,
+        range,
+        false,
+    )?;
     for frame in frames {
         stream.push(frame)?;
     }

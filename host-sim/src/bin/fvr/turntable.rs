@@ -376,11 +376,8 @@ fn write_frames(
     let window_time = t.elapsed();
     let (w, h) = source.image;
     let create = || -> Result<ApngStream, String> {
-        if channels == 1 {
-            ApngStream::create(&args.out, (w, h), views.len(), args.fps, &style, range)
-        } else {
-            ApngStream::create_rgb(&args.out, (w, h), views.len(), args.fps, range)
-        }
+        let rgb = channels != 1;
+        ApngStream::create(&args.out, (w, h), views.len(), args.fps, &style, range, rgb)
     };
     let mut encode = window_time;
     if !kept.is_empty() {
