@@ -3,7 +3,7 @@
 //! names are refused in one line before any work.
 
 mod common;
-use common::{assert_error, assert_ok, fvr_line, temp_dir};
+use common::{assert_error, fvr_line, fvr_ok, temp_dir};
 
 use fvr_host::io::nrrd::{encode_nrrd, read_nrrd, Encoding, Endian, SampleType};
 use fvr_host::sources::{load_volume, RawLayout};
@@ -15,7 +15,7 @@ fn phantom_round_trips() {
     let dir = temp_dir("convert-phantom");
     let expected = load_volume("gaussians@24", None).unwrap();
     for _ in 0..2 {
-        assert_ok(&fvr_line("convert gaussians@24 --out g.nrrd --quiet", &dir));
+        fvr_ok("convert gaussians@24 --out g.nrrd --quiet", &dir);
         let back = read_nrrd(&dir.join("g.nrrd")).unwrap();
         assert_eq!(back.dims, expected.dims);
         assert_eq!(back.data, expected.data);
@@ -39,10 +39,7 @@ fn spacing_and_background_are_kept() {
     with_spacing.extend_from_slice(&bytes[header_end + 1..]);
     std::fs::write(dir.join("ct.nrrd"), with_spacing).unwrap();
 
-    assert_ok(&fvr_line(
-        "convert ct.nrrd --background -20 --out f.nrrd",
-        &dir,
-    ));
+    fvr_ok("convert ct.nrrd --background -20 --out f.nrrd", &dir);
     let back = read_nrrd(&dir.join("f.nrrd")).unwrap();
     assert_eq!(back.dims, dims);
     assert_eq!(back.spacing, [0.957031, 0.957031, 1.5]);
@@ -58,10 +55,10 @@ fn raw_input_converts() {
     let samples: Vec<u16> = (0..60u16).map(|n| n * 1000).collect();
     let bytes: Vec<u8> = samples.iter().flat_map(|v| v.to_le_bytes()).collect();
     std::fs::write(dir.join("v.raw"), bytes).unwrap();
-    assert_ok(&fvr_line(
+    fvr_ok(
         "convert v.raw --raw-dims 5,4,3 --raw-type u16 --out v.nrrd",
         &dir,
-    ));
+    );
     let back = read_nrrd(&dir.join("v.nrrd")).unwrap();
     let expected = load_volume(
         dir.join("v.raw").to_str().unwrap(),
@@ -88,7 +85,7 @@ fn bad_outputs_are_refused() {
     assert!(!dir.join("g.png").exists());
     let out = fvr_line("convert gaussians@16 --out missing/g.nrrd", &dir);
     assert_error(&out, &["missing/g.nrrd", "its directory does not exist"]);
-    assert_ok(&fvr_line("convert gaussians@16 --out g.nrrd", &dir));
+    fvr_ok("convert gaussians@16 --out g.nrrd", &dir);
     let before = std::fs::read(dir.join("g.nrrd")).unwrap();
     let out = fvr_line("convert g.nrrd --out g.nrrd", &dir);
     assert_error(&out, &["refusing to overwrite an input"]);

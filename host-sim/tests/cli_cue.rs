@@ -4,7 +4,7 @@
 //! differs from the X-ray one; an explicit window applies as given.
 
 mod common;
-use common::{assert_ok, fvr_line, grey_png as grey, temp_dir};
+use common::{fvr_ok, grey_png as grey, temp_dir};
 
 fn mean_abs_diff(a: &[u8], b: &[u8]) -> f64 {
     assert_eq!(a.len(), b.len());
@@ -21,14 +21,11 @@ fn mean_abs_diff(a: &[u8], b: &[u8]) -> f64 {
 #[test]
 fn a_cued_render_differs_visibly_from_the_xray_render() {
     let dir = temp_dir("cue-visible");
-    assert_ok(&fvr_line(
-        "render sphere@32 --dir 0,1,0 --out plain.png --quiet",
-        &dir,
-    ));
-    let out = assert_ok(&fvr_line(
+    fvr_ok("render sphere@32 --dir 0,1,0 --out plain.png --quiet", &dir);
+    let out = fvr_ok(
         "render sphere@32 --dir 0,1,0 --depth-cue linear:1,0.3 --out cued.png --stats-json",
         &dir,
-    ));
+    );
     let stats: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
     assert_eq!(stats["cue_window"], true, "{stats}");
     let (_, plain) = grey(&dir.join("plain.png"));
@@ -70,13 +67,13 @@ fn near_content_is_brighter_than_far_content() {
         (left as f64, right as f64)
     };
     let render = "render cubes.raw --raw-dims 32,32,32 --dir 0,1,0 --quiet";
-    assert_ok(&fvr_line(&format!("{render} --out plain.png"), &dir));
+    fvr_ok(&format!("{render} --out plain.png"), &dir);
     let (l, r) = halves("plain.png");
     assert!((l - r).abs() <= 2.0, "X-ray: near {l}, far {r}");
-    assert_ok(&fvr_line(
+    fvr_ok(
         &format!("{render} --depth-cue linear:1,0.3 --out cued.png"),
         &dir,
-    ));
+    );
     let (near, far) = halves("cued.png");
     assert!(near > 1.5 * far && far > 0.0, "near {near}, far {far}");
     // The near cube is dimmed by its weight (about 0.8), not stretched back
@@ -89,11 +86,8 @@ fn near_content_is_brighter_than_far_content() {
 fn an_explicit_window_is_untouched() {
     let dir = temp_dir("cue-window");
     let base = "render sphere@32 --dir 0,1,0 --depth-cue linear:1,0.3 --quiet";
-    assert_ok(&fvr_line(
-        &format!("{base} --window 40 --level 20 --out w.png"),
-        &dir,
-    ));
-    assert_ok(&fvr_line(&format!("{base} --out w.nrrd"), &dir));
+    fvr_ok(&format!("{base} --window 40 --level 20 --out w.png"), &dir);
+    fvr_ok(&format!("{base} --out w.nrrd"), &dir);
     let bytes = std::fs::read(dir.join("w.nrrd")).unwrap();
     let end = bytes.windows(2).position(|w| w == b"\n\n").unwrap() + 2;
     let values: Vec<f32> = bytes[end..]
@@ -113,14 +107,14 @@ fn an_explicit_window_is_untouched() {
 #[test]
 fn a_cued_turntable_takes_the_cue_aware_window() {
     let dir = temp_dir("cue-turntable");
-    assert_ok(&fvr_line(
+    fvr_ok(
         "render sphere@32 --dir 0,-1,0 --depth-cue linear:1,0.3 --out r.png --quiet",
         &dir,
-    ));
-    assert_ok(&fvr_line(
+    );
+    fvr_ok(
         "turntable sphere@32 --frames 1 --depth-cue linear:1,0.3 --out t.apng --quiet",
         &dir,
-    ));
+    );
     let (_, render) = grey(&dir.join("r.png"));
     let (_, frame) = grey(&dir.join("t.apng"));
     assert!(

@@ -4,7 +4,7 @@
 //! turntables are one line, exit 2, nothing written.
 
 mod common;
-use common::{assert_error, assert_ok, fvr_line, grey_png, temp_dir};
+use common::{assert_error, fvr_line, fvr_ok, grey_png, temp_dir};
 
 /// The f32 samples of a NRRD fvr wrote (raw, little-endian).
 fn samples(path: &std::path::Path) -> Vec<f32> {
@@ -20,21 +20,18 @@ fn samples(path: &std::path::Path) -> Vec<f32> {
 fn film_orders_pixels_as_the_integrals_and_keeps_the_nrrd() {
     let dir = temp_dir("film");
     let view = "render sphere@32 --dir 1,0.3,0.2";
-    assert_ok(&fvr_line(&format!("{view} --out p.nrrd --quiet"), &dir));
-    assert_ok(&fvr_line(
-        &format!("{view} --display film --out q.nrrd --quiet"),
-        &dir,
-    ));
+    fvr_ok(&format!("{view} --out p.nrrd --quiet"), &dir);
+    fvr_ok(&format!("{view} --display film --out q.nrrd --quiet"), &dir);
     assert_eq!(
         std::fs::read(dir.join("p.nrrd")).unwrap(),
         std::fs::read(dir.join("q.nrrd")).unwrap(),
         "an NRRD keeps the line integrals"
     );
-    assert_ok(&fvr_line(&format!("{view} --out lin.png --quiet"), &dir));
-    assert_ok(&fvr_line(
+    fvr_ok(&format!("{view} --out lin.png --quiet"), &dir);
+    fvr_ok(
         &format!("{view} --display film --out film.png --quiet"),
         &dir,
-    ));
+    );
     let p = samples(&dir.join("p.nrrd"));
     let (_, lin) = grey_png(&dir.join("lin.png"));
     let (_, film) = grey_png(&dir.join("film.png"));
@@ -77,10 +74,10 @@ fn film_orders_pixels_as_the_integrals_and_keeps_the_nrrd() {
         mean(&lin)
     );
     // An explicit gain is used as given: a tiny one keeps everything dark.
-    assert_ok(&fvr_line(
+    fvr_ok(
         &format!("{view} --display film:1e-6 --out dim.png --quiet"),
         &dir,
-    ));
+    );
     let (_, dim) = grey_png(&dir.join("dim.png"));
     assert!(dim.iter().all(|&v| v <= 1), "{:?}", dim.iter().max());
 }

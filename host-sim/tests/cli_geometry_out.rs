@@ -4,7 +4,7 @@
 //! origin as `space`, `space directions` and `space origin`.
 
 mod common;
-use common::{assert_ok, fvr_line, temp_dir};
+use common::{assert_ok, fvr_line, fvr_ok, temp_dir};
 
 use fvr_engine::volume::Orientation;
 use fvr_host::io::nifti::{encode_nifti_f32, offsets};
@@ -20,33 +20,30 @@ fn header(path: &std::path::Path) -> String {
 #[test]
 fn rendered_nrrd_headers_carry_kinds_and_pixel_size() {
     let dir = temp_dir("geometry-render");
-    assert_ok(&fvr_line("render sphere@16 --dir 1,0,0 --out g.nrrd", &dir));
+    fvr_ok("render sphere@16 --dir 1,0,0 --out g.nrrd", &dir);
     let h = header(&dir.join("g.nrrd"));
     assert!(h.contains("sizes: 16 16\n"), "{h}");
     assert!(h.contains("kinds: domain domain\n"), "{h}");
     assert!(h.contains("spacings: 1.0 1.0\n"), "{h}");
     // Zoomed: the pixel size divided by the zoom.
-    assert_ok(&fvr_line(
-        "render sphere@16 --dir 1,0,0 --zoom 4 --out z.nrrd",
-        &dir,
-    ));
+    fvr_ok("render sphere@16 --dir 1,0,0 --zoom 4 --out z.nrrd", &dir);
     let h = header(&dir.join("z.nrrd"));
     assert!(
         h.contains("sizes: 64 64\n") && h.contains("spacings: 0.25 0.25\n"),
         "{h}"
     );
     // A pixel size of its own.
-    assert_ok(&fvr_line(
+    fvr_ok(
         "render sphere@16 --dir 1,0,0 --pixel-size 0.75 --out p.nrrd",
         &dir,
-    ));
+    );
     assert!(header(&dir.join("p.nrrd")).contains("spacings: 0.75 0.75\n"));
     // Colour: one RGB image, which `fvr compare` and the image reader read
     // and the volume reader refuses.
-    assert_ok(&fvr_line(
+    fvr_ok(
         "render sphere@16 --dir 1,0.3,0.2 --light 1,1,0:1,0.5,0.2 --out c.nrrd",
         &dir,
-    ));
+    );
     let h = header(&dir.join("c.nrrd"));
     assert!(h.contains("sizes: 3 16 16\n"), "{h}");
     assert!(h.contains("kinds: RGB-color domain domain\n"), "{h}");
@@ -86,7 +83,7 @@ fn write_permuted_nifti(path: &std::path::Path) {
 fn convert_keeps_orientation_and_origin() {
     let dir = temp_dir("geometry-convert");
     write_permuted_nifti(&dir.join("p.nii"));
-    assert_ok(&fvr_line("convert p.nii --out a.nrrd", &dir));
+    fvr_ok("convert p.nii --out a.nrrd", &dir);
     let h = header(&dir.join("a.nrrd"));
     assert!(h.contains("space: right-anterior-superior\n"), "{h}");
     assert!(!h.contains("spacings"), "{h}");
@@ -100,7 +97,7 @@ fn convert_keeps_orientation_and_origin() {
     assert_eq!(o.origin, [30.0 - far, 40.0 - far, -5.0]);
     assert_eq!(a.spacing, [2.0; 3]);
     // NRRD → NRRD: the same header geometry and samples.
-    assert_ok(&fvr_line("convert a.nrrd --out b.nrrd", &dir));
+    fvr_ok("convert a.nrrd --out b.nrrd", &dir);
     let b = read_nrrd(&dir.join("b.nrrd")).unwrap();
     assert_eq!(b.orientation, a.orientation);
     assert_eq!(b.spacing, a.spacing);
@@ -118,7 +115,7 @@ fn convert_keeps_orientation_and_origin() {
         bytes.extend_from_slice(&(v as f32).to_le_bytes());
     }
     std::fs::write(dir.join("lps.nrrd"), bytes).unwrap();
-    assert_ok(&fvr_line("convert lps.nrrd --out c.nrrd", &dir));
+    fvr_ok("convert lps.nrrd --out c.nrrd", &dir);
     let back = read_nrrd(&dir.join("c.nrrd")).unwrap().orientation.unwrap();
     let want = [[-c, s, 0.0], [-s, -c, 0.0], [0.0, 0.0, 1.0]];
     for w in 0..3 {

@@ -2,7 +2,7 @@
 //! image `fvr render` writes for that view, bit for bit.
 
 mod common;
-use common::{assert_error, assert_ok, fvr_line, temp_dir};
+use common::{assert_error, fvr_line, fvr_ok, temp_dir};
 use std::path::Path;
 
 /// The float32 payload of a NRRD file written by fvr (raw, little endian:
@@ -25,10 +25,10 @@ fn every_frame_is_the_render_of_its_view_bit_for_bit() {
     let dir = temp_dir("project-bits");
     let views = "dx,dy,dz,ux,uy,uz\n1,0.45,0.3\n0,0,1,0,1,0\n# diagonal\n-1 1 1\n";
     std::fs::write(dir.join("v.csv"), views).unwrap();
-    let out = assert_ok(&fvr_line(
+    let out = fvr_ok(
         "project gaussians@32 --views v.csv --out s.nrrd --quiet",
         &dir,
-    ));
+    );
     assert!(
         out.contains("wrote s.nrrd (3 views of 32x32 grey)"),
         "{out}"
@@ -46,7 +46,7 @@ fn every_frame_is_the_render_of_its_view_bit_for_bit() {
     .enumerate()
     {
         let line = format!("render gaussians@32 --dir {d} --up {u} --out r{i}.nrrd --quiet");
-        assert_ok(&fvr_line(&line, &dir));
+        fvr_ok(&line, &dir);
         let (_, image) = nrrd_payload(&dir.join(format!("r{i}.nrrd")));
         let frame = &stack[i * image.len()..(i + 1) * image.len()];
         assert!(
@@ -67,16 +67,16 @@ fn every_frame_is_the_render_of_its_view_bit_for_bit() {
 fn zoomed_frames_are_the_zoomed_renders() {
     let dir = temp_dir("project-zoom");
     std::fs::write(dir.join("v.csv"), "1,0.45,0.3\n-1,1,1,0.2,0.3,1\n").unwrap();
-    let out = assert_ok(&fvr_line(
+    let out = fvr_ok(
         "project gaussians@32 --views v.csv --zoom 2 --out s.nrrd --quiet",
         &dir,
-    ));
+    );
     assert!(out.contains("(2 views of 64x64 grey)"), "{out}");
     let (header, stack) = nrrd_payload(&dir.join("s.nrrd"));
     assert!(header.contains("sizes: 64 64 2\n"), "{header}");
     let (plain_header, _) = {
         let line = "project gaussians@32 --views v.csv --out p.nrrd --quiet";
-        assert_ok(&fvr_line(line, &dir));
+        fvr_ok(line, &dir);
         nrrd_payload(&dir.join("p.nrrd"))
     };
     let spacing = |h: &str| -> f64 {
@@ -93,7 +93,7 @@ fn zoomed_frames_are_the_zoomed_renders() {
     {
         let line =
             format!("render gaussians@32 --dir {d} --up {u} --zoom 2 --out r{i}.nrrd --quiet");
-        assert_ok(&fvr_line(&line, &dir));
+        fvr_ok(&line, &dir);
         let (_, image) = nrrd_payload(&dir.join(format!("r{i}.nrrd")));
         assert_eq!(image.len(), 64 * 64 * 4);
         let frame = &stack[i * image.len()..(i + 1) * image.len()];
@@ -114,14 +114,14 @@ fn zoomed_frames_are_the_zoomed_renders() {
 #[test]
 fn random_views_are_saved_and_read_back_to_the_same_stack_in_npy() {
     let dir = temp_dir("project-random");
-    assert_ok(&fvr_line(
+    fvr_ok(
         "project sphere@16 --random 5 --seed 3 --size 12 --save-views v.csv --out a.npy --quiet",
         &dir,
-    ));
-    assert_ok(&fvr_line(
+    );
+    fvr_ok(
         "project sphere@16 --views v.csv --size 12 --out b.nrrd --quiet",
         &dir,
-    ));
+    );
     let a = std::fs::read(dir.join("a.npy")).unwrap();
     assert_eq!(&a[..8], b"\x93NUMPY\x01\x00");
     let len = u16::from_le_bytes([a[8], a[9]]) as usize;
@@ -134,10 +134,10 @@ fn random_views_are_saved_and_read_back_to_the_same_stack_in_npy() {
         "the saved views render the same stack"
     );
     // Another seed, other views.
-    assert_ok(&fvr_line(
+    fvr_ok(
         "project sphere@16 --random 5 --seed 4 --size 12 --out c.npy --quiet",
         &dir,
-    ));
+    );
     assert_ne!(std::fs::read(dir.join("c.npy")).unwrap(), a);
     let csv = std::fs::read_to_string(dir.join("v.csv")).unwrap();
     assert_eq!(csv.lines().count(), 6, "{csv}");
@@ -146,10 +146,10 @@ fn random_views_are_saved_and_read_back_to_the_same_stack_in_npy() {
 #[test]
 fn stats_json_is_alone_on_stdout() {
     let dir = temp_dir("project-json");
-    let out = assert_ok(&fvr_line(
+    let out = fvr_ok(
         "project sphere@16 --random 3 --out s.npy --stats-json --quiet",
         &dir,
-    ));
+    );
     assert_eq!(out.lines().count(), 1, "{out}");
     let v: serde_json::Value = serde_json::from_str(&out).expect("JSON");
     assert_eq!(v["views"], 3);

@@ -3,7 +3,7 @@
 //! on anisotropic voxels.
 
 mod common;
-use common::{assert_error, assert_ok, fvr, fvr_line, temp_dir};
+use common::{assert_error, assert_ok, fvr, fvr_line, fvr_ok, temp_dir};
 
 use std::path::Path;
 
@@ -52,10 +52,7 @@ fn write_volume_of(path: &Path, dims: [usize; 3], spacing: Option<[f64; 3]>) {
 fn render_uses_the_files_spacing_and_matches_exact_in_mm() {
     let dir = temp_dir("spacing-default");
     write_volume(&dir.join("v.nrrd"), Some(SPACING));
-    let stdout = assert_ok(&fvr_line(
-        "render v.nrrd --dir 1,0.3,0.2 --out a.nrrd --stats",
-        &dir,
-    ));
+    let stdout = fvr_ok("render v.nrrd --dir 1,0.3,0.2 --out a.nrrd --stats", &dir);
     assert!(
         stdout.contains("spacing       0.8 x 0.8 x 1.5 mm"),
         "{stdout}"
@@ -71,10 +68,10 @@ fn render_uses_the_files_spacing_and_matches_exact_in_mm() {
     assert!(snr >= 50.0, "{snr:.2} dB");
 
     // A coarser --pixel-size halves the pixel count across the same extent.
-    assert_ok(&fvr_line(
+    fvr_ok(
         "render v.nrrd --dir 1,0.3,0.2 --pixel-size 1.6 --size 32 --out b.nrrd",
         &dir,
-    ));
+    );
     let coarse = read_nrrd(&dir.join("b.nrrd")).unwrap();
     let sampling = Sampling::new(SPACING, 1.6).unwrap();
     let exact = exact_projection_sampled(&object(), DIMS, &view, &sampling, 32, 32).unwrap();
@@ -90,10 +87,7 @@ fn render_uses_the_files_spacing_and_matches_exact_in_mm() {
 fn default_pixel_size_fits_the_longest_side() {
     let dir = temp_dir("spacing-fit");
     write_volume_of(&dir.join("v.nrrd"), [64, 63, 35], Some(SPACING));
-    let stdout = assert_ok(&fvr_line(
-        "render v.nrrd --dir 0,1,0 --out a.nrrd --stats",
-        &dir,
-    ));
+    let stdout = fvr_ok("render v.nrrd --dir 0,1,0 --out a.nrrd --stats", &dir);
     assert!(stdout.contains("pixel size    0.8203125 mm"), "{stdout}");
     let out = fvr_line(
         "render v.nrrd --dir 0,1,0 --out b.nrrd --pixel-size 0.5",
@@ -123,10 +117,7 @@ fn ignore_spacing_is_the_voxel_unit_render() {
     let b = std::fs::read(dir.join("plain-out.nrrd")).unwrap();
     assert_eq!(a, b);
     let spaced = {
-        assert_ok(&fvr_line(
-            "render spaced.nrrd --dir 1,0.3,0.2 --out mm.nrrd",
-            &dir,
-        ));
+        fvr_ok("render spaced.nrrd --dir 1,0.3,0.2 --out mm.nrrd", &dir);
         std::fs::read(dir.join("mm.nrrd")).unwrap()
     };
     assert_ne!(a, spaced, "the spacing must change the image");
@@ -144,7 +135,7 @@ fn cued_or_lit_anisotropic_renders_are_refused_until_resampled() {
             &fvr_line(&format!("{base} {extra}"), &dir),
             &["0.8 x 0.8 x 1.5 mm", "--resample", "--ignore-spacing"],
         );
-        assert_ok(&fvr_line(&format!("{base} {extra} --resample 48"), &dir));
+        fvr_ok(&format!("{base} {extra} --resample 48"), &dir);
     }
 }
 
@@ -169,7 +160,7 @@ fn turntable_uses_the_spacing_too() {
     write_volume(&dir.join("v.nrrd"), Some(SPACING));
     let base = "turntable v.nrrd --frames 2 --size 32";
     for extra in ["", "--ignore-spacing", "--pixel-size 1.6"] {
-        assert_ok(&fvr_line(&format!("{base} {extra} --out s.apng"), &dir));
+        fvr_ok(&format!("{base} {extra} --out s.apng"), &dir);
         assert!(dir.join("s.apng").exists());
     }
     let out = fvr_line(&format!("{base} --pixel-size 0 --out t.apng"), &dir);

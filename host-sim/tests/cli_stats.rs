@@ -4,7 +4,7 @@
 //! and the same lines with `--stats`.
 
 mod common;
-use common::{assert_ok, fvr_line, temp_dir};
+use common::{assert_ok, fvr_line, fvr_ok, temp_dir};
 
 /// The keys every renderer's `--stats-json` starts with, in order.
 const COMMON: [&str; 25] = [
@@ -49,7 +49,7 @@ const RUNS: [(&str, &str, usize); 3] = [
 fn render_turntable_and_project_print_one_schema_and_only_json() {
     let dir = temp_dir("stats-schema");
     for (command, line, views) in RUNS {
-        let stdout = assert_ok(&fvr_line(&format!("{line} --stats-json"), &dir));
+        let stdout = fvr_ok(&format!("{line} --stats-json"), &dir);
         assert_eq!(stdout.lines().count(), 1, "{command}: {stdout}");
         let stats: serde_json::Value = serde_json::from_str(stdout.trim())
             .unwrap_or_else(|e| panic!("{command}: {e}: {stdout}"));
@@ -87,7 +87,7 @@ fn render_turntable_and_project_print_one_schema_and_only_json() {
 fn stats_lines_are_the_same_for_every_renderer() {
     let dir = temp_dir("stats-human");
     for (command, line, views) in RUNS {
-        let stdout = assert_ok(&fvr_line(&format!("{line} --stats --quiet"), &dir));
+        let stdout = fvr_ok(&format!("{line} --stats --quiet"), &dir);
         for needle in [
             "  volume        16x16x16 (sphere@16)",
             "  pixel size    1 mm",
@@ -108,12 +108,12 @@ fn rgb_images_are_announced_as_rgb() {
         "render teapot@32 --dir 0,-1,0 --light-ring 3 --out r.png",
         "turntable teapot@32 --frames 2 --light-ring 3 --out t.apng",
     ] {
-        let stdout = assert_ok(&fvr_line(&format!("{line} --stats"), &dir));
+        let stdout = fvr_ok(&format!("{line} --stats"), &dir);
         assert!(
             stdout.contains("32x32 RGB") && !stdout.contains("grey"),
             "{stdout}"
         );
-        let stdout = assert_ok(&fvr_line(&format!("{line} --stats-json"), &dir));
+        let stdout = fvr_ok(&format!("{line} --stats-json"), &dir);
         let stats: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
         assert_eq!(stats["image"], serde_json::json!([32, 32, 3]), "{stats}");
         assert_eq!(stats["kind"], "RGB", "{stats}");

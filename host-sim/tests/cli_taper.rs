@@ -4,7 +4,7 @@
 mod common;
 use std::path::Path;
 
-use common::{assert_error, assert_ok, fvr_line, temp_dir};
+use common::{assert_error, assert_ok, fvr_line, fvr_ok, temp_dir};
 use fvr_host::io::nrrd::read_nrrd_image;
 
 /// A 32 × 32 × 24 volume of CT-like voxels (1 × 1 × 1.5 mm): a column
@@ -56,7 +56,7 @@ fn taper_fades_the_cut_and_the_ringing() {
     write_cut_column(&dir.join("cut.nrrd"));
     // Seen from the side, the cut face is edge on: a step in the image.
     let view = "render cut.nrrd --dir 1,0,0 --filter kb4 --oversample 1 --precision f32";
-    assert_ok(&fvr_line(&format!("{view} --out plain.nrrd"), &dir));
+    fvr_ok(&format!("{view} --out plain.nrrd"), &dir);
     let out = fvr_line(
         &format!("{view} --taper 4 --out tapered.nrrd --stats-json"),
         &dir,
@@ -73,10 +73,10 @@ fn taper_fades_the_cut_and_the_ringing() {
     assert!(plain > 0.02, "the cut rings: {plain}");
     assert!(tapered < plain / 10.0, "plain {plain}, tapered {tapered}");
     // Without a number, 8 voxels; a scene says `taper = N`.
-    let json = stats(&assert_ok(&fvr_line(
+    let json = stats(&fvr_ok(
         &format!("{view} --taper --out t8.nrrd --stats-json"),
         &dir,
-    )));
+    ));
     assert_eq!(json["taper"]["voxels"], 8, "{json}");
     std::fs::write(
         dir.join("s.toml"),
@@ -85,7 +85,7 @@ fn taper_fades_the_cut_and_the_ringing() {
          [output]\npath = \"scene.nrrd\"\n",
     )
     .unwrap();
-    assert_ok(&fvr_line("render --scene s.toml", &dir));
+    fvr_ok("render --scene s.toml", &dir);
     let a = std::fs::read(dir.join("tapered.nrrd")).unwrap();
     let b = std::fs::read(dir.join("scene.nrrd")).unwrap();
     assert_eq!(a, b, "the scene's taper = 4 is --taper 4");
@@ -96,7 +96,7 @@ fn taper_fades_the_cut_and_the_ringing() {
 fn nothing_cut_nothing_changed() {
     let dir = temp_dir("taper-none");
     let view = "sphere@32 --dir 1,0.3,0.2 --filter kb4 --oversample 1";
-    assert_ok(&fvr_line(&format!("render {view} --out a.nrrd"), &dir));
+    fvr_ok(&format!("render {view} --out a.nrrd"), &dir);
     let out = fvr_line(&format!("render {view} --taper --out b.nrrd"), &dir);
     assert_ok(&out);
     assert!(String::from_utf8_lossy(&out.stderr).contains("nothing tapered"));
@@ -105,16 +105,13 @@ fn nothing_cut_nothing_changed() {
         std::fs::read(dir.join("b.nrrd")).unwrap()
     );
     // The turntable and the projection set take it too.
-    let json = stats(&assert_ok(&fvr_line(
+    let json = stats(&fvr_ok(
         "project sphere@16 --random 2 --taper 3 --out p.npy --stats-json",
         &dir,
-    )));
+    ));
     assert_eq!(json["taper"]["voxels"], 3, "{json}");
     assert_eq!(json["taper"]["faces"], serde_json::json!([]), "{json}");
-    assert_ok(&fvr_line(
-        "turntable sphere@16 --frames 2 --taper --out t.apng",
-        &dir,
-    ));
+    fvr_ok("turntable sphere@16 --frames 2 --taper --out t.apng", &dir);
 }
 
 #[test]

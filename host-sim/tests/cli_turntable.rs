@@ -4,7 +4,7 @@
 //! renders of their views.
 
 mod common;
-use common::{assert_error, assert_ok, fvr_line, png_frames, temp_dir};
+use common::{assert_error, assert_ok, fvr_line, fvr_ok, png_frames, temp_dir};
 use std::path::Path;
 
 /// Every frame of a PNG or APNG, decoded: (width, height, colour type,
@@ -38,10 +38,10 @@ fn correlation(a: &[u8], b: &[u8]) -> f64 {
 #[test]
 fn the_three_light_teapot_turns_in_colour_and_frame_0_is_its_render() {
     let dir = temp_dir("turntable-teapot");
-    let out = assert_ok(&fvr_line(
+    let out = fvr_ok(
         "turntable teapot@32 --light-ring 3 --frames 12 --out t.apng --quiet",
         &dir,
-    ));
+    );
     assert!(out.contains("12 frames, 32x32 RGB"), "{out}");
     let (w, h, color, turn) = frames(&dir.join("t.apng"));
     assert_eq!((w, h, color, turn.len()), (32, 32, png::ColorType::Rgb, 12));
@@ -50,19 +50,19 @@ fn the_three_light_teapot_turns_in_colour_and_frame_0_is_its_render() {
     // The camera moves: frames differ.
     assert_ne!(turn[0], turn[3]);
 
-    assert_ok(&fvr_line(
+    fvr_ok(
         "render teapot@32 --light-ring 3 --dir 0,-1,0 --up 0,0,1 --out f.png --quiet",
         &dir,
-    ));
+    );
     let (_, _, color, render) = frames(&dir.join("f.png"));
     assert_eq!(color, png::ColorType::Rgb);
     let r = correlation(&turn[0], &render[0]);
     assert!(r > 0.99, "frame 0 against the render: correlation {r}");
 
-    assert_ok(&fvr_line(
+    fvr_ok(
         "turntable teapot@32 --light-ring 3 --frames 1 --out one.apng --quiet",
         &dir,
-    ));
+    );
     let (_, _, _, one) = frames(&dir.join("one.apng"));
     assert!(
         one[0] == render[0],
@@ -98,18 +98,18 @@ fn a_scene_with_lights_makes_a_shaded_turntable() {
 #[test]
 fn turntable_takes_the_render_options_and_refuses_what_cannot_be_done() {
     let dir = temp_dir("turntable-options");
-    let text = assert_ok(&fvr_line(
+    let text = fvr_ok(
         "turntable gaussians@32 --frames 2 --depth-cue linear:1,0.3 --ambient 0.5 \
          --resample 24 --out cue.apng --stats-json",
         &dir,
-    ));
+    );
     let stats: serde_json::Value = serde_json::from_str(text.trim()).unwrap();
     assert_eq!(stats["dims"], serde_json::json!([24, 24, 24]), "{stats}");
     assert_eq!(stats["frames"], 2, "{stats}");
-    let text = assert_ok(&fvr_line(
+    let text = fvr_ok(
         "turntable gaussians@32 --frames 2 --preview-level 1 --out p.apng --quiet",
         &dir,
-    ));
+    );
     assert!(text.contains("2 frames, 16x16 grey"), "{text}");
     let (w, _, _, _) = frames(&dir.join("p.apng"));
     assert_eq!(w, 16);
@@ -142,22 +142,22 @@ fn turntable_takes_the_render_options_and_refuses_what_cannot_be_done() {
 #[test]
 fn zoomed_turntable_frames_are_zoomed_renders() {
     let dir = temp_dir("turntable-zoom");
-    assert_ok(&fvr_line(
+    fvr_ok(
         "render sphere@24 --dir 0,-1,0 --zoom 2 --out r.png --quiet",
         &dir,
-    ));
-    assert_ok(&fvr_line(
+    );
+    fvr_ok(
         "turntable sphere@24 --frames 1 --zoom 2 --out one.apng --quiet",
         &dir,
-    ));
+    );
     let (w, rendered) = common::grey_png(&dir.join("r.png"));
     let (tw, th, _, one) = frames(&dir.join("one.apng"));
     assert_eq!((tw as usize, th as usize), (w, w));
     assert_eq!(one[0], rendered, "frame 0 is the zoomed render");
-    let stdout = assert_ok(&fvr_line(
+    let stdout = fvr_ok(
         "turntable sphere@24 --frames 3 --zoom 3 --out three.apng --stats-json",
         &dir,
-    ));
+    );
     let stats: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
     let (tw, _, _, turn) = frames(&dir.join("three.apng"));
     assert_eq!(turn.len(), 3);

@@ -4,7 +4,7 @@
 //! line when they are bad), and refuses to start without a built page.
 
 mod common;
-use common::{assert_error, fvr_line, temp_dir};
+use common::{assert_error, fvr_line, fvr_ok, temp_dir};
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
@@ -112,7 +112,7 @@ fn uploads_are_read_by_the_projects_readers() {
     let server = Server::start("sphere@8", &dist);
     // A NRRD file as `fvr convert` writes it comes back as its volume.
     let dir = temp_dir("view-upload-files");
-    common::assert_ok(&fvr_line("--quiet convert gaussians@10 --out g.nrrd", &dir));
+    fvr_ok("--quiet convert gaussians@10 --out g.nrrd", &dir);
     let bytes = std::fs::read(dir.join("g.nrrd")).unwrap();
     let (status, wire) = server.request("POST", "/convert?name=g.nrrd", &bytes);
     assert_eq!(status, 200, "{}", String::from_utf8_lossy(&wire));

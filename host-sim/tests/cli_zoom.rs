@@ -3,7 +3,7 @@
 //! line.
 
 mod common;
-use common::{assert_error, assert_ok, fvr_line, temp_dir};
+use common::{assert_error, assert_ok, fvr_line, fvr_ok, temp_dir};
 
 use fvr_core::geometry::View;
 use fvr_engine::{Renderer, Settings};
@@ -104,10 +104,7 @@ fn zoom_on_the_command_line() {
     assert_error(&out, &["--zoom", "--preview-level"]);
     assert!(!dir.join("bad.png").exists());
     // A prepared spectrum has no volume: --zoom and --view are refused.
-    assert_ok(&fvr_line(
-        "prepare sphere@16 --for host --out s.fvrs --quiet",
-        &dir,
-    ));
+    fvr_ok("prepare sphere@16 --for host --out s.fvrs --quiet", &dir);
     for flag in ["--zoom 2", "--view left"] {
         let dir_flag = if flag.starts_with("--view") {
             ""

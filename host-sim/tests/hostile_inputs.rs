@@ -8,7 +8,7 @@ mod common;
 use std::path::Path;
 use std::process::Command;
 
-use common::{assert_error, assert_ok, fvr_line, temp_dir};
+use common::{assert_error, fvr_line, fvr_ok, temp_dir};
 
 /// `line` in `dir` is refused as overwriting an input, `file` unchanged.
 fn refused(dir: &Path, line: &str, file: &str) {
@@ -70,7 +70,7 @@ fn a_depth_profile_is_an_input() {
 #[test]
 fn a_data_set_named_by_the_environment_is_an_input() {
     let dir = temp_dir("inputs-dataset");
-    assert_ok(&fvr_line("convert sphere@16 --out head.nrrd", &dir));
+    fvr_ok("convert sphere@16 --out head.nrrd", &dir);
     let before = std::fs::read(dir.join("head.nrrd")).unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_fvr"))
         .args(["render", "ct-head", "--dir", "1,0,0", "--out", "head.nrrd"])
@@ -87,7 +87,7 @@ fn a_data_set_named_by_the_environment_is_an_input() {
 #[test]
 fn a_hard_link_to_an_input_is_the_input() {
     let dir = temp_dir("inputs-hardlink");
-    assert_ok(&fvr_line("convert sphere@16 --out v.nrrd", &dir));
+    fvr_ok("convert sphere@16 --out v.nrrd", &dir);
     std::fs::hard_link(dir.join("v.nrrd"), dir.join("alias.nrrd")).unwrap();
     refused(&dir, "convert v.nrrd --out alias.nrrd", "alias.nrrd");
     std::fs::remove_dir_all(&dir).unwrap();

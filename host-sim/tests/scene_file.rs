@@ -4,7 +4,7 @@
 //! file and the key.
 
 mod common;
-use common::{assert_error, assert_ok, assert_refused, fvr, fvr_in, fvr_line, temp_dir};
+use common::{assert_error, assert_ok, assert_refused, fvr, fvr_in, fvr_line, fvr_ok, temp_dir};
 use std::path::PathBuf;
 use std::process::Output;
 
@@ -57,7 +57,7 @@ fn scene_and_equivalent_flags_write_identical_nrrd_bytes() {
     std::fs::create_dir_all(dir.join("scenes/out")).unwrap();
     std::fs::write(dir.join("scenes/lit.toml"), SCENE).unwrap();
     // Run from elsewhere: the output lands next to the scene file.
-    assert_ok(&fvr_line("render --scene scenes/lit.toml", &dir));
+    fvr_ok("render --scene scenes/lit.toml", &dir);
     let mut flags = EQUIVALENT_FLAGS.to_vec();
     flags.extend(["--out", "flags.nrrd"]);
     assert_ok(&fvr(&flags, &dir));
@@ -74,17 +74,17 @@ fn flags_override_the_scene() {
     std::fs::write(dir.join("lit.toml"), SCENE).unwrap();
     // Size, output (relative to the working directory) and lights replaced:
     // one grey light makes an RGB image with equal channels.
-    let stdout = assert_ok(&fvr_line(
+    let stdout = fvr_ok(
         "render --scene lit.toml --size 16 --light 0,1,0:1 --out over.nrrd",
         &dir,
-    ));
+    );
     assert!(stdout.contains("wrote over.nrrd (16x16 RGB)"), "{stdout}");
     let image = fvr_host::io::nrrd::read_nrrd_image(&dir.join("over.nrrd")).unwrap();
     assert_eq!(image.dims, [3, 16, 16]);
     assert!(image.data.chunks(3).all(|p| p[0] == p[1] && p[1] == p[2]));
     assert!(image.data.iter().any(|&v| v > 0.0));
     // The volume on the command line replaces the scene's.
-    let stdout = assert_ok(&fvr_line("render sphere@16 --scene lit.toml --stats", &dir));
+    let stdout = fvr_ok("render sphere@16 --scene lit.toml --stats", &dir);
     assert!(stdout.contains("16x16x16 (sphere@16)"), "{stdout}");
 }
 

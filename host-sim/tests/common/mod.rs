@@ -62,6 +62,12 @@ pub fn fvr_line(command: &str, dir: &Path) -> Output {
     fvr(&command.split_whitespace().collect::<Vec<_>>(), dir)
 }
 
+/// Run `command` (as [`fvr_line`]) in `dir`; asserts exit status 0 (as
+/// [`assert_ok`]) and returns stdout.
+pub fn fvr_ok(command: &str, dir: &Path) -> String {
+    assert_ok(&fvr_line(command, dir))
+}
+
 /// Run `command` (as [`fvr_line`]) in a fresh directory named `name` (as
 /// [`temp_dir`]); returns the directory and the output.
 pub fn fvr_in(name: &str, command: &str) -> (PathBuf, Output) {
