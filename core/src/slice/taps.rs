@@ -108,22 +108,42 @@ impl<const W: usize, const LINE_EXP: bool, const POW2: bool, S: Sample>
                     step(x0, t, n)
                 }
             });
-            for c in 0..W {
-                let mut acc_y = T::ZERO;
-                for b in 0..W {
-                    let line = planes[c] + lines[b];
-                    let mut acc_x = T::ZERO;
-                    for t in 0..W {
-                        let v = data.get(line + xs[t]).copied().unwrap_or_default();
-                        acc_x += wx[t] * T::load_raw(v);
-                    }
-                    acc_y += wy[b] * self.line_sum(line, acc_x);
-                }
-                acc += wz[c] * acc_y;
-            }
+            let offsets = [&planes, &lines, &xs];
+            acc = wrapped_tap_sum(data, offsets, [wx, wy, wz], |line, sum| {
+                self.line_sum(line, sum)
+            });
         }
         acc
     }
+}
+
+/// The value at taps whose x-runs may wrap around the cube, tap by tap:
+/// `Σ_c wz_c·Σ_b wy_b·line_sum(line, Σ_t wx_t·raw(data[line + xs_t]))`
+/// with `line = planes_c + lines_b`, in this order (the core's bits; the
+/// host engine's walks fall back on it too). `line_sum` scales an x-line's
+/// sum (per-line exponents) or returns it; a tap past the data reads 0.
+#[inline(always)]
+pub fn wrapped_tap_sum<const W: usize, S: Sample, T: Real>(
+    data: &[S],
+    [planes, lines, xs]: [&[usize; W]; 3],
+    [wx, wy, wz]: [&[T; W]; 3],
+    line_sum: impl Fn(usize, T) -> T,
+) -> T {
+    let mut acc = T::ZERO;
+    for c in 0..W {
+        let mut acc_y = T::ZERO;
+        for b in 0..W {
+            let line = planes[c] + lines[b];
+            let mut acc_x = T::ZERO;
+            for t in 0..W {
+                let v = data.get(line + xs[t]).copied().unwrap_or_default();
+                acc_x += wx[t] * T::load_raw(v);
+            }
+            acc_y += wy[b] * line_sum(line, acc_x);
+        }
+        acc += wz[c] * acc_y;
+    }
+    acc
 }
 
 /// The extraction's hot loop: per slice point, three phase-table lookups

@@ -4,6 +4,7 @@
 //! ([`run_starts`], which the exact walk also prefetches).
 
 use fvr_core::num::{Real, Sample};
+use fvr_core::slice::wrapped_tap_sum;
 
 /// `i mod n` for the indices of one cube side: a mask when `POW2` (`n` a
 /// power of two), else as the core's mixed-radix walk: a remainder per
@@ -160,19 +161,7 @@ pub(crate) fn tap_sum_on<const W: usize, const POW2: bool, S: Sample, T: Real>(
         }
     } else {
         let xs: [usize; W] = core::array::from_fn(|t| side.step(x0, t));
-        for c in 0..W {
-            let mut acc_y = T::ZERO;
-            for b in 0..W {
-                let line = planes[c] + lines[b];
-                let mut acc_x = T::ZERO;
-                for t in 0..W {
-                    let v = data.get(line + xs[t]).copied().unwrap_or_default();
-                    acc_x += wx[t] * T::load_raw(v);
-                }
-                acc_y += wy[b] * acc_x;
-            }
-            acc += wz[c] * acc_y;
-        }
+        acc = wrapped_tap_sum(data, [&planes, &lines, &xs], [wx, wy, wz], |_, sum| sum);
     }
     acc
 }
