@@ -180,28 +180,53 @@ pub(super) fn extract_lines<
     };
     let raw_gain = T::exp2i(T::raw_exponent::<S>());
     let taps = TapSums::<W, LINE_EXP, POW2, S> { data, n, exponents };
-    // The mirror `−q` of a point: taps `−j − t`, i.e. the run from
-    // `−j − (W − 1)` with the weights reversed.
-    let mirror = |j: i32| -j - (W as i32 - 1);
-    let reversed = |w: &[T; W]| -> [T; W] { core::array::from_fn(|t| w[W - 1 - t]) };
     geometry.for_each_fixed_pair::<W, POW2>(n, grid, |y, plus, minus| {
-        let (jx, wx) = phases.taps_fixed_point(y[0]);
-        let (jy, wy) = phases.taps_fixed_point(y[1]);
-        let (jz, wz) = phases.taps_fixed_point(y[2]);
-        let wx = wx.map(|w| w * raw_gain);
-        let value = if plus {
-            taps.value(jx, &wx, jy, &wy, jz, &wz)
-        } else {
-            T::ZERO
-        };
-        let mirrored = if minus {
-            let (rx, ry, rz) = (reversed(&wx), reversed(&wy), reversed(&wz));
-            taps.value(mirror(jx), &rx, mirror(jy), &ry, mirror(jz), &rz)
-        } else {
-            T::ZERO
-        };
-        (value, mirrored)
+        mirror_pair(
+            phases,
+            y,
+            Some(raw_gain),
+            [plus, minus],
+            |[jx, jy, jz], [wx, wy, wz]| taps.value(jx, wx, jy, wy, jz, wz),
+        )
     });
+}
+
+/// The value at the fixed-point position `y` (when `plus`) and at its
+/// mirror `−q` (when `minus`), each `0` when not asked: the phase table's
+/// first tap `j` and weights `w` on each axis, the x-weights times `gain`
+/// (the raw widening's `2^e`, [`Real::load_raw`]) when given, summed by
+/// `value(j, w)`. The mirror's taps are `−j − t`, i.e. the run from
+/// `−j − (W − 1)` with the weights reversed. Every walk of the pairs, the
+/// core's and the host engine's, takes its points through this.
+#[inline(always)]
+pub fn mirror_pair<const W: usize, T: Real>(
+    phases: &PhaseTable<T, W>,
+    y: [i64; 3],
+    gain: Option<T>,
+    [plus, minus]: [bool; 2],
+    value: impl Fn([i32; 3], [&[T; W]; 3]) -> T,
+) -> (T, T) {
+    let (jx, wx) = phases.taps_fixed_point(y[0]);
+    let (jy, wy) = phases.taps_fixed_point(y[1]);
+    let (jz, wz) = phases.taps_fixed_point(y[2]);
+    let wx = match gain {
+        Some(g) => wx.map(|w| w * g),
+        None => wx,
+    };
+    let direct = if plus {
+        value([jx, jy, jz], [&wx, &wy, &wz])
+    } else {
+        T::ZERO
+    };
+    let mirrored = if minus {
+        let mirror = |j: i32| -j - (W as i32 - 1);
+        let reversed = |w: &[T; W]| -> [T; W] { core::array::from_fn(|t| w[W - 1 - t]) };
+        let taps = [mirror(jx), mirror(jy), mirror(jz)];
+        value(taps, [&reversed(&wx), &reversed(&wy), &reversed(&wz)])
+    } else {
+        T::ZERO
+    };
+    (direct, mirrored)
 }
 
 /// The extraction for any storage (e.g. bricked block exponents): the
@@ -245,25 +270,14 @@ pub(super) fn extract_general<const W: usize, const POW2: bool, S: Sample, Z: Cu
         }
         acc
     };
-    // The mirror `−q` of a point: taps `−j − t`, as in `extract_lines`.
-    let mirror = |j: i32| -j - (W as i32 - 1);
-    let reversed = |w: &[T; W]| -> [T; W] { core::array::from_fn(|t| w[W - 1 - t]) };
     geometry.for_each_fixed_pair::<W, POW2>(n, grid, |y, plus, minus| {
-        let (jx, wx) = phases.taps_fixed_point(y[0]);
-        let (jy, wy) = phases.taps_fixed_point(y[1]);
-        let (jz, wz) = phases.taps_fixed_point(y[2]);
-        let direct = if plus {
-            value(jx, &wx, jy, &wy, jz, &wz)
-        } else {
-            T::ZERO
-        };
-        let mirrored = if minus {
-            let (rx, ry, rz) = (reversed(&wx), reversed(&wy), reversed(&wz));
-            value(mirror(jx), &rx, mirror(jy), &ry, mirror(jz), &rz)
-        } else {
-            T::ZERO
-        };
-        (direct, mirrored)
+        mirror_pair(
+            phases,
+            y,
+            None,
+            [plus, minus],
+            |[jx, jy, jz], [wx, wy, wz]| value(jx, wx, jy, wy, jz, wz),
+        )
     });
 }
 
