@@ -5,11 +5,13 @@
 
 mod common;
 
+use std::io::Write;
 use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use common::{assert_error, assert_ok, fvr_line, png_frames, temp_dir};
+use fvr_host::io::atomic::{write_bytes, Output};
 
 /// The names in `dir`, sorted.
 fn names(dir: &Path) -> Vec<String> {
@@ -220,5 +222,55 @@ fn a_closed_pipe_is_not_a_panic() {
     }
     assert_eq!(decoded_frames(&dir.join("t.png")), 1);
     assert_eq!(decoded_frames(&dir.join("t.apng")), 2);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The library's own guarantees, under the program's: a dropped output
+/// leaves the previous file, a commit replaces it, a long name fits, and a
+/// link at the target is replaced, not followed.
+#[test]
+fn commit_replaces_and_drop_leaves_the_old_file() {
+    let dir = temp_dir("atomic-commit");
+    let target = dir.join("a.png");
+    std::fs::write(&target, b"old").unwrap();
+    let mut out = Output::create(&target).unwrap();
+    out.write_all(b"half").unwrap();
+    assert_eq!(names(&dir).len(), 2);
+    drop(out);
+    assert_eq!(std::fs::read(&target).unwrap(), b"old");
+    assert_eq!(names(&dir), ["a.png"]);
+    write_bytes(&target, b"new").unwrap();
+    assert_eq!(std::fs::read(&target).unwrap(), b"new");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        // Readable by others under the usual umask 022, as `File::create` makes it.
+        let mode = std::fs::metadata(&target).unwrap().permissions().mode();
+        assert_eq!(mode & 0o600, 0o600, "mode {mode:o}");
+    }
+    assert_eq!(names(&dir), ["a.png"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_long_name_fits() {
+    let dir = temp_dir("atomic-long");
+    let target = dir.join(format!("{}.apng", "x".repeat(250)));
+    write_bytes(&target, b"ok").unwrap();
+    assert_eq!(std::fs::read(&target).unwrap(), b"ok");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+#[cfg(unix)]
+fn a_symlinked_target_is_replaced_not_followed() {
+    let dir = temp_dir("atomic-link");
+    let victim = dir.join("victim.nrrd");
+    std::fs::write(&victim, b"input").unwrap();
+    let target = dir.join("out.png");
+    std::os::unix::fs::symlink(&victim, &target).unwrap();
+    write_bytes(&target, b"picture").unwrap();
+    assert_eq!(std::fs::read(&victim).unwrap(), b"input");
+    assert_eq!(std::fs::read(&target).unwrap(), b"picture");
     std::fs::remove_dir_all(&dir).unwrap();
 }
