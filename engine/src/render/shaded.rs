@@ -133,7 +133,7 @@ impl SceneSpectra {
                 ..scene.clone()
             };
             self.render(&scaled, view, width, height)
-        } else if let Some(image) = self.plain_xray(scene, view, sampling, width, height) {
+        } else if let Some(image) = self.plain_xray(scene, view, sampling, (width, height)) {
             image
         } else {
             let [x, y, z] = sampling.spacing();
@@ -157,8 +157,7 @@ impl SceneSpectra {
         scene: &Scene,
         view: &View,
         sampling: &Sampling,
-        width: usize,
-        height: usize,
+        (width, height): (usize, usize),
     ) -> Option<Result<Image, fvr_core::Error>> {
         let grey = plain_grey(scene)?;
         Some(
@@ -185,7 +184,7 @@ impl SceneSpectra {
         width: usize,
         height: usize,
     ) -> Result<Image, fvr_core::Error> {
-        if let Some(image) = self.plain_xray(scene, view, &Sampling::UNIT, width, height) {
+        if let Some(image) = self.plain_xray(scene, view, &Sampling::UNIT, (width, height)) {
             return image;
         }
         fn go<S: Sample, T: Real>(
