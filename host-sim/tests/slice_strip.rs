@@ -24,7 +24,7 @@ use fvr_core::spectrum::Spectrum;
 use fvr_core::volume::GridOversampling;
 use fvr_engine::render::turntable::orbit;
 use fvr_engine::render::view::ViewRenderer;
-use fvr_engine::render::view::{render_once, Walk};
+use fvr_engine::render::view::{render_once, Walk, WalkTaken};
 use fvr_engine::slice::column::{self, column_axis};
 use fvr_engine::slice::exact::{self, SliceJob, Tiling};
 use fvr_engine::slice::strip::{self, held_axis};
@@ -444,31 +444,36 @@ fn renderer_follows_its_walk() {
     // Rows holding z (the strip walk), a slice containing z (the column
     // walk) and rows holding no axis (the reordered exact walk, where the
     // core has its lanes).
-    for (dir, up) in [
-        ([1.0, 0.3, 0.2], [0.0, 0.0, 1.0]),
-        ([1.0, 0.3, 0.0], [0.0, 0.0, 1.0]),
-        ([0.7, 0.2, 1.0], [0.3, 1.0, 0.1]),
+    let lanes = if exact::reorders::<f16, f32>() {
+        WalkTaken::Reordered
+    } else {
+        WalkTaken::Exact
+    };
+    for (dir, up, taken) in [
+        ([1.0, 0.3, 0.2], [0.0, 0.0, 1.0], WalkTaken::Strip),
+        ([1.0, 0.3, 0.0], [0.0, 0.0, 1.0], WalkTaken::Column),
+        ([0.7, 0.2, 1.0], [0.3, 1.0, 0.1], lanes),
     ] {
         let view = View { dir, up };
         let held = held_axis(&Sampling::UNIT.slice_axes(&view.frame().unwrap())).is_some();
         for kind in [FilterKind::Kb4, FilterKind::Kb6] {
             let filter = Filter::new(kind, 1).unwrap();
             let spec = OwnedSpectrum::<f16>::prepare::<f32>(&volume, filter).unwrap();
-            let render = |walk: Walk| {
+            let render = |walk: Walk, taken: WalkTaken| {
                 let mut out = vec![0.0f32; n * n];
-                ViewRenderer::<f32>::new(n, filter)
-                    .with_walk(walk)
-                    .render_into(&spec, &view, n, n, &mut out)
-                    .unwrap();
+                let mut renderer = ViewRenderer::<f32>::new(n, filter).with_walk(walk);
+                assert_eq!(renderer.walked(), None);
+                renderer.render_into(&spec, &view, n, n, &mut out).unwrap();
+                assert_eq!(renderer.walked(), Some(taken), "{kind:?} {dir:?}");
                 out
             };
             let core = render_once::<f16, f32>(&spec.view(), &Request::new(view, n, n)).unwrap();
-            let exact = render(Walk::Exact);
+            let exact = render(Walk::Exact, WalkTaken::Exact);
             assert!(core
                 .iter()
                 .zip(&exact)
                 .all(|(a, b)| a.to_bits() == (*b as f64).to_bits()));
-            let fast = render(Walk::default());
+            let fast = render(Walk::default(), taken);
             let (mut signal, mut noise) = (0.0f64, 0.0f64);
             for (a, b) in core.iter().zip(&fast) {
                 signal += a * a;

@@ -39,6 +39,8 @@ pub struct ViewRenderer<T> {
     y_rows_views: usize,
     /// The zero-padded finish of a magnified image ([`Self::with_zoom`]).
     zoom: Option<ZoomFinish<T>>,
+    /// The walk that took the last view's slice.
+    walked: Option<WalkTaken>,
 }
 
 /// How a plain view's slice is summed.
@@ -56,6 +58,71 @@ pub enum Walk {
     /// Tap by tap in the core's order ([`exact::extract`]): the core's
     /// values bit for bit.
     Exact,
+}
+
+/// The walk that filled a view's slice: the first of the renderer's
+/// [`Walk`] that takes it, in the order they are tried.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WalkTaken {
+    /// Factored along the axis the slice contains ([`column::extract`]).
+    Column,
+    /// The strip walk on the spectrum with x and y exchanged
+    /// ([`strip::extract_exchanged`]).
+    Exchanged,
+    /// Reduced along the axis the slice's rows hold ([`strip::extract`]).
+    Strip,
+    /// Point by point, each point's sum reordered in lanes
+    /// ([`exact::extract_reordered`]).
+    Reordered,
+    /// Point by point in the core's order ([`exact::extract`]).
+    Exact,
+    /// The core's walk (a spectrum, grid or zoom the host's walks do not
+    /// take), on blocks of rows or on this thread.
+    Core,
+}
+
+impl WalkTaken {
+    /// The walk's name in reports: `column`, `exchanged`, `strip`,
+    /// `reordered`, `exact` or `core`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Column => "column",
+            Self::Exchanged => "exchanged",
+            Self::Strip => "strip",
+            Self::Reordered => "reordered",
+            Self::Exact => "exact",
+            Self::Core => "core",
+        }
+    }
+}
+
+/// Fill `grid` with the slice of `job` by the first walk of `walk` that
+/// takes it (`exchanged`: the job on the spectrum with x and y exchanged,
+/// where the renderer holds it); `None` (grid untouched) when none does.
+fn fill<S: Sample, T: Real>(
+    walk: Walk,
+    job: &SliceJob<'_, Spectrum<'_, S>, T>,
+    exchanged: Option<&(Spectrum<'_, S>, SliceAxes)>,
+    grid: &mut [T],
+    along: &mut Vec<T>,
+) -> Option<WalkTaken> {
+    if walk == Walk::Strip {
+        if column::extract(job, grid, along) {
+            return Some(WalkTaken::Column);
+        }
+        if let Some((spec, axes)) = exchanged {
+            if strip::extract_exchanged(&SliceJob { spec, axes, ..*job }, grid) {
+                return Some(WalkTaken::Exchanged);
+            }
+        }
+        if strip::extract(job, grid) {
+            return Some(WalkTaken::Strip);
+        }
+        if exact::extract_reordered(job, grid) {
+            return Some(WalkTaken::Reordered);
+        }
+    }
+    exact::extract(job, grid).then_some(WalkTaken::Exact)
 }
 
 impl<T: Real> ViewRenderer<T> {
@@ -79,6 +146,7 @@ impl<T: Real> ViewRenderer<T> {
             walk: Walk::default(),
             y_rows_views: 0,
             zoom: None,
+            walked: None,
         }
     }
 
@@ -196,6 +264,12 @@ impl<T: Real> ViewRenderer<T> {
         self
     }
 
+    /// The walk that took the last view's slice: `None` before the first
+    /// view, or when the last one failed before its slice was walked.
+    pub fn walked(&self) -> Option<WalkTaken> {
+        self.walked
+    }
+
     /// Render one view into `out` (`width × height`, row 0 at the top).
     ///
     /// The slice is extracted in blocks of rows on the renderer's threads
@@ -237,6 +311,7 @@ impl<T: Real> ViewRenderer<T> {
             mixed = MixedPlan::from_table(&self.tw, self.n)?;
             Inverse::Mixed(&mixed)
         };
+        self.walked = None;
         let owned = spec;
         let spec = spec.view();
         let n = spec.n();
@@ -248,26 +323,21 @@ impl<T: Real> ViewRenderer<T> {
             let (walk, along) = (self.walk, &mut self.along);
             let mut extract = |parallel: bool, grid: &mut [T]| {
                 let job = SliceJob::new(&spec, kernel, &axes, tiling, parallel);
-                (walk == Walk::Strip
-                    && (column::extract(&job, grid, along)
-                        || exchanged.as_ref().is_some_and(|(spec, axes)| {
-                            strip::extract_exchanged(&SliceJob { spec, axes, ..job }, grid)
-                        })
-                        || strip::extract(&job, grid)
-                        || exact::extract_reordered(&job, grid)))
-                    || exact::extract(&job, grid)
+                fill(walk, &job, exchanged.as_ref(), grid, along)
             };
             let filled = match (&self.pool, self.threads) {
                 (_, 1) => extract(false, grid),
                 (Some(pool), _) => pool.install(|| extract(true, grid)),
                 (None, _) => extract(true, grid),
             };
-            if filled {
+            if let Some(taken) = filled {
+                self.walked = Some(taken);
                 let place = placement_on_axes(spec.dims(), &axes, width, height, 1.0);
                 let crop = Crop::new(place, sampling.gain() / spec.scale(), width, height);
                 return self.finish(n, &crop, out);
             }
         }
+        self.walked = Some(WalkTaken::Core);
         let threads = match self.threads {
             0 => std::thread::available_parallelism().map_or(1, |t| t.get()),
             t => t,
