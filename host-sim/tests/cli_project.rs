@@ -158,6 +158,37 @@ fn stats_json_is_alone_on_stdout() {
     assert!(v["accuracy"]["predicted_db"].as_f64().is_some(), "{v}");
 }
 
+/// `--stats-json` counts the views each slice walk took: views containing
+/// an axis are factored along it (`column`), rows along an axis are
+/// reduced along it (`strip`), and the counts cover every view; `--stats`
+/// prints the same counts.
+#[test]
+fn stats_name_the_walk_of_every_view() {
+    let dir = temp_dir("project-walks");
+    std::fs::write(dir.join("v.csv"), "1,0,0\n0,1,0\n1,0.3,0\n1,0.3,0.2\n").unwrap();
+    let base = "project gaussians@32 --views v.csv --out s.nrrd --quiet";
+    let out = fvr_ok(&format!("{base} --stats-json"), &dir);
+    let v: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+    assert_eq!(
+        v["walks"],
+        serde_json::json!({"column": 3, "strip": 1}),
+        "{v}"
+    );
+    let out = fvr_ok(&format!("{base} --stats"), &dir);
+    assert!(out.contains("walks         column 3, strip 1"), "{out}");
+    let out = fvr_ok(
+        "project gaussians@32 --random 5 --out r.nrrd --stats-json --quiet",
+        &dir,
+    );
+    let v: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+    let counts = v["walks"].as_object().expect("walks");
+    assert_eq!(
+        counts.values().filter_map(|c| c.as_u64()).sum::<u64>(),
+        5,
+        "{v}"
+    );
+}
+
 /// `--filter`, `--oversample` and `--precision` are kept as given, each
 /// alone (the planner chooses the rest) and all three (none chosen), as
 /// `render` keeps them; they were once dropped for the planner's choice.

@@ -21,7 +21,7 @@ use rayon::prelude::*;
 
 use crate::error::PipelineError;
 use crate::image::finite::check_frames;
-use crate::render::view::ViewRenderer;
+use crate::render::view::{ViewRenderer, WalkCounts};
 use crate::renderer::Renderer;
 use crate::spectrum::{with_arithmetic, AnySpectrum};
 
@@ -63,6 +63,10 @@ pub struct BatchReport {
     pub shape: BatchShape,
     /// Wall time of the whole batch.
     pub time: Duration,
+    /// The walk that took each plain view's slice (none counted for views
+    /// drawn through [`Renderer::render`]: scenes, previews, adaptive
+    /// filtering).
+    pub walks: WalkCounts,
 }
 
 impl Renderer {
@@ -134,13 +138,17 @@ impl Renderer {
             return Ok(BatchReport {
                 shape,
                 time: t0.elapsed(),
+                walks: WalkCounts::default(),
             });
         }
         let size = self.image_size(size)?;
-        match self.plain_grey() {
+        let walks = match self.plain_grey() {
             Some((sampling, grey)) => self.plain_batch(views, &shape, &sampling, grey, out)?,
-            None => self.scene_batch(views, &shape, size, out)?,
-        }
+            None => {
+                self.scene_batch(views, &shape, size, out)?;
+                WalkCounts::default()
+            }
+        };
         if let Err(e) = check_frames(out, shape.frame_len(), &self.settings().scene) {
             // No frame of NaN or infinity is left for a caller to use.
             out.fill(0.0);
@@ -149,6 +157,7 @@ impl Renderer {
         Ok(BatchReport {
             shape,
             time: t0.elapsed(),
+            walks,
         })
     }
 
@@ -213,7 +222,7 @@ impl Renderer {
         sampling: &Sampling,
         grey: f64,
         out: &mut [f32],
-    ) -> Result<(), PipelineError> {
+    ) -> Result<WalkCounts, PipelineError> {
         let (w, h) = (shape.width, shape.height);
         let density = &self.spectra().density;
         // Fewer views than threads: one view at a time, each slice
@@ -222,18 +231,25 @@ impl Renderer {
         let one_at_a_time = views.len() < rayon::current_num_threads();
         with_arithmetic!(density, s, T => {
             ViewRenderer::<T>::share_for_batch(s, views, sampling);
+            let count = |walks: &mut WalkCounts, renderer: &ViewRenderer<T>| {
+                if let Some(walk) = renderer.walked() {
+                    walks.add(walk);
+                }
+            };
             if one_at_a_time {
                 let mut renderer = ViewRenderer::<T>::new(s.n(), s.filter());
                 let mut frame = vec![<T as Real>::ZERO; w * h];
+                let mut walks = WalkCounts::default();
                 for (dst, view) in out.chunks_mut(shape.frame_len()).zip(views) {
                     renderer.render_sampled_into(s, view, sampling, w, h, &mut frame)?;
+                    count(&mut walks, &renderer);
                     to_f32(dst, &frame, grey);
                 }
-                return Ok(());
+                return Ok(walks);
             }
             out.par_chunks_mut(shape.frame_len())
                 .zip(views.par_iter())
-                .try_for_each_init(
+                .map_init(
                     || {
                         let r = ViewRenderer::<T>::new(s.n(), s.filter()).with_threads(1);
                         (r, vec![<T as Real>::ZERO; w * h])
@@ -241,9 +257,12 @@ impl Renderer {
                     |(renderer, frame), (dst, view)| {
                         renderer.render_sampled_into(s, view, sampling, w, h, frame)?;
                         to_f32(dst, frame, grey);
-                        Ok::<(), PipelineError>(())
+                        let mut walks = WalkCounts::default();
+                        count(&mut walks, renderer);
+                        Ok::<WalkCounts, PipelineError>(walks)
                     },
                 )
+                .try_reduce(WalkCounts::default, |a, b| Ok(a.merged(b)))
         })
     }
 

@@ -82,6 +82,16 @@ pub enum WalkTaken {
 }
 
 impl WalkTaken {
+    /// Every walk, in the order the renderer tries them.
+    pub const ALL: [Self; 6] = [
+        Self::Column,
+        Self::Exchanged,
+        Self::Strip,
+        Self::Reordered,
+        Self::Exact,
+        Self::Core,
+    ];
+
     /// The walk's name in reports: `column`, `exchanged`, `strip`,
     /// `reordered`, `exact` or `core`.
     pub const fn name(self) -> &'static str {
@@ -93,6 +103,31 @@ impl WalkTaken {
             Self::Exact => "exact",
             Self::Core => "core",
         }
+    }
+}
+
+/// How many views each walk took ([`WalkTaken::ALL`]'s order).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WalkCounts(pub [usize; 6]);
+
+impl WalkCounts {
+    /// One more view taken by `walk`.
+    pub fn add(&mut self, walk: WalkTaken) {
+        self.0[walk as usize] += 1;
+    }
+
+    /// The walks that took views, each with its count, in
+    /// [`WalkTaken::ALL`]'s order.
+    pub fn taken(&self) -> impl Iterator<Item = (WalkTaken, usize)> + '_ {
+        WalkTaken::ALL
+            .into_iter()
+            .zip(self.0)
+            .filter(|&(_, count)| count > 0)
+    }
+
+    /// Both counts added.
+    pub fn merged(self, other: Self) -> Self {
+        Self(core::array::from_fn(|i| self.0[i] + other.0[i]))
     }
 }
 

@@ -3,10 +3,12 @@
 //! reconstructed radiographs, training data, registration).
 
 use crate::taper::TaperArgs;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::Args;
+use fvr_engine::render::view::WalkCounts;
 use fvr_engine::{PipelineError, Plan, Settings};
 use fvr_host::io::stack::{write_stack, StackFormat, StackShape};
 use fvr_host::progress;
@@ -71,6 +73,10 @@ const VIEWS_PER_CALL: usize = 32;
 struct ProjectExtra {
     /// Writing the stack (and the --save-views file).
     write_ms: f64,
+    /// How many views each slice walk took (`column`, `exchanged`,
+    /// `strip`, `reordered`, `exact`, `core`; walks that took none are
+    /// left out, and scenes, previews and adaptive views count none).
+    walks: BTreeMap<&'static str, usize>,
 }
 
 /// What the job holds beside the spectrum: the stack, and per-thread view
@@ -162,6 +168,7 @@ pub(crate) fn project(args: &ProjectArgs) -> Result<(), Error> {
     let bar = progress::count(views.len() as u64, "views");
     let t_views = Instant::now();
     let frame = shape.frame_len();
+    let mut walks = WalkCounts::default();
     // The engine refuses a frame that overflows f32; the message here
     // numbers the view in the whole job and names the options.
     let overflow = |view: usize, value: f32| {
@@ -192,7 +199,7 @@ pub(crate) fn project(args: &ProjectArgs) -> Result<(), Error> {
             .zip(stack.chunks_mut(VIEWS_PER_CALL * frame))
             .enumerate()
         {
-            renderer
+            let report = renderer
                 .render_batch_into(chunk, size, out)
                 .map_err(|e| match e {
                     PipelineError::Overflow { view, value, .. } => {
@@ -200,6 +207,7 @@ pub(crate) fn project(args: &ProjectArgs) -> Result<(), Error> {
                     }
                     other => other.into(),
                 })?;
+            walks = walks.merged(report.walks);
             bar.inc(chunk.len() as u64);
         }
     }
@@ -245,9 +253,17 @@ pub(crate) fn project(args: &ProjectArgs) -> Result<(), Error> {
     if args.report.stats_json {
         job.print_json(&ProjectExtra {
             write_ms: ms(t_write),
+            walks: walks.taken().map(|(w, c)| (w.name(), c)).collect(),
         });
     } else if args.report.stats {
         job.print_human();
+        let taken: Vec<String> = walks
+            .taken()
+            .map(|(w, c)| format!("{} {c}", w.name()))
+            .collect();
+        if !taken.is_empty() {
+            say!("  walks         {}", taken.join(", "));
+        }
         say!("  write         {:.1} ms", ms(t_write));
     }
     Ok(())
