@@ -375,7 +375,7 @@ fn flash_tables_equal_a_fresh_preparation() {
             &tw,
         )
         .unwrap();
-        assert_eq!(spec.scale(), stored.scale, "{:?}", stored.kind);
+        assert_eq!(spec.scale(), stored.header.scale, "{:?}", stored.kind);
         assert!(
             data.iter()
                 .zip(stored.data)
@@ -396,7 +396,7 @@ fn flash_tables_equal_a_fresh_preparation() {
         else {
             panic!("F16 precision gives an f16 spectrum");
         };
-        assert_eq!(host.view().scale(), stored.scale);
+        assert_eq!(host.view().scale(), stored.header.scale);
         assert!(host
             .view()
             .data()

@@ -64,7 +64,7 @@ pub fn f64_view() -> (Vec<f64>, Vec<f64>) {
     }
     let volume = DenseVolume::new(DIMS, &voxels).unwrap();
     let filter = DENSITY_KB3_Q15.filter().unwrap();
-    let n = DENSITY_KB3_Q15.n;
+    let n = DENSITY_KB3_Q15.header.n;
     let mut tw_buf = vec![0.0f64; Twiddles::<f64>::buffer_len(n)];
     let tw = Twiddles::new(&mut tw_buf, n).unwrap();
     let mut scratch = vec![0.0f64; prepare_scratch_len(n)];
