@@ -39,6 +39,19 @@ pub struct FixedBuffers<'a> {
     pub out: &'a mut [i16],
 }
 
+impl FixedBuffers<'_> {
+    /// The same buffers, borrowed again for one call of [`finish_fixed`]
+    /// (which takes them by value).
+    pub fn reborrow(&mut self) -> FixedBuffers<'_> {
+        FixedBuffers {
+            grid: self.grid,
+            aux: self.aux,
+            block: self.block,
+            out: self.out,
+        }
+    }
+}
+
 /// Turn the `m × m` slice `grid·2^exponent` into the `width × height`
 /// image at `place`: sub-pixel shift (a phase ramp, as [`super::finish`],
 /// with the cosines and sines in Q30), round to Q15 with one exponent
