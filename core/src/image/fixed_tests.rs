@@ -78,15 +78,21 @@ fn both(grid: &[i32], place: Placement, size: (usize, usize)) -> (Vec<f64>, Vec<
     (fixed, reference)
 }
 
-#[test]
-fn random_slices_meet_the_q15_floor_with_and_without_a_shift() {
-    let mut state = 0x1234_5678u32;
-    let grid: Vec<i32> = (0..M * M)
+/// An `M × M` slice of pseudo-random values below `2^(31 − shift)` in
+/// magnitude (a linear congruential generator from `seed`).
+fn random_grid(seed: u32, shift: u32) -> Vec<i32> {
+    let mut state = seed;
+    (0..M * M)
         .map(|_| {
             state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (state as i32) >> 9
+            (state as i32) >> shift
         })
-        .collect();
+        .collect()
+}
+
+#[test]
+fn random_slices_meet_the_q15_floor_with_and_without_a_shift() {
+    let grid = random_grid(0x1234_5678, 9);
     for (shift, size) in [
         ([0.0, 0.0], (M, M)),
         ([0.3, 0.75], (M, M)),
@@ -177,13 +183,7 @@ fn bad_buffers_are_refused() {
 fn the_image_cut_into_the_block_is_the_image() {
     let mut tw16 = vec![0i16; FixedTwiddles::<i16>::buffer_len(M)];
     let tw16 = FixedTwiddles::new(&mut tw16, M).unwrap();
-    let mut state = 0x9E37_79B9u32;
-    let grid: Vec<i32> = (0..M * M)
-        .map(|_| {
-            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (state as i32) >> 7
-        })
-        .collect();
+    let grid = random_grid(0x9E37_79B9, 7);
     let m = M as i64;
     for (col0, row0, shift, size) in [
         (-m / 2, m / 2, [0.0, 0.0], (M, M)),
