@@ -5,7 +5,7 @@
 //! check (`tests/qemu_fixed.rs`).
 
 use fvr_core::dht::fixed::FixedTwiddles;
-use fvr_core::image::fixed::{finish_fixed, FixedBuffers};
+use fvr_core::image::fixed::{finish_fixed, FixedBuffers, FixedSlice};
 use fvr_core::image::placement;
 use fvr_core::render::fixed::{render_fixed, scale_exponent, FixedSource};
 use fvr_core::slice::fixed::{extract_slice_fixed, FixedPhases};
@@ -91,16 +91,19 @@ pub fn render_view<C: InstructionClock>(
     let t2 = clock.now();
     let grid_exponent = extract_slice_fixed(&spectrum, phases, &axes, &mut *view.grid)?;
     let t3 = clock.now();
+    let slice = FixedSlice {
+        exponent: grid_exponent,
+        m: spectrum.n(),
+        place,
+        size,
+        tw,
+    };
     let staged_exponent = finish_fixed(
         FixedBuffers {
             out: &mut *staged,
             ..view.reborrow()
         },
-        grid_exponent,
-        spectrum.n(),
-        &place,
-        size,
-        tw,
+        &slice,
     )? - scale;
     let t4 = clock.now();
     if staged_exponent != exponent || *staged != *view.out {

@@ -29,6 +29,22 @@ fn floor_db() -> f64 {
         - 20.0 * libm::log10(crest)
 }
 
+/// The `M × M` slice at `exponent` of a `size` image at `place`.
+fn at<'a>(
+    exponent: i32,
+    place: Placement,
+    size: (usize, usize),
+    tw: &'a FixedTwiddles<'a, i16>,
+) -> FixedSlice<'a> {
+    FixedSlice {
+        exponent,
+        m: M,
+        place,
+        size,
+        tw,
+    }
+}
+
 /// [`finish_fixed`] of a copy of `grid` (`M × M`) at `exponent` into fresh
 /// buffers: the image's exponent and mantissas.
 fn finish_fixed_owned(
@@ -48,7 +64,7 @@ fn finish_fixed_owned(
         block: &mut block,
         out: &mut out,
     };
-    let exponent = finish_fixed(buffers, exponent, M, place, size, tw16).unwrap();
+    let exponent = finish_fixed(buffers, &at(exponent, *place, size, tw16)).unwrap();
     (exponent, out)
 }
 
@@ -165,11 +181,7 @@ fn bad_buffers_are_refused() {
                 block: &mut block,
                 out: &mut out[..out_len],
             },
-            0,
-            M,
-            &place,
-            size,
-            &tw16,
+            &at(0, place, size, &tw16),
         );
         assert!(result.is_err(), "{size:?}, short aux {short_aux}");
     }
@@ -197,7 +209,8 @@ fn the_image_cut_into_the_block_is_the_image() {
         let (mut g, mut aux) = (grid.clone(), vec![0i32; fixed_aux_len(M)]);
         let mut block = vec![0i16; M * M];
         let e_block =
-            finish_fixed_in_block(&mut g, &mut aux, &mut block, 3, M, &place, size, &tw16).unwrap();
+            finish_fixed_in_block(&mut g, &mut aux, &mut block, &at(3, place, size, &tw16))
+                .unwrap();
         assert_eq!(e_block, e_out, "{place:?} {size:?}");
         assert_eq!(&block[..size.0 * size.1], &out[..], "{place:?} {size:?}");
     }
@@ -210,11 +223,11 @@ fn the_image_cut_into_the_block_is_the_image() {
     for size in [(0, M), (M + 1, M)] {
         let mut aux4 = vec![0i32; fixed_aux_len(M)];
         assert!(
-            finish_fixed_in_block(&mut g, &mut aux4, &mut block, 0, M, &place, size, &tw16)
+            finish_fixed_in_block(&mut g, &mut aux4, &mut block, &at(0, place, size, &tw16))
                 .is_err()
         );
     }
     assert!(
-        finish_fixed_in_block(&mut g, &mut aux, &mut block, 0, M, &place, (M, M), &tw16).is_err()
+        finish_fixed_in_block(&mut g, &mut aux, &mut block, &at(0, place, (M, M), &tw16)).is_err()
     );
 }
