@@ -253,57 +253,65 @@ fn naive_2d_matches_the_direct_sum() {
     }
 }
 
-#[test]
-fn q15_1d_snr_meets_the_model_for_every_class_and_size() {
-    let tw = table::<i16>(1024);
+/// Every class at each side `2^bits` meets the model floor of `S`'s
+/// fraction bits: the 1D transform (`bits` roundings) for each seed.
+fn assert_1d_model<S: FixedSample>(
+    tw: &FixedTwiddles<'_, S>,
+    sides: impl IntoIterator<Item = u32> + Clone,
+    seeds: core::ops::Range<u64>,
+) {
     for class in CLASSES {
-        for bits in 1..=10 {
+        for bits in sides.clone() {
             let n = 1usize << bits;
-            let floor = floor_db(15, bits as f64, class.crest(n));
-            for seed in 0..3 {
-                let snr = snr_1d(class, n, seed, &tw);
+            let floor = floor_db(S::FRAC_BITS, bits as f64, class.crest(n));
+            for seed in seeds.clone() {
+                let snr = snr_1d(class, n, seed, tw);
                 assert!(
                     snr >= floor,
-                    "{class:?} N={n} seed {seed}: {snr:.1} < {floor:.1} dB"
+                    "Q{} {class:?} N={n} seed {seed}: {snr:.1} < {floor:.1} dB",
+                    S::FRAC_BITS
                 );
             }
         }
     }
 }
 
-#[test]
-fn q15_2d_snr_meets_the_model_for_every_class_and_size() {
-    let tw = table::<i16>(256);
+/// As [`assert_1d_model`] for the `n × n` 2D transform (`2·bits + 1`
+/// roundings, the correction's included), one seed.
+fn assert_2d_model<S: FixedSample>(
+    tw: &FixedTwiddles<'_, S>,
+    sides: impl IntoIterator<Item = u32> + Clone,
+    seed: u64,
+) {
     for class in CLASSES {
-        for bits in 3..=8 {
+        for bits in sides.clone() {
             let n = 1usize << bits;
-            let floor = floor_db(15, 2.0 * bits as f64 + 1.0, class.crest(n * n));
-            let snr = snr_2d(class, n, 1, &tw);
-            assert!(snr >= floor, "{class:?} {n}²: {snr:.1} < {floor:.1} dB");
+            let floor = floor_db(S::FRAC_BITS, 2.0 * bits as f64 + 1.0, class.crest(n * n));
+            let snr = snr_2d(class, n, seed, tw);
+            assert!(
+                snr >= floor,
+                "Q{} {class:?} {n}²: {snr:.1} < {floor:.1} dB",
+                S::FRAC_BITS
+            );
         }
     }
 }
 
 #[test]
+fn q15_1d_snr_meets_the_model_for_every_class_and_size() {
+    assert_1d_model(&table::<i16>(1024), 1..=10, 0..3);
+}
+
+#[test]
+fn q15_2d_snr_meets_the_model_for_every_class_and_size() {
+    assert_2d_model(&table::<i16>(256), 3..=8, 1);
+}
+
+#[test]
 fn q31_meets_the_same_model_with_31_fraction_bits() {
     let tw = table::<i32>(1024);
-    for class in CLASSES {
-        for bits in [1, 4, 7, 10] {
-            let n = 1usize << bits;
-            let floor = floor_db(31, bits as f64, class.crest(n));
-            let snr = snr_1d(class, n, 2, &tw);
-            assert!(
-                snr >= floor,
-                "Q31 {class:?} N={n}: {snr:.1} < {floor:.1} dB"
-            );
-        }
-        for bits in [3, 5] {
-            let n = 1usize << bits;
-            let floor = floor_db(31, 2.0 * bits as f64 + 1.0, class.crest(n * n));
-            let snr = snr_2d(class, n, 2, &tw);
-            assert!(snr >= floor, "Q31 {class:?} {n}²: {snr:.1} < {floor:.1} dB");
-        }
-    }
+    assert_1d_model(&tw, [1, 4, 7, 10], 2..3);
+    assert_2d_model(&tw, [3, 5], 2);
 }
 
 #[test]
