@@ -157,6 +157,26 @@ fn phantom_voxels() -> Vec<f32> {
     voxels
 }
 
+/// The `StoredHeader` (src/stored.rs) of a spectrum of the phantom
+/// prepared for `filter`, of side `n` and power-of-two scale `scale`, as
+/// Rust source; f64 values by their bits, so they round-trip exactly.
+fn header_literal(filter: &Filter, scale: f64, n: usize) -> String {
+    format!(
+        "StoredHeader {{\n        \
+             oversample: {OVERSAMPLE},\n        \
+             beta: f64::from_bits({:#018x}),\n        \
+             scale: f64::from_bits({:#018x}),\n        \
+             n: {n},\n        \
+             dims: [{}, {}, {}],\n    \
+         }}",
+        filter.beta().to_bits(),
+        scale.to_bits(),
+        DIMS[0],
+        DIMS[1],
+        DIMS[2],
+    )
+}
+
 /// The kb3 density spectrum of the scene's phantom in Q15 with one block
 /// exponent per x-line, for the Cortex-M3's integer view
 /// (`src/stored_q15.rs`): prepared in f64 by the core
@@ -189,11 +209,7 @@ fn make_q15_view_tables(out: &Path) {
          /// The phantom's kb3 density spectrum (β = {beta}), {n}³ Q15 with one\n\
          /// exponent per x-line, prepared in f64 and rounded once; scale 2^{e}.\n\
          pub static DENSITY_KB3_Q15: StoredQ15 = StoredQ15 {{\n    \
-             oversample: {OVERSAMPLE},\n    \
-             beta: f64::from_bits({beta_bits:#018x}),\n    \
-             scale: f64::from_bits({scale_bits:#018x}),\n    \
-             n: {n},\n    \
-             dims: [{}, {}, {}],\n    \
+             header: {header},\n    \
              data: &DENSITY_KB3_Q15_DATA,\n    \
              exponents: &DENSITY_KB3_Q15_EXPONENTS,\n\
          }};\n\
@@ -202,12 +218,8 @@ fn make_q15_view_tables(out: &Path) {
              decode_q15(include_bytes!(concat!(env!(\"OUT_DIR\"), \"/density-kb3.q15\")));\n\
          static DENSITY_KB3_Q15_EXPONENTS: [i8; {lines}] =\n    \
              decode_i8(include_bytes!(concat!(env!(\"OUT_DIR\"), \"/density-kb3.q15exp\")));\n",
-        DIMS[0],
-        DIMS[1],
-        DIMS[2],
         beta = filter.beta(),
-        beta_bits = filter.beta().to_bits(),
-        scale_bits = scale.to_bits(),
+        header = header_literal(&filter, scale, n),
         e = libm::log2(scale) as i32,
         cube = n * n * n,
         lines = n * n,
@@ -323,24 +335,16 @@ fn make_tables(out: &Path) -> Vec<Made> {
              /// σ = {design:.3}), {n}³ f16, scale 2^{e}.\n\
              pub static {upper}: StoredSpectrum = StoredSpectrum {{\n    \
                  kind: StoredKind::{variant_path}(FilterKind::{variant}),\n    \
-                 oversample: {OVERSAMPLE},\n    \
-                 beta: f64::from_bits({beta_bits:#018x}),\n    \
-                 scale: f64::from_bits({scale_bits:#018x}),\n    \
-                 n: {n},\n    \
-                 dims: [{}, {}, {}],\n    \
+                 header: {header},\n    \
                  data: &{upper}_DATA,\n    \
                  kernel: &KERNEL_{kupper},\n\
              }};\n\
              #[allow(long_running_const_eval)]\n\
              static {upper}_DATA: [f16; {cube}] =\n    \
                  decode_f16(include_bytes!(concat!(env!(\"OUT_DIR\"), \"/{file}\")));\n",
-            DIMS[0],
-            DIMS[1],
-            DIMS[2],
             beta = filter.beta(),
             variant = variant(name),
-            beta_bits = filter.beta().to_bits(),
-            scale_bits = scale.to_bits(),
+            header = header_literal(&filter, scale, n),
             e = libm::log2(scale) as i32,
             cube = n * n * n,
             kupper = name.to_uppercase(),

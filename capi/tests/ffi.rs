@@ -116,6 +116,33 @@ fn lens(src: &fvr_source, req: &fvr_request) -> fvr_lens {
     l
 }
 
+/// The image, the source opened on it, a 16 × 16 request and buffers of
+/// the lengths the library asks for.
+struct Setup {
+    words: Vec<u64>,
+    len: usize,
+    src: fvr_source,
+    req: fvr_request,
+    b: Bufs,
+}
+
+/// The set-up of the tests that break one argument of a good render.
+fn setup_16x16() -> Setup {
+    let (words, len) = image();
+    // The handle points into `words`' heap buffer, which moving the `Vec`
+    // into `Setup` leaves in place.
+    let (_, src) = open(&words, len);
+    let req = request(16, 16);
+    let b = Bufs::new(lens(&src, &req));
+    Setup {
+        words,
+        len,
+        src,
+        req,
+        b,
+    }
+}
+
 #[test]
 fn renders_bit_for_bit_as_the_core_from_the_same_image() {
     let (words, len) = image();
@@ -174,109 +201,100 @@ fn renders_bit_for_bit_as_the_core_from_the_same_image() {
 
 #[test]
 fn null_pointers_are_fvr_err_null() {
-    let (words, len) = image();
-    let (_, src) = open(&words, len);
-    let req = request(16, 16);
-    let mut b = Bufs::new(lens(&src, &req));
+    let mut t = setup_16x16();
     let null = std::ptr::null_mut::<f32>();
     unsafe {
         assert_eq!(
-            fvr_source_open(std::ptr::null_mut(), words.as_ptr().cast(), len),
+            fvr_source_open(std::ptr::null_mut(), t.words.as_ptr().cast(), t.len),
             FVR_ERR_NULL
         );
         let mut s = fvr_source { opaque: [0; 4] };
-        assert_eq!(fvr_source_open(&mut s, std::ptr::null(), len), FVR_ERR_NULL);
+        assert_eq!(
+            fvr_source_open(&mut s, std::ptr::null(), t.len),
+            FVR_ERR_NULL
+        );
         assert_eq!(
             fvr_source_info(std::ptr::null(), &mut fvr_info::default()),
             FVR_ERR_NULL
         );
-        assert_eq!(fvr_source_info(&src, std::ptr::null_mut()), FVR_ERR_NULL);
+        assert_eq!(fvr_source_info(&t.src, std::ptr::null_mut()), FVR_ERR_NULL);
         assert_eq!(
-            fvr_buffer_lens(&src, std::ptr::null(), &mut fvr_lens::default()),
+            fvr_buffer_lens(&t.src, std::ptr::null(), &mut fvr_lens::default()),
             FVR_ERR_NULL
         );
         assert_eq!(
-            fvr_buffer_lens(&src, &req, std::ptr::null_mut()),
+            fvr_buffer_lens(&t.src, &t.req, std::ptr::null_mut()),
             FVR_ERR_NULL
         );
-        assert_eq!(fvr_render(std::ptr::null(), &req, &b.c()), FVR_ERR_NULL);
-        assert_eq!(fvr_render(&src, std::ptr::null(), &b.c()), FVR_ERR_NULL);
-        assert_eq!(fvr_render(&src, &req, std::ptr::null()), FVR_ERR_NULL);
+        assert_eq!(fvr_render(std::ptr::null(), &t.req, &t.b.c()), FVR_ERR_NULL);
+        assert_eq!(fvr_render(&t.src, std::ptr::null(), &t.b.c()), FVR_ERR_NULL);
+        assert_eq!(fvr_render(&t.src, &t.req, std::ptr::null()), FVR_ERR_NULL);
         for k in 0..3 {
-            let mut c = b.c();
+            let mut c = t.b.c();
             *buffer(&mut c, k).0 = null;
-            assert_eq!(fvr_render(&src, &req, &c), FVR_ERR_NULL, "buffer {k}");
+            assert_eq!(fvr_render(&t.src, &t.req, &c), FVR_ERR_NULL, "buffer {k}");
         }
     }
 }
 
 #[test]
 fn short_buffers_are_fvr_err_buffer_too_small() {
-    let (words, len) = image();
-    let (_, src) = open(&words, len);
-    let req = request(16, 16);
-    let mut b = Bufs::new(lens(&src, &req));
+    let mut t = setup_16x16();
     for k in 0..3 {
-        let mut c = b.c();
+        let mut c = t.b.c();
         *buffer(&mut c, k).1 -= 1;
         assert_eq!(
-            unsafe { fvr_render(&src, &req, &c) },
+            unsafe { fvr_render(&t.src, &t.req, &c) },
             FVR_ERR_BUFFER_TOO_SMALL,
             "{k}"
         );
     }
-    assert!(b.out.iter().all(|v| *v == 0.0), "nothing rendered");
+    assert!(t.b.out.iter().all(|v| *v == 0.0), "nothing rendered");
 }
 
 #[test]
 fn misaligned_pointers_are_fvr_err_misaligned() {
-    let (mut words, len) = image();
-    let (_, src) = open(&words, len);
-    let req = request(16, 16);
-    let mut b = Bufs::new(lens(&src, &req));
+    let mut t = setup_16x16();
     for k in 0..3 {
-        let mut c = b.c();
+        let mut c = t.b.c();
         let (p, _) = buffer(&mut c, k);
         // One byte on: no longer 4-byte aligned.
         *p = p.cast::<u8>().wrapping_add(1).cast::<f32>();
         assert_eq!(
-            unsafe { fvr_render(&src, &req, &c) },
+            unsafe { fvr_render(&t.src, &t.req, &c) },
             FVR_ERR_MISALIGNED,
             "{k}"
         );
     }
     // The image one byte past an 8-byte boundary (moved there whole).
-    let bytes = bytes_of(&mut words);
-    bytes.copy_within(0..len, 1);
+    let bytes = bytes_of(&mut t.words);
+    bytes.copy_within(0..t.len, 1);
     let mut s = fvr_source { opaque: [0; 4] };
-    let at1 = unsafe { words.as_ptr().cast::<u8>().add(1) };
+    let at1 = unsafe { t.words.as_ptr().cast::<u8>().add(1) };
     assert_eq!(
-        unsafe { fvr_source_open(&mut s, at1, len) },
+        unsafe { fvr_source_open(&mut s, at1, t.len) },
         FVR_ERR_MISALIGNED
     );
     // A misaligned handle.
     let mut raw = [0u64; 8];
     let handle = unsafe { raw.as_mut_ptr().cast::<u8>().add(4).cast::<fvr_source>() };
     assert_eq!(
-        unsafe { fvr_source_open(handle, at1, len) },
+        unsafe { fvr_source_open(handle, at1, t.len) },
         FVR_ERR_MISALIGNED
     );
 }
 
 #[test]
 fn overlapping_buffers_are_fvr_err_overlap() {
-    let (words, len) = image();
-    let (_, src) = open(&words, len);
-    let req = request(16, 16);
-    let mut b = Bufs::new(lens(&src, &req));
-    let mut c = b.c();
+    let mut t = setup_16x16();
+    let mut c = t.b.c();
     c.out = c.grid;
     c.out_len = 16 * 16;
-    assert_eq!(unsafe { fvr_render(&src, &req, &c) }, FVR_ERR_OVERLAP);
-    let mut c = b.c();
+    assert_eq!(unsafe { fvr_render(&t.src, &t.req, &c) }, FVR_ERR_OVERLAP);
+    let mut c = t.b.c();
     c.aux = unsafe { c.grid.add(1) };
     c.aux_len = 1.min(c.aux_len);
-    assert_eq!(unsafe { fvr_render(&src, &req, &c) }, FVR_ERR_OVERLAP);
+    assert_eq!(unsafe { fvr_render(&t.src, &t.req, &c) }, FVR_ERR_OVERLAP);
 }
 
 #[test]

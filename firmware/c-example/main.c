@@ -48,6 +48,16 @@ static char *text(char *p, const char *s) {
     return p;
 }
 
+/* Say which call failed and with what status; the program's exit status. */
+static int failed(const char *call, fvr_status s) {
+    sh_puts("c-example: ");
+    sh_puts(call);
+    sh_puts(": ");
+    sh_puts(fvr_status_str((int32_t)s));
+    sh_puts("\n");
+    return 1;
+}
+
 int main(void) {
     SYST_RVR = RELOAD;
     SYST_CVR = 0;
@@ -59,12 +69,7 @@ int main(void) {
     uint32_t t0 = SYST_CVR;
     fvr_status s = fvr_source_open(&src, bs, BS_LEN);
     uint32_t open_ticks = ticks_since(t0);
-    if (s != FVR_OK) {
-        sh_puts("c-example: fvr_source_open: ");
-        sh_puts(fvr_status_str((int32_t)s));
-        sh_puts("\n");
-        return 1;
-    }
+    if (s != FVR_OK) return failed("fvr_source_open", s);
     fvr_request req = {{1.0, 0.3, 0.2}, {0.0, 0.0, 1.0}, SIDE, SIDE, 0};
     fvr_lens lens;
     s = fvr_buffer_lens(&src, &req, &lens);
@@ -76,12 +81,7 @@ int main(void) {
     t0 = SYST_CVR;
     s = fvr_render(&src, &req, &buf);
     uint32_t render_ticks = ticks_since(t0);
-    if (s != FVR_OK) {
-        sh_puts("c-example: fvr_render: ");
-        sh_puts(fvr_status_str((int32_t)s));
-        sh_puts("\n");
-        return 1;
-    }
+    if (s != FVR_OK) return failed("fvr_render", s);
     if (SYST_CSR & (1u << 16)) {
         sh_puts("c-example: SysTick wrapped; counts unusable\n");
         return 1;

@@ -255,7 +255,8 @@ fn run_inner(
         let rendered = render_frame(spec, &tables, &tw, &mut bufs, &clock)?;
         let (channels, counts) = (rendered.channels, rendered.counts);
         let image = bufs
-            .image
+            .render
+            .out
             .get(..channels * IMAGE_LEN)
             .ok_or(RunError::Host("image buffer shorter than the frame"))?;
 
@@ -498,9 +499,7 @@ macro_rules! firmware_main {
                 $crate::device::abort("frame buffers taken twice")
             };
             let bufs = $crate::frame::FrameBuffers {
-                fields,
-                aux,
-                image,
+                render: fvr_core::render::Buffers::new(fields, aux, image),
                 staged,
             };
             $crate::device::run($program, &$frames, &[$($spectrum),+], &[$($derivative),*], bufs)

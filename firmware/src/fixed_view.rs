@@ -5,7 +5,7 @@
 //! check (`tests/qemu_fixed.rs`).
 
 use fvr_core::dht::fixed::FixedTwiddles;
-use fvr_core::image::fixed::{finish_fixed, FixedBuffers};
+use fvr_core::image::fixed::{finish_fixed, FixedBuffers, FixedSlice};
 use fvr_core::image::placement;
 use fvr_core::render::fixed::{render_fixed, scale_exponent, FixedSource};
 use fvr_core::slice::fixed::{extract_slice_fixed, FixedPhases};
@@ -21,17 +21,13 @@ pub const GRID_LEN: usize = IMAGE_SIDE * IMAGE_SIDE;
 /// Elements of the auxiliary scratch.
 pub const AUX_LEN: usize = fvr_core::image::fixed::fixed_aux_len(IMAGE_SIDE);
 
-/// The buffers of the integer view (in `.bss` on the device).
+/// The buffers of the integer view (in `.bss` on the device): the core's
+/// (the `i32` slice grid, the auxiliary scratch, the Q15 slice block and
+/// the image of `render_fixed`), and the image of the staged render.
 #[derive(Debug)]
 pub struct ViewBuffers<'a> {
-    /// The `i32` slice grid.
-    pub grid: &'a mut [i32],
-    /// Auxiliary scratch.
-    pub aux: &'a mut [i32],
-    /// The Q15 slice block.
-    pub block: &'a mut [i16],
-    /// The image of `render_fixed`.
-    pub image: &'a mut [i16],
+    /// The buffers `render_fixed` and `finish_fixed` take.
+    pub view: FixedBuffers<'a>,
     /// The image of the staged render.
     pub staged: &'a mut [i16],
 }
@@ -66,8 +62,8 @@ impl From<fvr_core::Error> for ViewError {
     }
 }
 
-/// Render the plain kb3 frame in integers into `bufs.image` and, staged,
-/// into `bufs.staged`; returns the image's exponent (pixel `i` is
+/// Render the plain kb3 frame in integers into `bufs.view.out` and,
+/// staged, into `bufs.staged`; returns the image's exponent (pixel `i` is
 /// `image[i]·2^e`) and the counts.
 ///
 /// # Errors
@@ -75,7 +71,7 @@ impl From<fvr_core::Error> for ViewError {
 pub fn render_view<C: InstructionClock>(
     phases: &FixedPhases<WIDTH>,
     tw: &FixedTwiddles<'_, i16>,
-    bufs: ViewBuffers<'_>,
+    ViewBuffers { mut view, staged }: ViewBuffers<'_>,
     clock: &C,
 ) -> Result<(i32, ViewCounts), ViewError> {
     let spectrum = DENSITY_KB3_Q15.spectrum()?;
@@ -86,40 +82,31 @@ pub fn render_view<C: InstructionClock>(
     };
     let size = (IMAGE_SIDE, IMAGE_SIDE);
     let t0 = clock.now();
-    let exponent = render_fixed(
-        &source,
-        &VIEW,
-        size,
-        FixedBuffers {
-            grid: &mut *bufs.grid,
-            aux: &mut *bufs.aux,
-            block: &mut *bufs.block,
-            out: &mut *bufs.image,
-        },
-    )?;
+    let exponent = render_fixed(&source, &VIEW, size, view.reborrow())?;
     let t1 = clock.now();
     let frame = VIEW.frame()?;
     let axes = frame.slice_axes();
     let place = placement(spectrum.dims(), &frame, IMAGE_SIDE, IMAGE_SIDE);
     let scale = scale_exponent(spectrum.scale())?;
     let t2 = clock.now();
-    let grid_exponent = extract_slice_fixed(&spectrum, phases, &axes, &mut *bufs.grid)?;
+    let grid_exponent = extract_slice_fixed(&spectrum, phases, &axes, &mut *view.grid)?;
     let t3 = clock.now();
-    let staged = finish_fixed(
-        FixedBuffers {
-            grid: &mut *bufs.grid,
-            aux: &mut *bufs.aux,
-            block: &mut *bufs.block,
-            out: &mut *bufs.staged,
-        },
-        grid_exponent,
-        spectrum.n(),
-        &place,
+    let slice = FixedSlice {
+        exponent: grid_exponent,
+        m: spectrum.n(),
+        place,
         size,
         tw,
+    };
+    let staged_exponent = finish_fixed(
+        FixedBuffers {
+            out: &mut *staged,
+            ..view.reborrow()
+        },
+        &slice,
     )? - scale;
     let t4 = clock.now();
-    if staged != exponent || bufs.staged != bufs.image {
+    if staged_exponent != exponent || *staged != *view.out {
         return Err(ViewError::StagedDiffers);
     }
     Ok((

@@ -71,7 +71,7 @@ pub struct FrameCounts {
 }
 
 /// A rendered frame: the image is the first `channels·IMAGE_LEN` elements
-/// of [`FrameBuffers::image`], channel fastest.
+/// of the image of [`FrameBuffers::render`], channel fastest.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Rendered {
     /// Channels of the image (1 grey, 3 RGB).
@@ -91,28 +91,14 @@ pub const IMAGE_LEN: usize = IMAGE_SIDE * IMAGE_SIDE;
 /// program's frames by [`crate::scene::buffer_sizes`].
 #[derive(Debug)]
 pub struct FrameBuffers<'a> {
-    /// Scratch grids: the slice grid of a plain frame ([`GRID_LEN`]), the
-    /// fields of `render_scene` (`fields_len(scene, n)`).
-    pub fields: &'a mut [f32],
-    /// Auxiliary scratch, [`AUX_LEN`].
-    pub aux: &'a mut [f32],
-    /// The image (`channels·`[`IMAGE_LEN`]).
-    pub image: &'a mut [f32],
+    /// The buffers [`render`] writes: its scratch grids (the slice grid of
+    /// a plain frame, [`GRID_LEN`]; the fields of `render_scene`,
+    /// `fields_len(scene, n)`), the auxiliary scratch ([`AUX_LEN`]) and
+    /// the image (`channels·`[`IMAGE_LEN`]).
+    pub render: Buffers<'a, f32>,
     /// The image of the staged render, or of the re-timed inverse (as
-    /// long as `image`).
+    /// long as the image).
     pub staged: &'a mut [f32],
-}
-
-impl FrameBuffers<'_> {
-    /// The buffers [`render`] writes: the scratch grids, the auxiliary
-    /// scratch and the image.
-    fn core(&mut self) -> Buffers<'_, f32> {
-        Buffers {
-            grid: self.fields,
-            aux: self.aux,
-            out: self.image,
-        }
-    }
 }
 
 /// Why a frame failed.
@@ -332,23 +318,23 @@ fn render_plain<C: InstructionClock>(
     render(
         &Source::new(&spectrum, kernel, tw),
         &Request::new(spec.view, w, h),
-        bufs.core(),
+        bufs.render.reborrow(),
     )?;
     let t1 = clock.now();
     let frame = spec.view.frame()?;
-    extract_slice(&spectrum, kernel, &frame, &mut bufs.fields[..n * n]);
+    extract_slice(&spectrum, kernel, &frame, &mut bufs.render.grid[..n * n]);
     let t2 = clock.now();
     let place = placement(spectrum.dims(), &frame, w, h);
     finish(
-        &mut bufs.fields[..n * n],
+        &mut bufs.render.grid[..n * n],
         n,
         &Crop::new(place, 1.0 / spectrum.scale(), w, h),
         tw,
-        bufs.aux,
+        bufs.render.aux,
         bufs.staged,
     )?;
     let t3 = clock.now();
-    if let Some(pixel) = bufs.image[..w * h]
+    if let Some(pixel) = bufs.render.out[..w * h]
         .iter()
         .zip(bufs.staged.iter())
         .position(|(a, b)| a.to_bits() != b.to_bits())
@@ -361,7 +347,13 @@ fn render_plain<C: InstructionClock>(
     let t4 = clock.now();
     inverse_again(&spectrum, &frame, 1, tw, bufs)?;
     let t5 = clock.now();
-    dht_2d(&mut bufs.fields[..n * n], n, n, &mut bufs.aux[..n], tw)?;
+    dht_2d(
+        &mut bufs.render.grid[..n * n],
+        n,
+        n,
+        &mut bufs.render.aux[..n],
+        tw,
+    )?;
     let t6 = clock.now();
     Ok(Rendered {
         channels: 1,
@@ -413,7 +405,7 @@ fn render_cued_or_shaded<C: InstructionClock>(
             scene: Some(&scene),
             ..Request::new(spec.view, IMAGE_SIDE, IMAGE_SIDE)
         },
-        bufs.core(),
+        bufs.render.reborrow(),
     )?;
     let t1 = clock.now();
     let frame = spec.view.frame()?;
@@ -421,7 +413,13 @@ fn render_cued_or_shaded<C: InstructionClock>(
     inverse_again(&spectrum, &frame, channels, tw, bufs)?;
     let t3 = clock.now();
     let n = spectrum.n();
-    dht_2d(&mut bufs.fields[..n * n], n, n, &mut bufs.aux[..n], tw)?;
+    dht_2d(
+        &mut bufs.render.grid[..n * n],
+        n,
+        n,
+        &mut bufs.render.aux[..n],
+        tw,
+    )?;
     let t4 = clock.now();
     let render = t1 - t0;
     let inverse = t3 - t2;
@@ -454,7 +452,7 @@ fn inverse_again(
     let gain = 1.0 / spectrum.scale();
     for c in 0..channels {
         finish(
-            &mut bufs.fields[..n * n],
+            &mut bufs.render.grid[..n * n],
             n,
             &Crop {
                 channels,
@@ -462,7 +460,7 @@ fn inverse_again(
                 ..Crop::new(place, gain, w, h)
             },
             tw,
-            bufs.aux,
+            bufs.render.aux,
             bufs.staged,
         )?;
     }

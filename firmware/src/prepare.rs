@@ -98,11 +98,13 @@ pub const fn view_lens(n: usize) -> (usize, usize) {
     (grid_len(n), aux_len(n))
 }
 
-/// Instruction counts of [`prepare_and_render`].
+/// Instruction counts of a device preparation ([`prepare_and_render`],
+/// `crate::prepare_q15::prepare_and_render_q15`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PrepCounts {
-    /// `Spectrum::prepare`: premultiplier table, the volume's bound,
-    /// premultiplication and placement, and the 3D DHT.
+    /// The preparation: for f16, `Spectrum::prepare` (premultiplier table,
+    /// the volume's bound, premultiplication and placement, and the 3D
+    /// DHT).
     pub prepare: u64,
     /// The `n × n` plain view rendered from the spectrum.
     pub render: u64,
@@ -168,22 +170,43 @@ pub fn time_dht_3d<const N: usize, C: InstructionClock>(
     clock: &C,
 ) -> Result<u64> {
     let cube = &mut bufs.spectrum[..spectrum_len(N)];
-    cube.fill(f16::ZERO);
-    cube[1] = f16::from_f32(8192.0);
+    time_on_impulse(cube, f16::from_f32(8192.0), clock, |cube| {
+        dht_3d(cube, [N; 3], bufs.scratch, tw)
+    })
+}
+
+/// The instructions `transform` takes on the test signal of the device
+/// preparations in `cube` (overwritten): `impulse` at `x = 1`, zero
+/// elsewhere.
+///
+/// # Errors
+/// As `transform`.
+pub fn time_on_impulse<S: Copy + Default, R, C: InstructionClock>(
+    cube: &mut [S],
+    impulse: S,
+    clock: &C,
+    transform: impl FnOnce(&mut [S]) -> Result<R>,
+) -> Result<u64> {
+    cube.fill(S::default());
+    cube[1] = impulse;
     let t0 = clock.now();
-    dht_3d(cube, [N; 3], bufs.scratch, tw)?;
+    transform(cube)?;
     Ok(clock.now() - t0)
 }
 
 /// FNV-1a (32 bits) over the little-endian bytes of `values`' bit patterns:
 /// a checksum of a spectrum the device logs and the host recomputes.
 pub fn fnv1a_f16(values: &[f16]) -> u32 {
+    fnv1a(values.iter().flat_map(|v| v.to_bits().to_le_bytes()))
+}
+
+/// FNV-1a (32 bits) over `bytes`: the checksum of the device preparations'
+/// spectra.
+pub fn fnv1a(bytes: impl IntoIterator<Item = u8>) -> u32 {
     let mut h: u32 = 0x811C_9DC5;
-    for v in values {
-        for b in v.to_bits().to_le_bytes() {
-            h ^= b as u32;
-            h = h.wrapping_mul(0x0100_0193);
-        }
+    for b in bytes {
+        h ^= b as u32;
+        h = h.wrapping_mul(0x0100_0193);
     }
     h
 }

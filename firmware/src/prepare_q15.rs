@@ -18,7 +18,7 @@ use fvr_core::spectrum::{Q15Storage, Spectrum};
 use fvr_core::Result;
 
 use crate::frame::InstructionClock;
-use crate::prepare::PrepInput;
+use crate::prepare::{fnv1a, time_on_impulse, PrepCounts, PrepInput};
 use crate::scene::VIEW;
 
 /// Width of the kb3 filter the programs prepare for.
@@ -28,17 +28,13 @@ pub const WIDTH: usize = 3;
 pub const TWIDDLES_LEN: usize = FixedTwiddles::<i16>::buffer_len(TWIDDLE_SIDE);
 
 /// Everything the program holds in RAM for side `n`: the cube, its
-/// exponents and premultipliers, and the buffers of one `n × n` integer
-/// view, whose image is cut into its Q15 block
-/// (`render_fixed_in_block`: no image buffer of its own).
+/// exponents and premultipliers (the core's [`Q15Storage`]), and the
+/// buffers of one `n × n` integer view, whose image is cut into its Q15
+/// block (`render_fixed_in_block`: no image buffer of its own).
 #[derive(Debug)]
 pub struct Q15Buffers<'a> {
-    /// The cube, `n³`: the padded volume, then the spectrum's mantissas.
-    pub mantissas: &'a mut [Q15],
-    /// One exponent per x-line, `n²`.
-    pub exponents: &'a mut [i8],
-    /// The fixed-point premultipliers, `n`.
-    pub premul: &'a mut [i32],
+    /// Where `Spectrum::prepare_q15` works and leaves the spectrum.
+    pub storage: Q15Storage<'a, 'a>,
     /// The view's `i32` slice, `n²`.
     pub grid: &'a mut [i32],
     /// The view's auxiliary scratch, `4n`.
@@ -53,19 +49,8 @@ pub const fn q15_lens(n: usize) -> (usize, usize, usize, usize, usize) {
     (n * n * n, n * n, n, n * n, fixed_aux_len(n))
 }
 
-/// Instruction counts of [`prepare_and_render_q15`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Q15Counts {
-    /// `Spectrum::prepare_q15`: premultipliers (soft float, `2n` filter
-    /// responses), the two integer passes over the volume, the 3D DHT and
-    /// the lines' normalization.
-    pub prepare: u64,
-    /// The `n × n` integer view rendered from the spectrum.
-    pub render: u64,
-}
-
 /// The result of [`prepare_and_render_q15`]: the spectrum is in
-/// [`Q15Buffers::mantissas`] and [`Q15Buffers::exponents`], the image in
+/// [`Q15Buffers::storage`] (mantissas and exponents), the image in
 /// [`Q15Buffers::block`]`[..n²]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PreparedQ15 {
@@ -73,8 +58,11 @@ pub struct PreparedQ15 {
     pub scale: f64,
     /// The image's exponent: pixel `i` is `image[i]·2^e`.
     pub image_exponent: i32,
-    /// Instruction counts.
-    pub counts: Q15Counts,
+    /// Instruction counts: `Spectrum::prepare_q15` (premultipliers in soft
+    /// float, `2n` filter responses; the two integer passes over the
+    /// volume, the 3D DHT and the lines' normalization) and the integer
+    /// view.
+    pub counts: PrepCounts,
 }
 
 /// The Q15 twiddles for the data (as [`Q15`]) from the flash table, in
@@ -114,16 +102,7 @@ pub fn prepare_and_render_q15<const N: usize, C: InstructionClock>(
     let volume = input.volume()?;
     let filter = input.filter()?;
     let t0 = clock.now();
-    let spectrum = Spectrum::prepare_q15(
-        &volume,
-        filter,
-        Q15Storage {
-            mantissas: &mut *bufs.mantissas,
-            exponents: &mut *bufs.exponents,
-            premul: &mut *bufs.premul,
-        },
-        tw_data,
-    )?;
+    let spectrum = Spectrum::prepare_q15(&volume, filter, bufs.storage.reborrow(), tw_data)?;
     let t1 = clock.now();
     let spectrum = spectrum.with_side::<N>()?;
     let source = FixedSource {
@@ -144,7 +123,7 @@ pub fn prepare_and_render_q15<const N: usize, C: InstructionClock>(
     Ok(PreparedQ15 {
         scale: spectrum.scale(),
         image_exponent,
-        counts: Q15Counts {
+        counts: PrepCounts {
             prepare: t1 - t0,
             render: t3 - t2,
         },
@@ -152,9 +131,9 @@ pub fn prepare_and_render_q15<const N: usize, C: InstructionClock>(
 }
 
 /// The 3D DHT alone (`dht_3d_lines`), timed on a test signal in
-/// `bufs.mantissas` (overwritten): an impulse of `2^13` at `x = 1`. Its
+/// `bufs.storage.mantissas` (overwritten): an impulse of `2^13` at `x = 1`. Its
 /// cost depends little on the values (the scaling shifts), so this splits
-/// [`Q15Counts::prepare`] closely, not exactly.
+/// [`PrepCounts::prepare`] closely, not exactly.
 ///
 /// # Errors
 /// As `dht_3d_lines`.
@@ -163,27 +142,25 @@ pub fn time_dht_3d_q15<const N: usize, C: InstructionClock>(
     bufs: &mut Q15Buffers<'_>,
     clock: &C,
 ) -> Result<u64> {
-    let cube = &mut bufs.mantissas[..N * N * N];
-    cube.fill(Q15(0));
-    cube[1] = Q15(1 << 13);
-    let t0 = clock.now();
-    dht_3d_lines(cube, [N; 3], &mut bufs.exponents[..N * N], tw)?;
-    Ok(clock.now() - t0)
+    let Q15Storage {
+        mantissas,
+        exponents,
+        ..
+    } = &mut bufs.storage;
+    time_on_impulse(&mut mantissas[..N * N * N], Q15(1 << 13), clock, |cube| {
+        dht_3d_lines(cube, [N; 3], &mut exponents[..N * N], tw)
+    })
 }
 
 /// FNV-1a (32 bits) over the little-endian mantissas, then the exponents:
 /// the checksum the device logs and the host recomputes.
 pub fn fnv1a_q15(mantissas: &[Q15], exponents: &[i8]) -> u32 {
-    let bytes = mantissas
-        .iter()
-        .flat_map(|m| m.0.to_le_bytes())
-        .chain(exponents.iter().map(|&e| e as u8));
-    let mut h: u32 = 0x811C_9DC5;
-    for b in bytes {
-        h ^= b as u32;
-        h = h.wrapping_mul(0x0100_0193);
-    }
-    h
+    fnv1a(
+        mantissas
+            .iter()
+            .flat_map(|m| m.0.to_le_bytes())
+            .chain(exponents.iter().map(|&e| e as u8)),
+    )
 }
 
 /// The longest transform the flash table serves (`fvr-fixed-bench`'s side).

@@ -56,7 +56,10 @@ fn run_inner<const N: usize>(
 
     let prepared =
         prepare_and_render_q15::<N, _>(input, (&tw_data, &tw_view), phases, &mut bufs, &clock)?;
-    let (mantissas, exponents) = (&bufs.mantissas[..N * N * N], &bufs.exponents[..N * N]);
+    let (mantissas, exponents) = (
+        &bufs.storage.mantissas[..N * N * N],
+        &bufs.storage.exponents[..N * N],
+    );
     let checksum = fnv1a_q15(mantissas, exponents);
 
     let mut file = HostFile::create(spectrum_file)?;
@@ -119,9 +122,11 @@ macro_rules! prepare_q15_main {
                 let mut block = BLOCK.borrow(cs).borrow_mut();
                 let mut phases = PHASES.borrow(cs).borrow_mut();
                 let bufs = $crate::prepare_q15::Q15Buffers {
-                    mantissas: &mut cube[..],
-                    exponents: &mut exponents[..],
-                    premul: &mut premul[..],
+                    storage: fvr_core::spectrum::Q15Storage {
+                        mantissas: &mut cube[..],
+                        exponents: &mut exponents[..],
+                        premul: &mut premul[..],
+                    },
                     grid: &mut grid[..],
                     aux: &mut aux[..],
                     block: &mut block[..],

@@ -13,11 +13,10 @@ use fvr_core::Result;
 
 use crate::scene::{StoredKind, SIDE};
 
-/// A spectrum in flash with what it takes to rebuild the core's objects.
+/// What a spectrum in flash, f16 ([`StoredSpectrum`]) or Q15
+/// (`crate::stored_q15::StoredQ15`), was prepared with on the host.
 #[derive(Debug)]
-pub struct StoredSpectrum {
-    /// What was transformed, and for which filter.
-    pub kind: StoredKind,
+pub struct StoredHeader {
     /// Oversampling factor of the filter design.
     pub oversample: u32,
     /// Kaiser–Bessel β the volume was premultiplied for.
@@ -28,6 +27,25 @@ pub struct StoredSpectrum {
     pub n: usize,
     /// Dimensions of the original volume.
     pub dims: [usize; 3],
+}
+
+impl StoredHeader {
+    /// The filter of `kind`, as designed on the host.
+    ///
+    /// # Errors
+    /// A bad oversampling or β (not for tables made by `build.rs`).
+    pub fn filter(&self, kind: FilterKind) -> Result<Filter> {
+        Filter::from_parts(kind, self.oversample, self.beta)
+    }
+}
+
+/// A spectrum in flash with what it takes to rebuild the core's objects.
+#[derive(Debug)]
+pub struct StoredSpectrum {
+    /// What was transformed, and for which filter.
+    pub kind: StoredKind,
+    /// How it was prepared.
+    pub header: StoredHeader,
     /// The coefficients `s·H`, `x` fastest.
     pub data: &'static [f16],
     /// The kernel, `k(i/1024)` for `i = 0 ..= W·512`.
@@ -45,7 +63,7 @@ impl StoredSpectrum {
     /// # Errors
     /// A bad oversampling or β (not for tables made by `build.rs`).
     pub fn filter(&self) -> Result<Filter> {
-        Filter::from_parts(self.filter_kind(), self.oversample, self.beta)
+        self.header.filter(self.filter_kind())
     }
 
     /// The core's view of the spectrum.
@@ -57,8 +75,8 @@ impl StoredSpectrum {
     /// # Errors
     /// As `Spectrum::from_parts`; a side other than [`SIDE`].
     pub fn spectrum(&self) -> Result<Spectrum<'static, f16, Side<SIDE>>> {
-        Spectrum::from_parts(self.data, self.n, self.scale, self.filter()?, self.dims)?
-            .with_side::<SIDE>()
+        let h = &self.header;
+        Spectrum::from_parts(self.data, h.n, h.scale, self.filter()?, h.dims)?.with_side::<SIDE>()
     }
 
     /// The kernel table, copied from flash (12 KiB of f32 at most).

@@ -9,20 +9,13 @@ use fvr_core::spectrum::{Side, Spectrum};
 use fvr_core::Result;
 
 use crate::scene::SIDE;
+use crate::stored::StoredHeader;
 
 /// A Q15 line-block spectrum in flash.
 #[derive(Debug)]
 pub struct StoredQ15 {
-    /// Oversampling factor of the filter design.
-    pub oversample: u32,
-    /// Kaiser–Bessel β the volume was premultiplied for.
-    pub beta: f64,
-    /// The power-of-two scale `s` of the stored values.
-    pub scale: f64,
-    /// Side of the cube.
-    pub n: usize,
-    /// Dimensions of the original volume.
-    pub dims: [usize; 3],
+    /// How it was prepared (for kb3).
+    pub header: StoredHeader,
     /// The mantissas, `x` fastest.
     pub data: &'static [Q15],
     /// One exponent per x-line.
@@ -35,7 +28,7 @@ impl StoredQ15 {
     /// # Errors
     /// A bad oversampling or β (not for tables made by `build.rs`).
     pub fn filter(&self) -> Result<Filter> {
-        Filter::from_parts(FilterKind::Kb3, self.oversample, self.beta)
+        self.header.filter(FilterKind::Kb3)
     }
 
     /// The core's view of the spectrum, its side fixed at compile time.
@@ -43,16 +36,10 @@ impl StoredQ15 {
     /// # Errors
     /// As `Spectrum::from_blocks`; a side other than [`SIDE`].
     pub fn spectrum(&self) -> Result<Spectrum<'static, Q15, Side<SIDE>>> {
-        let blocks = BlockExponents::new(BlockLayout::Line, self.exponents, self.n)?;
-        Spectrum::from_blocks(
-            self.data,
-            blocks,
-            self.n,
-            self.scale,
-            self.filter()?,
-            self.dims,
-        )?
-        .with_side::<SIDE>()
+        let h = &self.header;
+        let blocks = BlockExponents::new(BlockLayout::Line, self.exponents, h.n)?;
+        Spectrum::from_blocks(self.data, blocks, h.n, h.scale, self.filter()?, h.dims)?
+            .with_side::<SIDE>()
     }
 
     /// Bytes of flash the mantissas and exponents take.

@@ -244,28 +244,25 @@ fn malformed_recordings_are_refused() {
         rec
     };
     let mut px = [0u16; 4];
-    let good = frame(&[
-        (0, &[CASET]),
-        (1, &[0, 0, 0, 1]),
-        (0, &[RASET]),
-        (1, &[0, 0, 0, 1]),
-        (0, &[RAMWR]),
-        (1, &[1, 2, 3, 4, 5, 6, 7, 8]),
-    ]);
+    // A 2 × 2 window (columns and rows 0 ..= 1), then `pixels` written.
+    let window_2x2 = |pixels: &[u8]| {
+        frame(&[
+            (0, &[CASET]),
+            (1, &[0, 0, 0, 1]),
+            (0, &[RASET]),
+            (1, &[0, 0, 0, 1]),
+            (0, &[RAMWR]),
+            (1, pixels),
+        ])
+    };
+    let good = window_2x2(&[1, 2, 3, 4, 5, 6, 7, 8]);
     assert!(decode_frame(&good, &mut px).is_ok());
     assert_eq!(px, [0x0102, 0x0304, 0x0506, 0x0708]);
     assert_eq!(
         decode_frame(&good[..good.len() - 1], &mut px),
         Err(DecodeError::Truncated { offset: 36 })
     );
-    let short = frame(&[
-        (0, &[CASET]),
-        (1, &[0, 0, 0, 1]),
-        (0, &[RASET]),
-        (1, &[0, 0, 0, 1]),
-        (0, &[RAMWR]),
-        (1, &[1, 2, 3, 4, 5, 6]),
-    ]);
+    let short = window_2x2(&[1, 2, 3, 4, 5, 6]);
     assert_eq!(
         decode_frame(&short, &mut px),
         Err(DecodeError::PixelCount {

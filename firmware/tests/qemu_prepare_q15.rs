@@ -31,6 +31,7 @@ use common::{below_floors, qemu_out_dir, read_output, NoClock};
 use fvr_core::f16;
 use fvr_core::num::Q15;
 use fvr_core::slice::fixed::FixedPhases;
+use fvr_core::spectrum::Q15Storage;
 use fvr_engine::spectrum::{AnySpectrum, OwnedSpectrum};
 use fvr_engine::volume::Volume;
 use fvr_firmware::prepare::{PrepInput, PREP_32, PREP_64};
@@ -79,9 +80,11 @@ fn host_run<const N: usize>(input: &PrepInput) -> (Q15Run, f64) {
         (&tw_data, &tw_view),
         &phases,
         &mut Q15Buffers {
-            mantissas: &mut mantissas,
-            exponents: &mut exponents,
-            premul: &mut premul,
+            storage: Q15Storage {
+                mantissas: &mut mantissas,
+                exponents: &mut exponents,
+                premul: &mut premul,
+            },
             grid: &mut grid,
             aux: &mut aux,
             block: &mut block,

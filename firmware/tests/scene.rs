@@ -6,10 +6,11 @@
 
 mod common;
 
-use common::{exact_image, floor_db, host_image, snr_db, tables};
+use common::{exact_image, floor_db, host_image, phantom_voxels, snr_db, tables};
 use fvr_core::dht::Twiddles;
 use fvr_core::f16;
 use fvr_core::filter::{DerivativeTable, Filter, FilterKind, KernelTable};
+use fvr_core::render::Buffers;
 use fvr_core::shading::ViewPlan;
 use fvr_core::spectrum::Spectrum;
 use fvr_core::volume::DenseVolume;
@@ -22,7 +23,7 @@ use fvr_firmware::frame::{
 };
 use fvr_firmware::nrrd::{write_samples_le, Header};
 use fvr_firmware::scene::{
-    buffer_sizes, density, FrameSpec, Shading, StoredKind, BENCH_FRAMES, DIMS, IMAGE_SIDE, LIGHTS,
+    buffer_sizes, FrameSpec, Shading, StoredKind, BENCH_FRAMES, DIMS, IMAGE_SIDE, LIGHTS,
     OVERSAMPLE, PROGRAMS, SCENE_FRAMES,
 };
 use fvr_firmware::stored::{
@@ -50,16 +51,7 @@ fn every_frame() -> impl Iterator<Item = (&'static str, &'static FrameSpec)> {
 
 /// The phantom sampled as `build.rs` samples it.
 fn phantom_volume() -> Volume {
-    let [nx, ny, nz] = DIMS;
-    let mut data = Vec::with_capacity(nx * ny * nz);
-    for k in 0..nz {
-        for j in 0..ny {
-            for i in 0..nx {
-                data.push(density([i as f64, j as f64, k as f64]) as f32);
-            }
-        }
-    }
-    Volume::new(DIMS, data)
+    Volume::new(DIMS, phantom_voxels())
 }
 
 /// Every frame against its f64 reference: exact line integrals for plain
@@ -230,9 +222,7 @@ fn staged_render_equals_render_bit_for_bit() {
     let (mut image, mut staged) = (vec![0.0; sizes.image], vec![0.0; sizes.image]);
     for (_, spec) in every_frame() {
         let mut bufs = FrameBuffers {
-            fields: &mut fields,
-            aux: &mut aux,
-            image: &mut image,
+            render: Buffers::new(&mut fields, &mut aux, &mut image),
             staged: &mut staged,
         };
         let rendered =
@@ -267,40 +257,38 @@ fn staged_render_equals_render_bit_for_bit() {
 
 #[test]
 fn a_frame_without_its_tables_is_an_error_naming_it() {
-    let spec = &BENCH_FRAMES[2];
-    let err = tables_for(spec, &[&DENSITY_KB3], &[]).unwrap_err();
-    assert_eq!(
-        err,
-        FrameError::MissingSpectrum {
-            frame: "plain-kb6",
-            kind: StoredKind::Density(FilterKind::Kb6)
-        }
-    );
-    assert_eq!(
-        err.to_string(),
-        "frame plain-kb6: no stored density spectrum for kb6"
-    );
-    // The lit frame without the |∇f| spectrum, the cued one without the
-    // derivative table.
-    let lit = &SCENE_FRAMES[2];
-    let err = tables_for(lit, &[&DENSITY_KB3], &[]).unwrap_err();
-    assert_eq!(
-        err.to_string(),
-        "frame lit-kb3: no stored gradient spectrum for kb3"
-    );
-    let cued = &SCENE_FRAMES[1];
-    let err = tables_for(cued, &[&DENSITY_KB3], &[]).unwrap_err();
-    assert_eq!(
-        err,
-        FrameError::MissingDerivative {
-            frame: "cued-kb3",
-            filter: FilterKind::Kb3
-        }
-    );
-    assert_eq!(
-        err.to_string(),
-        "frame cued-kb3: no stored kernel-derivative table for kb3 (its linear depth cue needs one)"
-    );
+    // A kb6 frame without its density spectrum, the lit frame without the
+    // |∇f| spectrum, the cued one without the derivative table.
+    for (spec, expected, message) in [
+        (
+            &BENCH_FRAMES[2],
+            FrameError::MissingSpectrum {
+                frame: "plain-kb6",
+                kind: StoredKind::Density(FilterKind::Kb6),
+            },
+            "frame plain-kb6: no stored density spectrum for kb6",
+        ),
+        (
+            &SCENE_FRAMES[2],
+            FrameError::MissingSpectrum {
+                frame: "lit-kb3",
+                kind: StoredKind::GradientMagnitude(FilterKind::Kb3),
+            },
+            "frame lit-kb3: no stored gradient spectrum for kb3",
+        ),
+        (
+            &SCENE_FRAMES[1],
+            FrameError::MissingDerivative {
+                frame: "cued-kb3",
+                filter: FilterKind::Kb3,
+            },
+            "frame cued-kb3: no stored kernel-derivative table for kb3 (its linear depth cue needs one)",
+        ),
+    ] {
+        let err = tables_for(spec, &[&DENSITY_KB3], &[]).unwrap_err();
+        assert_eq!(err, expected);
+        assert_eq!(err.to_string(), message);
+    }
     // A program must link exactly what its frames read: the two programs'
     // lists (src/bin/*.rs) pass, a missing or an unused table fails.
     let scene_tables = [&DENSITY_KB3, &GRADIENT_KB3];
@@ -375,7 +363,7 @@ fn flash_tables_equal_a_fresh_preparation() {
             &tw,
         )
         .unwrap();
-        assert_eq!(spec.scale(), stored.scale, "{:?}", stored.kind);
+        assert_eq!(spec.scale(), stored.header.scale, "{:?}", stored.kind);
         assert!(
             data.iter()
                 .zip(stored.data)
@@ -396,7 +384,7 @@ fn flash_tables_equal_a_fresh_preparation() {
         else {
             panic!("F16 precision gives an f16 spectrum");
         };
-        assert_eq!(host.view().scale(), stored.scale);
+        assert_eq!(host.view().scale(), stored.header.scale);
         assert!(host
             .view()
             .data()

@@ -36,25 +36,24 @@ pub(super) fn keys_cubic(a: f64) -> f64 {
 /// `Σ ((x/2)^k / k!)²`, summed until terms fall below 1e-17 of the sum.
 pub fn bessel_i0(x: f64) -> f64 {
     let q = x * x / 4.0;
-    let mut term = 1.0;
-    let mut sum = 1.0;
-    let mut k = 1.0;
-    while term > 1e-17 * sum && k < 500.0 {
-        term *= q / (k * k);
-        sum += term;
-        k += 1.0;
-    }
-    sum
+    power_series(1.0, |k| q / (k * k))
 }
 
 /// `I1(x)/x` by its power series `½·Σ (x²/4)^k / (k!·(k+1)!)`, finite at 0.
 pub fn bessel_i1_over_x(x: f64) -> f64 {
     let q = x * x / 4.0;
-    let mut term = 0.5;
-    let mut sum = 0.5;
+    power_series(0.5, |k| q / (k * (k + 1.0)))
+}
+
+/// `Σ t_k` for `t_0 = first` and `t_k = t_{k−1}·ratio(k)`, summed until a
+/// term falls below 1e-17 of the sum (at most 499 terms after the first).
+#[inline(always)]
+fn power_series(first: f64, ratio: impl Fn(f64) -> f64) -> f64 {
+    let mut term = first;
+    let mut sum = first;
     let mut k = 1.0;
     while term > 1e-17 * sum && k < 500.0 {
-        term *= q / (k * (k + 1.0));
+        term *= ratio(k);
         sum += term;
         k += 1.0;
     }

@@ -39,6 +39,35 @@ pub struct FixedBuffers<'a> {
     pub out: &'a mut [i16],
 }
 
+impl FixedBuffers<'_> {
+    /// The same buffers, borrowed again for one call of [`finish_fixed`]
+    /// (which takes them by value).
+    pub fn reborrow(&mut self) -> FixedBuffers<'_> {
+        FixedBuffers {
+            grid: self.grid,
+            aux: self.aux,
+            block: self.block,
+            out: self.out,
+        }
+    }
+}
+
+/// What [`finish_fixed`] turns into an image: the `m × m` slice grid holds
+/// `grid·2^exponent`, and the `width × height` image sits at `place`.
+#[derive(Clone, Copy, Debug)]
+pub struct FixedSlice<'a> {
+    /// The slice's exponent.
+    pub exponent: i32,
+    /// The grid's side.
+    pub m: usize,
+    /// Where the image sits on the grid.
+    pub place: Placement,
+    /// The image's `(width, height)`.
+    pub size: (usize, usize),
+    /// Q15 twiddles serving side `m`.
+    pub tw: &'a FixedTwiddles<'a, i16>,
+}
+
 /// Turn the `m × m` slice `grid·2^exponent` into the `width × height`
 /// image at `place`: sub-pixel shift (a phase ramp, as [`super::finish`],
 /// with the cosines and sines in Q30), round to Q15 with one exponent
@@ -49,22 +78,16 @@ pub struct FixedBuffers<'a> {
 /// # Errors
 /// An image side of 0 or above `m`, buffers of the wrong size, or
 /// twiddles too short.
-pub fn finish_fixed(
-    buffers: FixedBuffers<'_>,
-    exponent: i32,
-    m: usize,
-    place: &Placement,
-    (width, height): (usize, usize),
-    tw: &FixedTwiddles<'_, i16>,
-) -> Result<i32> {
+pub fn finish_fixed(buffers: FixedBuffers<'_>, slice: &FixedSlice<'_>) -> Result<i32> {
     let FixedBuffers {
         grid,
         aux,
         block,
         out,
     } = buffers;
+    let (m, place, (width, height)) = (slice.m, &slice.place, slice.size);
     check_len("fixed-point image", width * height, out.len())?;
-    let exponent = to_block(grid, aux, block, exponent, m, place, (width, height), tw)?;
+    let exponent = to_block(grid, aux, block, slice)?;
     let mask = m - 1;
     let (row0, col0) = (place.row0 as usize, place.col0 as usize);
     for (row, line) in out.chunks_exact_mut(width).enumerate() {
@@ -88,18 +111,14 @@ pub fn finish_fixed(
 ///
 /// # Errors
 /// As [`finish_fixed`].
-#[allow(clippy::too_many_arguments)]
 pub fn finish_fixed_in_block(
     grid: &mut [i32],
     aux: &mut [i32],
     block: &mut [i16],
-    exponent: i32,
-    m: usize,
-    place: &Placement,
-    (width, height): (usize, usize),
-    tw: &FixedTwiddles<'_, i16>,
+    slice: &FixedSlice<'_>,
 ) -> Result<i32> {
-    let exponent = to_block(grid, aux, block, exponent, m, place, (width, height), tw)?;
+    let (m, place, (width, height)) = (slice.m, &slice.place, slice.size);
+    let exponent = to_block(grid, aux, block, slice)?;
     let mask = m - 1;
     let (row0, col0) = (place.row0 as usize, place.col0 as usize);
     for r in 0..height {
@@ -124,22 +143,23 @@ pub fn finish_fixed_in_block(
 /// The steps of [`finish_fixed`] before the crop: the checks, the shift,
 /// the slice to Q15 in `block` and its inverse 2D DHT in place; returns
 /// the block's exponent.
-#[allow(clippy::too_many_arguments)]
 fn to_block(
     grid: &mut [i32],
     aux: &mut [i32],
     block: &mut [i16],
-    exponent: i32,
-    m: usize,
-    place: &Placement,
-    (width, height): (usize, usize),
-    tw: &FixedTwiddles<'_, i16>,
+    slice: &FixedSlice<'_>,
 ) -> Result<i32> {
+    let FixedSlice {
+        mut exponent,
+        m,
+        place,
+        size: (width, height),
+        tw,
+    } = *slice;
     check_image(width, height, m)?;
     check_len("fixed-point slice grid", m * m, grid.len())?;
     check_len("Q15 slice block", m * m, block.len())?;
     require_len("fixed-point auxiliary scratch", fixed_aux_len(m), aux.len())?;
-    let mut exponent = exponent;
     if place.shift != [0.0, 0.0] {
         exponent += bring_under(grid, SHIFT_HEADROOM_LOG2);
         apply_shift(grid, m, place.shift, aux);

@@ -29,6 +29,22 @@ fn floor_db() -> f64 {
         - 20.0 * libm::log10(crest)
 }
 
+/// The `M × M` slice at `exponent` of a `size` image at `place`.
+fn at<'a>(
+    exponent: i32,
+    place: Placement,
+    size: (usize, usize),
+    tw: &'a FixedTwiddles<'a, i16>,
+) -> FixedSlice<'a> {
+    FixedSlice {
+        exponent,
+        m: M,
+        place,
+        size,
+        tw,
+    }
+}
+
 /// [`finish_fixed`] of a copy of `grid` (`M × M`) at `exponent` into fresh
 /// buffers: the image's exponent and mantissas.
 fn finish_fixed_owned(
@@ -48,7 +64,7 @@ fn finish_fixed_owned(
         block: &mut block,
         out: &mut out,
     };
-    let exponent = finish_fixed(buffers, exponent, M, place, size, tw16).unwrap();
+    let exponent = finish_fixed(buffers, &at(exponent, *place, size, tw16)).unwrap();
     (exponent, out)
 }
 
@@ -78,15 +94,21 @@ fn both(grid: &[i32], place: Placement, size: (usize, usize)) -> (Vec<f64>, Vec<
     (fixed, reference)
 }
 
-#[test]
-fn random_slices_meet_the_q15_floor_with_and_without_a_shift() {
-    let mut state = 0x1234_5678u32;
-    let grid: Vec<i32> = (0..M * M)
+/// An `M × M` slice of pseudo-random values below `2^(31 − shift)` in
+/// magnitude (a linear congruential generator from `seed`).
+fn random_grid(seed: u32, shift: u32) -> Vec<i32> {
+    let mut state = seed;
+    (0..M * M)
         .map(|_| {
             state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (state as i32) >> 9
+            (state as i32) >> shift
         })
-        .collect();
+        .collect()
+}
+
+#[test]
+fn random_slices_meet_the_q15_floor_with_and_without_a_shift() {
+    let grid = random_grid(0x1234_5678, 9);
     for (shift, size) in [
         ([0.0, 0.0], (M, M)),
         ([0.3, 0.75], (M, M)),
@@ -159,11 +181,7 @@ fn bad_buffers_are_refused() {
                 block: &mut block,
                 out: &mut out[..out_len],
             },
-            0,
-            M,
-            &place,
-            size,
-            &tw16,
+            &at(0, place, size, &tw16),
         );
         assert!(result.is_err(), "{size:?}, short aux {short_aux}");
     }
@@ -177,13 +195,7 @@ fn bad_buffers_are_refused() {
 fn the_image_cut_into_the_block_is_the_image() {
     let mut tw16 = vec![0i16; FixedTwiddles::<i16>::buffer_len(M)];
     let tw16 = FixedTwiddles::new(&mut tw16, M).unwrap();
-    let mut state = 0x9E37_79B9u32;
-    let grid: Vec<i32> = (0..M * M)
-        .map(|_| {
-            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (state as i32) >> 7
-        })
-        .collect();
+    let grid = random_grid(0x9E37_79B9, 7);
     let m = M as i64;
     for (col0, row0, shift, size) in [
         (-m / 2, m / 2, [0.0, 0.0], (M, M)),
@@ -197,7 +209,8 @@ fn the_image_cut_into_the_block_is_the_image() {
         let (mut g, mut aux) = (grid.clone(), vec![0i32; fixed_aux_len(M)]);
         let mut block = vec![0i16; M * M];
         let e_block =
-            finish_fixed_in_block(&mut g, &mut aux, &mut block, 3, M, &place, size, &tw16).unwrap();
+            finish_fixed_in_block(&mut g, &mut aux, &mut block, &at(3, place, size, &tw16))
+                .unwrap();
         assert_eq!(e_block, e_out, "{place:?} {size:?}");
         assert_eq!(&block[..size.0 * size.1], &out[..], "{place:?} {size:?}");
     }
@@ -210,11 +223,11 @@ fn the_image_cut_into_the_block_is_the_image() {
     for size in [(0, M), (M + 1, M)] {
         let mut aux4 = vec![0i32; fixed_aux_len(M)];
         assert!(
-            finish_fixed_in_block(&mut g, &mut aux4, &mut block, 0, M, &place, size, &tw16)
+            finish_fixed_in_block(&mut g, &mut aux4, &mut block, &at(0, place, size, &tw16))
                 .is_err()
         );
     }
     assert!(
-        finish_fixed_in_block(&mut g, &mut aux, &mut block, 0, M, &place, (M, M), &tw16).is_err()
+        finish_fixed_in_block(&mut g, &mut aux, &mut block, &at(0, place, (M, M), &tw16)).is_err()
     );
 }

@@ -78,11 +78,46 @@ pub fn f16_bits_to_f32_raw(bits: u16) -> f32 {
     f32::from_bits((((bits as i16 as i32) << 13) as u32) & 0x8FFF_FFFF)
 }
 
-impl Sample for f16 {
-    const NAME: &'static str = "f16";
-    const BITS: u32 = 16;
-    const SCALE_LOG2: i32 = 14;
-    const MAX_FINITE: f64 = 65504.0;
+/// [`Sample`] for a 16-bit type of `half`: its bit pattern and `half`'s
+/// conversions; `$extra` holds the items that differ (the widening to f32,
+/// and for binary16 its raw form).
+macro_rules! impl_sample_half {
+    ($t:ident, $name:literal, $max_finite:expr, { $($extra:tt)* }) => {
+        impl Sample for $t {
+            const NAME: &'static str = $name;
+            const BITS: u32 = 16;
+            const SCALE_LOG2: i32 = 14;
+            const MAX_FINITE: f64 = $max_finite;
+            $($extra)*
+            #[inline(always)]
+            fn pattern16(self) -> Option<u16> {
+                Some(self.to_bits())
+            }
+            #[inline(always)]
+            fn from_pattern16(p: u16) -> Option<Self> {
+                Some($t::from_bits(p))
+            }
+            #[inline(always)]
+            fn from_f32(v: f32) -> Self {
+                $t::from_f32(v)
+            }
+            #[inline(always)]
+            fn from_f64(v: f64) -> Self {
+                $t::from_f64(v)
+            }
+            #[inline(always)]
+            fn to_f64(self) -> f64 {
+                $t::to_f64(self)
+            }
+            #[inline(always)]
+            fn is_finite(self) -> bool {
+                $t::is_finite(self)
+            }
+        }
+    };
+}
+
+impl_sample_half!(f16, "f16", 65504.0, {
     /// The raw rebias ([`f16_bits_to_f32_raw`]) on Arm; elsewhere the value
     /// itself ([`f16_bits_to_f32_finite`]), whose operands are never
     /// subnormal. Either way the products of the hot loops are the same
@@ -97,34 +132,10 @@ impl Sample for f16 {
         }
     }
     #[inline(always)]
-    fn pattern16(self) -> Option<u16> {
-        Some(self.to_bits())
-    }
-    #[inline(always)]
-    fn from_pattern16(p: u16) -> Option<Self> {
-        Some(f16::from_bits(p))
-    }
-    #[inline(always)]
-    fn from_f32(v: f32) -> Self {
-        f16::from_f32(v)
-    }
-    #[inline(always)]
-    fn from_f64(v: f64) -> Self {
-        f16::from_f64(v)
-    }
-    #[inline(always)]
     fn to_f32(self) -> f32 {
         f16_bits_to_f32(self.to_bits())
     }
-    #[inline(always)]
-    fn to_f64(self) -> f64 {
-        f16::to_f64(self)
-    }
-    #[inline(always)]
-    fn is_finite(self) -> bool {
-        f16::is_finite(self)
-    }
-}
+});
 
 impl Sample for f32 {
     const NAME: &'static str = "f32";
@@ -180,37 +191,9 @@ impl Sample for f64 {
     }
 }
 
-impl Sample for bf16 {
-    const NAME: &'static str = "bf16";
-    const MAX_FINITE: f64 = 3.389_531_389_251_535_5e38;
-    const BITS: u32 = 16;
-    const SCALE_LOG2: i32 = 14;
-    #[inline(always)]
-    fn pattern16(self) -> Option<u16> {
-        Some(self.to_bits())
-    }
-    #[inline(always)]
-    fn from_pattern16(p: u16) -> Option<Self> {
-        Some(bf16::from_bits(p))
-    }
-    #[inline(always)]
-    fn from_f32(v: f32) -> Self {
-        bf16::from_f32(v)
-    }
-    #[inline(always)]
-    fn from_f64(v: f64) -> Self {
-        bf16::from_f64(v)
-    }
+impl_sample_half!(bf16, "bf16", 3.389_531_389_251_535_5e38, {
     #[inline(always)]
     fn to_f32(self) -> f32 {
         bf16::to_f32(self)
     }
-    #[inline(always)]
-    fn to_f64(self) -> f64 {
-        bf16::to_f64(self)
-    }
-    #[inline(always)]
-    fn is_finite(self) -> bool {
-        bf16::is_finite(self)
-    }
-}
+});

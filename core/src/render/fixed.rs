@@ -10,8 +10,8 @@
 use crate::dht::fixed::FixedTwiddles;
 use crate::error::{Error, Result};
 use crate::geometry::View;
-use crate::image::fixed::{finish_fixed, finish_fixed_in_block, FixedBuffers};
-use crate::image::{placement, Placement};
+use crate::image::fixed::{finish_fixed, finish_fixed_in_block, FixedBuffers, FixedSlice};
+use crate::image::placement;
 use crate::num::Q15;
 use crate::slice::fixed::{extract_slice_fixed, FixedPhases};
 use crate::spectrum::{CubeSide, Spectrum};
@@ -27,7 +27,7 @@ pub struct FixedSource<'a, Z, const W: usize> {
     pub twiddles: &'a FixedTwiddles<'a, i16>,
 }
 
-/// Render the `width × height` X-ray projection along `view` (voxel units,
+/// Render the `size = (width, height)` X-ray projection along `view` (voxel units,
 /// level 0) into `buffers.out`; returns the exponent `e`: pixel `i` is
 /// `out[i]·2^e`, `∫ f dt` in voxel units of the input volume. The buffers
 /// are those of [`finish_fixed`] for the spectrum's side.
@@ -39,19 +39,11 @@ pub struct FixedSource<'a, Z, const W: usize> {
 pub fn render_fixed<Z: CubeSide, const W: usize>(
     source: &FixedSource<'_, Z, W>,
     view: &View,
-    (width, height): (usize, usize),
+    size: (usize, usize),
     buffers: FixedBuffers<'_>,
 ) -> Result<i32> {
-    let (exponent, place, scale) = extract(source, view, (width, height), buffers.grid)?;
-    let image = finish_fixed(
-        buffers,
-        exponent,
-        source.spectrum.n(),
-        &place,
-        (width, height),
-        source.twiddles,
-    )?;
-    Ok(image - scale)
+    let (slice, scale) = extract(source, view, size, buffers.grid)?;
+    Ok(finish_fixed(buffers, &slice)? - scale)
 }
 
 /// [`render_fixed`] with the image cut into the Q15 block
@@ -65,41 +57,38 @@ pub fn render_fixed<Z: CubeSide, const W: usize>(
 pub fn render_fixed_in_block<Z: CubeSide, const W: usize>(
     source: &FixedSource<'_, Z, W>,
     view: &View,
-    (width, height): (usize, usize),
+    size: (usize, usize),
     grid: &mut [i32],
     aux: &mut [i32],
     block: &mut [i16],
 ) -> Result<i32> {
-    let (exponent, place, scale) = extract(source, view, (width, height), grid)?;
-    let image = finish_fixed_in_block(
-        grid,
-        aux,
-        block,
-        exponent,
-        source.spectrum.n(),
-        &place,
-        (width, height),
-        source.twiddles,
-    )?;
-    Ok(image - scale)
+    let (slice, scale) = extract(source, view, size, grid)?;
+    Ok(finish_fixed_in_block(grid, aux, block, &slice)? - scale)
 }
 
 /// The set-up and the extraction of a fixed-point view: the slice in
-/// `grid`, its exponent, the image's placement and the spectrum's scale
-/// exponent.
-fn extract<Z: CubeSide, const W: usize>(
-    source: &FixedSource<'_, Z, W>,
+/// `grid`, what the finish needs of it (its exponent, the image's
+/// placement and size, the twiddles), and the spectrum's scale exponent.
+fn extract<'a, Z: CubeSide, const W: usize>(
+    source: &FixedSource<'a, Z, W>,
     view: &View,
-    (width, height): (usize, usize),
+    size: (usize, usize),
     grid: &mut [i32],
-) -> Result<(i32, Placement, i32)> {
+) -> Result<(FixedSlice<'a>, i32)> {
     let spec = source.spectrum;
     let frame = view.frame()?;
     let axes = frame.slice_axes();
-    let place = placement(spec.dims(), &frame, width, height);
+    let place = placement(spec.dims(), &frame, size.0, size.1);
     let scale = scale_exponent(spec.scale())?;
     let exponent = extract_slice_fixed(spec, source.phases, &axes, grid)?;
-    Ok((exponent, place, scale))
+    let slice = FixedSlice {
+        exponent,
+        m: spec.n(),
+        place,
+        size,
+        tw: source.twiddles,
+    };
+    Ok((slice, scale))
 }
 
 /// `k` for a scale `2^k` (the spectrum's scale is a power of two).

@@ -127,6 +127,16 @@ impl<'a, T> Buffers<'a, T> {
     pub fn new(grid: &'a mut [T], aux: &'a mut [T], out: &'a mut [T]) -> Self {
         Self { grid, aux, out }
     }
+
+    /// The same buffers, borrowed again for one call of a function that
+    /// takes them by value.
+    pub fn reborrow(&mut self) -> Buffers<'_, T> {
+        Buffers {
+            grid: self.grid,
+            aux: self.aux,
+            out: self.out,
+        }
+    }
 }
 
 /// Deepest level: the preview grid keeps at least 2 samples a side.

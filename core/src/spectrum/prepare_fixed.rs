@@ -26,6 +26,18 @@ pub struct Q15Storage<'a, 's> {
     pub premul: &'s mut [i32],
 }
 
+impl Q15Storage<'_, '_> {
+    /// The same buffers, borrowed again for one [`Spectrum::prepare_q15`]
+    /// (which takes them by value).
+    pub fn reborrow(&mut self) -> Q15Storage<'_, '_> {
+        Q15Storage {
+            mantissas: self.mantissas,
+            exponents: self.exponents,
+            premul: self.premul,
+        }
+    }
+}
+
 impl<'a> Spectrum<'a, Q15> {
     /// Premultiply `volume` for `filter`, zero-pad it into the cube of side
     /// [`padded_size`](crate::volume::padded_size)`(dims, filter.oversample())`

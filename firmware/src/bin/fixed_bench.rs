@@ -22,6 +22,8 @@ mod fixed_input;
 mod device {
     use fvr_core::dht::fixed::{idht_2d, FixedTwiddles};
     use fvr_core::dht::{self, Twiddles};
+    use fvr_core::image::fixed::FixedBuffers;
+    use fvr_core::render::Buffers;
     use fvr_core::slice::fixed::FixedPhases;
     use fvr_firmware::capture::ByteSink;
     use fvr_firmware::device::{calibrated_clock, exit_with, HostFile, RunError, SysTickClock};
@@ -202,10 +204,12 @@ mod device {
             views.phases,
             tw,
             ViewBuffers {
-                grid: &mut views.grid[..],
-                aux: &mut views.aux[..],
-                block: &mut views.block[..],
-                image: &mut views.image[..],
+                view: FixedBuffers {
+                    grid: &mut views.grid[..],
+                    aux: &mut views.aux[..],
+                    block: &mut views.block[..],
+                    out: &mut views.image[..],
+                },
                 staged: &mut views.staged[..],
             },
             clock,
@@ -229,9 +233,11 @@ mod device {
         let tables = tables_for(spec, &[&DENSITY_KB3], &[]).map_err(RunError::Frame)?;
         let ftw = twiddles().map_err(core_error)?;
         let mut bufs = FrameBuffers {
-            fields: &mut float_grid[..],
-            aux: &mut views.float_aux[..],
-            image: &mut views.float_image[..],
+            render: Buffers::new(
+                &mut float_grid[..],
+                &mut views.float_aux[..],
+                &mut views.float_image[..],
+            ),
             staged: &mut views.float_staged[..],
         };
         let rendered =

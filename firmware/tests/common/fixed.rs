@@ -5,6 +5,7 @@ use super::NoClock;
 use fvr_core::dht::fixed::FixedTwiddles;
 use fvr_core::dht::Twiddles;
 use fvr_core::filter::KernelTable;
+use fvr_core::image::fixed::FixedBuffers;
 use fvr_core::image::{aux_len, grid_len};
 use fvr_core::render::{render, Buffers, Request, Source};
 use fvr_core::slice::extract_slice;
@@ -12,7 +13,7 @@ use fvr_core::slice::fixed::FixedPhases;
 use fvr_core::spectrum::{prepare_scratch_len, Spectrum};
 use fvr_core::volume::DenseVolume;
 use fvr_firmware::fixed_view::{render_view, ViewBuffers, AUX_LEN, GRID_LEN, WIDTH};
-use fvr_firmware::scene::{density, DIMS, IMAGE_SIDE, VIEW};
+use fvr_firmware::scene::{DIMS, IMAGE_SIDE, VIEW};
 use fvr_firmware::stored::DENSITY_KB3;
 use fvr_firmware::stored_q15::DENSITY_KB3_Q15;
 
@@ -32,10 +33,12 @@ pub fn integer_view() -> (i32, Vec<i16>) {
         &phases,
         &tw,
         ViewBuffers {
-            grid: &mut grid,
-            aux: &mut aux,
-            block: &mut block,
-            image: &mut image,
+            view: FixedBuffers {
+                grid: &mut grid,
+                aux: &mut aux,
+                block: &mut block,
+                out: &mut image,
+            },
             staged: &mut staged,
         },
         &NoClock,
@@ -53,18 +56,10 @@ pub fn values(exponent: i32, mantissas: &[i16]) -> Vec<f64> {
 /// The same view by the f64 pipeline (spectrum prepared in f64, f64
 /// kernel table and arithmetic): the image and its slice.
 pub fn f64_view() -> (Vec<f64>, Vec<f64>) {
-    let [nx, ny, nz] = DIMS;
-    let mut voxels = Vec::with_capacity(nx * ny * nz);
-    for k in 0..nz {
-        for j in 0..ny {
-            for i in 0..nx {
-                voxels.push(density([i as f64, j as f64, k as f64]) as f32);
-            }
-        }
-    }
+    let voxels = super::phantom_voxels();
     let volume = DenseVolume::new(DIMS, &voxels).unwrap();
     let filter = DENSITY_KB3_Q15.filter().unwrap();
-    let n = DENSITY_KB3_Q15.n;
+    let n = DENSITY_KB3_Q15.header.n;
     let mut tw_buf = vec![0.0f64; Twiddles::<f64>::buffer_len(n)];
     let tw = Twiddles::new(&mut tw_buf, n).unwrap();
     let mut scratch = vec![0.0f64; prepare_scratch_len(n)];

@@ -11,7 +11,7 @@ use fvr_core::render::{render, Buffers, Request, Source};
 use fvr_core::shading::fields_len;
 use fvr_engine::volume::phantom::{Gaussian, GaussianMixture, Phantom};
 use fvr_firmware::frame::{tables_for, FrameTables, InstructionClock};
-use fvr_firmware::scene::{Blob, FrameSpec, Shading, BLOBS, DIMS, IMAGE_SIDE};
+use fvr_firmware::scene::{density, Blob, FrameSpec, Shading, BLOBS, DIMS, IMAGE_SIDE};
 use fvr_firmware::stored::{all, all_derivatives, twiddles};
 use fvr_host::reference::shaded::exact_scene_projection;
 
@@ -19,6 +19,21 @@ use fvr_host::reference::shaded::exact_scene_projection;
 /// `|∇f|` term, as in tests/tests/shading.rs: for Gaussians of σ ≥ 1.8
 /// voxels its fourth-order error is far below every figure measured here.
 pub const GRADIENT_STEP: f64 = 0.05;
+
+/// The phantom sampled at voxel centres `(i, j, k)`, `i` fastest, rounded
+/// to f32: as `build.rs` samples it for the flash tables.
+pub fn phantom_voxels() -> Vec<f32> {
+    let [nx, ny, nz] = DIMS;
+    let mut voxels = Vec::with_capacity(nx * ny * nz);
+    for k in 0..nz {
+        for j in 0..ny {
+            for i in 0..nx {
+                voxels.push(density([i as f64, j as f64, k as f64]) as f32);
+            }
+        }
+    }
+    voxels
+}
 
 /// The flash tables a frame reads, among all the stored ones.
 pub fn tables(spec: &FrameSpec) -> FrameTables {

@@ -93,8 +93,7 @@ fn naive_3d_matches_the_direct_sum() {
 
 #[test]
 fn q15_3d_snr_meets_the_model_for_every_class_at_8_16_32() {
-    let mut buf = Vec::new();
-    let tw = table::<i16>(&mut buf, 32);
+    let tw = table::<i16>(32);
     for class in CLASSES {
         for n in [8usize, 16, 32] {
             let floor = floor_3d(n, class.crest(n * n * n));
@@ -109,8 +108,7 @@ fn q15_3d_snr_meets_the_model_for_every_class_at_8_16_32() {
 #[test]
 #[ignore]
 fn q15_3d_at_64() {
-    let mut buf = Vec::new();
-    let tw = table::<i16>(&mut buf, 64);
+    let tw = table::<i16>(64);
     for class in [Class::Random, Class::Impulse, Class::Constant] {
         let floor = floor_3d(64, class.crest(64 * 64 * 64));
         let snr = snr_3d(class, 64, 5, &tw);
@@ -131,8 +129,7 @@ const NON_CUBIC: [[usize; 3]; 6] = [
 
 #[test]
 fn non_cubic_3d_matches_the_direct_sum() {
-    let mut buf = Vec::new();
-    let tw = table::<i16>(&mut buf, 16);
+    let tw = table::<i16>(16);
     for dims in NON_CUBIC {
         let len: usize = dims.iter().product();
         let mut data: Vec<i16> = quantize(&uniform(len, 6));
@@ -147,8 +144,7 @@ fn non_cubic_3d_matches_the_direct_sum() {
 
 #[test]
 fn all_zero_stays_zero_with_exponent_zero() {
-    let mut buf = Vec::new();
-    let tw = table::<i16>(&mut buf, 16);
+    let tw = table::<i16>(16);
     let mut data = vec![0i16; 16 * 16 * 16];
     assert_eq!(dht_3d(&mut data, [16; 3], &tw).unwrap(), 0);
     assert!(data.iter().all(|&m| m == 0));
@@ -160,8 +156,7 @@ fn all_zero_stays_zero_with_exponent_zero() {
 /// the floor with the worst crest factor, `√N`.
 #[test]
 fn full_scale_extremes_neither_wrap_nor_miss_the_floor() {
-    let mut buf = Vec::new();
-    let tw = table::<i16>(&mut buf, 32);
+    let tw = table::<i16>(32);
     for n in [2usize, 8, 32] {
         let len = n * n * n;
         let patterns: [&dyn Fn(usize) -> i16; 3] = [
@@ -190,8 +185,7 @@ fn full_scale_extremes_neither_wrap_nor_miss_the_floor() {
 
 #[test]
 fn every_impulse_position_at_8_cubed() {
-    let mut buf = Vec::new();
-    let tw = table::<i16>(&mut buf, 8);
+    let tw = table::<i16>(8);
     let floor = floor_3d(8, Class::Impulse.crest(512));
     for p in 0..512 {
         for amp in [i16::MIN, 1, 12345] {
@@ -210,8 +204,7 @@ fn every_impulse_position_at_8_cubed() {
 
 #[test]
 fn round_trip_3d() {
-    let mut buf = Vec::new();
-    let tw = table::<i16>(&mut buf, 32);
+    let tw = table::<i16>(32);
     for n in [2usize, 8, 16, 32] {
         let len = n * n * n;
         let original: Vec<i16> = quantize(&uniform(len, 12));
@@ -228,8 +221,7 @@ fn round_trip_3d() {
 
 #[test]
 fn q31_3d_meets_the_model_with_31_fraction_bits() {
-    let mut buf = Vec::new();
-    let tw = table::<i32>(&mut buf, 16);
+    let tw = table::<i32>(16);
     for class in CLASSES {
         let n = 16;
         let mut data: Vec<i32> = quantize(&class.signal(n * n * n, n, 3));
@@ -243,8 +235,7 @@ fn q31_3d_meets_the_model_with_31_fraction_bits() {
 
 #[test]
 fn bad_shapes_are_errors() {
-    let mut buf = Vec::new();
-    let tw = table::<i16>(&mut buf, 8);
+    let tw = table::<i16>(8);
     let mut data = vec![0i16; 8 * 8 * 8];
     assert!(matches!(
         dht_3d(&mut data, [8, 8, 4], &tw),
@@ -279,8 +270,7 @@ fn snr_3d_lines<S: FixedSample>(
 
 #[test]
 fn per_line_exponents_meet_the_model_for_every_class_and_shape() {
-    let mut buf = Vec::new();
-    let tw = table::<i16>(&mut buf, 32);
+    let tw = table::<i16>(32);
     for class in CLASSES {
         for n in [2usize, 8, 16, 32] {
             let floor = floor_3d(n, class.crest(n * n * n));
@@ -300,8 +290,7 @@ fn per_line_exponents_meet_the_model_for_every_class_and_shape() {
         );
         assert!(snr >= floor, "{dims:?}: {snr:.1} < {floor:.1} dB");
     }
-    let mut buf31 = Vec::new();
-    let tw31 = table::<i32>(&mut buf31, 16);
+    let tw31 = table::<i32>(16);
     let mut data: Vec<i32> = quantize(&uniform(4096, 1));
     let snr = snr_3d_lines(&mut data, [16; 3], &tw31);
     let floor = floor_db(31, 13.0, Class::Random.crest(4096));
@@ -310,8 +299,7 @@ fn per_line_exponents_meet_the_model_for_every_class_and_shape() {
 
 #[test]
 fn per_line_exponents_at_the_extremes() {
-    let mut buf = Vec::new();
-    let tw = table::<i16>(&mut buf, 32);
+    let tw = table::<i16>(32);
     let mut zeros = vec![0i16; 8 * 8 * 8];
     let mut exps = vec![1i8; 64];
     assert_eq!(dht_3d_lines(&mut zeros, [8; 3], &mut exps, &tw).unwrap(), 0);
@@ -348,8 +336,7 @@ fn per_line_exponents_at_the_extremes() {
 /// exponent for the cube. Printed with `--nocapture`.
 #[test]
 fn per_line_exponents_keep_more_on_a_ball() {
-    let mut buf = Vec::new();
-    let tw = table::<i16>(&mut buf, 32);
+    let tw = table::<i16>(32);
     for n in [16usize, 32] {
         let c = n as f64 / 2.0;
         let ball: Vec<f64> = (0..n * n * n)

@@ -230,7 +230,15 @@ fn snr_2d<S: FixedSample>(class: Class, n: usize, seed: u64, tw: &FixedTwiddles<
     snr_db(&reference, &values(&data, exp))
 }
 
-fn table<S: FixedSample>(buf: &mut Vec<S>, len: usize) -> FixedTwiddles<'_, S> {
+/// The twiddle table for transforms of length up to `len`, in a buffer
+/// that lives as long as the test process.
+fn table<S: FixedSample>(len: usize) -> FixedTwiddles<'static, S> {
+    table_in(std::boxed::Box::leak(std::boxed::Box::default()), len)
+}
+
+/// The twiddle table for transforms of length up to `len`, in `buf`
+/// (resized), for a test that reads the stored entries too.
+fn table_in<S: FixedSample>(buf: &mut Vec<S>, len: usize) -> FixedTwiddles<'_, S> {
     buf.resize(FixedTwiddles::<S>::buffer_len(len), S::default());
     FixedTwiddles::new(buf, len).unwrap()
 }
@@ -245,66 +253,70 @@ fn naive_2d_matches_the_direct_sum() {
     }
 }
 
-#[test]
-fn q15_1d_snr_meets_the_model_for_every_class_and_size() {
-    let mut buf = Vec::new();
-    let tw = table::<i16>(&mut buf, 1024);
+/// Every class at each side `2^bits` meets the model floor of `S`'s
+/// fraction bits: the 1D transform (`bits` roundings) for each seed.
+fn assert_1d_model<S: FixedSample>(
+    tw: &FixedTwiddles<'_, S>,
+    sides: impl IntoIterator<Item = u32> + Clone,
+    seeds: core::ops::Range<u64>,
+) {
     for class in CLASSES {
-        for bits in 1..=10 {
+        for bits in sides.clone() {
             let n = 1usize << bits;
-            let floor = floor_db(15, bits as f64, class.crest(n));
-            for seed in 0..3 {
-                let snr = snr_1d(class, n, seed, &tw);
+            let floor = floor_db(S::FRAC_BITS, bits as f64, class.crest(n));
+            for seed in seeds.clone() {
+                let snr = snr_1d(class, n, seed, tw);
                 assert!(
                     snr >= floor,
-                    "{class:?} N={n} seed {seed}: {snr:.1} < {floor:.1} dB"
+                    "Q{} {class:?} N={n} seed {seed}: {snr:.1} < {floor:.1} dB",
+                    S::FRAC_BITS
                 );
             }
         }
     }
 }
 
-#[test]
-fn q15_2d_snr_meets_the_model_for_every_class_and_size() {
-    let mut buf = Vec::new();
-    let tw = table::<i16>(&mut buf, 256);
+/// As [`assert_1d_model`] for the `n × n` 2D transform (`2·bits + 1`
+/// roundings, the correction's included), one seed.
+fn assert_2d_model<S: FixedSample>(
+    tw: &FixedTwiddles<'_, S>,
+    sides: impl IntoIterator<Item = u32> + Clone,
+    seed: u64,
+) {
     for class in CLASSES {
-        for bits in 3..=8 {
+        for bits in sides.clone() {
             let n = 1usize << bits;
-            let floor = floor_db(15, 2.0 * bits as f64 + 1.0, class.crest(n * n));
-            let snr = snr_2d(class, n, 1, &tw);
-            assert!(snr >= floor, "{class:?} {n}²: {snr:.1} < {floor:.1} dB");
+            let floor = floor_db(S::FRAC_BITS, 2.0 * bits as f64 + 1.0, class.crest(n * n));
+            let snr = snr_2d(class, n, seed, tw);
+            assert!(
+                snr >= floor,
+                "Q{} {class:?} {n}²: {snr:.1} < {floor:.1} dB",
+                S::FRAC_BITS
+            );
         }
     }
+}
+
+#[test]
+fn q15_1d_snr_meets_the_model_for_every_class_and_size() {
+    assert_1d_model(&table::<i16>(1024), 1..=10, 0..3);
+}
+
+#[test]
+fn q15_2d_snr_meets_the_model_for_every_class_and_size() {
+    assert_2d_model(&table::<i16>(256), 3..=8, 1);
 }
 
 #[test]
 fn q31_meets_the_same_model_with_31_fraction_bits() {
-    let mut buf = Vec::new();
-    let tw = table::<i32>(&mut buf, 1024);
-    for class in CLASSES {
-        for bits in [1, 4, 7, 10] {
-            let n = 1usize << bits;
-            let floor = floor_db(31, bits as f64, class.crest(n));
-            let snr = snr_1d(class, n, 2, &tw);
-            assert!(
-                snr >= floor,
-                "Q31 {class:?} N={n}: {snr:.1} < {floor:.1} dB"
-            );
-        }
-        for bits in [3, 5] {
-            let n = 1usize << bits;
-            let floor = floor_db(31, 2.0 * bits as f64 + 1.0, class.crest(n * n));
-            let snr = snr_2d(class, n, 2, &tw);
-            assert!(snr >= floor, "Q31 {class:?} {n}²: {snr:.1} < {floor:.1} dB");
-        }
-    }
+    let tw = table::<i32>(1024);
+    assert_1d_model(&tw, [1, 4, 7, 10], 2..3);
+    assert_2d_model(&tw, [3, 5], 2);
 }
 
 #[test]
 fn every_impulse_position_and_sign_at_64() {
-    let mut buf = Vec::new();
-    let tw = table::<i16>(&mut buf, 64);
+    let tw = table::<i16>(64);
     let floor = floor_db(15, 6.0, Class::Impulse.crest(64));
     for p in 0..64 {
         for amp in [i16::MAX, -i16::MAX, i16::MIN, 1, -1, 12345] {
@@ -321,8 +333,7 @@ fn every_impulse_position_and_sign_at_64() {
 
 #[test]
 fn every_2d_impulse_position_at_8x8() {
-    let mut buf = Vec::new();
-    let tw = table::<i16>(&mut buf, 8);
+    let tw = table::<i16>(8);
     let floor = floor_db(15, 7.0, Class::Impulse.crest(64));
     for p in 0..64 {
         let mut data = vec![0i16; 64];
@@ -336,8 +347,7 @@ fn every_2d_impulse_position_at_8x8() {
 
 #[test]
 fn round_trip_1d_and_2d() {
-    let mut buf = Vec::new();
-    let tw = table::<i16>(&mut buf, 256);
+    let tw = table::<i16>(256);
     for bits in 1..=8 {
         let n = 1usize << bits;
         let original: Vec<i16> = quantize(&uniform(n, 9));
@@ -364,8 +374,7 @@ fn round_trip_1d_and_2d() {
 
 #[test]
 fn non_square_2d_matches_the_reference() {
-    let mut buf = Vec::new();
-    let tw = table::<i16>(&mut buf, 64);
+    let tw = table::<i16>(64);
     for (nx, ny) in [(64, 4), (4, 64), (16, 2), (2, 16), (1, 8), (8, 1), (32, 8)] {
         let mut data: Vec<i16> = quantize(&uniform(nx * ny, 3));
         let reference = naive_2d_direct(&integers(&data), nx, ny);
@@ -382,8 +391,7 @@ fn non_square_2d_matches_the_reference() {
 #[test]
 #[ignore]
 fn q15_table() {
-    let mut buf = Vec::new();
-    let tw = table::<i16>(&mut buf, 1024);
+    let tw = table::<i16>(1024);
     std::println!(
         "| transform | N | {} |",
         CLASSES.map(Class::name).join(" | ")
@@ -407,8 +415,7 @@ fn q15_table() {
         let row: Vec<_> = CLASSES.map(|c| cell(snr_2d(c, n, 1, &tw))).into();
         std::println!("| 2D | {n}² | {} |", row.join(" | "));
     }
-    let mut buf31 = Vec::new();
-    let tw31 = table::<i32>(&mut buf31, 1024);
+    let tw31 = table::<i32>(1024);
     let row: Vec<_> = CLASSES.map(|c| cell(snr_1d(c, 1024, 1, &tw31))).into();
     std::println!("| 1D, Q31 | 1024 | {} |", row.join(" | "));
     let row: Vec<_> = CLASSES.map(|c| cell(snr_2d(c, 256, 1, &tw31))).into();
