@@ -23,7 +23,7 @@ mod taps;
 
 pub(crate) use reads::{scaled, LineReads, XRun};
 pub use rows::row_interval;
-pub use taps::{mirror_pair, wrapped_tap_sum};
+pub use taps::{wrapped_tap_sum, LineSum, Unscaled};
 
 use crate::error::{Error, Result};
 use crate::filter::{KernelTable, PhaseTable, MAX_WIDTH};

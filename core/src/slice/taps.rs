@@ -108,26 +108,51 @@ impl<const W: usize, const LINE_EXP: bool, const POW2: bool, S: Sample>
                     step(x0, t, n)
                 }
             });
-            let offsets = [&planes, &lines, &xs];
-            acc = wrapped_tap_sum(data, offsets, [wx, wy, wz], |line, sum| {
-                self.line_sum(line, sum)
-            });
+            acc = wrapped_tap_sum(data, [&planes, &lines, &xs], [wx, wy, wz], self);
         }
         acc
+    }
+}
+
+impl<const W: usize, const LINE_EXP: bool, const POW2: bool, S: Sample, T: Real> LineSum<T>
+    for TapSums<'_, W, LINE_EXP, POW2, S>
+{
+    #[inline(always)]
+    fn line_sum(&self, line: usize, sum: T) -> T {
+        TapSums::line_sum(self, line, sum)
+    }
+}
+
+/// How [`wrapped_tap_sum`] takes an x-line's sum: scaled by the line's
+/// block exponent, or as it is ([`Unscaled`]). A trait rather than a
+/// closure: its method is always inlined, so the walk keeps the bounds the
+/// compiler proved on the data.
+pub trait LineSum<T> {
+    /// The sum `sum` of the x-line starting at `line`, as the value takes it.
+    fn line_sum(&self, line: usize, sum: T) -> T;
+}
+
+/// Every x-line's sum as it is.
+#[derive(Clone, Copy, Debug)]
+pub struct Unscaled;
+
+impl<T> LineSum<T> for Unscaled {
+    #[inline(always)]
+    fn line_sum(&self, _line: usize, sum: T) -> T {
+        sum
     }
 }
 
 /// The value at taps whose x-runs may wrap around the cube, tap by tap:
 /// `Σ_c wz_c·Σ_b wy_b·line_sum(line, Σ_t wx_t·raw(data[line + xs_t]))`
 /// with `line = planes_c + lines_b`, in this order (the core's bits; the
-/// host engine's walks fall back on it too). `line_sum` scales an x-line's
-/// sum (per-line exponents) or returns it; a tap past the data reads 0.
+/// host engine's walks fall back on it too). A tap past the data reads 0.
 #[inline(always)]
 pub fn wrapped_tap_sum<const W: usize, S: Sample, T: Real>(
     data: &[S],
     [planes, lines, xs]: [&[usize; W]; 3],
     [wx, wy, wz]: [&[T; W]; 3],
-    line_sum: impl Fn(usize, T) -> T,
+    lines_as: &impl LineSum<T>,
 ) -> T {
     let mut acc = T::ZERO;
     for c in 0..W {
@@ -139,7 +164,7 @@ pub fn wrapped_tap_sum<const W: usize, S: Sample, T: Real>(
                 let v = data.get(line + xs[t]).copied().unwrap_or_default();
                 acc_x += wx[t] * T::load_raw(v);
             }
-            acc_y += wy[b] * line_sum(line, acc_x);
+            acc_y += wy[b] * lines_as.line_sum(line, acc_x);
         }
         acc += wz[c] * acc_y;
     }
@@ -180,53 +205,28 @@ pub(super) fn extract_lines<
     };
     let raw_gain = T::exp2i(T::raw_exponent::<S>());
     let taps = TapSums::<W, LINE_EXP, POW2, S> { data, n, exponents };
+    // The mirror `−q` of a point: taps `−j − t`, i.e. the run from
+    // `−j − (W − 1)` with the weights reversed.
+    let mirror = |j: i32| -j - (W as i32 - 1);
+    let reversed = |w: &[T; W]| -> [T; W] { core::array::from_fn(|t| w[W - 1 - t]) };
     geometry.for_each_fixed_pair::<W, POW2>(n, grid, |y, plus, minus| {
-        mirror_pair(
-            phases,
-            y,
-            Some(raw_gain),
-            [plus, minus],
-            |[jx, jy, jz], [wx, wy, wz]| taps.value(jx, wx, jy, wy, jz, wz),
-        )
+        let (jx, wx) = phases.taps_fixed_point(y[0]);
+        let (jy, wy) = phases.taps_fixed_point(y[1]);
+        let (jz, wz) = phases.taps_fixed_point(y[2]);
+        let wx = wx.map(|w| w * raw_gain);
+        let value = if plus {
+            taps.value(jx, &wx, jy, &wy, jz, &wz)
+        } else {
+            T::ZERO
+        };
+        let mirrored = if minus {
+            let (rx, ry, rz) = (reversed(&wx), reversed(&wy), reversed(&wz));
+            taps.value(mirror(jx), &rx, mirror(jy), &ry, mirror(jz), &rz)
+        } else {
+            T::ZERO
+        };
+        (value, mirrored)
     });
-}
-
-/// The value at the fixed-point position `y` (when `plus`) and at its
-/// mirror `−q` (when `minus`), each `0` when not asked: the phase table's
-/// first tap `j` and weights `w` on each axis, the x-weights times `gain`
-/// (the raw widening's `2^e`, [`Real::load_raw`]) when given, summed by
-/// `value(j, w)`. The mirror's taps are `−j − t`, i.e. the run from
-/// `−j − (W − 1)` with the weights reversed. Every walk of the pairs, the
-/// core's and the host engine's, takes its points through this.
-#[inline(always)]
-pub fn mirror_pair<const W: usize, T: Real>(
-    phases: &PhaseTable<T, W>,
-    y: [i64; 3],
-    gain: Option<T>,
-    [plus, minus]: [bool; 2],
-    value: impl Fn([i32; 3], [&[T; W]; 3]) -> T,
-) -> (T, T) {
-    let (jx, wx) = phases.taps_fixed_point(y[0]);
-    let (jy, wy) = phases.taps_fixed_point(y[1]);
-    let (jz, wz) = phases.taps_fixed_point(y[2]);
-    let wx = match gain {
-        Some(g) => wx.map(|w| w * g),
-        None => wx,
-    };
-    let direct = if plus {
-        value([jx, jy, jz], [&wx, &wy, &wz])
-    } else {
-        T::ZERO
-    };
-    let mirrored = if minus {
-        let mirror = |j: i32| -j - (W as i32 - 1);
-        let reversed = |w: &[T; W]| -> [T; W] { core::array::from_fn(|t| w[W - 1 - t]) };
-        let taps = [mirror(jx), mirror(jy), mirror(jz)];
-        value(taps, [&reversed(&wx), &reversed(&wy), &reversed(&wz)])
-    } else {
-        T::ZERO
-    };
-    (direct, mirrored)
 }
 
 /// The extraction for any storage (e.g. bricked block exponents): the
@@ -270,14 +270,25 @@ pub(super) fn extract_general<const W: usize, const POW2: bool, S: Sample, Z: Cu
         }
         acc
     };
+    // The mirror `−q` of a point: taps `−j − t`, as in `extract_lines`.
+    let mirror = |j: i32| -j - (W as i32 - 1);
+    let reversed = |w: &[T; W]| -> [T; W] { core::array::from_fn(|t| w[W - 1 - t]) };
     geometry.for_each_fixed_pair::<W, POW2>(n, grid, |y, plus, minus| {
-        mirror_pair(
-            phases,
-            y,
-            None,
-            [plus, minus],
-            |[jx, jy, jz], [wx, wy, wz]| value(jx, wx, jy, wy, jz, wz),
-        )
+        let (jx, wx) = phases.taps_fixed_point(y[0]);
+        let (jy, wy) = phases.taps_fixed_point(y[1]);
+        let (jz, wz) = phases.taps_fixed_point(y[2]);
+        let direct = if plus {
+            value(jx, &wx, jy, &wy, jz, &wz)
+        } else {
+            T::ZERO
+        };
+        let mirrored = if minus {
+            let (rx, ry, rz) = (reversed(&wx), reversed(&wy), reversed(&wz));
+            value(mirror(jx), &rx, mirror(jy), &ry, mirror(jz), &rz)
+        } else {
+            T::ZERO
+        };
+        (direct, mirrored)
     });
 }
 

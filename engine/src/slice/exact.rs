@@ -37,7 +37,6 @@
 use fvr_core::filter::{KernelTable, PhaseTable};
 use fvr_core::geometry::SliceAxes;
 use fvr_core::num::{Real, Sample};
-use fvr_core::slice::mirror_pair;
 use fvr_core::spectrum::Spectrum;
 use rayon::prelude::*;
 
@@ -577,18 +576,28 @@ impl<const W: usize, const POW2: bool, S: Sample, T: Real, Src: TapSource<S>>
     Taps<'_, W, POW2, S, T, Src>
 {
     /// The value at fixed-point position `y` (when `plus`) and at its
-    /// mirror `−q` (when `minus`), as the core's walk takes them
-    /// ([`mirror_pair`]).
+    /// mirror `−q` (when `minus`): taps `−j − t`, the run from
+    /// `−j − (W − 1)` with the weights reversed.
     #[inline(always)]
     fn point(&self, y: [i64; 3], plus: bool, minus: bool) -> (T, T) {
-        let gain = Some(self.raw_gain);
-        mirror_pair(
-            self.phases,
-            y,
-            gain,
-            [plus, minus],
-            |[jx, jy, jz], [wx, wy, wz]| self.value(jx, wx, jy, wy, jz, wz),
-        )
+        let (jx, wx) = self.phases.taps_fixed_point(y[0]);
+        let (jy, wy) = self.phases.taps_fixed_point(y[1]);
+        let (jz, wz) = self.phases.taps_fixed_point(y[2]);
+        let wx = wx.map(|w| w * self.raw_gain);
+        let value = if plus {
+            self.value(jx, &wx, jy, &wy, jz, &wz)
+        } else {
+            T::ZERO
+        };
+        let mirrored = if minus {
+            let mirror = |j: i32| -j - (W as i32 - 1);
+            let reversed = |w: &[T; W]| -> [T; W] { core::array::from_fn(|t| w[W - 1 - t]) };
+            let (rx, ry, rz) = (reversed(&wx), reversed(&wy), reversed(&wz));
+            self.value(mirror(jx), &rx, mirror(jy), &ry, mirror(jz), &rz)
+        } else {
+            T::ZERO
+        };
+        (value, mirrored)
     }
 
     /// Prefetch the runs of the point at fixed-point position `y` (when

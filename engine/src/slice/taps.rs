@@ -4,7 +4,7 @@
 //! ([`run_starts`], which the exact walk also prefetches).
 
 use fvr_core::num::{Real, Sample};
-use fvr_core::slice::wrapped_tap_sum;
+use fvr_core::slice::{wrapped_tap_sum, Unscaled};
 
 /// `i mod n` for the indices of one cube side: a mask when `POW2` (`n` a
 /// power of two), else as the core's mixed-radix walk: a remainder per
@@ -161,7 +161,7 @@ pub(crate) fn tap_sum_on<const W: usize, const POW2: bool, S: Sample, T: Real>(
         }
     } else {
         let xs: [usize; W] = core::array::from_fn(|t| side.step(x0, t));
-        acc = wrapped_tap_sum(data, [&planes, &lines, &xs], [wx, wy, wz], |_, sum| sum);
+        acc = wrapped_tap_sum(data, [&planes, &lines, &xs], [wx, wy, wz], &Unscaled);
     }
     acc
 }
